@@ -1,0 +1,2 @@
+pub fn placeholder() {}
+pub mod scene;

@@ -1,0 +1,176 @@
+//! The GPU context: adapter chosen from the environment (as wgpu's own tests do), the device with
+//! the optional features the queues can use, and bounded waits.
+//!
+//! Environment: `WGPU_ADAPTER_NAME` (substring of the adapter name), `WGPU_BACKEND`
+//! (e.g. `vulkan`), `WGPU_POWER_PREF`. No adapter is a loud error, never a silent skip.
+
+use std::time::Duration;
+
+use crate::error::RunError;
+
+/// How long any single wait for the GPU may last before the run is abandoned with an error.
+/// Generous, because lavapipe on two cores is slow; a real GPU finishes in milliseconds.
+pub const DEFAULT_GPU_TIMEOUT: Duration = Duration::from_secs(120);
+
+/// An adapter, its device and queue, and what they can do.
+pub struct Gpu {
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: wgpu::AdapterInfo,
+    /// `@coherent` storage buffers are available, so queue payloads may use plain loads/stores.
+    /// Without it the queue moves payload words with atomic loads/stores (always coherent).
+    pub coherent: bool,
+    /// Timestamp queries at pass boundaries are available: runs report GPU time.
+    pub timestamps: bool,
+    pub timeout: Duration,
+}
+
+impl Gpu {
+    /// Opens the adapter named by the environment, or the default one.
+    pub fn from_env() -> Result<Gpu, RunError> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
+            backends: wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY),
+            ..wgpu::InstanceDescriptor::new_without_display_handle()
+        });
+        let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(
+            &instance, None,
+        ))
+        .map_err(|e| {
+            RunError::NoAdapter(format!(
+                "{e}. Install a Vulkan driver (on Debian: `apt-get install -y mesa-vulkan-drivers` \
+                 for lavapipe) or set WGPU_ADAPTER_NAME / WGPU_BACKEND"
+            ))
+        })?;
+        Self::from_adapter(adapter)
+    }
+
+    /// Opens a device on `adapter` with the features the scheduler benefits from.
+    pub fn from_adapter(adapter: wgpu::Adapter) -> Result<Gpu, RunError> {
+        let info = adapter.get_info();
+        let available = adapter.features();
+        let wanted = wgpu::Features::MEMORY_DECORATION_COHERENT | wgpu::Features::TIMESTAMP_QUERY;
+        let features = available & wanted;
+        let alimits = adapter.limits();
+        let limits = wgpu::Limits {
+            max_storage_buffer_binding_size: alimits.max_storage_buffer_binding_size,
+            max_buffer_size: alimits.max_buffer_size,
+            max_storage_buffers_per_shader_stage: alimits
+                .max_storage_buffers_per_shader_stage
+                .min(16),
+            max_compute_workgroup_storage_size: alimits.max_compute_workgroup_storage_size,
+            max_compute_invocations_per_workgroup: 256,
+            max_compute_workgroup_size_x: 256,
+            ..wgpu::Limits::default()
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("scheduler"),
+            required_features: features,
+            required_limits: limits,
+            ..Default::default()
+        }))
+        .map_err(|e| RunError::NoAdapter(format!("request_device on {}: {e}", info.name)))?;
+        Ok(Gpu {
+            coherent: features.contains(wgpu::Features::MEMORY_DECORATION_COHERENT),
+            timestamps: features.contains(wgpu::Features::TIMESTAMP_QUERY),
+            adapter,
+            device,
+            queue,
+            info,
+            timeout: DEFAULT_GPU_TIMEOUT,
+        })
+    }
+
+    /// A one-line description: name and backend.
+    pub fn adapter_name(&self) -> String {
+        format!("{} ({:?})", self.info.name, self.info.backend)
+    }
+
+    /// Waits for all submitted work, bounded by `self.timeout`.
+    pub fn wait(&self, what: &str) -> Result<(), RunError> {
+        match self.device.poll(wgpu::PollType::Wait {
+            submission_index: None,
+            timeout: Some(self.timeout),
+        }) {
+            Ok(_) => Ok(()),
+            Err(wgpu::PollError::Timeout) => Err(RunError::Timeout {
+                what: what.to_string(),
+                seconds: self.timeout.as_secs_f64(),
+            }),
+            Err(e) => Err(RunError::Device(format!("{what}: {e}"))),
+        }
+    }
+
+    /// Copies `size` bytes of `src` from `offset` to the host; bounded wait.
+    pub fn read_buffer(
+        &self,
+        src: &wgpu::Buffer,
+        offset: u64,
+        size: u64,
+    ) -> Result<Vec<u8>, RunError> {
+        if size == 0 {
+            return Ok(Vec::new());
+        }
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(src, offset, &staging, 0, size);
+        self.queue.submit([enc.finish()]);
+        let slice = staging.slice(..);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        self.wait("reading a buffer back")?;
+        match rx.recv_timeout(Duration::from_secs(1)) {
+            Ok(Ok(())) => {}
+            Ok(Err(e)) => return Err(RunError::Device(format!("map_async: {e}"))),
+            Err(_) => return Err(RunError::Device("buffer map never completed".into())),
+        }
+        let data = slice
+            .get_mapped_range()
+            .map_err(|e| RunError::Device(format!("mapped range: {e}")))?
+            .to_vec();
+        staging.unmap();
+        Ok(data)
+    }
+
+    /// Reads `count` u32 words starting at word `offset`.
+    pub fn read_words(
+        &self,
+        src: &wgpu::Buffer,
+        offset: u64,
+        count: u64,
+    ) -> Result<Vec<u32>, RunError> {
+        let bytes = self.read_buffer(src, offset * 4, count * 4)?;
+        Ok(bytemuck::cast_slice(&bytes).to_vec())
+    }
+
+    /// A storage buffer of `words` u32 words (at least one), zeroed.
+    pub fn storage_buffer(&self, label: &str, words: u64) -> wgpu::Buffer {
+        self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: words.max(1) * 4,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        })
+    }
+
+    /// Compiles WGSL, turning a validation error into a `RunError` that carries the message
+    /// (naga's error names the line), instead of a panic in wgpu's error handler.
+    pub fn shader(&self, label: &str, source: &str) -> Result<wgpu::ShaderModule, RunError> {
+        crate::wgsl::validate(label, source)?;
+        Ok(self
+            .device
+            .create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(label),
+                source: wgpu::ShaderSource::Wgsl(source.into()),
+            }))
+    }
+}

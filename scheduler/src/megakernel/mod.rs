@@ -1,0 +1,465 @@
+//! The persistent megakernel strategy: one dispatch whose workgroups pull batches from the
+//! procedure queues until no work is left. A launch is bounded (loop turns, waits); when one ends
+//! with work left, the host compacts the queues (dropping consumed slots, keeping every live item),
+//! grows a queue that lacked room, and launches again. Protocol: `docs/scheduler.md`.
+
+pub mod layout;
+pub mod wgsl;
+
+use std::time::Instant;
+
+use layout::*;
+
+use crate::error::RunError;
+use crate::gpu::Gpu;
+use crate::pipeline::{Kernels, storage_entry};
+use crate::program::{Program, Seed};
+use crate::queue_layout::QueueLayout;
+use crate::stats::RunStats;
+use crate::timing::PassTimer;
+
+/// How many workgroups a launch has.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Workgroups {
+    /// As many as the probe launch finds running at the same time, at most `max`. The default:
+    /// a persistent workgroup must never wait on one that has not started.
+    Probe { max: u32 },
+    /// Exactly this many (tests use it to oversubscribe on purpose; waits stay bounded).
+    Fixed(u32),
+}
+
+/// Which queue a workgroup takes its next batch from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum QueuePolicy {
+    /// The first queue with work in this order of procedure names (unnamed ones follow in
+    /// reverse registration order). "Later stages first" keeps queues short.
+    Priority(Vec<String>),
+    /// The queue whose oldest waiting batch was published first.
+    Fifo,
+}
+
+#[derive(Debug, Clone)]
+pub struct MegakernelConfig {
+    pub workgroups: Workgroups,
+    pub policy: QueuePolicy,
+    /// Workgroup steps per claimed batch (a step runs 256 / threads_per_item items).
+    pub batch_steps: u32,
+    /// Loop turns per workgroup per launch; far below lavapipe's 65,535-iteration cut.
+    pub max_iterations: u32,
+    /// Polls of one slot's flag before it is abandoned to the next launch.
+    pub spin_limit: u32,
+    /// Slots per queue at the start of a run (at least twice the seeds).
+    pub initial_capacity: u32,
+    /// A queue grows by doubling up to this many slots; beyond it the run reports an overflow.
+    pub max_capacity: u32,
+    pub max_launches: u32,
+}
+
+impl Default for MegakernelConfig {
+    fn default() -> Self {
+        MegakernelConfig {
+            workgroups: Workgroups::Probe { max: 4096 },
+            policy: QueuePolicy::Priority(Vec::new()),
+            batch_steps: 1,
+            max_iterations: 16_384,
+            spin_limit: 4096,
+            initial_capacity: 1 << 16,
+            max_capacity: 1 << 26,
+            max_launches: 10_000,
+        }
+    }
+}
+
+pub struct Megakernel {
+    program: Program,
+    config: MegakernelConfig,
+    kernels: Kernels,
+    /// Workgroups per launch; 0 until the first run's probe (the probe needs the user's group).
+    workgroups: std::cell::Cell<u32>,
+    outbox_stride: u32,
+    ob_off: Vec<u32>,
+    priority: Vec<u32>,
+}
+
+/// Buffers of one queue layout.
+struct DeviceQueues {
+    layout: QueueLayout,
+    ctrl: wgpu::Buffer,
+    slots: wgpu::Buffer,
+    flags: wgpu::Buffer,
+    bind: wgpu::BindGroup,
+}
+
+impl Megakernel {
+    pub fn new(
+        gpu: &Gpu,
+        program: &Program,
+        config: MegakernelConfig,
+    ) -> Result<Megakernel, RunError> {
+        if config.max_iterations == 0 || config.max_iterations > 30_000 {
+            return Err(RunError::Program(
+                "max_iterations must be 1..=30000 (lavapipe cuts loops at 65,535)".into(),
+            ));
+        }
+        if config.spin_limit == 0 || config.spin_limit > 30_000 {
+            return Err(RunError::Program("spin_limit must be 1..=30000".into()));
+        }
+        let nq = program.queue_count();
+        let priority = priority_order(program, &config.policy)?;
+        // Outbox: per source queue, room for a whole batch's worst-case output to each target.
+        let mut ob_off = vec![0u32; nq * nq];
+        let mut outbox_stride = 1;
+        for (q, p) in program.procs.iter().enumerate() {
+            let batch = (p.items_per_step * config.batch_steps.max(1)).min(MAX_BATCH);
+            let mut off = 0;
+            for t in 0..nq {
+                ob_off[q * nq + t] = off;
+                off += batch * p.emits[t] * program.procs[t].words();
+            }
+            outbox_stride = outbox_stride.max(off);
+        }
+        let source = wgsl::source(program, gpu.coherent);
+        let entries = [
+            storage_entry(0, false),
+            storage_entry(1, false),
+            storage_entry(2, false),
+            storage_entry(3, false),
+            storage_entry(4, true),
+        ];
+        let kernels = Kernels::new(
+            gpu,
+            program,
+            "megakernel",
+            &source,
+            &entries,
+            &["megakernel"],
+            None,
+        )?;
+        let workgroups = match config.workgroups {
+            Workgroups::Fixed(n) => n.max(1),
+            Workgroups::Probe { .. } => 0,
+        };
+        Ok(Megakernel {
+            program: program.clone(),
+            config,
+            kernels,
+            workgroups: std::cell::Cell::new(workgroups),
+            outbox_stride,
+            ob_off,
+            priority,
+        })
+    }
+
+    /// Workgroups per launch, probing on first use.
+    pub fn workgroups(&self, gpu: &Gpu, user: Option<&wgpu::BindGroup>) -> Result<u32, RunError> {
+        if self.workgroups.get() == 0 {
+            let Workgroups::Probe { max } = self.config.workgroups else {
+                unreachable!()
+            };
+            self.workgroups.set(self.probe(gpu, max.max(1), user)?);
+        }
+        Ok(self.workgroups.get())
+    }
+
+    /// Counts workgroups that run at the same time (see `probe` in the shader).
+    fn probe(&self, gpu: &Gpu, max: u32, user: Option<&wgpu::BindGroup>) -> Result<u32, RunError> {
+        let nq = self.program.queue_count();
+        let layout = QueueLayout::new(&self.program, vec![1; nq])?;
+        let mut params = self.params(&layout);
+        params[P_PROBE] = 1;
+        params[P_SPIN] = 20_000;
+        let dq = self.device_queues(gpu, layout, &params, 1)?;
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&self.kernels.pipelines[0]);
+            pass.set_bind_group(0, &dq.bind, &[]);
+            if let Some(u) = user {
+                pass.set_bind_group(1, u, &[]);
+            }
+            pass.dispatch_workgroups(max, 1, 1);
+        }
+        gpu.queue.submit([enc.finish()]);
+        let ctrl = gpu.read_words(&dq.ctrl, 0, ctrl_words(nq) as u64)?;
+        Ok(ctrl[g(nq, G_PROBE_RESIDENT)].clamp(1, max))
+    }
+
+    fn params(&self, layout: &QueueLayout) -> Vec<u32> {
+        let nq = self.program.queue_count();
+        let mut p = vec![0u32; P_QUEUES + nq * 5 + nq * nq];
+        p[P_MAX_ITERS] = self.config.max_iterations;
+        p[P_SPIN] = self.config.spin_limit;
+        p[P_POLICY] = matches!(self.config.policy, QueuePolicy::Fifo) as u32;
+        p[P_OUTBOX_STRIDE] = self.outbox_stride;
+        p[P_BATCH_STEPS] = self.config.batch_steps.max(1);
+        for q in 0..nq {
+            p[P_QUEUES + q * 4] = layout.capacity[q];
+            p[P_QUEUES + q * 4 + 1] = layout.slot_base[q];
+            p[P_QUEUES + q * 4 + 2] = layout.flag_base[q];
+            p[P_QUEUES + nq * 4 + q] = self.priority[q];
+        }
+        p[P_QUEUES + nq * 5..].copy_from_slice(&self.ob_off);
+        p
+    }
+
+    fn device_queues(
+        &self,
+        gpu: &Gpu,
+        layout: QueueLayout,
+        params: &[u32],
+        workgroups: u32,
+    ) -> Result<DeviceQueues, RunError> {
+        let nq = self.program.queue_count();
+        let ctrl = gpu.storage_buffer("ctrl", ctrl_words(nq) as u64);
+        let slots = gpu.storage_buffer("slots", layout.total_words);
+        let flags = gpu.storage_buffer("flags", layout.total_slots);
+        let outbox = gpu.storage_buffer("outbox", workgroups as u64 * self.outbox_stride as u64);
+        let params_buf = gpu.storage_buffer("params", params.len() as u64);
+        gpu.queue
+            .write_buffer(&params_buf, 0, bytemuck::cast_slice(params));
+        let bind = self.kernels.bind_group0(
+            gpu,
+            &[
+                (0, &ctrl),
+                (1, &slots),
+                (2, &flags),
+                (3, &outbox),
+                (4, &params_buf),
+            ],
+        );
+        Ok(DeviceQueues {
+            layout,
+            ctrl,
+            slots,
+            flags,
+            bind,
+        })
+    }
+
+    /// Writes live items (per queue, words back to back) as the whole queue state of a launch.
+    fn upload(&self, gpu: &Gpu, dq: &DeviceQueues, live: &[Vec<u32>]) {
+        let nq = self.program.queue_count();
+        let mut ctrl = vec![0u32; ctrl_words(nq)];
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        enc.clear_buffer(&dq.flags, 0, None);
+        gpu.queue.submit([enc.finish()]);
+        let mut pending = 0;
+        for (q, items) in live.iter().enumerate() {
+            let n = (items.len() / dq.layout.words[q] as usize) as u32;
+            pending += n;
+            ctrl[layout::q(q, Q_RESERVE)] = n;
+            ctrl[layout::q(q, Q_COUNT)] = n;
+            ctrl[layout::q(q, Q_BUDGET)] = n;
+            ctrl[layout::q(q, Q_PEAK)] = n;
+            if n > 0 {
+                gpu.queue.write_buffer(
+                    &dq.slots,
+                    dq.layout.slot_base[q] as u64 * 4,
+                    bytemuck::cast_slice(items),
+                );
+                let f = vec![SEED_STAMP; n as usize];
+                gpu.queue.write_buffer(
+                    &dq.flags,
+                    dq.layout.flag_base[q] as u64 * 4,
+                    bytemuck::cast_slice(&f),
+                );
+            }
+        }
+        ctrl[g(nq, G_PENDING)] = pending;
+        gpu.queue
+            .write_buffer(&dq.ctrl, 0, bytemuck::cast_slice(&ctrl));
+    }
+
+    /// Runs the program to completion from `seeds`. `user` is bind group 1, if the program has one.
+    pub fn run(
+        &self,
+        gpu: &Gpu,
+        seeds: &[Seed],
+        user: Option<&wgpu::BindGroup>,
+    ) -> Result<RunStats, RunError> {
+        self.kernels.check_user_group(user)?;
+        let workgroups = self.workgroups(gpu, user)?;
+        let start = Instant::now();
+        let nq = self.program.queue_count();
+        let mut live = QueueLayout::seed_items(&self.program, seeds)?;
+        let mut capacity: Vec<u32> = (0..nq)
+            .map(|q| {
+                let n = (live[q].len() / self.program.procs[q].words() as usize) as u32;
+                self.config.initial_capacity.max(n.saturating_mul(2)).max(1)
+            })
+            .collect();
+        if let Some(q) = (0..nq).find(|&q| capacity[q] > self.config.max_capacity) {
+            return Err(RunError::QueueOverflow {
+                queue: self.program.procs[q].proc.name.clone(),
+                capacity: self.config.max_capacity as u64,
+                needed_more_than: capacity[q] as u64 / 2,
+            });
+        }
+        let mut stats = RunStats {
+            strategy: "megakernel".into(),
+            executed: vec![0; nq],
+            peak_occupancy: vec![0; nq],
+            workgroups,
+            ..Default::default()
+        };
+        let mut timer = PassTimer::new(gpu);
+        let mut dq: Option<DeviceQueues> = None;
+        loop {
+            let layout = QueueLayout::new(&self.program, capacity.clone())?;
+            if dq.as_ref().is_none_or(|d| d.layout != layout) {
+                dq = Some(self.device_queues(
+                    gpu,
+                    layout.clone(),
+                    &self.params(&layout),
+                    workgroups,
+                )?);
+            }
+            let d = dq.as_ref().unwrap();
+            self.upload(gpu, d, &live);
+            if stats.launches >= self.config.max_launches as u64 {
+                return Err(RunError::NoProgress(format!(
+                    "work left after {} megakernel launches",
+                    stats.launches
+                )));
+            }
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            {
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("megakernel"),
+                    timestamp_writes: timer.writes(),
+                });
+                pass.set_pipeline(&self.kernels.pipelines[0]);
+                pass.set_bind_group(0, &d.bind, &[]);
+                if let Some(u) = user {
+                    pass.set_bind_group(1, u, &[]);
+                }
+                pass.dispatch_workgroups(workgroups, 1, 1);
+            }
+            timer.resolve(&mut enc);
+            gpu.queue.submit([enc.finish()]);
+            let ctrl = gpu.read_words(&d.ctrl, 0, ctrl_words(nq) as u64)?;
+            timer.collect(gpu)?;
+            stats.launches += 1;
+            if ctrl[g(nq, G_ERROR)] == ERR_EMIT {
+                let (p, t) = (ctrl[g(nq, G_ERR_A)] as usize, ctrl[g(nq, G_ERR_B)] as usize);
+                return Err(RunError::EmitLimit {
+                    procedure: self.program.procs[p].proc.name.clone(),
+                    target: self.program.procs[t].proc.name.clone(),
+                    declared: self.program.procs[p].emits[t],
+                });
+            }
+            let mut progress = 0;
+            for q in 0..nq {
+                stats.executed[q] += ctrl[layout::q(q, Q_EXECUTED)] as u64;
+                progress += ctrl[layout::q(q, Q_EXECUTED)] as u64;
+                stats.batches += ctrl[layout::q(q, Q_BATCHES)] as u64;
+                stats.peak_occupancy[q] =
+                    stats.peak_occupancy[q].max(ctrl[layout::q(q, Q_PEAK)] as u64);
+            }
+            stats.idle_polls += ctrl[g(nq, G_IDLE)] as u64;
+            stats.abandoned += ctrl[g(nq, G_ABANDONED)] as u64;
+            if ctrl[g(nq, G_PENDING)] == 0 && ctrl[g(nq, G_ABANDONED)] == 0 {
+                break;
+            }
+            // Work is left: keep every published, unconsumed slot, in ticket order.
+            live = self.compact(gpu, d, &ctrl)?;
+            let mut grew = false;
+            for q in 0..nq {
+                let n = (live[q].len() / d.layout.words[q] as usize) as u32;
+                let blocked = ctrl[layout::q(q, Q_BLOCKED)] != 0;
+                if (blocked && progress == 0) || n > capacity[q] / 2 {
+                    if capacity[q] >= self.config.max_capacity {
+                        if progress == 0 {
+                            return Err(RunError::QueueOverflow {
+                                queue: self.program.procs[q].proc.name.clone(),
+                                capacity: capacity[q] as u64,
+                                needed_more_than: n as u64,
+                            });
+                        }
+                        continue;
+                    }
+                    capacity[q] = capacity[q].saturating_mul(2).min(self.config.max_capacity);
+                    stats.queue_growths += 1;
+                    grew = true;
+                }
+            }
+            if progress == 0 && !grew && ctrl[g(nq, G_ABANDONED)] == 0 {
+                return Err(RunError::NoProgress(
+                    "a megakernel launch executed no item".into(),
+                ));
+            }
+        }
+        stats.queue_bytes = dq
+            .as_ref()
+            .map_or(0, |d| d.layout.total_words * 4 + d.layout.total_slots * 4);
+        stats.gpu_ms = timer.total_ms();
+        stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
+        Ok(stats)
+    }
+
+    /// Reads back each queue's reserved slots and keeps the published, unconsumed ones.
+    fn compact(
+        &self,
+        gpu: &Gpu,
+        d: &DeviceQueues,
+        ctrl: &[u32],
+    ) -> Result<Vec<Vec<u32>>, RunError> {
+        let nq = self.program.queue_count();
+        let mut live = vec![Vec::new(); nq];
+        let mut total_live = 0u64;
+        for q in 0..nq {
+            let reserved = ctrl[layout::q(q, Q_RESERVE)] as u64;
+            if reserved == 0 {
+                continue;
+            }
+            let w = d.layout.words[q] as usize;
+            let flags = gpu.read_words(&d.flags, d.layout.flag_base[q] as u64, reserved)?;
+            let slots =
+                gpu.read_words(&d.slots, d.layout.slot_base[q] as u64, reserved * w as u64)?;
+            for (i, f) in flags.iter().enumerate() {
+                match *f {
+                    CONSUMED => {}
+                    EMPTY => {
+                        return Err(RunError::Device(format!(
+                            "queue `{}` slot {i} was reserved but never published: protocol violation",
+                            self.program.procs[q].proc.name
+                        )));
+                    }
+                    _ => {
+                        live[q].extend_from_slice(&slots[i * w..(i + 1) * w]);
+                        total_live += 1;
+                    }
+                }
+            }
+        }
+        // Every item still pending or abandoned must be among the live slots, and nothing else.
+        let expected = ctrl[g(nq, G_PENDING)] as u64 + ctrl[g(nq, G_ABANDONED)] as u64;
+        if total_live != expected {
+            return Err(RunError::Device(format!(
+                "queue accounting mismatch after a launch: {total_live} live slots, {expected} pending"
+            )));
+        }
+        Ok(live)
+    }
+}
+
+fn priority_order(program: &Program, policy: &QueuePolicy) -> Result<Vec<u32>, RunError> {
+    let nq = program.queue_count();
+    let mut order = Vec::new();
+    if let QueuePolicy::Priority(names) = policy {
+        for n in names {
+            let q = program.index_of(n).ok_or_else(|| {
+                RunError::Program(format!("priority names unknown procedure `{n}`"))
+            })?;
+            if !order.contains(&(q as u32)) {
+                order.push(q as u32);
+            }
+        }
+    }
+    for q in (0..nq as u32).rev() {
+        if !order.contains(&q) {
+            order.push(q);
+        }
+    }
+    Ok(order)
+}

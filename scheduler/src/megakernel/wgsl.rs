@@ -1,0 +1,40 @@
+//! Generates the megakernel's WGSL: the program's shared code, queue word accessors (plain
+//! `@coherent` loads where the device has them, atomics otherwise), enqueue functions that write
+//! to the workgroup's outbox, and the loop in `shaders/megakernel.wgsl`.
+
+use crate::program::Program;
+
+pub const TEMPLATE: &str = include_str!("../../../shaders/megakernel.wgsl");
+
+pub fn source(program: &Program, coherent: bool) -> String {
+    let mut s = program.tables_wgsl();
+    s += &program.common_wgsl();
+    if coherent {
+        s += "@group(0) @binding(1) @coherent var<storage, read_write> slots: array<u32>;\n\
+              fn sched_slot_load_word(i: u32) -> u32 { return slots[i]; }\n\
+              fn sched_slot_store_word(i: u32, w: u32) { slots[i] = w; }\n";
+    } else {
+        s += "@group(0) @binding(1) var<storage, read_write> slots: array<atomic<u32>>;\n\
+              fn sched_slot_load_word(i: u32) -> u32 { return atomicLoad(&slots[i]); }\n\
+              fn sched_slot_store_word(i: u32, w: u32) { atomicStore(&slots[i], w); }\n";
+    }
+    s += &program.execute_switch("sched_slot");
+    // The outbox only needs typed stores; loads of the same prefix are generated and unused.
+    let mut seen = Vec::new();
+    for p in &program.procs {
+        if !seen.contains(&p.layout.name) {
+            seen.push(p.layout.name.clone());
+            s += &crate::wgsl::load_store_fns(&p.layout, "sched_ob");
+        }
+    }
+    for (t, p) in program.procs.iter().enumerate() {
+        s += &format!(
+            "fn enqueue_{name}(item: {ty}) {{\n    if !sched_active {{ return; }}\n    \
+             let at = sched_outbox_slot({t}u);\n    if at != 0xffffffffu {{ sched_ob_store_{ty}(at, item); }}\n}}\n",
+            name = p.proc.name,
+            ty = p.layout.name
+        );
+    }
+    s += TEMPLATE;
+    s
+}

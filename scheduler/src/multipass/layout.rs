@@ -1,0 +1,29 @@
+//! Host twin of the mp_ctrl and params word layouts in `shaders/multipass.wgsl`.
+
+pub const CSTRIDE: usize = 8;
+pub const C_COUNT: usize = 0;
+pub const C_PEAK: usize = 1;
+pub const C_EXEC: usize = 2;
+pub const C_EMITS: usize = 3;
+pub const C_NEXT: usize = 4;
+pub const G_ROUNDS: usize = 0;
+pub const G_ERROR: usize = 1;
+pub const G_ERR_A: usize = 2;
+pub const G_ERR_B: usize = 3;
+pub const G_HALT: usize = 4;
+pub const G_PLANNED: usize = 5;
+pub const ERR_EMIT: u32 = 1;
+pub const ERR_OVERFLOW: u32 = 2;
+pub const SCAN_BLOCK: u32 = 1024;
+pub const P_QUEUES: usize = 8;
+pub const P_QSTRIDE: usize = 8;
+
+pub fn ctrl_words(nq: usize) -> usize {
+    nq * CSTRIDE + 8 + nq * nq
+}
+pub fn c(q: usize, i: usize) -> usize {
+    q * CSTRIDE + i
+}
+pub fn g(nq: usize, i: usize) -> usize {
+    nq * CSTRIDE + i
+}

@@ -1,0 +1,305 @@
+//! The multi-pass baseline (Patney & Owens 2008): rounds of one dispatch per procedure, then a
+//! scan/compact per target queue. Rounds are encoded in chunks and planned on the device; the
+//! host reads back only between chunks. A round whose outputs would not fit is refused on the
+//! device with its inputs intact; the host grows the queue and resumes.
+
+pub mod layout;
+pub mod wgsl;
+
+use std::time::Instant;
+
+use layout::*;
+
+use crate::error::RunError;
+use crate::gpu::Gpu;
+use crate::pipeline::{Kernels, storage_entry};
+use crate::program::{Program, Seed};
+use crate::queue_layout::QueueLayout;
+use crate::stats::RunStats;
+use crate::timing::PassTimer;
+
+#[derive(Debug, Clone)]
+pub struct MultipassConfig {
+    /// Rounds encoded per submission; the host checks for completion between chunks.
+    pub rounds_per_submit: u32,
+    pub max_rounds: u32,
+    pub initial_capacity: u32,
+    pub max_capacity: u32,
+}
+
+impl Default for MultipassConfig {
+    fn default() -> Self {
+        MultipassConfig {
+            rounds_per_submit: 16,
+            max_rounds: 100_000,
+            initial_capacity: 1 << 16,
+            max_capacity: 1 << 26,
+        }
+    }
+}
+
+pub struct Multipass {
+    program: Program,
+    config: MultipassConfig,
+    kernels: Kernels,
+}
+
+struct DeviceRounds {
+    layout: QueueLayout,
+    ctrl: wgpu::Buffer,
+    items: [wgpu::Buffer; 2],
+    indirect: wgpu::Buffer,
+    plan_bind: wgpu::BindGroup,
+    /// bind[parity]: round r reads items[r % 2] and writes items[(r + 1) % 2].
+    bind: [wgpu::BindGroup; 2],
+}
+
+impl Multipass {
+    pub fn new(
+        gpu: &Gpu,
+        program: &Program,
+        config: MultipassConfig,
+    ) -> Result<Multipass, RunError> {
+        if program.queue_count() > 16 {
+            return Err(RunError::Program(
+                "the multi-pass strategy supports at most 16 procedures".into(),
+            ));
+        }
+        let source = wgsl::source(program);
+        let entries: Vec<_> = (0..7).map(|b| storage_entry(b, b == 6)).collect();
+        let eps = wgsl::entry_points(program);
+        let eps: Vec<&str> = eps.iter().map(|s| s.as_str()).collect();
+        let group2 = [storage_entry(0, false)];
+        let kernels = Kernels::new(
+            gpu,
+            program,
+            "multipass",
+            &source,
+            &entries,
+            &eps,
+            Some((&group2, &["mp_plan"])),
+        )?;
+        Ok(Multipass {
+            program: program.clone(),
+            config,
+            kernels,
+        })
+    }
+
+    fn device_rounds(&self, gpu: &Gpu, layout: QueueLayout) -> DeviceRounds {
+        let nq = self.program.queue_count();
+        let ctrl = gpu.storage_buffer("mp_ctrl", ctrl_words(nq) as u64);
+        let items = [
+            gpu.storage_buffer("items a", layout.total_words),
+            gpu.storage_buffer("items b", layout.total_words),
+        ];
+        let emit = gpu.storage_buffer("emit", layout.total_words);
+        let emit_flags = gpu.storage_buffer("emit flags", layout.total_slots);
+        let mut params = vec![0u32; P_QUEUES + nq * P_QSTRIDE];
+        let mut sum_words = 0u32;
+        for q in 0..nq {
+            let p = &mut params[P_QUEUES + q * P_QSTRIDE..];
+            p[0] = layout.capacity[q];
+            p[1] = layout.slot_base[q];
+            p[2] = layout.slot_base[q];
+            p[3] = layout.flag_base[q];
+            p[4] = sum_words;
+            sum_words += layout.capacity[q].div_ceil(SCAN_BLOCK);
+        }
+        let sums = gpu.storage_buffer("block sums", sum_words as u64);
+        let params_buf = gpu.storage_buffer("mp params", params.len() as u64);
+        gpu.queue
+            .write_buffer(&params_buf, 0, bytemuck::cast_slice(&params));
+        let indirect = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("round dispatch args"),
+            size: (3 * 3 * nq * 4) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
+            mapped_at_creation: false,
+        });
+        let bind = [0, 1].map(|par| {
+            self.kernels.bind_group0(
+                gpu,
+                &[
+                    (0, &ctrl),
+                    (1, &items[par]),
+                    (2, &items[1 - par]),
+                    (3, &emit),
+                    (4, &emit_flags),
+                    (5, &sums),
+                    (6, &params_buf),
+                ],
+            )
+        });
+        let plan_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("indirect args"),
+            layout: self.kernels.group2.as_ref().expect("multipass has group 2"),
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: indirect.as_entire_binding(),
+            }],
+        });
+        DeviceRounds {
+            layout,
+            ctrl,
+            items,
+            indirect,
+            plan_bind,
+            bind,
+        }
+    }
+
+    /// Makes `live` (per queue, words back to back) the inputs of the next round, at parity 0.
+    fn upload(&self, gpu: &Gpu, d: &DeviceRounds, live: &[Vec<u32>]) {
+        let nq = self.program.queue_count();
+        let mut ctrl = vec![0u32; ctrl_words(nq)];
+        for (q, items) in live.iter().enumerate() {
+            ctrl[c(q, C_NEXT)] = (items.len() / d.layout.words[q] as usize) as u32;
+            if !items.is_empty() {
+                gpu.queue.write_buffer(
+                    &d.items[0],
+                    d.layout.slot_base[q] as u64 * 4,
+                    bytemuck::cast_slice(items),
+                );
+            }
+        }
+        gpu.queue
+            .write_buffer(&d.ctrl, 0, bytemuck::cast_slice(&ctrl));
+    }
+
+    fn encode_rounds(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        d: &DeviceRounds,
+        rounds: u32,
+        timer: &PassTimer,
+        user: Option<&wgpu::BindGroup>,
+    ) {
+        let nq = self.program.queue_count();
+        let p = &self.kernels.pipelines;
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("multipass rounds"),
+            timestamp_writes: timer.writes(),
+        });
+        if let Some(u) = user {
+            pass.set_bind_group(1, u, &[]);
+        }
+        pass.set_bind_group(2, &d.plan_bind, &[]);
+        let args = |slot: usize| (slot * 12) as u64;
+        for r in 0..rounds as usize {
+            pass.set_bind_group(0, &d.bind[r % 2], &[]);
+            pass.set_pipeline(&p[0]);
+            pass.dispatch_workgroups(1, 1, 1);
+            for q in 0..nq {
+                pass.set_pipeline(&p[1 + q]);
+                pass.dispatch_workgroups_indirect(&d.indirect, args(q));
+            }
+            for t in 0..nq {
+                pass.set_pipeline(&p[1 + nq + t]);
+                pass.dispatch_workgroups_indirect(&d.indirect, args(nq + t));
+                pass.set_pipeline(&p[1 + 2 * nq + t]);
+                pass.dispatch_workgroups_indirect(&d.indirect, args(2 * nq + t));
+                pass.set_pipeline(&p[1 + 3 * nq + t]);
+                pass.dispatch_workgroups_indirect(&d.indirect, args(nq + t));
+            }
+        }
+    }
+
+    pub fn run(
+        &self,
+        gpu: &Gpu,
+        seeds: &[Seed],
+        user: Option<&wgpu::BindGroup>,
+    ) -> Result<RunStats, RunError> {
+        self.kernels.check_user_group(user)?;
+        let start = Instant::now();
+        let nq = self.program.queue_count();
+        let mut live = QueueLayout::seed_items(&self.program, seeds)?;
+        let mut capacity: Vec<u32> = (0..nq)
+            .map(|q| {
+                let n = (live[q].len() / self.program.procs[q].words() as usize) as u32;
+                self.config.initial_capacity.max(n).max(1)
+            })
+            .collect();
+        let mut stats = RunStats {
+            strategy: "multipass".into(),
+            executed: vec![0; nq],
+            peak_occupancy: vec![0; nq],
+            ..Default::default()
+        };
+        let mut timer = PassTimer::new(gpu);
+        let mut encoded = 0u64;
+        let mut d = self.device_rounds(gpu, QueueLayout::new(&self.program, capacity.clone())?);
+        self.upload(gpu, &d, &live);
+        loop {
+            if encoded >= self.config.max_rounds as u64 {
+                return Err(RunError::NoProgress(format!(
+                    "work left after {encoded} multi-pass rounds"
+                )));
+            }
+            let rounds = self.config.rounds_per_submit.max(1);
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            self.encode_rounds(&mut enc, &d, rounds, &timer, user);
+            timer.resolve(&mut enc);
+            gpu.queue.submit([enc.finish()]);
+            encoded += rounds as u64;
+            let ctrl = gpu.read_words(&d.ctrl, 0, ctrl_words(nq) as u64)?;
+            timer.collect(gpu)?;
+            let error = ctrl[g(nq, G_ERROR)];
+            let (a, b) = (ctrl[g(nq, G_ERR_A)] as usize, ctrl[g(nq, G_ERR_B)]);
+            if error == ERR_EMIT {
+                return Err(RunError::EmitLimit {
+                    procedure: self.program.procs[a].proc.name.clone(),
+                    target: self.program.procs[b as usize].proc.name.clone(),
+                    declared: self.program.procs[a].emits[b as usize],
+                });
+            }
+            let halted = error == ERR_OVERFLOW;
+            let next: Vec<u32> = (0..nq).map(|q| ctrl[c(q, C_NEXT)]).collect();
+            if !halted && next.iter().all(|&n| n == 0) {
+                self.accumulate(&mut stats, &ctrl);
+                break;
+            }
+            if halted {
+                // The refused round's inputs are intact in items[planned % 2]: grow and resume.
+                self.accumulate(&mut stats, &ctrl);
+                if capacity[a] >= self.config.max_capacity {
+                    return Err(RunError::QueueOverflow {
+                        queue: self.program.procs[a].proc.name.clone(),
+                        capacity: capacity[a] as u64,
+                        needed_more_than: b as u64,
+                    });
+                }
+                while capacity[a] < b && capacity[a] < self.config.max_capacity {
+                    capacity[a] = capacity[a].saturating_mul(2).min(self.config.max_capacity);
+                }
+                stats.queue_growths += 1;
+                let parity = ctrl[g(nq, G_PLANNED)] as usize % 2;
+                live = (0..nq)
+                    .map(|q| {
+                        let w = d.layout.words[q] as u64;
+                        gpu.read_words(
+                            &d.items[parity],
+                            d.layout.slot_base[q] as u64,
+                            next[q] as u64 * w,
+                        )
+                    })
+                    .collect::<Result<_, _>>()?;
+                d = self.device_rounds(gpu, QueueLayout::new(&self.program, capacity.clone())?);
+                self.upload(gpu, &d, &live);
+            }
+        }
+        stats.queue_bytes = d.layout.total_words * 4 * 3 + d.layout.total_slots * 4;
+        stats.gpu_ms = timer.total_ms();
+        stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
+        Ok(stats)
+    }
+
+    fn accumulate(&self, stats: &mut RunStats, ctrl: &[u32]) {
+        let nq = self.program.queue_count();
+        for q in 0..nq {
+            stats.executed[q] += ctrl[c(q, C_EXEC)] as u64;
+            stats.peak_occupancy[q] = stats.peak_occupancy[q].max(ctrl[c(q, C_PEAK)] as u64);
+        }
+        stats.rounds += ctrl[g(nq, G_ROUNDS)] as u64;
+    }
+}

@@ -1,0 +1,133 @@
+//! Small wgpu helpers shared by the strategies: storage bindings, pipelines, bind groups.
+
+use crate::error::RunError;
+use crate::gpu::Gpu;
+use crate::program::Program;
+
+/// A compute-visible storage buffer binding.
+pub fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// Group 0 (the scheduler's, from `entries`) and group 1 (the user's, if any), and one compute
+/// pipeline per entry point of `source`.
+pub struct Kernels {
+    pub group0: wgpu::BindGroupLayout,
+    /// Group 2, for the entry points that write indirect dispatch arguments: the buffer must not
+    /// be bound to the dispatches that read it as arguments.
+    pub group2: Option<wgpu::BindGroupLayout>,
+    pub pipelines: Vec<wgpu::ComputePipeline>,
+    pub has_user_group: bool,
+}
+
+impl Kernels {
+    pub fn new(
+        gpu: &Gpu,
+        program: &Program,
+        label: &str,
+        source: &str,
+        entries: &[wgpu::BindGroupLayoutEntry],
+        entry_points: &[&str],
+        group2: Option<(&[wgpu::BindGroupLayoutEntry], &[&str])>,
+    ) -> Result<Kernels, RunError> {
+        let module = gpu.shader(label, source)?;
+        let group0 = gpu
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(label),
+                entries,
+            });
+        let user = (!program.user.layout.is_empty()).then(|| {
+            gpu.device
+                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some("user"),
+                    entries: &program.user.layout,
+                })
+        });
+        let g2 = group2.map(|(entries, _)| {
+            gpu.device
+                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some("indirect args"),
+                    entries,
+                })
+        });
+        let layouts = [Some(&group0), user.as_ref()];
+        let layout = gpu
+            .device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(label),
+                bind_group_layouts: if user.is_some() {
+                    &layouts
+                } else {
+                    &layouts[..1]
+                },
+                immediate_size: 0,
+            });
+        let layouts2 = [Some(&group0), user.as_ref(), g2.as_ref()];
+        let layout2 = gpu
+            .device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(label),
+                bind_group_layouts: &layouts2,
+                immediate_size: 0,
+            });
+        let uses2 = |ep: &str| group2.is_some_and(|(_, eps)| eps.contains(&ep));
+        let pipelines = entry_points
+            .iter()
+            .map(|ep| {
+                gpu.device
+                    .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                        label: Some(ep),
+                        layout: Some(if uses2(ep) { &layout2 } else { &layout }),
+                        module: &module,
+                        entry_point: Some(ep),
+                        compilation_options: Default::default(),
+                        cache: None,
+                    })
+            })
+            .collect();
+        Ok(Kernels {
+            group0,
+            group2: g2,
+            pipelines,
+            has_user_group: user.is_some(),
+        })
+    }
+
+    pub fn bind_group0(&self, gpu: &Gpu, buffers: &[(u32, &wgpu::Buffer)]) -> wgpu::BindGroup {
+        let entries: Vec<wgpu::BindGroupEntry> = buffers
+            .iter()
+            .map(|(b, buf)| wgpu::BindGroupEntry {
+                binding: *b,
+                resource: buf.as_entire_binding(),
+            })
+            .collect();
+        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &self.group0,
+            entries: &entries,
+        })
+    }
+
+    /// Checks that the user supplied a bind group exactly when the program declared one.
+    pub fn check_user_group(&self, user: Option<&wgpu::BindGroup>) -> Result<(), RunError> {
+        match (self.has_user_group, user.is_some()) {
+            (true, false) => Err(RunError::Program(
+                "the program declares user bindings but the run got no bind group".into(),
+            )),
+            (false, true) => Err(RunError::Program(
+                "the run got a user bind group but the program declares no user bindings".into(),
+            )),
+            _ => Ok(()),
+        }
+    }
+}

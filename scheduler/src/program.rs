@@ -1,0 +1,232 @@
+//! A program: procedures registered together, validated, with the WGSL both strategies share
+//! (item structs, bodies, user declarations, the procedure tables). Each strategy adds its own
+//! enqueue functions and driver loop around this.
+
+use crate::error::RunError;
+use crate::procedure::Procedure;
+use crate::wgsl::{self, StructLayout};
+
+/// Workgroup size of every scheduler kernel; threads per item divide it.
+pub const WORKGROUP_SIZE: u32 = 256;
+
+/// A procedure after validation: its queue index, item layout and resolved emit table.
+#[derive(Debug, Clone)]
+pub struct ProcInfo {
+    pub proc: Procedure,
+    pub layout: StructLayout,
+    /// Items one workgroup step runs: `WORKGROUP_SIZE / threads_per_item`.
+    pub items_per_step: u32,
+    /// `emits[t]`: worst-case items emitted to queue `t` per executed item.
+    pub emits: Vec<u32>,
+}
+
+impl ProcInfo {
+    pub fn words(&self) -> u32 {
+        self.layout.words()
+    }
+}
+
+/// User resources for bind group 1: WGSL declarations (and helpers) plus the layout entries.
+#[derive(Debug, Clone, Default)]
+pub struct UserBindings {
+    pub wgsl: String,
+    pub layout: Vec<wgpu::BindGroupLayoutEntry>,
+}
+
+#[derive(Debug, Clone)]
+pub struct Program {
+    pub procs: Vec<ProcInfo>,
+    pub user: UserBindings,
+}
+
+impl Program {
+    /// Validates procedures: unique identifiers, known targets, threads per item a power of two
+    /// from 1 to 256, item structs that can travel in a queue, and bodies that compile.
+    pub fn new(procedures: Vec<Procedure>, user: UserBindings) -> Result<Program, RunError> {
+        if procedures.is_empty() {
+            return Err(RunError::Program(
+                "a program needs at least one procedure".into(),
+            ));
+        }
+        let index = |name: &str| procedures.iter().position(|p| p.name == name);
+        let mut procs = Vec::new();
+        for (i, p) in procedures.iter().enumerate() {
+            if !is_identifier(&p.name) {
+                return Err(RunError::Program(format!(
+                    "`{}` is not a WGSL identifier",
+                    p.name
+                )));
+            }
+            if index(&p.name) != Some(i) {
+                return Err(RunError::Program(format!(
+                    "procedure `{}` registered twice",
+                    p.name
+                )));
+            }
+            let t = p.threads_per_item;
+            if !t.is_power_of_two() || t > WORKGROUP_SIZE {
+                return Err(RunError::Program(format!(
+                    "procedure `{}`: threads per item must be a power of two from 1 to {WORKGROUP_SIZE}, got {t}",
+                    p.name
+                )));
+            }
+            let mut emits = vec![0; procedures.len()];
+            for (target, max) in &p.max_emits {
+                let ti = index(target).ok_or_else(|| {
+                    RunError::Program(format!(
+                        "procedure `{}` emits to unknown `{target}`",
+                        p.name
+                    ))
+                })?;
+                emits[ti] += max;
+            }
+            let layout = wgsl::struct_layout(&p.item.wgsl, &p.item.name)?;
+            if layout.words() == 0 {
+                return Err(RunError::Program(format!(
+                    "item `{}` is empty",
+                    p.item.name
+                )));
+            }
+            procs.push(ProcInfo {
+                proc: p.clone(),
+                layout,
+                items_per_step: WORKGROUP_SIZE / t,
+                emits,
+            });
+        }
+        let program = Program { procs, user };
+        // Compile the shared part once on its own, so a body error names the body, not a strategy.
+        let probe = format!(
+            "{}\n{}\n@compute @workgroup_size(1) fn sched_probe() {{}}",
+            program.common_wgsl(),
+            (0..program.procs.len())
+                .map(|t| format!(
+                    "fn enqueue_{}(item: {}) {{}}\n",
+                    program.procs[t].proc.name, program.procs[t].layout.name
+                ))
+                .collect::<String>()
+        );
+        wgsl::validate("procedures", &probe)?;
+        Ok(program)
+    }
+
+    pub fn queue_count(&self) -> usize {
+        self.procs.len()
+    }
+
+    pub fn index_of(&self, name: &str) -> Option<usize> {
+        self.procs.iter().position(|p| p.proc.name == name)
+    }
+
+    /// WGSL common to both strategies: item structs, `Invocation`, per-procedure workgroup
+    /// memory, user declarations, the bodies, and `sched_execute`, which runs queue `q`'s body on
+    /// the item stored at `base` of whatever word storage `load_prefix` names.
+    pub fn common_wgsl(&self) -> String {
+        let mut s = String::from(
+            "struct Invocation {\n    // thread within the item, 0..threads_per_item\n    thread: u32,\n    \
+             // item slot within the workgroup step, 0..items_per_step\n    slot: u32,\n    \
+             // false for padding slots at the end of a batch\n    live: bool,\n}\n",
+        );
+        let mut seen = Vec::new();
+        for p in &self.procs {
+            if !seen.contains(&p.layout.name) {
+                seen.push(p.layout.name.clone());
+                s += &p.proc.item.wgsl;
+                s += "\n";
+            }
+        }
+        for p in &self.procs {
+            if let Some(sh) = &p.proc.shared {
+                s += &format!(
+                    "var<workgroup> {}_shared: array<{}, {}>;\n",
+                    p.proc.name,
+                    sh.wgsl_type,
+                    sh.per_item * p.items_per_step
+                );
+            }
+        }
+        s += &self.user.wgsl;
+        s += "\n";
+        for p in &self.procs {
+            s += &p.proc.body;
+            s += "\n";
+        }
+        s
+    }
+
+    /// `fn sched_execute(q, base, inv)`: loads the item at word `base` with `{prefix}_load_*`
+    /// (only for active invocations) and calls the body of procedure `q`.
+    pub fn execute_switch(&self, prefix: &str) -> String {
+        let mut s = String::new();
+        let mut seen = Vec::new();
+        for p in &self.procs {
+            if !seen.contains(&p.layout.name) {
+                seen.push(p.layout.name.clone());
+                s += &wgsl::load_store_fns(&p.layout, prefix);
+            }
+        }
+        s += "fn sched_execute(q: u32, base: u32, inv: Invocation) {\n    switch q {\n";
+        for (i, p) in self.procs.iter().enumerate() {
+            s += &format!(
+                "        case {i}u: {{ var it: {t}; if inv.live {{ it = {prefix}_load_{t}(base); }} {n}_execute(it, inv); }}\n",
+                t = p.layout.name,
+                n = p.proc.name
+            );
+        }
+        s += "        default: {}\n    }\n}\n";
+        s
+    }
+
+    /// Constant tables: queue count, threads per item, item words, emit table.
+    pub fn tables_wgsl(&self) -> String {
+        let nq = self.procs.len();
+        let list = |f: &dyn Fn(&ProcInfo) -> u32| {
+            self.procs
+                .iter()
+                .map(|p| format!("{}u", f(p)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let emits: Vec<String> = self
+            .procs
+            .iter()
+            .flat_map(|p| p.emits.iter().map(|e| format!("{e}u")))
+            .collect();
+        format!(
+            "const NQ: u32 = {nq}u;\n\
+             const THREADS: array<u32, {nq}> = array<u32, {nq}>({});\n\
+             const WORDS: array<u32, {nq}> = array<u32, {nq}>({});\n\
+             // EMITS[q * NQ + t]: worst-case items procedure q emits to queue t per item\n\
+             const EMITS: array<u32, {n2}> = array<u32, {n2}>({});\n",
+            list(&|p| p.proc.threads_per_item),
+            list(&|p| p.words()),
+            emits.join(", "),
+            n2 = nq * nq
+        )
+    }
+}
+
+fn is_identifier(s: &str) -> bool {
+    let mut c = s.chars();
+    matches!(c.next(), Some(ch) if ch.is_ascii_alphabetic() || ch == '_')
+        && c.all(|ch| ch.is_ascii_alphanumeric() || ch == '_')
+        && !s.starts_with("sched_")
+        && !s.starts_with("__")
+}
+
+/// Initial work: raw item words for one queue, by procedure name.
+#[derive(Debug, Clone)]
+pub struct Seed {
+    pub procedure: String,
+    /// Items packed back to back, `words` per item, as the `#[repr(C)]` host twin lays them out.
+    pub words: Vec<u32>,
+}
+
+impl Seed {
+    pub fn new<T: bytemuck::Pod>(procedure: &str, items: &[T]) -> Self {
+        Seed {
+            procedure: procedure.into(),
+            words: bytemuck::cast_slice(items).to_vec(),
+        }
+    }
+}

@@ -1,0 +1,64 @@
+//! Where each procedure's queue lives in the shared item storage: one region per queue,
+//! `capacity` slots of the item's words. Both strategies use it; growing a queue means a new layout.
+
+use crate::error::RunError;
+use crate::program::{Program, Seed};
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct QueueLayout {
+    pub capacity: Vec<u32>,
+    pub words: Vec<u32>,
+    /// First word of queue q's slots.
+    pub slot_base: Vec<u32>,
+    /// First slot index of queue q (for per-slot arrays such as flags).
+    pub flag_base: Vec<u32>,
+    pub total_words: u64,
+    pub total_slots: u64,
+}
+
+impl QueueLayout {
+    pub fn new(program: &Program, capacity: Vec<u32>) -> Result<QueueLayout, RunError> {
+        let words: Vec<u32> = program.procs.iter().map(|p| p.words()).collect();
+        let (mut w, mut f) = (0u64, 0u64);
+        let (mut slot_base, mut flag_base) = (Vec::new(), Vec::new());
+        for (c, wd) in capacity.iter().zip(&words) {
+            slot_base.push(w as u32);
+            flag_base.push(f as u32);
+            w += *c as u64 * *wd as u64;
+            f += *c as u64;
+        }
+        if w >= u32::MAX as u64 / 2 {
+            return Err(RunError::Program(format!(
+                "queues need {w} words; word indices must stay below 2^31"
+            )));
+        }
+        Ok(QueueLayout {
+            capacity,
+            words,
+            slot_base,
+            flag_base,
+            total_words: w,
+            total_slots: f,
+        })
+    }
+
+    /// Per-queue seed items (words back to back), validated against the program.
+    pub fn seed_items(program: &Program, seeds: &[Seed]) -> Result<Vec<Vec<u32>>, RunError> {
+        let mut per_queue = vec![Vec::new(); program.queue_count()];
+        for s in seeds {
+            let q = program.index_of(&s.procedure).ok_or_else(|| {
+                RunError::Program(format!("seed for unknown procedure `{}`", s.procedure))
+            })?;
+            let w = program.procs[q].words() as usize;
+            if s.words.len() % w != 0 {
+                return Err(RunError::Program(format!(
+                    "seed for `{}`: {} words is not a whole number of {w}-word items",
+                    s.procedure,
+                    s.words.len()
+                )));
+            }
+            per_queue[q].extend_from_slice(&s.words);
+        }
+        Ok(per_queue)
+    }
+}

@@ -1,0 +1,35 @@
+//! What a run reports, whatever the strategy.
+
+/// Statistics of one run. Counters that do not apply to a strategy are zero.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RunStats {
+    pub strategy: String,
+    /// Items executed, per procedure (program order).
+    pub executed: Vec<u64>,
+    /// Multi-pass: rounds that ran some work.
+    pub rounds: u64,
+    /// Megakernel: batches run, and loop turns that found nothing to claim.
+    pub batches: u64,
+    pub idle_polls: u64,
+    /// Megakernel: launches (a launch ends early at its loop bound or when a queue needs room).
+    pub launches: u64,
+    /// Megakernel: slots whose bounded wait ran out and were handed to the next launch.
+    pub abandoned: u64,
+    /// Queues grown because live work did not fit.
+    pub queue_growths: u64,
+    /// Most items waiting at once, per queue.
+    pub peak_occupancy: Vec<u64>,
+    /// Bytes of queue storage allocated at the end of the run.
+    pub queue_bytes: u64,
+    pub workgroups: u32,
+    /// GPU time from timestamp queries, when the adapter has them.
+    pub gpu_ms: Option<f64>,
+    /// Host wall time: upload, all submissions, read-backs.
+    pub wall_ms: f64,
+}
+
+impl RunStats {
+    pub fn items(&self) -> u64 {
+        self.executed.iter().sum()
+    }
+}

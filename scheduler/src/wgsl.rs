@@ -1,0 +1,278 @@
+//! WGSL through naga: validation with readable errors, struct layout reflection (so host
+//! `#[repr(C)]` types can be checked against the shader's view), and generation of the code that
+//! moves a struct to and from a flat array of u32 words, which is how every queue stores items.
+
+use crate::error::RunError;
+
+/// Parses and validates `source`; the error message carries naga's line/column report.
+pub fn validate(label: &str, source: &str) -> Result<naga::Module, RunError> {
+    let module = naga::front::wgsl::parse_str(source)
+        .map_err(|e| RunError::Program(format!("{label}: {}", e.emit_to_string(source))))?;
+    naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::all(),
+    )
+    .validate(&module)
+    .map_err(|e| RunError::Program(format!("{label}: {}", e.emit_to_string(source))))?;
+    Ok(module)
+}
+
+/// One 32-bit scalar of a struct, flattened: the WGSL expression that reaches it from the struct
+/// value (e.g. `.cp[3].x`), its word offset, and its scalar kind.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Leaf {
+    pub path: String,
+    pub word: u32,
+    pub kind: ScalarKind,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ScalarKind {
+    U32,
+    I32,
+    F32,
+}
+
+/// The layout of a WGSL struct as naga computes it for storage buffers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StructLayout {
+    pub name: String,
+    /// Size in bytes (a multiple of the alignment, as `array<T>` strides it).
+    pub size: u32,
+    /// Top-level members: (name, byte offset).
+    pub members: Vec<(String, u32)>,
+    /// Every scalar, flattened.
+    pub leaves: Vec<Leaf>,
+}
+
+impl StructLayout {
+    pub fn words(&self) -> u32 {
+        self.size / 4
+    }
+}
+
+/// Reflects struct `name` declared in `source` (which may contain other declarations).
+pub fn struct_layout(source: &str, name: &str) -> Result<StructLayout, RunError> {
+    let module = naga::front::wgsl::parse_str(source).map_err(|e| {
+        RunError::Program(format!(
+            "item struct `{name}`: {}",
+            e.emit_to_string(source)
+        ))
+    })?;
+    let mut layouter = naga::proc::Layouter::default();
+    layouter
+        .update(module.to_ctx())
+        .map_err(|e| RunError::Program(format!("layout of `{name}`: {e}")))?;
+    let (handle, ty) = module
+        .types
+        .iter()
+        .find(|(_, t)| t.name.as_deref() == Some(name))
+        .ok_or_else(|| RunError::Program(format!("no struct `{name}` in the item WGSL")))?;
+    let naga::TypeInner::Struct { members, .. } = &ty.inner else {
+        return Err(RunError::Program(format!("`{name}` is not a struct")));
+    };
+    let mut leaves = Vec::new();
+    flatten(
+        &module,
+        &layouter,
+        handle,
+        String::new(),
+        0,
+        &mut leaves,
+        name,
+    )?;
+    Ok(StructLayout {
+        name: name.to_string(),
+        size: layouter[handle].size,
+        members: members
+            .iter()
+            .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
+            .collect(),
+        leaves,
+    })
+}
+
+fn flatten(
+    module: &naga::Module,
+    layouter: &naga::proc::Layouter,
+    ty: naga::Handle<naga::Type>,
+    path: String,
+    byte: u32,
+    out: &mut Vec<Leaf>,
+    owner: &str,
+) -> Result<(), RunError> {
+    let scalar_kind = |s: naga::Scalar, path: &str| -> Result<ScalarKind, RunError> {
+        match (s.kind, s.width) {
+            (naga::ScalarKind::Uint, 4) => Ok(ScalarKind::U32),
+            (naga::ScalarKind::Sint, 4) => Ok(ScalarKind::I32),
+            (naga::ScalarKind::Float, 4) => Ok(ScalarKind::F32),
+            _ => Err(RunError::Program(format!(
+                "item struct `{owner}` field `{path}`: only 32-bit u32/i32/f32 scalars can travel in a queue"
+            ))),
+        }
+    };
+    match &module.types[ty].inner {
+        naga::TypeInner::Scalar(s) => out.push(Leaf {
+            kind: scalar_kind(*s, &path)?,
+            path,
+            word: byte / 4,
+        }),
+        naga::TypeInner::Vector { size, scalar } => {
+            let kind = scalar_kind(*scalar, &path)?;
+            for (i, c) in ["x", "y", "z", "w"].iter().take(*size as usize).enumerate() {
+                out.push(Leaf {
+                    path: format!("{path}.{c}"),
+                    word: byte / 4 + i as u32,
+                    kind,
+                });
+            }
+        }
+        naga::TypeInner::Matrix {
+            columns,
+            rows,
+            scalar,
+        } => {
+            let kind = scalar_kind(*scalar, &path)?;
+            let col_stride = if *rows == naga::VectorSize::Tri {
+                4
+            } else {
+                *rows as u32
+            };
+            for c in 0..*columns as u32 {
+                for r in 0..*rows as u32 {
+                    out.push(Leaf {
+                        path: format!("{path}[{c}][{r}]"),
+                        word: byte / 4 + c * col_stride + r,
+                        kind,
+                    });
+                }
+            }
+        }
+        naga::TypeInner::Array {
+            base,
+            size: naga::ArraySize::Constant(n),
+            stride,
+        } => {
+            for i in 0..n.get() {
+                flatten(
+                    module,
+                    layouter,
+                    *base,
+                    format!("{path}[{i}]"),
+                    byte + i * stride,
+                    out,
+                    owner,
+                )?;
+            }
+        }
+        naga::TypeInner::Struct { members, .. } => {
+            for m in members {
+                let name = m.name.clone().unwrap_or_default();
+                flatten(
+                    module,
+                    layouter,
+                    m.ty,
+                    format!("{path}.{name}"),
+                    byte + m.offset,
+                    out,
+                    owner,
+                )?;
+            }
+        }
+        other => {
+            return Err(RunError::Program(format!(
+                "item struct `{owner}` field `{path}`: type {other:?} cannot travel in a queue"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Generates `fn {prefix}_load_{T}(base: u32) -> T` and `fn {prefix}_store_{T}(base: u32, v: T)`
+/// over the word accessors `{prefix}_load_word(i) -> u32` and `{prefix}_store_word(i, w)`.
+pub fn load_store_fns(layout: &StructLayout, prefix: &str) -> String {
+    let t = &layout.name;
+    let mut s = format!("fn {prefix}_load_{t}(base: u32) -> {t} {{\n    var v: {t};\n");
+    for l in &layout.leaves {
+        let w = format!("{prefix}_load_word(base + {}u)", l.word);
+        let e = match l.kind {
+            ScalarKind::U32 => w,
+            ScalarKind::I32 => format!("bitcast<i32>({w})"),
+            ScalarKind::F32 => format!("bitcast<f32>({w})"),
+        };
+        s += &format!("    v{} = {e};\n", l.path);
+    }
+    s += "    return v;\n}\n";
+    s += &format!("fn {prefix}_store_{t}(base: u32, v: {t}) {{\n");
+    for l in &layout.leaves {
+        let e = match l.kind {
+            ScalarKind::U32 => format!("v{}", l.path),
+            _ => format!("bitcast<u32>(v{})", l.path),
+        };
+        s += &format!("    {prefix}_store_word(base + {}u, {e});\n", l.word);
+    }
+    s += "}\n";
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SRC: &str = "struct Inner { a: vec3<f32>, b: u32 }
+        struct Item { id: u32, p: array<vec4<f32>, 2>, inner: Inner, k: i32 }";
+
+    #[test]
+    fn layout_follows_wgsl_alignment_rules() {
+        let l = struct_layout(SRC, "Item").unwrap();
+        // id at 0, p (align 16) at 16..48, inner (align 16) at 48..64, k at 64; size rounds to 80.
+        assert_eq!(
+            l.members,
+            vec![
+                ("id".into(), 0),
+                ("p".into(), 16),
+                ("inner".into(), 48),
+                ("k".into(), 64)
+            ]
+        );
+        assert_eq!(l.size, 80);
+        assert_eq!(l.leaves.len(), 1 + 8 + 4 + 1);
+        assert_eq!(
+            l.leaves[9],
+            Leaf {
+                path: ".inner.a.x".into(),
+                word: 12,
+                kind: ScalarKind::F32
+            }
+        );
+        assert_eq!(
+            l.leaves[12],
+            Leaf {
+                path: ".inner.b".into(),
+                word: 15,
+                kind: ScalarKind::U32
+            }
+        );
+    }
+
+    #[test]
+    fn generated_load_store_is_valid_wgsl() {
+        let l = struct_layout(SRC, "Item").unwrap();
+        let src = format!(
+            "{SRC}\n@group(0) @binding(0) var<storage, read_write> w: array<u32>;\n\
+             fn q_load_word(i: u32) -> u32 {{ return w[i]; }}\n\
+             fn q_store_word(i: u32, x: u32) {{ w[i] = x; }}\n{}\n\
+             @compute @workgroup_size(1) fn main() {{ q_store_Item(20u, q_load_Item(0u)); }}",
+            load_store_fns(&l, "q")
+        );
+        validate("test", &src).unwrap();
+    }
+
+    #[test]
+    fn unsupported_field_types_are_rejected_by_name() {
+        let e = struct_layout("struct X { a: f16 }", "X");
+        assert!(e.is_err());
+        let e = struct_layout("struct X { a: vec2<u32>, b: atomic<u32> }", "X").unwrap_err();
+        assert!(e.to_string().contains(".b"), "{e}");
+    }
+}

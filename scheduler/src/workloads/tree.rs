@@ -1,0 +1,368 @@
+//! A synthetic split tree: the first workload the scheduler is proven on. Each node's child count
+//! comes from a hash of its id (fixed `k`, or uniform in `0..=k`), nodes carry a payload that
+//! children derive from their parent's (so a word lost or misplaced in a queue changes the
+//! result), and leaves fold an order-independent checksum. Inner nodes run `branch`, childless
+//! nodes run `leaf`. A CPU reference gives exact item counts and the checksum.
+
+use crate::error::RunError;
+use crate::gpu::Gpu;
+use crate::procedure::{ItemType, Procedure};
+use crate::program::{Program, Seed, UserBindings};
+use crate::stats::RunStats;
+use crate::strategy::Scheduler;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Fanout {
+    /// Every inner node has exactly k children.
+    Fixed(u32),
+    /// 0..=k children, uniformly, from the node id.
+    Uniform(u32),
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct TreeParams {
+    pub roots: u32,
+    /// Nodes at this depth have no children (roots are at depth 0).
+    pub max_depth: u32,
+    pub fanout: Fanout,
+    /// Hash rounds per inner node: the per-item work cost.
+    pub work: u32,
+    /// Payload words per item (item size = 2 + payload words).
+    pub payload_words: u32,
+    pub seed: u32,
+}
+
+impl TreeParams {
+    /// The benchmark tree: 64 roots, binary, depth 14 = 2,097,088 items, trivial work.
+    pub fn binary_benchmark() -> Self {
+        TreeParams {
+            roots: 64,
+            max_depth: 14,
+            fanout: Fanout::Fixed(2),
+            work: 0,
+            payload_words: 1,
+            seed: 1,
+        }
+    }
+
+    fn max_children(&self) -> u32 {
+        match self.fanout {
+            Fanout::Fixed(k) | Fanout::Uniform(k) => k,
+        }
+    }
+
+    pub fn describe(&self) -> String {
+        let f = match self.fanout {
+            Fanout::Fixed(k) => format!("fixed:{k}"),
+            Fanout::Uniform(k) => format!("uniform:0..{k}"),
+        };
+        format!(
+            "roots={} depth={} fanout={f} work={} payload={} seed={}",
+            self.roots, self.max_depth, self.work, self.payload_words, self.seed
+        )
+    }
+}
+
+/// What a run of the tree produced: items per procedure and the leaf checksum.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TreeResult {
+    pub branches: u64,
+    pub leaves: u64,
+    /// Leaves that reached the output buckets (must equal `leaves`).
+    pub leaves_folded: u64,
+    pub leaf_sum: u32,
+    pub leaf_xor: u32,
+}
+
+pub fn hash(x: u32) -> u32 {
+    let mut h = x;
+    h ^= h >> 16;
+    h = h.wrapping_mul(0x7feb_352d);
+    h ^= h >> 15;
+    h = h.wrapping_mul(0x846c_a68b);
+    h ^= h >> 16;
+    h
+}
+
+const BUCKETS: u32 = 256;
+
+/// The host twin of the WGSL `TreeNode` with `payload_words` payload words.
+fn node_words(id: u32, depth: u32, payload: &[u32]) -> Vec<u32> {
+    let mut w = vec![id, depth];
+    w.extend_from_slice(payload);
+    w
+}
+
+impl TreeParams {
+    fn children(&self, id: u32, depth: u32) -> u32 {
+        if depth >= self.max_depth {
+            return 0;
+        }
+        match self.fanout {
+            Fanout::Fixed(k) => k,
+            Fanout::Uniform(k) => hash(id ^ self.seed.wrapping_mul(0x9e37_79b9)) % (k + 1),
+        }
+    }
+
+    fn root(&self, i: u32) -> (u32, Vec<u32>) {
+        let id = hash(i.wrapping_add(self.seed.wrapping_mul(0x632b_e5ab)));
+        let payload = (0..self.payload_words)
+            .map(|w| hash(id ^ w.wrapping_mul(0x85eb_ca6b)))
+            .collect();
+        (id, payload)
+    }
+
+    fn child(&self, id: u32, payload: &[u32], work: u32, j: u32) -> (u32, Vec<u32>) {
+        let cid = hash(id.wrapping_mul(0x9e37_79b9).wrapping_add(j + 1));
+        let mut p: Vec<u32> = payload
+            .iter()
+            .enumerate()
+            .map(|(w, &x)| hash(x ^ cid ^ (w as u32).wrapping_mul(0x85eb_ca6b)))
+            .collect();
+        p[0] ^= work;
+        (cid, p)
+    }
+
+    fn work_of(&self, id: u32) -> u32 {
+        let mut x = id;
+        for i in 0..self.work {
+            x = hash(x.wrapping_add(i));
+        }
+        x
+    }
+
+    fn leaf_hash(id: u32, depth: u32, payload: &[u32]) -> u32 {
+        let mut h = hash(id ^ (depth << 24));
+        for &x in payload {
+            h = hash(h ^ x);
+        }
+        h
+    }
+
+    /// The CPU reference: walks the whole tree.
+    pub fn reference(&self) -> TreeResult {
+        let mut r = TreeResult {
+            branches: 0,
+            leaves: 0,
+            leaves_folded: 0,
+            leaf_sum: 0,
+            leaf_xor: 0,
+        };
+        let mut stack: Vec<(u32, u32, Vec<u32>)> = (0..self.roots)
+            .map(|i| {
+                let (id, p) = self.root(i);
+                (id, 0, p)
+            })
+            .collect();
+        while let Some((id, depth, payload)) = stack.pop() {
+            let c = self.children(id, depth);
+            if c == 0 {
+                let h = Self::leaf_hash(id, depth, &payload);
+                r.leaves += 1;
+                r.leaves_folded += 1;
+                r.leaf_sum = r.leaf_sum.wrapping_add(h);
+                r.leaf_xor ^= hash(h);
+            } else {
+                r.branches += 1;
+                let work = self.work_of(id);
+                for j in 0..c {
+                    let (cid, p) = self.child(id, &payload, work, j);
+                    stack.push((cid, depth + 1, p));
+                }
+            }
+        }
+        r
+    }
+
+    pub fn program(&self) -> Result<Program, RunError> {
+        let p = self.payload_words;
+        if p == 0 || p > 254 {
+            return Err(RunError::Program("payload words must be 1..=254".into()));
+        }
+        let item = ItemType::new(
+            "TreeNode",
+            &format!("struct TreeNode {{ id: u32, depth: u32, payload: array<u32, {p}> }}"),
+        );
+        let k = self.max_children();
+        let uniform = matches!(self.fanout, Fanout::Uniform(_)) as u32;
+        let user = UserBindings {
+            wgsl: format!(
+                "@group(1) @binding(0) var<storage, read_write> tree_out: array<atomic<u32>>;\n\
+                 const TREE_MAX_DEPTH: u32 = {}u;\nconst TREE_K: u32 = {k}u;\nconst TREE_UNIFORM: u32 = {uniform}u;\n\
+                 const TREE_SEED: u32 = {}u;\nconst TREE_WORK: u32 = {}u;\nconst TREE_P: u32 = {p}u;\n{}",
+                self.max_depth,
+                self.seed.wrapping_mul(0x9e37_79b9),
+                self.work,
+                TREE_WGSL
+            ),
+            layout: vec![crate::pipeline::storage_entry(0, false)],
+        };
+        let branch = Procedure::new("branch", item.clone(), 1)
+            .emits("branch", k)
+            .emits("leaf", k)
+            .body(BRANCH_WGSL);
+        let leaf = Procedure::new("leaf", item, 1).body(LEAF_WGSL);
+        Program::new(vec![branch, leaf], user)
+    }
+
+    pub fn seeds(&self) -> Vec<Seed> {
+        let (mut branch, mut leaf) = (Vec::new(), Vec::new());
+        for i in 0..self.roots {
+            let (id, payload) = self.root(i);
+            let words = node_words(id, 0, &payload);
+            if self.children(id, 0) > 0 {
+                branch.extend(words)
+            } else {
+                leaf.extend(words)
+            }
+        }
+        vec![
+            Seed {
+                procedure: "branch".into(),
+                words: branch,
+            },
+            Seed {
+                procedure: "leaf".into(),
+                words: leaf,
+            },
+        ]
+    }
+}
+
+const TREE_WGSL: &str = r#"
+fn tree_hash(x: u32) -> u32 {
+    var h = x;
+    h ^= h >> 16u; h *= 0x7feb352du; h ^= h >> 15u; h *= 0x846ca68bu; h ^= h >> 16u;
+    return h;
+}
+fn tree_children(id: u32, depth: u32) -> u32 {
+    if depth >= TREE_MAX_DEPTH { return 0u; }
+    if TREE_UNIFORM == 1u { return tree_hash(id ^ TREE_SEED) % (TREE_K + 1u); }
+    return TREE_K;
+}
+"#;
+
+const BRANCH_WGSL: &str = r#"
+fn branch_execute(item: TreeNode, inv: Invocation) {
+    var x = item.id;
+    for (var i = 0u; i < TREE_WORK; i++) { x = tree_hash(x + i); }
+    let c = tree_children(item.id, item.depth);
+    for (var j = 0u; j < c; j++) {
+        var child: TreeNode;
+        child.id = tree_hash(item.id * 0x9e3779b9u + j + 1u);
+        child.depth = item.depth + 1u;
+        for (var w = 0u; w < TREE_P; w++) {
+            child.payload[w] = tree_hash(item.payload[w] ^ child.id ^ (w * 0x85ebca6bu));
+        }
+        child.payload[0] ^= x;
+        if tree_children(child.id, child.depth) > 0u { enqueue_branch(child); } else { enqueue_leaf(child); }
+    }
+}
+"#;
+
+const LEAF_WGSL: &str = r#"
+fn leaf_execute(item: TreeNode, inv: Invocation) {
+    if !inv.live { return; }
+    var h = tree_hash(item.id ^ (item.depth << 24u));
+    for (var w = 0u; w < TREE_P; w++) { h = tree_hash(h ^ item.payload[w]); }
+    // Spread over buckets: one counter for a million leaves would serialise the GPU.
+    let b = (item.id & 255u) * 4u;
+    atomicAdd(&tree_out[b], 1u);
+    atomicAdd(&tree_out[b + 1u], h);
+    atomicXor(&tree_out[b + 2u], tree_hash(h));
+}
+"#;
+
+/// The tree's GPU resources: its output buckets and their bind group.
+pub struct TreeRun {
+    pub params: TreeParams,
+    pub program: Program,
+    out: wgpu::Buffer,
+    bind: wgpu::BindGroup,
+}
+
+impl TreeRun {
+    pub fn new(gpu: &Gpu, params: TreeParams) -> Result<TreeRun, RunError> {
+        let program = params.program()?;
+        let out = gpu.storage_buffer("tree out", (BUCKETS * 4) as u64);
+        let layout = gpu
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("tree"),
+                entries: &program.user.layout,
+            });
+        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("tree"),
+            layout: &layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: out.as_entire_binding(),
+            }],
+        });
+        Ok(TreeRun {
+            params,
+            program,
+            out,
+            bind,
+        })
+    }
+
+    /// Runs once and reads the result back.
+    pub fn run(
+        &self,
+        gpu: &Gpu,
+        scheduler: &Scheduler,
+    ) -> Result<(RunStats, TreeResult), RunError> {
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        enc.clear_buffer(&self.out, 0, None);
+        gpu.queue.submit([enc.finish()]);
+        let stats = scheduler.run(gpu, &self.params.seeds(), Some(&self.bind))?;
+        let words = gpu.read_words(&self.out, 0, (BUCKETS * 4) as u64)?;
+        let mut r = TreeResult {
+            branches: stats.executed[0],
+            leaves: stats.executed[1],
+            leaves_folded: 0,
+            leaf_sum: 0,
+            leaf_xor: 0,
+        };
+        for b in words.chunks(4) {
+            r.leaves_folded += b[0] as u64;
+            r.leaf_sum = r.leaf_sum.wrapping_add(b[1]);
+            r.leaf_xor ^= b[2];
+        }
+        Ok((stats, r))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn binary_benchmark_tree_has_the_documented_size() {
+        let r = TreeParams {
+            work: 0,
+            ..TreeParams::binary_benchmark()
+        }
+        .reference();
+        assert_eq!(r.branches + r.leaves, 2_097_088);
+        assert_eq!(r.leaves, 64 << 14);
+    }
+
+    #[test]
+    fn uniform_fanout_depends_on_seed() {
+        let a = TreeParams {
+            roots: 8,
+            max_depth: 12,
+            fanout: Fanout::Uniform(3),
+            work: 0,
+            payload_words: 3,
+            seed: 1,
+        };
+        let b = TreeParams {
+            seed: 2,
+            ..a.clone()
+        };
+        assert_ne!(a.reference(), b.reference());
+    }
+}

@@ -1,0 +1,301 @@
+// Persistent megakernel: every workgroup loops, claiming a batch from one procedure queue,
+// running it, and publishing what it emitted, until no work is left in this launch.
+// The protocol and why it is correct under WGSL's relaxed atomics: docs/scheduler.md.
+// Generated code before this file: NQ/THREADS/WORDS/EMITS tables, the procedures, the
+// `sched_slot_*` word accessors over `slots`, `sched_execute`, and `enqueue_*`.
+
+// ---- ctrl layout (u32 words); host twin: scheduler/src/megakernel/layout.rs ----
+const QSTRIDE: u32 = 16u;
+const Q_RESERVE: u32 = 0u;   // tickets handed to producers (linear within a launch)
+const Q_HEAD: u32 = 1u;      // tickets handed to consumers
+const Q_COUNT: u32 = 2u;     // written, unclaimed items (i32; may dip below 0 transiently)
+const Q_BUDGET: u32 = 3u;    // tickets appended + worst-case tickets promised to running batches
+const Q_PEAK: u32 = 4u;      // most items waiting at once
+const Q_EXECUTED: u32 = 5u;
+const Q_BATCHES: u32 = 6u;
+const Q_BLOCKED: u32 = 7u;   // 1 when a batch was refused for lack of room in this queue
+fn gw(i: u32) -> u32 { return NQ * QSTRIDE + i; }
+const G_PENDING: u32 = 0u;   // items appended and neither processed nor abandoned in this launch
+const G_STOP: u32 = 1u;
+const G_ERROR: u32 = 2u;
+const G_ERR_A: u32 = 3u;
+const G_ERR_B: u32 = 4u;
+const G_IDLE: u32 = 5u;
+const G_SEQ: u32 = 6u;
+const G_ABANDONED: u32 = 7u;
+const G_PROBE_STARTED: u32 = 8u;
+const G_PROBE_FINISHED: u32 = 9u;
+const G_PROBE_RESIDENT: u32 = 10u;
+const G_ITER_EXITS: u32 = 11u;
+
+const ERR_EMIT: u32 = 1u;
+
+// ---- params (read-only words); host twin: MegakernelParams ----
+const P_MAX_ITERS: u32 = 0u;
+const P_SPIN: u32 = 1u;
+const P_PROBE: u32 = 2u;
+const P_POLICY: u32 = 3u;      // 0 = priority order, 1 = oldest batch first (FIFO)
+const P_OUTBOX_STRIDE: u32 = 4u;
+const P_BATCH_STEPS: u32 = 5u;
+fn q_cap(q: u32) -> u32 { return params[8u + q * 4u]; }
+fn q_slot_base(q: u32) -> u32 { return params[9u + q * 4u]; }
+fn q_flag_base(q: u32) -> u32 { return params[10u + q * 4u]; }
+fn prio(i: u32) -> u32 { return params[8u + NQ * 4u + i]; }
+fn ob_off(q: u32, t: u32) -> u32 { return params[8u + NQ * 5u + q * NQ + t]; }
+
+const MAX_BATCH: u32 = 1024u;
+const EMPTY: u32 = 0u;            // slot flag: not written yet
+const CONSUMED: u32 = 0xffffffffu; // slot flag: processed; any other value: ready, = batch stamp
+
+const CMD_IDLE: u32 = 0u;
+const CMD_RUN: u32 = 1u;
+const CMD_EXIT: u32 = 2u;
+
+@group(0) @binding(0) var<storage, read_write> ctrl: array<atomic<u32>>;
+@group(0) @binding(2) var<storage, read_write> flags: array<atomic<u32>>;
+@group(0) @binding(3) var<storage, read_write> outbox: array<u32>;
+@group(0) @binding(4) var<storage, read> params: array<u32>;
+
+var<workgroup> wg_cmd: u32;
+var<workgroup> wg_q: u32;
+var<workgroup> wg_h: u32;
+var<workgroup> wg_n: u32;
+var<workgroup> wg_stamp: u32;
+var<workgroup> wg_ready: array<u32, MAX_BATCH>;
+var<workgroup> wg_emit_count: array<atomic<u32>, NQ>;
+var<workgroup> wg_emit_base: array<u32, NQ>;
+var<workgroup> wg_emit_n: array<u32, NQ>;
+var<workgroup> wg_abandoned: atomic<u32>;
+
+var<private> sched_proc: u32;
+var<private> sched_active: bool;
+var<private> sched_batch_n: u32;
+var<private> sched_outbox: u32;
+var<private> sched_blocked: bool;
+
+fn sched_ob_load_word(i: u32) -> u32 { return outbox[i]; }
+fn sched_ob_store_word(i: u32, w: u32) { outbox[i] = w; }
+
+fn sched_raise(code: u32, a: u32, b: u32) {
+    if atomicExchange(&ctrl[gw(G_ERROR)], code) == 0u {
+        atomicStore(&ctrl[gw(G_ERR_A)], a);
+        atomicStore(&ctrl[gw(G_ERR_B)], b);
+    }
+    atomicStore(&ctrl[gw(G_STOP)], 1u);
+}
+
+// Where enqueue_<t> puts the j-th item emitted to queue t in this batch, or a raised error.
+fn sched_outbox_slot(t: u32) -> u32 {
+    let j = atomicAdd(&wg_emit_count[t], 1u);
+    if j >= sched_batch_n * EMITS[sched_proc * NQ + t] {
+        sched_raise(ERR_EMIT, sched_proc, t);
+        return 0xffffffffu;
+    }
+    return sched_outbox + ob_off(sched_proc, t) + j * WORDS[t];
+}
+
+fn release_budget(q: u32, n: u32, upto: u32) {
+    for (var t = 0u; t < upto; t++) {
+        let e = EMITS[q * NQ + t];
+        if e > 0u { atomicSub(&ctrl[t * QSTRIDE + Q_BUDGET], n * e); }
+    }
+}
+
+// Reserves room for the worst-case output of n items of q in every target queue, or nothing.
+fn reserve_budget(q: u32, n: u32) -> bool {
+    for (var t = 0u; t < NQ; t++) {
+        let e = EMITS[q * NQ + t];
+        if e == 0u { continue; }
+        let need = n * e;
+        let old = atomicAdd(&ctrl[t * QSTRIDE + Q_BUDGET], need);
+        if old + need > q_cap(t) {
+            atomicSub(&ctrl[t * QSTRIDE + Q_BUDGET], need);
+            release_budget(q, n, t);
+            atomicStore(&ctrl[t * QSTRIDE + Q_BLOCKED], 1u);
+            sched_blocked = true;
+            return false;
+        }
+    }
+    return true;
+}
+
+// Leader only. Claims up to a batch of written items of q: an optimistic decrement of the count
+// (undone in part if it overshot), then tickets from head. Claimed tickets were all reserved
+// before, since the count only grows after items are written.
+fn try_claim(q: u32) -> bool {
+    let avail = bitcast<i32>(atomicLoad(&ctrl[q * QSTRIDE + Q_COUNT]));
+    if avail <= 0 { return false; }
+    let bmax = min((256u / THREADS[q]) * params[P_BATCH_STEPS], MAX_BATCH);
+    let want = min(u32(avail), bmax);
+    if !reserve_budget(q, want) { return false; }
+    let old = bitcast<i32>(atomicSub(&ctrl[q * QSTRIDE + Q_COUNT], want));
+    let got = u32(clamp(old, 0, i32(want)));
+    if got < want {
+        atomicAdd(&ctrl[q * QSTRIDE + Q_COUNT], want - got);
+        release_budget(q, want - got, NQ);
+    }
+    if got == 0u { return false; }
+    wg_q = q;
+    wg_n = got;
+    wg_h = atomicAdd(&ctrl[q * QSTRIDE + Q_HEAD], got);
+    return true;
+}
+
+// Leader only: the oldest waiting batch by its stamp, for the FIFO policy.
+fn fifo_pick() -> u32 {
+    var best = NQ;
+    var best_stamp = CONSUMED;
+    for (var q = 0u; q < NQ; q++) {
+        if bitcast<i32>(atomicLoad(&ctrl[q * QSTRIDE + Q_COUNT])) <= 0 { continue; }
+        let h = atomicLoad(&ctrl[q * QSTRIDE + Q_HEAD]);
+        if h >= q_cap(q) { continue; }
+        let f = atomicLoad(&flags[q_flag_base(q) + h]);
+        if f != EMPTY && f < best_stamp { best = q; best_stamp = f; }
+    }
+    return best;
+}
+
+fn leader_decide() -> u32 {
+    if atomicLoad(&ctrl[gw(G_STOP)]) != 0u { return CMD_EXIT; }
+    sched_blocked = false;
+    if params[P_POLICY] == 1u {
+        let q = fifo_pick();
+        if q < NQ && try_claim(q) { return CMD_RUN; }
+    }
+    for (var i = 0u; i < NQ; i++) {
+        if try_claim(prio(i)) { return CMD_RUN; }
+    }
+    // Nothing claimable. Pending counts every item still to run in this launch, including
+    // those being produced right now, so zero means this launch is finished.
+    if atomicLoad(&ctrl[gw(G_PENDING)]) == 0u { return CMD_EXIT; }
+    if sched_blocked {
+        // Work waits for room that only compaction between launches can give: end the launch.
+        atomicStore(&ctrl[gw(G_STOP)], 1u);
+        return CMD_EXIT;
+    }
+    return CMD_IDLE;
+}
+
+// Co-residency probe: a workgroup that starts before any workgroup has finished runs at the
+// same time as every workgroup that started before it.
+fn probe(lid: u32) {
+    if lid == 0u {
+        let t = atomicAdd(&ctrl[gw(G_PROBE_STARTED)], 1u);
+        if atomicLoad(&ctrl[gw(G_PROBE_FINISHED)]) == 0u {
+            atomicMax(&ctrl[gw(G_PROBE_RESIDENT)], t + 1u);
+        }
+        for (var i = 0u; i < params[P_SPIN]; i++) {
+            if atomicLoad(&ctrl[gw(G_PROBE_FINISHED)]) != 0u { break; }
+        }
+        atomicAdd(&ctrl[gw(G_PROBE_FINISHED)], 1u);
+    }
+}
+
+@compute @workgroup_size(256)
+fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>) {
+    if params[P_PROBE] != 0u {
+        probe(lid);
+        return;
+    }
+    sched_outbox = wid.x * params[P_OUTBOX_STRIDE];
+    var idle = 0u;
+    var iter = 0u;
+    // Bounded far below lavapipe's silent 65,535-iteration cut; the host relaunches if needed.
+    for (; iter < params[P_MAX_ITERS]; iter++) {
+        if lid == 0u {
+            wg_cmd = leader_decide();
+            atomicStore(&wg_abandoned, 0u);
+        }
+        if lid < NQ { atomicStore(&wg_emit_count[lid], 0u); }
+        let cmd = workgroupUniformLoad(&wg_cmd);
+        if cmd == CMD_EXIT { break; }
+        if cmd == CMD_IDLE { idle++; continue; }
+        let q = workgroupUniformLoad(&wg_q);
+        let h = workgroupUniformLoad(&wg_h);
+        let n = workgroupUniformLoad(&wg_n);
+
+        // 1. Wait, bounded, for each claimed slot's producer to publish it. A slot whose wait
+        //    runs out is abandoned to the compaction between launches: never lost.
+        for (var i = lid; i < n; i += 256u) {
+            var ok = 0u;
+            for (var s = 0u; s < params[P_SPIN]; s++) {
+                if atomicLoad(&flags[q_flag_base(q) + h + i]) != EMPTY { ok = 1u; break; }
+            }
+            wg_ready[i] = ok;
+            if ok == 0u { atomicAdd(&wg_abandoned, 1u); }
+        }
+        storageBarrier(); // acquire: flags seen before the payload is read
+
+        // 2. Run the batch, items_per_step items at a time.
+        let per_step = 256u / THREADS[q];
+        let slot = lid / THREADS[q];
+        sched_proc = q;
+        sched_batch_n = n;
+        for (var first = 0u; first < n; first += per_step) {
+            let idx = first + slot;
+            sched_active = idx < n && wg_ready[min(idx, MAX_BATCH - 1u)] != 0u;
+            let base = q_slot_base(q) + (h + idx) * WORDS[q];
+            sched_execute(q, base, Invocation(lid % THREADS[q], slot, sched_active));
+        }
+        storageBarrier(); // outbox writes visible to the whole workgroup
+
+        // 3. Reserve tickets for what was emitted, one atomic per target queue.
+        if lid == 0u {
+            let abandoned = atomicLoad(&wg_abandoned);
+            var emitted = 0u;
+            for (var t = 0u; t < NQ; t++) {
+                let k = min(atomicLoad(&wg_emit_count[t]), n * EMITS[q * NQ + t]);
+                wg_emit_n[t] = k;
+                emitted += k;
+                if k > 0u {
+                    let base = atomicAdd(&ctrl[t * QSTRIDE + Q_RESERVE], k);
+                    wg_emit_base[t] = base;
+                    let waiting = base + k - min(atomicLoad(&ctrl[t * QSTRIDE + Q_HEAD]), base + k);
+                    atomicMax(&ctrl[t * QSTRIDE + Q_PEAK], waiting);
+                }
+                // Unused promised room goes back.
+                let promised = n * EMITS[q * NQ + t];
+                if promised > k { atomicSub(&ctrl[t * QSTRIDE + Q_BUDGET], promised - k); }
+            }
+            // Children are pending before their parent stops being pending.
+            if emitted > 0u { atomicAdd(&ctrl[gw(G_PENDING)], emitted); }
+            wg_stamp = atomicAdd(&ctrl[gw(G_SEQ)], 1u) + 2u;
+            atomicAdd(&ctrl[q * QSTRIDE + Q_EXECUTED], n - abandoned);
+            atomicAdd(&ctrl[q * QSTRIDE + Q_BATCHES], 1u);
+            if abandoned > 0u { atomicAdd(&ctrl[gw(G_ABANDONED)], abandoned); }
+        }
+        workgroupBarrier();
+
+        // 4. Copy the payloads into the reserved slots.
+        for (var t = 0u; t < NQ; t++) {
+            let words = wg_emit_n[t] * WORDS[t];
+            let dst = q_slot_base(t) + wg_emit_base[t] * WORDS[t];
+            let src = sched_outbox + ob_off(q, t);
+            for (var w = lid; w < words; w += 256u) {
+                sched_slot_store_word(dst + w, outbox[src + w]);
+            }
+        }
+        storageBarrier(); // release: payloads before the flags that publish them
+
+        // 5. Publish: flag new slots with the batch stamp, mark processed inputs consumed.
+        for (var t = 0u; t < NQ; t++) {
+            for (var j = lid; j < wg_emit_n[t]; j += 256u) {
+                atomicStore(&flags[q_flag_base(t) + wg_emit_base[t] + j], wg_stamp);
+            }
+        }
+        for (var i = lid; i < n; i += 256u) {
+            if wg_ready[i] != 0u { atomicStore(&flags[q_flag_base(q) + h + i], CONSUMED); }
+        }
+        storageBarrier();
+        if lid == 0u {
+            for (var t = 0u; t < NQ; t++) {
+                if wg_emit_n[t] > 0u { atomicAdd(&ctrl[t * QSTRIDE + Q_COUNT], wg_emit_n[t]); }
+            }
+            atomicSub(&ctrl[gw(G_PENDING)], n);
+        }
+    }
+    if lid == 0u {
+        if idle > 0u { atomicAdd(&ctrl[gw(G_IDLE)], idle); }
+        if iter >= params[P_MAX_ITERS] { atomicAdd(&ctrl[gw(G_ITER_EXITS)], 1u); }
+    }
+}
