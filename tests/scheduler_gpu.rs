@@ -33,3 +33,219 @@ fn tree_matches_cpu_reference_on_both_strategies() {
         assert_eq!(result, reference, "{kind:?}");
     }
 }
+
+/// Deterministic pseudo-random numbers for the stress test (no extra dependency).
+struct Lcg(u64);
+impl Lcg {
+    fn below(&mut self, n: u32) -> u32 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 33) % n as u64) as u32
+    }
+}
+
+fn stress_configs() -> Vec<(&'static str, MegakernelConfig)> {
+    let base = MegakernelConfig::default();
+    vec![
+        (
+            "one workgroup",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(1),
+                initial_capacity: 1 << 12,
+                ..base.clone()
+            },
+        ),
+        (
+            // Tiny queues grow; short launches end with work left; one-poll waits abandon slots.
+            "tiny queues, short launches, impatient waits",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(3),
+                policy: QueuePolicy::Fifo,
+                batch_steps: 2,
+                max_iterations: 24,
+                spin_limit: 1,
+                initial_capacity: 16,
+                ..base.clone()
+            },
+        ),
+        (
+            "oversubscribed",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(24),
+                batch_steps: 4,
+                max_iterations: 200,
+                initial_capacity: 64,
+                ..base.clone()
+            },
+        ),
+        (
+            "probed",
+            MegakernelConfig {
+                policy: QueuePolicy::Fifo,
+                initial_capacity: 256,
+                ..base
+            },
+        ),
+    ]
+}
+
+#[test]
+fn stress_randomized_trees_match_the_cpu_reference_exactly() {
+    let gpu = gpu();
+    let mut rng = Lcg(0x5eed);
+    let (mut runs, mut multi_launch, mut grown, mut abandoned) = (0, 0, 0, 0);
+    for payload in [1u32, 62] {
+        let shape = TreeParams {
+            roots: 1,
+            max_depth: 1,
+            fanout: Fanout::Uniform(4),
+            work: 0,
+            payload_words: payload,
+            seed: 0,
+        };
+        let mut tree = TreeRun::new(&gpu, shape).unwrap();
+        let mut schedulers: Vec<(String, Scheduler)> = stress_configs()
+            .into_iter()
+            .map(|(name, c)| {
+                (
+                    name.to_string(),
+                    Scheduler::megakernel(&gpu, &tree.program, c).unwrap(),
+                )
+            })
+            .collect();
+        schedulers.push((
+            "multipass, tiny queues".into(),
+            Scheduler::multipass(
+                &gpu,
+                &tree.program,
+                MultipassConfig {
+                    rounds_per_submit: 3,
+                    initial_capacity: 16,
+                    ..Default::default()
+                },
+            )
+            .unwrap(),
+        ));
+        schedulers.push((
+            "multipass".into(),
+            Scheduler::new(&gpu, &tree.program, StrategyKind::Multipass, 1 << 12).unwrap(),
+        ));
+        for _ in 0..25 {
+            let fanout = if rng.below(3) == 0 {
+                Fanout::Fixed(1 + rng.below(2))
+            } else {
+                Fanout::Uniform(2 + rng.below(3))
+            };
+            let params = TreeParams {
+                roots: 1 + rng.below(8),
+                max_depth: 2 + rng.below(9),
+                fanout,
+                work: rng.below(4),
+                payload_words: payload,
+                seed: rng.below(1 << 30),
+            };
+            let reference = params.reference();
+            if reference.branches + reference.leaves > 20_000 {
+                continue;
+            }
+            tree.set_params(params.clone()).unwrap();
+            for (name, s) in &schedulers {
+                let (stats, result) = tree
+                    .run(&gpu, s)
+                    .unwrap_or_else(|e| panic!("{name}, {}: {e}", params.describe()));
+                assert_eq!(
+                    result,
+                    reference,
+                    "{name}, {}: {stats:?}",
+                    params.describe()
+                );
+                runs += 1;
+                multi_launch += (stats.launches > 1) as u32;
+                grown += (stats.queue_growths > 0) as u32;
+                abandoned += (stats.abandoned > 0) as u32;
+            }
+        }
+    }
+    eprintln!(
+        "{runs} runs: {multi_launch} needed several launches, {grown} grew a queue, {abandoned} abandoned a wait"
+    );
+    assert!(runs >= 250, "only {runs} runs");
+    // The hard paths must have been exercised, or this test proves little.
+    assert!(
+        multi_launch > 20 && grown > 20,
+        "{multi_launch} multi-launch, {grown} grown"
+    );
+}
+
+#[test]
+fn emitting_more_than_declared_is_an_error_not_a_silent_drop() {
+    let gpu = gpu();
+    let item = ItemType::new("Word", "struct Word { v: u32 }");
+    // Declares one child but emits two.
+    let liar = Procedure::new("liar", item.clone(), 1)
+        .emits("sink", 1)
+        .body("fn liar_execute(item: Word, inv: Invocation) { enqueue_sink(item); enqueue_sink(item); }");
+    let sink =
+        Procedure::new("sink", item, 1).body("fn sink_execute(item: Word, inv: Invocation) {}");
+    let program = Program::new(vec![liar, sink], UserBindings::default()).unwrap();
+    let seeds = [Seed::new("liar", &[7u32; 10])];
+    for kind in StrategyKind::ALL {
+        let s = Scheduler::new(&gpu, &program, kind, 64).unwrap();
+        match s.run(&gpu, &seeds, None) {
+            Err(RunError::EmitLimit {
+                procedure,
+                target,
+                declared,
+            }) => {
+                assert_eq!(
+                    (procedure.as_str(), target.as_str(), declared),
+                    ("liar", "sink", 1),
+                    "{kind:?}"
+                );
+            }
+            other => panic!("{kind:?}: expected an emit-limit error, got {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn a_queue_that_cannot_hold_live_work_reports_overflow() {
+    let gpu = gpu();
+    let item = ItemType::new("Word", "struct Word { v: u32 }");
+    let fan = Procedure::new("fan", item.clone(), 1)
+        .emits("sink", 8)
+        .body("fn fan_execute(item: Word, inv: Invocation) { for (var i = 0u; i < 8u; i++) { enqueue_sink(item); } }");
+    let sink =
+        Procedure::new("sink", item, 1).body("fn sink_execute(item: Word, inv: Invocation) {}");
+    let program = Program::new(vec![fan, sink], UserBindings::default()).unwrap();
+    let seeds = [Seed::new("fan", &[1u32; 4])];
+    let mk = Scheduler::megakernel(
+        &gpu,
+        &program,
+        MegakernelConfig {
+            initial_capacity: 8,
+            max_capacity: 8,
+            workgroups: Workgroups::Fixed(2),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let mp = Scheduler::multipass(
+        &gpu,
+        &program,
+        MultipassConfig {
+            initial_capacity: 8,
+            max_capacity: 8,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    for s in [mk, mp] {
+        match s.run(&gpu, &seeds, None) {
+            Err(RunError::QueueOverflow { queue, .. }) => assert_eq!(queue, "sink"),
+            other => panic!("expected an overflow of `sink`, got {other:?}"),
+        }
+    }
+}

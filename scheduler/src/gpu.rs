@@ -147,7 +147,7 @@ impl Gpu {
         count: u64,
     ) -> Result<Vec<u32>, RunError> {
         let bytes = self.read_buffer(src, offset * 4, count * 4)?;
-        Ok(bytemuck::cast_slice(&bytes).to_vec())
+        Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 
     /// A storage buffer of `words` u32 words (at least one), zeroed.

@@ -79,6 +79,8 @@ pub struct Megakernel {
     outbox_stride: u32,
     ob_off: Vec<u32>,
     priority: Vec<u32>,
+    /// Buffers of the last run, reused when the next run needs the same layout.
+    cache: std::cell::RefCell<Option<DeviceQueues>>,
 }
 
 /// Buffers of one queue layout.
@@ -147,6 +149,7 @@ impl Megakernel {
             outbox_stride,
             ob_off,
             priority,
+            cache: Default::default(),
         })
     }
 
@@ -303,7 +306,7 @@ impl Megakernel {
             ..Default::default()
         };
         let mut timer = PassTimer::new(gpu);
-        let mut dq: Option<DeviceQueues> = None;
+        let mut dq: Option<DeviceQueues> = self.cache.take();
         loop {
             let layout = QueueLayout::new(&self.program, capacity.clone())?;
             if dq.as_ref().is_none_or(|d| d.layout != layout) {

@@ -42,6 +42,8 @@ pub struct Multipass {
     program: Program,
     config: MultipassConfig,
     kernels: Kernels,
+    /// Buffers of the last run, reused when the next run needs the same layout.
+    cache: std::cell::RefCell<Option<DeviceRounds>>,
 }
 
 struct DeviceRounds {
@@ -83,6 +85,7 @@ impl Multipass {
             program: program.clone(),
             config,
             kernels,
+            cache: Default::default(),
         })
     }
 
@@ -171,6 +174,7 @@ impl Multipass {
         enc: &mut wgpu::CommandEncoder,
         d: &DeviceRounds,
         rounds: u32,
+        first_round: u64,
         timer: &PassTimer,
         user: Option<&wgpu::BindGroup>,
     ) {
@@ -186,7 +190,7 @@ impl Multipass {
         pass.set_bind_group(2, &d.plan_bind, &[]);
         let args = |slot: usize| (slot * 12) as u64;
         for r in 0..rounds as usize {
-            pass.set_bind_group(0, &d.bind[r % 2], &[]);
+            pass.set_bind_group(0, &d.bind[(first_round as usize + r) % 2], &[]);
             pass.set_pipeline(&p[0]);
             pass.dispatch_workgroups(1, 1, 1);
             for q in 0..nq {
@@ -228,7 +232,13 @@ impl Multipass {
         };
         let mut timer = PassTimer::new(gpu);
         let mut encoded = 0u64;
-        let mut d = self.device_rounds(gpu, QueueLayout::new(&self.program, capacity.clone())?);
+        // Rounds encoded since the last upload: round r reads items[r % 2].
+        let mut since_upload = 0u64;
+        let layout = QueueLayout::new(&self.program, capacity.clone())?;
+        let mut d = match self.cache.take() {
+            Some(d) if d.layout == layout => d,
+            _ => self.device_rounds(gpu, layout),
+        };
         self.upload(gpu, &d, &live);
         loop {
             if encoded >= self.config.max_rounds as u64 {
@@ -238,10 +248,11 @@ impl Multipass {
             }
             let rounds = self.config.rounds_per_submit.max(1);
             let mut enc = gpu.device.create_command_encoder(&Default::default());
-            self.encode_rounds(&mut enc, &d, rounds, &timer, user);
+            self.encode_rounds(&mut enc, &d, rounds, since_upload, &timer, user);
             timer.resolve(&mut enc);
             gpu.queue.submit([enc.finish()]);
             encoded += rounds as u64;
+            since_upload += rounds as u64;
             let ctrl = gpu.read_words(&d.ctrl, 0, ctrl_words(nq) as u64)?;
             timer.collect(gpu)?;
             let error = ctrl[g(nq, G_ERROR)];
@@ -286,11 +297,13 @@ impl Multipass {
                     .collect::<Result<_, _>>()?;
                 d = self.device_rounds(gpu, QueueLayout::new(&self.program, capacity.clone())?);
                 self.upload(gpu, &d, &live);
+                since_upload = 0;
             }
         }
         stats.queue_bytes = d.layout.total_words * 4 * 3 + d.layout.total_slots * 4;
         stats.gpu_ms = timer.total_ms();
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
+        *self.cache.borrow_mut() = Some(d);
         Ok(stats)
     }
 

@@ -184,18 +184,18 @@ impl TreeParams {
             &format!("struct TreeNode {{ id: u32, depth: u32, payload: array<u32, {p}> }}"),
         );
         let k = self.max_children();
-        let uniform = matches!(self.fanout, Fanout::Uniform(_)) as u32;
         let user = UserBindings {
             wgsl: format!(
                 "@group(1) @binding(0) var<storage, read_write> tree_out: array<atomic<u32>>;\n\
-                 const TREE_MAX_DEPTH: u32 = {}u;\nconst TREE_K: u32 = {k}u;\nconst TREE_UNIFORM: u32 = {uniform}u;\n\
-                 const TREE_SEED: u32 = {}u;\nconst TREE_WORK: u32 = {}u;\nconst TREE_P: u32 = {p}u;\n{}",
-                self.max_depth,
-                self.seed.wrapping_mul(0x9e37_79b9),
-                self.work,
+                 // Tree shape at run time, so one compiled program serves every tree of this payload size.\n\
+                 @group(1) @binding(1) var<storage, read> tree_cfg: array<u32, 5>;\n\
+                 const TREE_P: u32 = {p}u;\n{}",
                 TREE_WGSL
             ),
-            layout: vec![crate::pipeline::storage_entry(0, false)],
+            layout: vec![
+                crate::pipeline::storage_entry(0, false),
+                crate::pipeline::storage_entry(1, true),
+            ],
         };
         let branch = Procedure::new("branch", item.clone(), 1)
             .emits("branch", k)
@@ -236,16 +236,16 @@ fn tree_hash(x: u32) -> u32 {
     return h;
 }
 fn tree_children(id: u32, depth: u32) -> u32 {
-    if depth >= TREE_MAX_DEPTH { return 0u; }
-    if TREE_UNIFORM == 1u { return tree_hash(id ^ TREE_SEED) % (TREE_K + 1u); }
-    return TREE_K;
+    if depth >= tree_cfg[0] { return 0u; }
+    if tree_cfg[2] == 1u { return tree_hash(id ^ tree_cfg[3]) % (tree_cfg[1] + 1u); }
+    return tree_cfg[1];
 }
 "#;
 
 const BRANCH_WGSL: &str = r#"
 fn branch_execute(item: TreeNode, inv: Invocation) {
     var x = item.id;
-    for (var i = 0u; i < TREE_WORK; i++) { x = tree_hash(x + i); }
+    for (var i = 0u; i < tree_cfg[4]; i++) { x = tree_hash(x + i); }
     let c = tree_children(item.id, item.depth);
     for (var j = 0u; j < c; j++) {
         var child: TreeNode;
@@ -278,13 +278,17 @@ pub struct TreeRun {
     pub params: TreeParams,
     pub program: Program,
     out: wgpu::Buffer,
+    cfg: wgpu::Buffer,
     bind: wgpu::BindGroup,
+    /// The fan-out the program declared in its max_emits.
+    declared_children: u32,
 }
 
 impl TreeRun {
     pub fn new(gpu: &Gpu, params: TreeParams) -> Result<TreeRun, RunError> {
         let program = params.program()?;
         let out = gpu.storage_buffer("tree out", (BUCKETS * 4) as u64);
+        let cfg = gpu.storage_buffer("tree cfg", 5);
         let layout = gpu
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -294,17 +298,38 @@ impl TreeRun {
         let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("tree"),
             layout: &layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: out.as_entire_binding(),
-            }],
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: out.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: cfg.as_entire_binding(),
+                },
+            ],
         });
         Ok(TreeRun {
+            declared_children: params.max_children(),
             params,
             program,
             out,
+            cfg,
             bind,
         })
+    }
+
+    /// Another tree of the same payload size: same compiled program, new shape.
+    pub fn set_params(&mut self, params: TreeParams) -> Result<(), RunError> {
+        if params.payload_words != self.params.payload_words
+            || params.max_children() > self.declared_children
+        {
+            return Err(RunError::Program(
+                "a tree of another payload size or larger fan-out needs its own program".into(),
+            ));
+        }
+        self.params = params;
+        Ok(())
     }
 
     /// Runs once and reads the result back.
@@ -316,6 +341,16 @@ impl TreeRun {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&self.out, 0, None);
         gpu.queue.submit([enc.finish()]);
+        let p = &self.params;
+        let cfg = [
+            p.max_depth,
+            p.max_children(),
+            matches!(p.fanout, Fanout::Uniform(_)) as u32,
+            p.seed.wrapping_mul(0x9e37_79b9),
+            p.work,
+        ];
+        gpu.queue
+            .write_buffer(&self.cfg, 0, bytemuck::cast_slice(&cfg));
         let stats = scheduler.run(gpu, &self.params.seeds(), Some(&self.bind))?;
         let words = gpu.read_words(&self.out, 0, (BUCKETS * 4) as u64)?;
         let mut r = TreeResult {
