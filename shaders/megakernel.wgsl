@@ -225,6 +225,9 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
             if ok == 0u { atomicAdd(&wg_abandoned, 1u); }
         }
         storageBarrier(); // acquire: flags seen before the payload is read
+        // wg_ready is workgroup memory, which storageBarrier does not order: lanes other than the
+        // one that waited read it when threads_per_item > 1.
+        workgroupBarrier();
 
         // 2. Run the batch, items_per_step items at a time.
         let per_step = 256u / THREADS[q];
@@ -236,6 +239,8 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
             sched_active = idx < n && wg_ready[min(idx, MAX_BATCH - 1u)] != 0u;
             let base = q_slot_base(q) + (h + idx) * WORDS[q];
             sched_execute(q, base, Invocation(lid % THREADS[q], slot, sched_active));
+            // The next step may reuse the body's workgroup memory: all threads finish this one first.
+            workgroupBarrier();
         }
         storageBarrier(); // outbox writes visible to the whole workgroup
 

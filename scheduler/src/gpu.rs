@@ -29,6 +29,12 @@ pub struct Gpu {
 impl Gpu {
     /// Opens the adapter named by the environment, or the default one.
     pub fn from_env() -> Result<Gpu, RunError> {
+        Self::from_env_requiring(wgpu::Features::empty())
+    }
+
+    /// Like [`Gpu::from_env`], for programs whose user code needs more `features` (e.g. 64-bit
+    /// atomics); an adapter without them is an error that names them.
+    pub fn from_env_requiring(features: wgpu::Features) -> Result<Gpu, RunError> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
             backends: wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY),
             ..wgpu::InstanceDescriptor::new_without_display_handle()
@@ -42,15 +48,22 @@ impl Gpu {
                  for lavapipe) or set WGPU_ADAPTER_NAME / WGPU_BACKEND"
             ))
         })?;
-        Self::from_adapter(adapter)
+        Self::from_adapter(adapter, features)
     }
 
     /// Opens a device on `adapter` with the features the scheduler benefits from.
-    pub fn from_adapter(adapter: wgpu::Adapter) -> Result<Gpu, RunError> {
+    pub fn from_adapter(adapter: wgpu::Adapter, required: wgpu::Features) -> Result<Gpu, RunError> {
         let info = adapter.get_info();
         let available = adapter.features();
+        if !available.contains(required) {
+            return Err(RunError::NoAdapter(format!(
+                "{} lacks the features {:?}",
+                info.name,
+                required - available
+            )));
+        }
         let wanted = wgpu::Features::MEMORY_DECORATION_COHERENT | wgpu::Features::TIMESTAMP_QUERY;
-        let features = available & wanted;
+        let features = (available & wanted) | required;
         let alimits = adapter.limits();
         let limits = wgpu::Limits {
             max_storage_buffer_binding_size: alimits.max_storage_buffer_binding_size,
@@ -150,16 +163,31 @@ impl Gpu {
         Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 
-    /// A storage buffer of `words` u32 words (at least one), zeroed.
-    pub fn storage_buffer(&self, label: &str, words: u64) -> wgpu::Buffer {
-        self.device.create_buffer(&wgpu::BufferDescriptor {
+    /// The largest storage buffer binding this device allows, in bytes.
+    pub fn max_binding_bytes(&self) -> u64 {
+        let l = self.device.limits();
+        l.max_storage_buffer_binding_size.min(l.max_buffer_size)
+    }
+
+    /// A storage buffer of `words` u32 words (at least one), zeroed. A size beyond the device's
+    /// limits is an error naming the buffer, not a panic in wgpu's error handler.
+    pub fn storage_buffer(&self, label: &str, words: u64) -> Result<wgpu::Buffer, RunError> {
+        let bytes = words.max(1) * 4;
+        if bytes > self.max_binding_bytes() {
+            return Err(RunError::Device(format!(
+                "buffer `{label}` needs {bytes} bytes, more than this device's storage binding \
+                 limit of {} bytes",
+                self.max_binding_bytes()
+            )));
+        }
+        Ok(self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
             size: words.max(1) * 4,
             usage: wgpu::BufferUsages::STORAGE
                 | wgpu::BufferUsages::COPY_DST
                 | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
-        })
+        }))
     }
 
     /// Compiles WGSL, turning a validation error into a `RunError` that carries the message

@@ -42,6 +42,18 @@ impl QueueLayout {
         })
     }
 
+    /// The most slots each queue may grow to: the configured limit, and an equal share of the
+    /// largest storage binding the device allows (all queues live in one binding), so that a
+    /// queue that would not fit is reported as an overflow instead of failing buffer creation.
+    pub fn capacity_limits(program: &Program, max_binding_bytes: u64, configured: u32) -> Vec<u32> {
+        let share = max_binding_bytes / 4 / program.queue_count().max(1) as u64;
+        program
+            .procs
+            .iter()
+            .map(|p| (share / p.words() as u64).min(configured as u64).max(1) as u32)
+            .collect()
+    }
+
     /// Per-queue seed items (words back to back), validated against the program.
     pub fn seed_items(program: &Program, seeds: &[Seed]) -> Result<Vec<Vec<u32>>, RunError> {
         let mut per_queue = vec![Vec::new(); program.queue_count()];

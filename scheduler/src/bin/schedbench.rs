@@ -34,7 +34,7 @@ fn parse() -> Result<Options, String> {
         tree: TreeParams::binary_benchmark(),
         workgroups: None,
         policy: QueuePolicy::Priority(Vec::new()),
-        batch_steps: 4,
+        batch_steps: 1,
         capacity: 1 << 22,
     };
     let mut args = std::env::args().skip(1);

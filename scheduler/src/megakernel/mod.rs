@@ -75,12 +75,12 @@ pub struct Megakernel {
     config: MegakernelConfig,
     kernels: Kernels,
     /// Workgroups per launch; 0 until the first run's probe (the probe needs the user's group).
-    workgroups: std::cell::Cell<u32>,
+    workgroups: std::sync::atomic::AtomicU32,
     outbox_stride: u32,
     ob_off: Vec<u32>,
     priority: Vec<u32>,
     /// Buffers of the last run, reused when the next run needs the same layout.
-    cache: std::cell::RefCell<Option<DeviceQueues>>,
+    cache: std::sync::Mutex<Option<DeviceQueues>>,
 }
 
 /// Buffers of one queue layout.
@@ -145,7 +145,7 @@ impl Megakernel {
             program: program.clone(),
             config,
             kernels,
-            workgroups: std::cell::Cell::new(workgroups),
+            workgroups: std::sync::atomic::AtomicU32::new(workgroups),
             outbox_stride,
             ob_off,
             priority,
@@ -155,13 +155,16 @@ impl Megakernel {
 
     /// Workgroups per launch, probing on first use.
     pub fn workgroups(&self, gpu: &Gpu, user: Option<&wgpu::BindGroup>) -> Result<u32, RunError> {
-        if self.workgroups.get() == 0 {
+        if self.workgroups.load(std::sync::atomic::Ordering::Relaxed) == 0 {
             let Workgroups::Probe { max } = self.config.workgroups else {
                 unreachable!()
             };
-            self.workgroups.set(self.probe(gpu, max.max(1), user)?);
+            self.workgroups.store(
+                self.probe(gpu, max.max(1), user)?,
+                std::sync::atomic::Ordering::Relaxed,
+            );
         }
-        Ok(self.workgroups.get())
+        Ok(self.workgroups.load(std::sync::atomic::Ordering::Relaxed))
     }
 
     /// Counts workgroups that run at the same time (see `probe` in the shader).
@@ -213,11 +216,11 @@ impl Megakernel {
         workgroups: u32,
     ) -> Result<DeviceQueues, RunError> {
         let nq = self.program.queue_count();
-        let ctrl = gpu.storage_buffer("ctrl", ctrl_words(nq) as u64);
-        let slots = gpu.storage_buffer("slots", layout.total_words);
-        let flags = gpu.storage_buffer("flags", layout.total_slots);
-        let outbox = gpu.storage_buffer("outbox", workgroups as u64 * self.outbox_stride as u64);
-        let params_buf = gpu.storage_buffer("params", params.len() as u64);
+        let ctrl = gpu.storage_buffer("ctrl", ctrl_words(nq) as u64)?;
+        let slots = gpu.storage_buffer("slots", layout.total_words)?;
+        let flags = gpu.storage_buffer("flags", layout.total_slots)?;
+        let outbox = gpu.storage_buffer("outbox", workgroups as u64 * self.outbox_stride as u64)?;
+        let params_buf = gpu.storage_buffer("params", params.len() as u64)?;
         gpu.queue
             .write_buffer(&params_buf, 0, bytemuck::cast_slice(params));
         let bind = self.kernels.bind_group0(
@@ -285,17 +288,23 @@ impl Megakernel {
         let start = Instant::now();
         let nq = self.program.queue_count();
         let mut live = QueueLayout::seed_items(&self.program, seeds)?;
+        let max_cap = QueueLayout::capacity_limits(
+            &self.program,
+            gpu.max_binding_bytes(),
+            self.config.max_capacity,
+        );
         let mut capacity: Vec<u32> = (0..nq)
             .map(|q| {
                 let n = (live[q].len() / self.program.procs[q].words() as usize) as u32;
-                self.config.initial_capacity.max(n.saturating_mul(2)).max(1)
+                let want = self.config.initial_capacity.max(n.saturating_mul(2)).max(1);
+                want.min(max_cap[q]).max(n)
             })
             .collect();
-        if let Some(q) = (0..nq).find(|&q| capacity[q] > self.config.max_capacity) {
+        if let Some(q) = (0..nq).find(|&q| capacity[q] > max_cap[q]) {
             return Err(RunError::QueueOverflow {
                 queue: self.program.procs[q].proc.name.clone(),
-                capacity: self.config.max_capacity as u64,
-                needed_more_than: capacity[q] as u64 / 2,
+                capacity: max_cap[q] as u64,
+                needed_more_than: capacity[q] as u64,
             });
         }
         let mut stats = RunStats {
@@ -306,7 +315,7 @@ impl Megakernel {
             ..Default::default()
         };
         let mut timer = PassTimer::new(gpu);
-        let mut dq: Option<DeviceQueues> = self.cache.take();
+        let mut dq: Option<DeviceQueues> = self.cache.lock().unwrap().take();
         loop {
             let layout = QueueLayout::new(&self.program, capacity.clone())?;
             if dq.as_ref().is_none_or(|d| d.layout != layout) {
@@ -367,29 +376,43 @@ impl Megakernel {
             // Work is left: keep every published, unconsumed slot, in ticket order.
             live = self.compact(gpu, d, &ctrl)?;
             let mut grew = false;
+            // A queue at its limit that blocked a launch in which nothing ran; a blocked queue
+            // is named before one that is merely full.
+            let mut stuck: Option<(usize, u64, bool)> = None;
             for q in 0..nq {
                 let n = (live[q].len() / d.layout.words[q] as usize) as u32;
                 let blocked = ctrl[layout::q(q, Q_BLOCKED)] != 0;
                 if (blocked && progress == 0) || n > capacity[q] / 2 {
-                    if capacity[q] >= self.config.max_capacity {
-                        if progress == 0 {
-                            return Err(RunError::QueueOverflow {
-                                queue: self.program.procs[q].proc.name.clone(),
-                                capacity: capacity[q] as u64,
-                                needed_more_than: n as u64,
-                            });
+                    if capacity[q] >= max_cap[q] {
+                        // A blocked claim needed room beyond the whole capacity.
+                        let needed = if blocked {
+                            capacity[q] as u64
+                        } else {
+                            n as u64
+                        };
+                        if stuck.is_none_or(|s| blocked && !s.2) {
+                            stuck = Some((q, needed, blocked));
                         }
                         continue;
                     }
-                    capacity[q] = capacity[q].saturating_mul(2).min(self.config.max_capacity);
+                    capacity[q] = capacity[q].saturating_mul(2).min(max_cap[q]);
                     stats.queue_growths += 1;
                     grew = true;
                 }
             }
-            if progress == 0 && !grew && ctrl[g(nq, G_ABANDONED)] == 0 {
-                return Err(RunError::NoProgress(
-                    "a megakernel launch executed no item".into(),
-                ));
+            if progress == 0 && !grew {
+                if let Some((q, needed, _)) = stuck {
+                    return Err(RunError::QueueOverflow {
+                        queue: self.program.procs[q].proc.name.clone(),
+                        capacity: capacity[q] as u64,
+                        needed_more_than: needed,
+                    });
+                }
+                if ctrl[g(nq, G_ABANDONED)] == 0 {
+                    return Err(RunError::NoProgress(
+                        "a megakernel launch executed no item".into(),
+                    ));
+                }
             }
         }
         stats.queue_bytes = dq
@@ -397,6 +420,8 @@ impl Megakernel {
             .map_or(0, |d| d.layout.total_words * 4 + d.layout.total_slots * 4);
         stats.gpu_ms = timer.total_ms();
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
+        // Keep the device queues for the next run of the same size.
+        *self.cache.lock().unwrap() = dq;
         Ok(stats)
     }
 

@@ -43,7 +43,7 @@ pub struct Multipass {
     config: MultipassConfig,
     kernels: Kernels,
     /// Buffers of the last run, reused when the next run needs the same layout.
-    cache: std::cell::RefCell<Option<DeviceRounds>>,
+    cache: std::sync::Mutex<Option<DeviceRounds>>,
 }
 
 struct DeviceRounds {
@@ -89,15 +89,15 @@ impl Multipass {
         })
     }
 
-    fn device_rounds(&self, gpu: &Gpu, layout: QueueLayout) -> DeviceRounds {
+    fn device_rounds(&self, gpu: &Gpu, layout: QueueLayout) -> Result<DeviceRounds, RunError> {
         let nq = self.program.queue_count();
-        let ctrl = gpu.storage_buffer("mp_ctrl", ctrl_words(nq) as u64);
+        let ctrl = gpu.storage_buffer("mp_ctrl", ctrl_words(nq) as u64)?;
         let items = [
-            gpu.storage_buffer("items a", layout.total_words),
-            gpu.storage_buffer("items b", layout.total_words),
+            gpu.storage_buffer("items a", layout.total_words)?,
+            gpu.storage_buffer("items b", layout.total_words)?,
         ];
-        let emit = gpu.storage_buffer("emit", layout.total_words);
-        let emit_flags = gpu.storage_buffer("emit flags", layout.total_slots);
+        let emit = gpu.storage_buffer("emit", layout.total_words)?;
+        let emit_flags = gpu.storage_buffer("emit flags", layout.total_slots)?;
         let mut params = vec![0u32; P_QUEUES + nq * P_QSTRIDE];
         let mut sum_words = 0u32;
         for q in 0..nq {
@@ -109,8 +109,8 @@ impl Multipass {
             p[4] = sum_words;
             sum_words += layout.capacity[q].div_ceil(SCAN_BLOCK);
         }
-        let sums = gpu.storage_buffer("block sums", sum_words as u64);
-        let params_buf = gpu.storage_buffer("mp params", params.len() as u64);
+        let sums = gpu.storage_buffer("block sums", sum_words as u64)?;
+        let params_buf = gpu.storage_buffer("mp params", params.len() as u64)?;
         gpu.queue
             .write_buffer(&params_buf, 0, bytemuck::cast_slice(&params));
         let indirect = gpu.device.create_buffer(&wgpu::BufferDescriptor {
@@ -141,14 +141,14 @@ impl Multipass {
                 resource: indirect.as_entire_binding(),
             }],
         });
-        DeviceRounds {
+        Ok(DeviceRounds {
             layout,
             ctrl,
             items,
             indirect,
             plan_bind,
             bind,
-        }
+        })
     }
 
     /// Makes `live` (per queue, words back to back) the inputs of the next round, at parity 0.
@@ -218,12 +218,25 @@ impl Multipass {
         let start = Instant::now();
         let nq = self.program.queue_count();
         let mut live = QueueLayout::seed_items(&self.program, seeds)?;
+        // Reduce and scatter dispatch one workgroup per SCAN_BLOCK slots, at most 65,535.
+        let max_cap = QueueLayout::capacity_limits(
+            &self.program,
+            gpu.max_binding_bytes(),
+            self.config.max_capacity.min(65_535 * SCAN_BLOCK),
+        );
         let mut capacity: Vec<u32> = (0..nq)
             .map(|q| {
                 let n = (live[q].len() / self.program.procs[q].words() as usize) as u32;
-                self.config.initial_capacity.max(n).max(1)
+                self.config.initial_capacity.min(max_cap[q]).max(n).max(1)
             })
             .collect();
+        if let Some(q) = (0..nq).find(|&q| capacity[q] > max_cap[q]) {
+            return Err(RunError::QueueOverflow {
+                queue: self.program.procs[q].proc.name.clone(),
+                capacity: max_cap[q] as u64,
+                needed_more_than: capacity[q] as u64,
+            });
+        }
         let mut stats = RunStats {
             strategy: "multipass".into(),
             executed: vec![0; nq],
@@ -235,9 +248,9 @@ impl Multipass {
         // Rounds encoded since the last upload: round r reads items[r % 2].
         let mut since_upload = 0u64;
         let layout = QueueLayout::new(&self.program, capacity.clone())?;
-        let mut d = match self.cache.take() {
+        let mut d = match self.cache.lock().unwrap().take() {
             Some(d) if d.layout == layout => d,
-            _ => self.device_rounds(gpu, layout),
+            _ => self.device_rounds(gpu, layout)?,
         };
         self.upload(gpu, &d, &live);
         loop {
@@ -273,15 +286,15 @@ impl Multipass {
             if halted {
                 // The refused round's inputs are intact in items[planned % 2]: grow and resume.
                 self.accumulate(&mut stats, &ctrl);
-                if capacity[a] >= self.config.max_capacity {
+                if capacity[a] >= max_cap[a] {
                     return Err(RunError::QueueOverflow {
                         queue: self.program.procs[a].proc.name.clone(),
                         capacity: capacity[a] as u64,
                         needed_more_than: b as u64,
                     });
                 }
-                while capacity[a] < b && capacity[a] < self.config.max_capacity {
-                    capacity[a] = capacity[a].saturating_mul(2).min(self.config.max_capacity);
+                while capacity[a] < b && capacity[a] < max_cap[a] {
+                    capacity[a] = capacity[a].saturating_mul(2).min(max_cap[a]);
                 }
                 stats.queue_growths += 1;
                 let parity = ctrl[g(nq, G_PLANNED)] as usize % 2;
@@ -295,7 +308,7 @@ impl Multipass {
                         )
                     })
                     .collect::<Result<_, _>>()?;
-                d = self.device_rounds(gpu, QueueLayout::new(&self.program, capacity.clone())?);
+                d = self.device_rounds(gpu, QueueLayout::new(&self.program, capacity.clone())?)?;
                 self.upload(gpu, &d, &live);
                 since_upload = 0;
             }
@@ -303,7 +316,7 @@ impl Multipass {
         stats.queue_bytes = d.layout.total_words * 4 * 3 + d.layout.total_slots * 4;
         stats.gpu_ms = timer.total_ms();
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
-        *self.cache.borrow_mut() = Some(d);
+        *self.cache.lock().unwrap() = Some(d);
         Ok(stats)
     }
 

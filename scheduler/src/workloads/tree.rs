@@ -287,8 +287,8 @@ pub struct TreeRun {
 impl TreeRun {
     pub fn new(gpu: &Gpu, params: TreeParams) -> Result<TreeRun, RunError> {
         let program = params.program()?;
-        let out = gpu.storage_buffer("tree out", (BUCKETS * 4) as u64);
-        let cfg = gpu.storage_buffer("tree cfg", 5);
+        let out = gpu.storage_buffer("tree out", (BUCKETS * 4) as u64)?;
+        let cfg = gpu.storage_buffer("tree cfg", 5)?;
         let layout = gpu
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
