@@ -38,13 +38,22 @@ pub enum QueuePolicy {
     Fifo,
 }
 
+/// Turns of the persistent loop per launch on lavapipe: with bodies' own loops (a Reyes grid
+/// samples its micropolygons in nested loops) this keeps an invocation's total loop
+/// iterations far below lavapipe's cumulative 65,535 cut.
+pub const LAVAPIPE_MAX_ITERATIONS: u32 = 96;
+/// Polls of a flag per wait on lavapipe (the polls count against the same cut).
+pub const LAVAPIPE_SPIN_LIMIT: u32 = 64;
+
 #[derive(Debug, Clone)]
 pub struct MegakernelConfig {
     pub workgroups: Workgroups,
     pub policy: QueuePolicy,
     /// Workgroup steps per claimed batch (a step runs 256 / threads_per_item items).
     pub batch_steps: u32,
-    /// Loop turns per workgroup per launch; far below lavapipe's 65,535-iteration cut.
+    /// Loop turns per workgroup per launch; far below lavapipe's 65,535-iteration cut. On
+    /// lavapipe that cut counts every loop iteration nested in the persistent loop, bodies'
+    /// loops included, so there it is lowered to [`LAVAPIPE_MAX_ITERATIONS`].
     pub max_iterations: u32,
     /// Polls of one slot's flag before it is abandoned to the next launch.
     pub spin_limit: u32,
@@ -96,8 +105,15 @@ impl Megakernel {
     pub fn new(
         gpu: &Gpu,
         program: &Program,
-        config: MegakernelConfig,
+        mut config: MegakernelConfig,
     ) -> Result<Megakernel, RunError> {
+        if gpu.info.name.contains("llvmpipe") {
+            // lavapipe's loop limiter is one counter per invocation for a whole outermost loop
+            // and everything nested in it: after 65,535 iterations in total, every loop exits at
+            // its first test. A persistent launch must stay far below that, bodies included.
+            config.max_iterations = config.max_iterations.min(LAVAPIPE_MAX_ITERATIONS);
+            config.spin_limit = config.spin_limit.min(LAVAPIPE_SPIN_LIMIT);
+        }
         if config.max_iterations == 0 || config.max_iterations > 30_000 {
             return Err(RunError::Program(
                 "max_iterations must be 1..=30000 (lavapipe cuts loops at 65,535)".into(),
@@ -448,10 +464,25 @@ impl Megakernel {
                 match *f {
                     CONSUMED => {}
                     EMPTY => {
-                        return Err(RunError::Device(format!(
-                            "queue `{}` slot {i} was reserved but never published: protocol violation",
-                            self.program.procs[q].proc.name
-                        )));
+                        let empties = flags.iter().filter(|&&f| f == EMPTY).count();
+                        return Err(RunError::Device(
+                            format!(
+                                "queue `{}` slot {i} was reserved but never published: protocol violation \
+                             ({empties} such slots; reserve {reserved}, head {}, count {}, budget {}, capacity {})",
+                                self.program.procs[q].proc.name,
+                                ctrl[layout::q(q, Q_HEAD)],
+                                ctrl[layout::q(q, Q_COUNT)] as i32,
+                                ctrl[layout::q(q, Q_BUDGET)],
+                                d.layout.capacity[q]
+                            ) + &format!(
+                                " all: {:?}",
+                                (0..nq)
+                                    .map(|q| (0..8)
+                                        .map(|k| ctrl[layout::q(q, k)])
+                                        .collect::<Vec<_>>())
+                                    .collect::<Vec<_>>()
+                            ),
+                        ));
                     }
                     _ => {
                         live[q].extend_from_slice(&slots[i * w..(i + 1) * w]);

@@ -1,0 +1,66 @@
+//! The CPU reference of the whole GPU pipeline: the stage twins in `stages/` driven by a work
+//! stack. The order of work differs from the GPU's, which cannot change the image: every sample
+//! keeps the maximum of its keys.
+
+use crate::frame::FrameData;
+use crate::image::FrameImage;
+use crate::stages::{self, bound::Cull, bound::Decision};
+
+/// The image plus what each stage did, in the GPU's terms (`stages::C_*` counters; executed
+/// items per procedure: bound, splitu, splitv, diceshade).
+pub struct CpuRender {
+    pub image: FrameImage,
+    pub counters: [u64; stages::COUNTERS],
+    pub executed: [u64; 4],
+}
+
+pub fn render_cpu(data: &FrameData) -> CpuRender {
+    let f = &data.frame;
+    let spp = f.spp_x * f.spp_y;
+    let mut samples = vec![0u64; (f.width * f.height * spp) as usize];
+    let mut counters = [0u64; stages::COUNTERS];
+    let mut executed = [0u64; 4];
+    let mut work: Vec<_> = data.items.clone();
+    while let Some(item) = work.pop() {
+        executed[0] += 1;
+        match stages::bound::bound(&item, f) {
+            Decision::Cull(c) => {
+                counters[match c {
+                    Cull::Clip => stages::C_CULL_CLIP,
+                    Cull::Offscreen => stages::C_CULL_OFFSCREEN,
+                    Cull::Near => stages::C_CULL_NEAR,
+                }] += 1
+            }
+            Decision::Split { along_u, item, eye } => {
+                counters[stages::C_EYE_SPLITS] += eye as u64;
+                executed[if along_u { 1 } else { 2 }] += 1;
+                for second in [false, true] {
+                    work.push(stages::split::split_half(&item, along_u, second));
+                }
+            }
+            Decision::Dice {
+                item,
+                depth_limited,
+            } => {
+                counters[stages::C_DEPTH_LIMIT] += depth_limited as u64;
+                counters[stages::C_MAX_DEPTH] =
+                    counters[stages::C_MAX_DEPTH].max(item.splits() as u64);
+                executed[3] += 1;
+                let (mps, culled) = stages::dice_shade::dice_shade(&item, data, &mut samples);
+                counters[stages::C_MICROPOLYGONS] += mps as u64;
+                counters[stages::C_BACKFACE] += culled as u64;
+            }
+        }
+    }
+    let (rgba, depth) = stages::resolve::resolve(&samples, f.width, f.height, spp);
+    CpuRender {
+        image: FrameImage {
+            width: f.width,
+            height: f.height,
+            rgba,
+            depth,
+        },
+        counters,
+        executed,
+    }
+}

@@ -1,0 +1,338 @@
+//! What the GPU stages read about a frame: the host twins of the WGSL structs in
+//! `shaders/reyes/common.wgsl` (`#[repr(C)]` bytemuck types, layouts checked against naga's
+//! reflection in the tests), and their construction from a [`Scene`] and [`RenderOptions`].
+
+use crate::scene::{Light, Patch, Scene, SurfaceKind};
+use bytemuck::{Pod, Zeroable};
+
+/// A queue item of every Reyes stage: a (sub)patch.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct PatchItem {
+    /// 16 control points, xyz, camera space, `cp[4*v + u]`.
+    pub cp: [f32; 48],
+    /// Parameter range in the original patch: u0, u1, v0, v1.
+    pub uv: [f32; 4],
+    pub patch_id: u32,
+    /// Bits 0..7: splits so far; bits 8..15: splits made because of the near plane.
+    pub depth: u32,
+    /// Dice rates set by Bound: u in bits 0..7, v in bits 8..15.
+    pub rates: u32,
+    /// Crack dilation in pixels, set by Bound.
+    pub dilate: f32,
+}
+
+impl PatchItem {
+    pub fn point(&self, i: usize) -> [f32; 3] {
+        [self.cp[3 * i], self.cp[3 * i + 1], self.cp[3 * i + 2]]
+    }
+    pub fn splits(&self) -> u32 {
+        self.depth & 255
+    }
+    pub fn eye_splits(&self) -> u32 {
+        (self.depth >> 8) & 255
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct Frame {
+    pub width: u32,
+    pub height: u32,
+    pub spp_x: u32,
+    pub spp_y: u32,
+    pub focal: f32,
+    pub near: f32,
+    pub far: f32,
+    pub mp_size: f32,
+    pub bound_px: f32,
+    pub grid_max: u32,
+    pub max_depth: u32,
+    pub max_eye_splits: u32,
+    pub n_lights: u32,
+    pub seed: u32,
+    pub pad0: u32,
+    pub pad1: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct Material {
+    pub color: [f32; 3],
+    /// 0 constant, 1 matte, 2 plastic
+    pub kind: u32,
+    pub specular: [f32; 3],
+    pub ka: f32,
+    pub kd: f32,
+    pub ks: f32,
+    pub roughness: f32,
+    pub pad: f32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct GpuLight {
+    pub color: [f32; 3],
+    /// 0 ambient, 1 distant (`vec` = direction of travel), 2 point (`vec` = position)
+    pub kind: u32,
+    pub vec: [f32; 3],
+    pub pad: f32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct PatchInfo {
+    pub material: u32,
+    /// bit 0: flip the normal; bit 1: two-sided
+    pub flags: u32,
+}
+
+/// Quality and size settings of a render; `None` fields come from the scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderOptions {
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+    pub pixel_samples: Option<(u32, u32)>,
+    /// Target micropolygon edge in pixels (RenderMan's shading rate is its square).
+    pub mp_size: f32,
+    /// `Some(px)`: Patney & Owens' fixed rule (split to a `px` screen bound, dice 16x16).
+    pub bound_px: Option<f32>,
+    /// Most segments per grid side (grid points = segments + 1 <= 16).
+    pub grid_max: u32,
+    pub max_depth: u32,
+    pub max_eye_splits: u32,
+    pub seed: u32,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            width: None,
+            height: None,
+            pixel_samples: None,
+            mp_size: 1.0,
+            bound_px: None,
+            grid_max: 15,
+            max_depth: 24,
+            max_eye_splits: 10,
+            seed: 0x5eed,
+        }
+    }
+}
+
+/// Everything uploaded for one frame.
+#[derive(Clone, Debug)]
+pub struct FrameData {
+    pub frame: Frame,
+    pub materials: Vec<Material>,
+    pub lights: Vec<GpuLight>,
+    pub patch_info: Vec<PatchInfo>,
+    pub items: Vec<PatchItem>,
+}
+
+/// Largest image side accepted (the sample buffer must also fit the adapter; checked there).
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+
+impl FrameData {
+    pub fn new(scene: &Scene, o: &RenderOptions) -> Result<FrameData, String> {
+        let width = o.width.unwrap_or(scene.width);
+        let height = o.height.unwrap_or(scene.height);
+        if width == 0 || height == 0 || width > MAX_IMAGE_SIDE || height > MAX_IMAGE_SIDE {
+            return Err(format!(
+                "image size {width}x{height} is not supported: each side must be 1..={MAX_IMAGE_SIDE}"
+            ));
+        }
+        let (sx, sy) = o.pixel_samples.unwrap_or(scene.pixel_samples);
+        if !(1..=16).contains(&sx) || !(1..=16).contains(&sy) {
+            return Err(format!("pixel samples {sx}x{sy}: each must be 1..=16"));
+        }
+        if !(1..=15).contains(&o.grid_max) || !(o.mp_size > 0.0) {
+            return Err("grid_max must be 1..=15 and the micropolygon size positive".into());
+        }
+        let fov = scene.camera.fov_deg.to_radians();
+        let focal = width.min(height) as f64 / 2.0 / (fov / 2.0).tan();
+        let lights = gpu_lights(scene);
+        let frame = Frame {
+            width,
+            height,
+            spp_x: sx,
+            spp_y: sy,
+            focal: focal as f32,
+            near: scene.camera.near as f32,
+            far: scene.camera.far.min(f32::MAX as f64) as f32,
+            mp_size: o.mp_size,
+            bound_px: o.bound_px.unwrap_or(0.0),
+            grid_max: if o.bound_px.is_some() { 15 } else { o.grid_max },
+            max_depth: o.max_depth.min(255),
+            max_eye_splits: o.max_eye_splits.min(255),
+            n_lights: lights.len() as u32,
+            seed: o.seed,
+            pad0: 0,
+            pad1: 0,
+        };
+        Ok(FrameData {
+            frame,
+            materials: scene.materials.iter().map(gpu_material).collect(),
+            lights,
+            patch_info: scene.patches.iter().map(patch_info).collect(),
+            items: scene
+                .patches
+                .iter()
+                .enumerate()
+                .map(|(i, p)| root_item(i as u32, p))
+                .collect(),
+        })
+    }
+}
+
+fn f3(v: glam::DVec3) -> [f32; 3] {
+    [v.x as f32, v.y as f32, v.z as f32]
+}
+
+fn gpu_material(m: &crate::scene::Material) -> Material {
+    Material {
+        color: f3(m.color),
+        kind: match m.kind {
+            SurfaceKind::Constant => 0,
+            SurfaceKind::Matte => 1,
+            SurfaceKind::Plastic => 2,
+        },
+        specular: f3(m.specular_color),
+        ka: m.ka as f32,
+        kd: m.kd as f32,
+        ks: m.ks as f32,
+        roughness: m.roughness as f32,
+        pad: 0.0,
+    }
+}
+
+/// The scene's lights; a scene without any gets one distant light from the eye.
+fn gpu_lights(scene: &Scene) -> Vec<GpuLight> {
+    let light = |kind, color, vec| GpuLight {
+        color: f3(color),
+        kind,
+        vec: f3(vec),
+        pad: 0.0,
+    };
+    if scene.lights.is_empty() {
+        return vec![light(1, glam::DVec3::ONE, glam::DVec3::Z)];
+    }
+    scene
+        .lights
+        .iter()
+        .map(|l| match l {
+            Light::Ambient { color } => light(0, *color, glam::DVec3::ZERO),
+            Light::Distant { color, dir } => light(1, *color, *dir),
+            Light::Point { color, pos } => light(2, *color, *pos),
+        })
+        .collect()
+}
+
+fn patch_info(p: &Patch) -> PatchInfo {
+    PatchInfo {
+        material: p.material,
+        flags: p.flip_normal as u32 | (p.two_sided as u32) << 1,
+    }
+}
+
+fn root_item(id: u32, p: &Patch) -> PatchItem {
+    let mut cp = [0f32; 48];
+    for (i, c) in p.cp.iter().enumerate() {
+        cp[3 * i..3 * i + 3].copy_from_slice(&f3(*c));
+    }
+    PatchItem {
+        cp,
+        uv: [0.0, 1.0, 0.0, 1.0],
+        patch_id: id,
+        depth: 0,
+        rates: 0,
+        dilate: 0.0,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use scheduler::wgsl::struct_layout;
+
+    /// Each host struct has the size and field offsets naga computes for its WGSL twin.
+    #[test]
+    fn host_structs_match_wgsl_layouts() {
+        let src = &[crate::shaders::PATCH_ITEM, crate::shaders::COMMON].concat();
+        let check = |name: &str, size: usize, offsets: &[(&str, usize)]| {
+            let l = struct_layout(src, name).unwrap();
+            assert_eq!(l.size as usize, size, "{name} size");
+            for (field, off) in offsets {
+                let got = l
+                    .members
+                    .iter()
+                    .find(|(n, _)| n == field)
+                    .map(|m| m.1 as usize);
+                assert_eq!(got, Some(*off), "{name}.{field}");
+            }
+        };
+        use std::mem::{offset_of, size_of};
+        check(
+            "PatchItem",
+            size_of::<PatchItem>(),
+            &[
+                ("cp", offset_of!(PatchItem, cp)),
+                ("uv", offset_of!(PatchItem, uv)),
+                ("patch_id", offset_of!(PatchItem, patch_id)),
+                ("depth", offset_of!(PatchItem, depth)),
+                ("rates", offset_of!(PatchItem, rates)),
+                ("dilate", offset_of!(PatchItem, dilate)),
+            ],
+        );
+        check(
+            "Frame",
+            size_of::<Frame>(),
+            &[
+                ("focal", offset_of!(Frame, focal)),
+                ("bound_px", offset_of!(Frame, bound_px)),
+                ("n_lights", offset_of!(Frame, n_lights)),
+                ("seed", offset_of!(Frame, seed)),
+            ],
+        );
+        check(
+            "Material",
+            size_of::<Material>(),
+            &[
+                ("kind", offset_of!(Material, kind)),
+                ("specular", offset_of!(Material, specular)),
+                ("ka", offset_of!(Material, ka)),
+                ("roughness", offset_of!(Material, roughness)),
+            ],
+        );
+        check(
+            "Light",
+            size_of::<GpuLight>(),
+            &[
+                ("kind", offset_of!(GpuLight, kind)),
+                ("vec", offset_of!(GpuLight, vec)),
+            ],
+        );
+        check(
+            "PatchInfo",
+            size_of::<PatchInfo>(),
+            &[("flags", offset_of!(PatchInfo, flags))],
+        );
+    }
+
+    #[test]
+    fn bad_image_sizes_are_errors() {
+        let scene = crate::scene::builtin_teapot();
+        for (w, h) in [(0, 10), (10, 0), (MAX_IMAGE_SIDE + 1, 10)] {
+            let o = RenderOptions {
+                width: Some(w),
+                height: Some(h),
+                ..Default::default()
+            };
+            assert!(
+                FrameData::new(&scene, &o)
+                    .unwrap_err()
+                    .contains("image size")
+            );
+        }
+    }
+}

@@ -1,0 +1,11 @@
+//! The Reyes WGSL sources, one stage per file in `shaders/reyes/` (each with a Rust twin in
+//! `stages/`).
+
+pub const PATCH_ITEM: &str = include_str!("../../shaders/reyes/patch_item.wgsl");
+pub const COMMON: &str = include_str!("../../shaders/reyes/common.wgsl");
+pub const BOUND: &str = include_str!("../../shaders/reyes/bound.wgsl");
+pub const SPLIT: &str = include_str!("../../shaders/reyes/split.wgsl");
+pub const SHADE: &str = include_str!("../../shaders/reyes/shade.wgsl");
+pub const SAMPLE: &str = include_str!("../../shaders/reyes/sample.wgsl");
+pub const DICE_SHADE: &str = include_str!("../../shaders/reyes/dice_shade.wgsl");
+pub const RESOLVE: &str = include_str!("../../shaders/reyes/resolve.wgsl");

@@ -1,0 +1,150 @@
+//! Twin of `shaders/reyes/bound.wgsl`: screen bound, culling, and the split-or-dice decision.
+
+use super::{cp_point, project};
+use crate::frame::{Frame, PatchItem};
+use glam::Vec2;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Cull {
+    /// Wholly in front of the near plane or behind the far plane.
+    Clip,
+    Offscreen,
+    /// Still crossing the near plane after the allowed eye splits.
+    Near,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Decision {
+    Cull(Cull),
+    /// Split along u (else v); `eye` marks a near-plane split (the item's count is already raised).
+    Split {
+        along_u: bool,
+        item: PatchItem,
+        eye: bool,
+    },
+    /// Dice with the rates and dilation filled in; `depth_limited` when it wanted another split.
+    Dice {
+        item: PatchItem,
+        depth_limited: bool,
+    },
+}
+
+pub fn bound(item: &PatchItem, f: &Frame) -> Decision {
+    let cp = &item.cp;
+    let pts: Vec<(Vec2, f32)> = (0..16)
+        .map(|k| {
+            let p = cp_point(cp, k);
+            let s = if p.z >= f.near {
+                project(f, p)
+            } else {
+                [0.0, 0.0]
+            };
+            (Vec2::from(s), p.z)
+        })
+        .collect();
+    let zmin = pts.iter().map(|p| p.1).fold(pts[0].1, f32::min);
+    let zmax = pts.iter().map(|p| p.1).fold(pts[0].1, f32::max);
+    if zmax < f.near || zmin > f.far {
+        return Decision::Cull(Cull::Clip);
+    }
+    let depth = item.splits();
+    if zmin < f.near {
+        if item.eye_splits() >= f.max_eye_splits || depth >= f.max_depth {
+            return Decision::Cull(Cull::Near);
+        }
+        let mut e = *item;
+        e.depth += 256;
+        let along_u = polygon_length(cp, 1, 4) >= polygon_length(cp, 4, 1);
+        return Decision::Split {
+            along_u,
+            item: e,
+            eye: true,
+        };
+    }
+    let lo = pts.iter().fold(pts[0].0, |a, p| a.min(p.0));
+    let hi = pts.iter().fold(pts[0].0, |a, p| a.max(p.0));
+    if hi.x < 0.0 || hi.y < 0.0 || lo.x > f.width as f32 || lo.y > f.height as f32 {
+        return Decision::Cull(Cull::Offscreen);
+    }
+    let (mut lu, mut lv) = (0f32, 0f32);
+    for r in 0..4 {
+        let (mut su, mut sv) = (0f32, 0f32);
+        for i in 0..3 {
+            su += pts[4 * r + i].0.distance(pts[4 * r + i + 1].0);
+            sv += pts[4 * i + r].0.distance(pts[4 * (i + 1) + r].0);
+        }
+        lu = lu.max(su);
+        lv = lv.max(sv);
+    }
+    let (split, nu, nv) = dice_decision(f, lu, lv, hi - lo);
+    if split != 0 && depth < f.max_depth {
+        return Decision::Split {
+            along_u: split == 1,
+            item: *item,
+            eye: false,
+        };
+    }
+    let mut g = *item;
+    g.rates = nu | nv << 8;
+    g.dilate = crack_dilation(f, cp, nu, nv, zmin);
+    Decision::Dice {
+        item: g,
+        depth_limited: split != 0,
+    }
+}
+
+/// Camera-space control polygon length along rows (`step` 1, `across` 4) or columns.
+fn polygon_length(cp: &[f32; 48], step: usize, across: usize) -> f32 {
+    let mut best = 0f32;
+    for r in 0..4 {
+        let mut s = 0f32;
+        for i in 0..3 {
+            s += cp_point(cp, r * across + i * step)
+                .distance(cp_point(cp, r * across + (i + 1) * step));
+        }
+        best = best.max(s);
+    }
+    best
+}
+
+/// (0 dice | 1 split u | 2 split v, rate u, rate v).
+fn dice_decision(f: &Frame, lu: f32, lv: f32, extent: Vec2) -> (u32, u32, u32) {
+    let gmax = f.grid_max as f32;
+    if f.bound_px > 0.0 {
+        let split = extent.x.max(extent.y) > f.bound_px;
+        let dir = if lu >= lv { 1 } else { 2 };
+        return (if split { dir } else { 0 }, f.grid_max, f.grid_max);
+    }
+    let nu = (lu / f.mp_size).ceil();
+    let nv = (lv / f.mp_size).ceil();
+    if nu > gmax || nv > gmax {
+        let dir = if nu / gmax >= nv / gmax { 1 } else { 2 };
+        return (dir, f.grid_max, f.grid_max);
+    }
+    (0, nu.max(1.0) as u32, nv.max(1.0) as u32)
+}
+
+/// See `crack_dilation` in bound.wgsl and docs/reyes.md.
+pub fn crack_dilation(f: &Frame, cp: &[f32; 48], nu: u32, nv: u32, zmin: f32) -> f32 {
+    let mut m = 0f32;
+    for e in 0..4 {
+        let along_u = e < 2;
+        let start = if along_u {
+            if e == 1 { 12 } else { 0 }
+        } else if e == 3 {
+            3
+        } else {
+            0
+        };
+        let step = if along_u { 1 } else { 4 };
+        let n = if along_u { nu } else { nv } as f32;
+        let b: Vec<_> = (0..4).map(|k| cp_point(cp, start + k * step)).collect();
+        let c2 = 6.0
+            * (b[0] - 2.0 * b[1] + b[2])
+                .length()
+                .max((b[1] - 2.0 * b[2] + b[3]).length());
+        m = m.max(c2 / (8.0 * n * n));
+    }
+    let slack = 2.0 * (1.0 + (f.width.max(f.height) as f32) / f.focal);
+    m * f.focal / zmin * slack + 1.0e-3
+}

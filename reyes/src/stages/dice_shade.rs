@@ -1,0 +1,91 @@
+//! Twin of `shaders/reyes/dice_shade.wgsl`: the grid of points with normals from the patch's
+//! derivatives, shaded; then every micropolygon sampled.
+
+use super::{cp_point, project, sample::sample_micropolygon, shade};
+use crate::frame::{FrameData, PatchItem};
+use glam::Vec3;
+
+fn bern3(t: f32) -> [f32; 4] {
+    let s = 1.0 - t;
+    [s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t]
+}
+
+fn dbern3(t: f32) -> [f32; 4] {
+    let s = 1.0 - t;
+    [
+        -3.0 * s * s,
+        3.0 * s * s - 6.0 * t * s,
+        6.0 * t * s - 3.0 * t * t,
+        3.0 * t * t,
+    ]
+}
+
+/// Position, d/du, d/dv of the patch at (u, v).
+pub fn eval_patch(cp: &[f32; 48], u: f32, v: f32) -> [Vec3; 3] {
+    let (bu, bv, du, dv) = (bern3(u), bern3(v), dbern3(u), dbern3(v));
+    let (mut p, mut pu, mut pv) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
+    for j in 0..4 {
+        for i in 0..4 {
+            let c = cp_point(cp, 4 * j + i);
+            p += c * (bu[i] * bv[j]);
+            pu += c * (du[i] * bv[j]);
+            pv += c * (bu[i] * dv[j]);
+        }
+    }
+    [p, pu, pv]
+}
+
+/// The outside normal; at a vanishing tangent it is taken slightly inside the patch.
+pub fn patch_normal(cp: &[f32; 48], u: f32, v: f32, flip: bool) -> Vec3 {
+    let e = eval_patch(cp, u, v);
+    let mut n = e[1].cross(e[2]);
+    let scale = e[1].dot(e[1]) * e[2].dot(e[2]);
+    if !(n.dot(n) > 1.0e-12 * scale) {
+        let (iu, iv) = (u + (0.5 - u) * 1.0e-3, v + (0.5 - v) * 1.0e-3);
+        let f = eval_patch(cp, iu, iv);
+        n = f[1].cross(f[2]);
+    }
+    if flip { -n } else { n }
+}
+
+/// Grid points (x, y in pixels, z, packed colour bits as f32), row-major, (nu+1) x (nv+1).
+pub fn dice(item: &PatchItem, data: &FrameData) -> (u32, u32, Vec<[f32; 4]>) {
+    let f = &data.frame;
+    let (nu, nv) = (item.rates & 255, (item.rates >> 8) & 255);
+    let info = data.patch_info[item.patch_id as usize];
+    let m = &data.materials[info.material as usize];
+    let mut grid = Vec::with_capacity(((nu + 1) * (nv + 1)) as usize);
+    for t in 0..(nu + 1) * (nv + 1) {
+        let u = (t % (nu + 1)) as f32 / nu as f32;
+        let v = (t / (nu + 1)) as f32 / nv as f32;
+        let e = eval_patch(&item.cp, u, v);
+        let n = patch_normal(&item.cp, u, v, info.flags & 1 != 0);
+        let c = shade::shade(e[0], n, m, &data.lights);
+        let back = n.dot(e[0]) > 0.0;
+        let z = e[0].z.max(f.near);
+        let s = project(f, Vec3::new(e[0].x, e[0].y, z));
+        grid.push([s[0], s[1], z, f32::from_bits(shade::pack_color(c, back))]);
+    }
+    (nu, nv, grid)
+}
+
+/// Dices, shades and samples one grid into `samples`; returns (micropolygons, back-face culled).
+pub fn dice_shade(item: &PatchItem, data: &FrameData, samples: &mut [u64]) -> (u32, u32) {
+    let (nu, nv, g) = dice(item, data);
+    let two_sided = data.patch_info[item.patch_id as usize].flags & 2 != 0;
+    let cols = (nu + 1) as usize;
+    let mut culled = 0;
+    for t in 0..(nu * nv) as usize {
+        let (i, j) = (t % nu as usize, t / nu as usize);
+        let q = [
+            g[j * cols + i],
+            g[j * cols + i + 1],
+            g[(j + 1) * cols + i + 1],
+            g[(j + 1) * cols + i],
+        ];
+        if !sample_micropolygon(q, item.dilate, two_sided, &data.frame, samples) {
+            culled += 1;
+        }
+    }
+    (nu * nv, culled)
+}

@@ -1,0 +1,48 @@
+//! The Reyes stages as CPU code: each file is the Rust twin of the WGSL file of the same name in
+//! `shaders/reyes/`, in f32 and in the same order of operations, so that the CPU pipeline
+//! (`crate::cpu_render`) is a reference the GPU image is checked against.
+
+pub mod bound;
+pub mod dice_shade;
+pub mod resolve;
+pub mod sample;
+pub mod shade;
+pub mod split;
+
+use glam::Vec3;
+
+/// Counters the stages keep, indexed like `C_*` in `shaders/reyes/common.wgsl`.
+pub const C_CULL_CLIP: usize = 0;
+pub const C_CULL_OFFSCREEN: usize = 1;
+pub const C_CULL_NEAR: usize = 2;
+pub const C_DEPTH_LIMIT: usize = 3;
+pub const C_MICROPOLYGONS: usize = 4;
+pub const C_MAX_DEPTH: usize = 5;
+pub const C_EYE_SPLITS: usize = 6;
+pub const C_BACKFACE: usize = 7;
+pub const COUNTERS: usize = 16;
+
+pub(crate) fn cp_point(cp: &[f32; 48], i: usize) -> Vec3 {
+    Vec3::new(cp[3 * i], cp[3 * i + 1], cp[3 * i + 2])
+}
+
+pub(crate) fn set_cp_point(cp: &mut [f32; 48], i: usize, p: Vec3) {
+    cp[3 * i..3 * i + 3].copy_from_slice(&p.to_array());
+}
+
+pub(crate) fn project(f: &crate::frame::Frame, p: Vec3) -> [f32; 2] {
+    [
+        0.5 * f.width as f32 + f.focal * p.x / p.z,
+        0.5 * f.height as f32 - f.focal * p.y / p.z,
+    ]
+}
+
+pub fn reyes_hash(x: u32) -> u32 {
+    let mut h = x;
+    h ^= h >> 16;
+    h = h.wrapping_mul(0x7feb_352d);
+    h ^= h >> 15;
+    h = h.wrapping_mul(0x846c_a68b);
+    h ^= h >> 16;
+    h
+}

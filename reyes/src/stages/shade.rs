@@ -1,0 +1,62 @@
+//! Twin of `shaders/reyes/shade.wgsl`: RenderMan's constant, matte and plastic surfaces.
+
+use crate::frame::{GpuLight, Material};
+use glam::Vec3;
+
+pub fn shade(p: Vec3, n: Vec3, m: &Material, lights: &[GpuLight]) -> Vec3 {
+    let i = p.normalize();
+    let nn = n.normalize();
+    let nf = if nn.dot(i) > 0.0 { -nn } else { nn };
+    let v = -i;
+    let (mut amb, mut diff, mut spec) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
+    for l in lights {
+        let color = Vec3::from(l.color);
+        if l.kind == 0 {
+            amb += color;
+            continue;
+        }
+        let mut dir = -Vec3::from(l.vec);
+        let mut cl = color;
+        if l.kind == 2 {
+            let d = Vec3::from(l.vec) - p;
+            cl = color / d.dot(d).max(1.0e-20);
+            dir = d;
+        }
+        let ld = dir.normalize();
+        diff += cl * nf.dot(ld).max(0.0);
+        let h = (ld + v).normalize();
+        spec += cl * nf.dot(h).max(0.0).powf(1.0 / m.roughness.max(1.0e-4));
+    }
+    let cs = Vec3::from(m.color);
+    if m.kind == 0 {
+        return cs;
+    }
+    let mut c = cs * (m.ka * amb + m.kd * diff);
+    if m.kind == 2 {
+        c += Vec3::from(m.specular) * m.ks * spec;
+    }
+    c
+}
+
+pub fn srgb_encode(x: f32) -> f32 {
+    let c = x.clamp(0.0, 1.0);
+    if c <= 0.0031308 {
+        12.92 * c
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+pub fn srgb_decode(x: f32) -> f32 {
+    if x <= 0.04045 {
+        x / 12.92
+    } else {
+        ((x + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// 10 bits per channel of sRGB-encoded colour; bit 30 marks a point seen from its back.
+pub fn pack_color(c: Vec3, back: bool) -> u32 {
+    let q = |x: f32| (srgb_encode(x) * 1023.0).round() as u32;
+    q(c.x) | q(c.y) << 10 | q(c.z) << 20 | (back as u32) << 30
+}

@@ -1,0 +1,128 @@
+// Bound: 16 threads per patch, one per control point. Projects the control points, reduces them
+// to a screen bound, culls, and decides: split in u, split in v, or dice (with its rates).
+// Rust twin: reyes/src/stages/bound.rs.
+
+// (x, y) in pixels, z in camera space, w = 1 when the point is in front of the near plane.
+fn bound_execute(item: PatchItem, inv: Invocation) {
+    var cp = item.cp;
+    let p = cp_point(&cp, inv.thread);
+    let front = p.z >= frame.near;
+    var s = vec2<f32>(0.0);
+    if front { s = project(p); }
+    bound_shared[inv.slot * 16u + inv.thread] = vec4<f32>(s, p.z, select(0.0, 1.0, front));
+    workgroupBarrier();
+    if !inv.live || inv.thread != 0u { return; }
+
+    var pts: array<vec4<f32>, 16>;
+    for (var k = 0u; k < 16u; k++) { pts[k] = bound_shared[inv.slot * 16u + k]; }
+    var zmin = pts[0].z;
+    var zmax = pts[0].z;
+    for (var k = 1u; k < 16u; k++) { zmin = min(zmin, pts[k].z); zmax = max(zmax, pts[k].z); }
+    if zmax < frame.near || zmin > frame.far {
+        atomicAdd(&counters[C_CULL_CLIP], 1u);
+        return;
+    }
+    let depth = item.depth & 255u;
+    let eye = (item.depth >> 8u) & 255u;
+    if zmin < frame.near {
+        // Crossing the near plane: no screen bound exists. Split a bounded number of times.
+        if eye >= frame.max_eye_splits || depth >= frame.max_depth {
+            atomicAdd(&counters[C_CULL_NEAR], 1u);
+            return;
+        }
+        var e = item;
+        e.depth = item.depth + 256u;
+        atomicAdd(&counters[C_EYE_SPLITS], 1u);
+        if polygon_length(&cp, 1u, 4u) >= polygon_length(&cp, 4u, 1u) {
+            enqueue_splitu(e);
+        } else {
+            enqueue_splitv(e);
+        }
+        return;
+    }
+    var lo = pts[0].xy;
+    var hi = pts[0].xy;
+    for (var k = 1u; k < 16u; k++) { lo = min(lo, pts[k].xy); hi = max(hi, pts[k].xy); }
+    if hi.x < 0.0 || hi.y < 0.0 || lo.x > f32(frame.width) || lo.y > f32(frame.height) {
+        atomicAdd(&counters[C_CULL_OFFSCREEN], 1u);
+        return;
+    }
+    // Screen lengths of the control polygon along u and v bound the curves' lengths.
+    var lu = 0.0;
+    var lv = 0.0;
+    for (var r = 0u; r < 4u; r++) {
+        var su = 0.0;
+        var sv = 0.0;
+        for (var i = 0u; i < 3u; i++) {
+            su += distance(pts[4u * r + i].xy, pts[4u * r + i + 1u].xy);
+            sv += distance(pts[4u * i + r].xy, pts[4u * (i + 1u) + r].xy);
+        }
+        lu = max(lu, su);
+        lv = max(lv, sv);
+    }
+    let d = dice_decision(lu, lv, hi - lo);
+    if d.x != 0u && depth < frame.max_depth {
+        if d.x == 1u { enqueue_splitu(item); } else { enqueue_splitv(item); }
+        return;
+    }
+    if d.x != 0u { atomicAdd(&counters[C_DEPTH_LIMIT], 1u); }
+    atomicMax(&counters[C_MAX_DEPTH], depth);
+    var g = item;
+    g.rates = d.y | (d.z << 8u);
+    g.dilate = crack_dilation(&cp, d.y, d.z, zmin);
+    enqueue_diceshade(g);
+}
+
+// Sum of |P[i+1] - P[i]| over a row (step along u = 1) or column (step = 4), in camera space,
+// maximised over the 4 rows/columns (`across` = 4 or 1).
+fn polygon_length(cp: ptr<function, array<f32, 48>>, step: u32, across: u32) -> f32 {
+    var best = 0.0;
+    for (var r = 0u; r < 4u; r++) {
+        var s = 0.0;
+        for (var i = 0u; i < 3u; i++) {
+            s += distance(cp_point(cp, r * across + i * step), cp_point(cp, r * across + (i + 1u) * step));
+        }
+        best = max(best, s);
+    }
+    return best;
+}
+
+// x: 0 dice, 1 split u, 2 split v; y, z: dice rates in u and v.
+fn dice_decision(lu: f32, lv: f32, extent: vec2<f32>) -> vec3<u32> {
+    let gmax = f32(frame.grid_max);
+    if frame.bound_px > 0.0 {
+        // Patney & Owens: split until the screen bound fits bound_px, then a fixed grid.
+        let split = max(extent.x, extent.y) > frame.bound_px;
+        return vec3<u32>(select(0u, select(2u, 1u, lu >= lv), split), frame.grid_max, frame.grid_max);
+    }
+    let nu = ceil(lu / frame.mp_size);
+    let nv = ceil(lv / frame.mp_size);
+    if nu > gmax || nv > gmax {
+        return vec3<u32>(select(2u, 1u, nu / gmax >= nv / gmax), frame.grid_max, frame.grid_max);
+    }
+    return vec3<u32>(0u, u32(max(nu, 1.0)), u32(max(nv, 1.0)));
+}
+
+// Largest gap, in pixels, between a boundary curve of this patch and the chord polyline a
+// neighbour may use for it: |C''| <= 6 max|second difference| of the control points, the chord
+// error of a segment of parameter length h is |C''| h^2 / 8, and a camera-space distance d at
+// depth >= zmin spans at most 2 d f / zmin pixels inside a 90 degree view. Micropolygons are
+// grown by this much so that T-junction gaps between grids diced at different rates close.
+fn crack_dilation(cp: ptr<function, array<f32, 48>>, nu: u32, nv: u32, zmin: f32) -> f32 {
+    var m = 0.0;
+    for (var e = 0u; e < 4u; e++) {
+        // Edges: rows 0 and 3 (along u), columns 0 and 3 (along v).
+        let along_u = e < 2u;
+        let start = select(select(0u, 3u, e == 3u), select(0u, 12u, e == 1u), along_u);
+        let step = select(4u, 1u, along_u);
+        let n = f32(select(nv, nu, along_u));
+        let b0 = cp_point(cp, start);
+        let b1 = cp_point(cp, start + step);
+        let b2 = cp_point(cp, start + 2u * step);
+        let b3 = cp_point(cp, start + 3u * step);
+        let c2 = 6.0 * max(length(b0 - 2.0 * b1 + b2), length(b1 - 2.0 * b2 + b3));
+        m = max(m, c2 / (8.0 * n * n));
+    }
+    let slack = 2.0 * (1.0 + max(f32(frame.width), f32(frame.height)) / frame.focal);
+    return m * frame.focal / zmin * slack + 1.0e-3;
+}

@@ -1,0 +1,15 @@
+// The queue item of every Reyes stage: a (sub)patch. Host twin: reyes/src/frame.rs.
+struct PatchItem {
+    // 16 control points, xyz each, camera space, row-major cp[4*v + u] (u fastest).
+    cp: array<f32, 48>,
+    // The item's parameter range in its original patch: (u0, u1, v0, v1).
+    uv: vec4<f32>,
+    // Index of the original patch (material, sides, orientation).
+    patch_id: u32,
+    // Bits 0..7: splits so far; bits 8..15: of those, splits made because of the near plane.
+    depth: u32,
+    // Set by Bound for DiceShade: segments in u (bits 0..7) and v (bits 8..15).
+    rates: u32,
+    // Set by Bound: crack dilation in pixels (see docs/reyes.md, "No cracks").
+    dilate: f32,
+}

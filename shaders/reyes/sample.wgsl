@@ -1,0 +1,72 @@
+// Sampling: one micropolygon (a bilinear quad of grid points, flat colour) against the jittered
+// sub-samples under its screen bound, with an inside test per triangle and a depth test by
+// 64-bit atomicMax. Rust twin: reyes/src/stages/sample.rs.
+
+fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 { return a.x * b.y - a.y * b.x; }
+
+// Position of sub-sample (sx, sy) of pixel (px, py): stratified, jittered by a hash.
+fn sample_position(px: u32, py: u32, sx: u32, sy: u32) -> vec2<f32> {
+    let id = ((py * frame.width + px) * frame.spp_y + sy) * frame.spp_x + sx;
+    let h = reyes_hash(id ^ frame.seed);
+    let j = vec2<f32>(f32(h & 0xffffu), f32(h >> 16u)) / 65536.0;
+    return vec2<f32>(f32(px), f32(py)) + (vec2<f32>(f32(sx), f32(sy)) + j)
+        / vec2<f32>(f32(frame.spp_x), f32(frame.spp_y));
+}
+
+// Depth at q if q is inside triangle (a, b, c) grown by `grow` pixels; negative otherwise.
+fn triangle_depth(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, q: vec2<f32>, grow: f32) -> f32 {
+    let area = cross2(b.xy - a.xy, c.xy - a.xy);
+    if abs(area) < 1.0e-12 { return -1.0; }
+    let s = sign(area);
+    let wa = s * cross2(c.xy - b.xy, q - b.xy);
+    let wb = s * cross2(a.xy - c.xy, q - c.xy);
+    let wc = s * cross2(b.xy - a.xy, q - a.xy);
+    if wa < -grow * distance(b.xy, c.xy) || wb < -grow * distance(a.xy, c.xy)
+        || wc < -grow * distance(a.xy, b.xy) {
+        return -1.0;
+    }
+    return (wa * a.z + wb * b.z + wc * c.z) / abs(area);
+}
+
+fn average_color(a: u32, b: u32, c: u32, d: u32) -> u32 {
+    var out = 0u;
+    for (var k = 0u; k < 30u; k += 10u) {
+        let sum = ((a >> k) & 1023u) + ((b >> k) & 1023u) + ((c >> k) & 1023u) + ((d >> k) & 1023u);
+        out |= ((sum + 2u) / 4u) << k;
+    }
+    return out;
+}
+
+fn sample_micropolygon(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, grow: f32, two_sided: bool) {
+    let ca = bitcast<u32>(a.w);
+    let cb = bitcast<u32>(b.w);
+    let cc = bitcast<u32>(c.w);
+    let cd = bitcast<u32>(d.w);
+    let back = 1u << 30u;
+    if !two_sided && (ca & cb & cc & cd & back) != 0u {
+        atomicAdd(&counters[C_BACKFACE], 1u);
+        return;
+    }
+    let color = average_color(ca, cb, cc, cd);
+    let lo = max(min(min(a.xy, b.xy), min(c.xy, d.xy)) - vec2<f32>(grow), vec2<f32>(0.0));
+    let hi = min(max(max(a.xy, b.xy), max(c.xy, d.xy)) + vec2<f32>(grow),
+                 vec2<f32>(f32(frame.width), f32(frame.height)) - vec2<f32>(1.0e-3));
+    if any(hi < lo) { return; }
+    let spp = frame.spp_x * frame.spp_y;
+    for (var py = u32(lo.y); py <= u32(hi.y); py++) {
+        for (var px = u32(lo.x); px <= u32(hi.x); px++) {
+            for (var sy = 0u; sy < frame.spp_y; sy++) {
+                for (var sx = 0u; sx < frame.spp_x; sx++) {
+                    let q = sample_position(px, py, sx, sy);
+                    if any(q < lo) || any(q > hi) { continue; }
+                    var z = triangle_depth(a, b, c, q, grow);
+                    if z < 0.0 { z = triangle_depth(a, c, d, q, grow); }
+                    if z < 0.0 { continue; }
+                    let key = (u64(~bitcast<u32>(z)) << 32u) | u64(color);
+                    let idx = (py * frame.width + px) * spp + sy * frame.spp_x + sx;
+                    atomicMax(&samples[idx], key);
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,233 @@
+//! GPU Reyes against its CPU twin, across strategies, and against the exact surfaces. Runs on
+//! lavapipe in CI; the adapter comes from the environment and a missing one fails loudly.
+
+use reyes::cpu_render::render_cpu;
+use reyes::frame::{FrameData, RenderOptions};
+use reyes::gpu_render::{GpuRenderer, required_features};
+use reyes::image::FrameImage;
+use reyes::scene::{self, Scene};
+use reyes::stages;
+use scheduler::{Gpu, StrategyKind};
+use std::path::Path;
+use std::sync::OnceLock;
+
+fn gpu() -> &'static Gpu {
+    static GPU: OnceLock<Gpu> = OnceLock::new();
+    GPU.get_or_init(|| {
+        Gpu::from_env_requiring(required_features())
+            .unwrap_or_else(|e| panic!("GPU tests need an adapter with 64-bit atomics: {e}"))
+    })
+}
+
+fn renderer(kind: StrategyKind) -> &'static GpuRenderer {
+    static MK: OnceLock<GpuRenderer> = OnceLock::new();
+    static MP: OnceLock<GpuRenderer> = OnceLock::new();
+    let cell = if kind == StrategyKind::Megakernel {
+        &MK
+    } else {
+        &MP
+    };
+    cell.get_or_init(|| GpuRenderer::new(gpu(), kind).unwrap())
+}
+
+fn small(w: u32, h: u32) -> RenderOptions {
+    RenderOptions {
+        width: Some(w),
+        height: Some(h),
+        ..Default::default()
+    }
+}
+
+/// Largest per-channel difference (colour in sRGB 8-bit steps, alpha in 1/255) and the share
+/// of pixels differing by more than 2 steps.
+fn compare(a: &FrameImage, b: &FrameImage) -> (u8, f64) {
+    let (x, y) = (a.rgba8(), b.rgba8());
+    let d: Vec<u8> = x
+        .chunks(4)
+        .zip(y.chunks(4))
+        .map(|(p, q)| (0..4).map(|c| p[c].abs_diff(q[c])).max().unwrap())
+        .collect();
+    let max = d.iter().copied().max().unwrap_or(0);
+    let over = d.iter().filter(|&&v| v > 2).count() as f64 / d.len() as f64;
+    (max, over)
+}
+
+fn data_dir() -> &'static Path {
+    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data"))
+}
+
+fn load(rel: &str) -> Scene {
+    let p = data_dir().join(rel);
+    scene::load(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+#[test]
+fn gpu_image_matches_the_cpu_pipeline_and_strategies_agree_exactly() {
+    let data = FrameData::new(&scene::builtin_teapot(), &small(120, 90)).unwrap();
+    let cpu = render_cpu(&data);
+    let mk = renderer(StrategyKind::Megakernel)
+        .render(gpu(), &data)
+        .unwrap();
+    let mp = renderer(StrategyKind::Multipass)
+        .render(gpu(), &data)
+        .unwrap();
+    // Sample keys are combined with atomicMax, which does not depend on the order of work:
+    // both strategies must give the same bits.
+    assert_eq!(
+        mk.image, mp.image,
+        "megakernel and multi-pass images differ"
+    );
+    assert_eq!(mk.counters, mp.counters);
+    assert_eq!(mk.run.executed, mp.run.executed);
+    // The CPU twin does the same f32 operations in the same order, so decisions and counts
+    // agree exactly; pixels may differ by GPU rounding of pow/sqrt/normalize (a few ulps) that
+    // moves a packed 10-bit colour by one step, or a sample lying exactly on an edge.
+    assert_eq!(
+        mk.run.executed.as_slice(),
+        cpu.executed.as_slice(),
+        "items per stage"
+    );
+    assert_eq!(
+        mk.counters[stages::C_MICROPOLYGONS],
+        cpu.counters[stages::C_MICROPOLYGONS]
+    );
+    let (max, over) = compare(&mk.image, &cpu.image);
+    assert!(
+        over < 0.002,
+        "{:.3}% of pixels differ by more than 2/255 (max {max})",
+        over * 100.0
+    );
+    assert!(
+        mk.image.covered_pixels() > 1500,
+        "teapot covers too little: {}",
+        mk.image.covered_pixels()
+    );
+}
+
+#[test]
+fn paper_mode_fixed_bound_and_pixel_samples_match_the_cpu_pipeline() {
+    let o = RenderOptions {
+        bound_px: Some(8.0),
+        pixel_samples: Some((3, 2)),
+        ..small(64, 48)
+    };
+    let data = FrameData::new(&scene::builtin_teapot(), &o).unwrap();
+    let cpu = render_cpu(&data);
+    let mk = renderer(StrategyKind::Megakernel)
+        .render(gpu(), &data)
+        .unwrap();
+    assert_eq!(mk.run.executed.as_slice(), cpu.executed.as_slice());
+    let (max, over) = compare(&mk.image, &cpu.image);
+    assert!(
+        over < 0.002,
+        "{:.3}% of pixels differ by more than 2/255 (max {max})",
+        over * 100.0
+    );
+}
+
+#[test]
+fn uteapot_rib_renders_like_the_cpu_pipeline() {
+    let s = load("rib/uteapot.rib");
+    let data = FrameData::new(&s, &small(100, 75)).unwrap();
+    let cpu = render_cpu(&data);
+    let mk = renderer(StrategyKind::Megakernel)
+        .render(gpu(), &data)
+        .unwrap();
+    let (max, over) = compare(&mk.image, &cpu.image);
+    assert!(
+        over < 0.002,
+        "{:.3}% of pixels differ by more than 2/255 (max {max})",
+        over * 100.0
+    );
+    assert!(mk.image.covered_pixels() > 500);
+}
+
+#[test]
+fn patches_behind_the_eye_are_split_then_culled_and_the_frame_stays_finite() {
+    // Move the camera into the teapot's spout region: patches cross the near plane.
+    let mut s = scene::builtin_teapot();
+    let shift = s.patches[0].cp[0];
+    for p in &mut s.patches {
+        for c in &mut p.cp {
+            c.z -= shift.z;
+        }
+    }
+    s.camera.near = 0.01;
+    let data = FrameData::new(&s, &small(64, 48)).unwrap();
+    let mk = renderer(StrategyKind::Megakernel)
+        .render(gpu(), &data)
+        .unwrap();
+    assert!(mk.counters[stages::C_EYE_SPLITS] > 0);
+    assert!(
+        mk.image
+            .rgba
+            .iter()
+            .all(|p| p.iter().all(|v| v.is_finite()))
+    );
+    let cpu = render_cpu(&data);
+    assert_eq!(
+        mk.counters[stages::C_CULL_NEAR],
+        cpu.counters[stages::C_CULL_NEAR]
+    );
+}
+
+/// Share of pixels where GPU coverage and exact coverage disagree by more than half a pixel.
+fn coverage_disagreement(img: &FrameImage, exact: &reyes::reference::Coverage) -> f64 {
+    let bad = img
+        .rgba
+        .iter()
+        .zip(&exact.frac)
+        .filter(|(p, e)| (p[3] - **e).abs() > 0.5)
+        .count();
+    bad as f64 / img.rgba.len() as f64
+}
+
+#[test]
+fn closed_surface_shows_no_background_inside_its_silhouette() {
+    let s = scene::load(Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenes/closed_blob.rib"
+    )))
+    .unwrap();
+    // Coarse dicing makes neighbouring grids meet at different rates (T-junctions).
+    for mp_size in [1.0, 6.0] {
+        let o = RenderOptions {
+            mp_size,
+            pixel_samples: Some((4, 4)),
+            ..small(128, 96)
+        };
+        let data = FrameData::new(&s, &o).unwrap();
+        let g = renderer(StrategyKind::Megakernel)
+            .render(gpu(), &data)
+            .unwrap();
+        let exact = reyes::reference::coverage(&s, 128, 96, 8);
+        let alpha: Vec<f32> = g.image.rgba.iter().map(|p| p[3]).collect();
+        assert_eq!(
+            reyes::reference::pinholes(&alpha, &exact),
+            0,
+            "pinholes at mp_size {mp_size}"
+        );
+        assert!(coverage_disagreement(&g.image, &exact) < 0.01);
+    }
+}
+
+#[test]
+fn rib_scenes_cover_what_the_exact_surfaces_cover() {
+    // Silhouette pixels may differ (micropolygons are chords of the surface, samples are
+    // jittered): at most 3% of pixels may differ by more than half their area.
+    for (rel, w, h) in [("rib/uteapot.rib", 80, 60), ("rib/killeroo.rib", 120, 78)] {
+        let s = load(rel);
+        let data = FrameData::new(&s, &small(w, h)).unwrap();
+        let g = renderer(StrategyKind::Megakernel)
+            .render(gpu(), &data)
+            .unwrap();
+        let exact = reyes::reference::coverage(&s, w, h, 4);
+        let d = coverage_disagreement(&g.image, &exact);
+        assert!(
+            d < 0.03,
+            "{rel}: {:.2}% of pixels disagree with the exact coverage",
+            d * 100.0
+        );
+        assert!(exact.area() > 100.0, "{rel}: scene covers almost nothing");
+    }
+}
