@@ -1,6 +1,7 @@
 # Sourced by the README commands: makes sure a Vulkan driver is installed (lavapipe from Debian's
 # mesa-vulkan-drivers when there is none), so the GPU code runs on machines without a GPU.
-if ! ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json >/dev/null 2>&1 && [ -z "${VK_DRIVER_FILES:-}${VK_ICD_FILENAMES:-}" ]; then
+if ! compgen -G "/usr/share/vulkan/icd.d/*.json" >/dev/null && ! compgen -G "/etc/vulkan/icd.d/*.json" >/dev/null \
+    && [ -z "${VK_DRIVER_FILES:-}${VK_ICD_FILENAMES:-}" ]; then
     echo "no Vulkan driver found: installing lavapipe (mesa-vulkan-drivers)" >&2
     if [ "$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi
     $SUDO apt-get update -qq
