@@ -12,11 +12,25 @@ fn trees() -> Vec<(&'static str, TreeParams)> {
             ("binary-depth14", TreeParams::binary_benchmark()),
             (
                 "irregular-deep",
-                TreeParams { roots: 64, max_depth: 40, fanout: Fanout::Uniform(3), work: 0, payload_words: 1, seed: 3 },
+                TreeParams {
+                    roots: 64,
+                    max_depth: 40,
+                    fanout: Fanout::Uniform(3),
+                    work: 0,
+                    payload_words: 1,
+                    seed: 3,
+                },
             ),
         ]
     } else {
-        vec![("binary-depth8", TreeParams { roots: 8, max_depth: 8, ..TreeParams::binary_benchmark() })]
+        vec![(
+            "binary-depth8",
+            TreeParams {
+                roots: 8,
+                max_depth: 8,
+                ..TreeParams::binary_benchmark()
+            },
+        )]
     }
 }
 
