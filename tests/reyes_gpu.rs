@@ -52,8 +52,8 @@ fn compare(a: &FrameImage, b: &FrameImage) -> (u8, f64) {
     (max, over)
 }
 
-fn data_dir() -> &'static Path {
-    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data"))
+fn data_dir() -> std::path::PathBuf {
+    reyes::shared_data_dir()
 }
 
 fn load(rel: &str) -> Scene {

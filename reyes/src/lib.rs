@@ -11,3 +11,17 @@ pub mod scene;
 pub mod shaders;
 pub mod stages;
 pub mod stats;
+
+/// Where the shared test scenes are (they may not be copied into the repository):
+/// `REYES_SHARED_DATA`, else `shared/data` next to the repository, else `/work/shared/data`.
+pub fn shared_data_dir() -> std::path::PathBuf {
+    if let Some(d) = std::env::var_os("REYES_SHARED_DATA") {
+        return d.into();
+    }
+    let beside = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data");
+    if beside.is_dir() {
+        beside
+    } else {
+        "/work/shared/data".into()
+    }
+}

@@ -791,10 +791,9 @@ mod tests {
     /// `cargo test -p reyes --release --lib reference::exact::tests::killeroo_timing --
     /// --ignored --nocapture`.
     #[test]
-    #[ignore = "timing; needs /work/shared/data"]
+    #[ignore = "timing, not a check; needs the shared data"]
     fn killeroo_timing() {
-        let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-            .join("../../shared/data/rib/killeroo.rib");
+        let path = crate::shared_data_dir().join("rib/killeroo.rib");
         let scene = crate::scene::load(&path).unwrap();
         let t = std::time::Instant::now();
         let cov = coverage(&scene, 200, 130, 4);

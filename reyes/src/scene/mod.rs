@@ -317,13 +317,11 @@ mod tests {
 
     /// The shared test data lives outside the repository (licence terms): read it in place.
     fn shared(rel: &str) -> PathBuf {
-        let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-            .join("../../shared/data")
-            .join(rel);
+        let p = crate::shared_data_dir().join(rel);
         assert!(
             p.is_file(),
-            "test data {} is missing (expected the shared data directory next to the \
-             repository: /work/shared/data)",
+            "test data {} is missing (set REYES_SHARED_DATA, or keep the shared data directory \
+             next to the repository or at /work/shared/data)",
             p.display()
         );
         p
