@@ -23,9 +23,6 @@ pub struct PatchItem {
 }
 
 impl PatchItem {
-    pub fn point(&self, i: usize) -> [f32; 3] {
-        [self.cp[3 * i], self.cp[3 * i + 1], self.cp[3 * i + 2]]
-    }
     pub fn splits(&self) -> u32 {
         self.depth & 255
     }

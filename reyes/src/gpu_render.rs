@@ -116,20 +116,11 @@ impl GpuRenderer {
         let infos = upload("patch info", bytemuck::cast_slice(&data.patch_info))?;
         let samples = gpu.storage_buffer("samples", pixels * spp * 2)?;
         let counters = gpu.storage_buffer("counters", COUNTERS as u64)?;
-        let buffers = [&frame, &materials, &lights, &infos, &samples, &counters];
-        let entries: Vec<_> = buffers
-            .iter()
-            .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry {
-                binding: i as u32,
-                resource: b.as_entire_binding(),
-            })
-            .collect();
-        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("reyes scene"),
-            layout: &self.user_layout,
-            entries: &entries,
-        });
+        let bind = gpu.bind_buffers(
+            "reyes scene",
+            &self.user_layout,
+            &[&frame, &materials, &lights, &infos, &samples, &counters],
+        );
         let seeds = [Seed::new::<PatchItem>("bound", &data.items)];
         let run = self.scheduler.run(gpu, &seeds, Some(&bind))?;
         let (image, resolve_gpu_ms) = self.resolve(gpu, f.width, f.height, spp as u32, &samples)?;
@@ -168,19 +159,7 @@ impl GpuRenderer {
         let rgba = gpu.storage_buffer("rgba", pixels * 4)?;
         let depth = gpu.storage_buffer("depth", pixels)?;
         let layout = self.resolve.get_bind_group_layout(0);
-        let entries: Vec<_> = [&params, samples, &rgba, &depth]
-            .iter()
-            .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry {
-                binding: i as u32,
-                resource: b.as_entire_binding(),
-            })
-            .collect();
-        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("resolve"),
-            layout: &layout,
-            entries: &entries,
-        });
+        let bind = gpu.bind_buffers("resolve", &layout, &[&params, samples, &rgba, &depth]);
         let mut timer = PassTimer::new(gpu);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         {

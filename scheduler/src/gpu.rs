@@ -190,6 +190,28 @@ impl Gpu {
         }))
     }
 
+    /// A bind group of whole storage buffers at bindings 0, 1, 2, ... in order.
+    pub fn bind_buffers(
+        &self,
+        label: &str,
+        layout: &wgpu::BindGroupLayout,
+        buffers: &[&wgpu::Buffer],
+    ) -> wgpu::BindGroup {
+        let entries: Vec<_> = buffers
+            .iter()
+            .enumerate()
+            .map(|(i, b)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource: b.as_entire_binding(),
+            })
+            .collect();
+        self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(label),
+            layout,
+            entries: &entries,
+        })
+    }
+
     /// Compiles WGSL, turning a validation error into a `RunError` that carries the message
     /// (naga's error names the line), instead of a panic in wgpu's error handler.
     pub fn shader(&self, label: &str, source: &str) -> Result<wgpu::ShaderModule, RunError> {

@@ -28,6 +28,22 @@ pub struct RunStats {
     pub wall_ms: f64,
 }
 
+/// Median and median absolute deviation (the spread measure robust to the odd slow run) of
+/// repeated timings; the median of an even count is the mean of the middle two.
+pub fn median_and_mad(v: &[f64]) -> (f64, f64) {
+    fn median(mut v: Vec<f64>) -> f64 {
+        v.sort_by(f64::total_cmp);
+        let n = v.len();
+        if n % 2 == 1 {
+            v[n / 2]
+        } else {
+            (v[n / 2 - 1] + v[n / 2]) / 2.0
+        }
+    }
+    let m = median(v.to_vec());
+    (m, median(v.iter().map(|x| (x - m).abs()).collect()))
+}
+
 impl RunStats {
     pub fn items(&self) -> u64 {
         self.executed.iter().sum()

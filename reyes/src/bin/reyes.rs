@@ -160,22 +160,12 @@ fn run(a: Args) -> Result<(), String> {
 
 /// Median and median absolute deviation of each run's GPU and wall time.
 fn run_summary(times: &[(Option<f64>, f64)]) -> serde_json::Value {
-    fn med_mad(mut v: Vec<f64>) -> serde_json::Value {
+    fn med_mad(v: Vec<f64>) -> serde_json::Value {
         if v.is_empty() {
             return serde_json::Value::Null;
         }
-        let med = |v: &mut Vec<f64>| {
-            v.sort_by(f64::total_cmp);
-            let n = v.len();
-            if n % 2 == 1 {
-                v[n / 2]
-            } else {
-                (v[n / 2 - 1] + v[n / 2]) / 2.0
-            }
-        };
-        let m = med(&mut v);
-        let mut dev: Vec<f64> = v.iter().map(|x| (x - m).abs()).collect();
-        serde_json::json!({ "median": m, "mad": med(&mut dev), "all": v })
+        let (median, mad) = scheduler::stats::median_and_mad(&v);
+        serde_json::json!({ "median": median, "mad": mad, "all": v })
     }
     serde_json::json!({
         "count": times.len(),

@@ -37,12 +37,5 @@ pub(crate) fn project(f: &crate::frame::Frame, p: Vec3) -> [f32; 2] {
     ]
 }
 
-pub fn reyes_hash(x: u32) -> u32 {
-    let mut h = x;
-    h ^= h >> 16;
-    h = h.wrapping_mul(0x7feb_352d);
-    h ^= h >> 15;
-    h = h.wrapping_mul(0x846c_a68b);
-    h ^= h >> 16;
-    h
-}
+/// The sample-jitter hash: the scheduler's integer hash (its WGSL twin is `reyes_hash`).
+pub use scheduler::workloads::tree::hash as reyes_hash;

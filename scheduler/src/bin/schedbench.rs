@@ -96,15 +96,6 @@ fn parse() -> Result<Options, String> {
     Ok(o)
 }
 
-fn median_and_spread(mut v: Vec<f64>) -> (f64, f64) {
-    v.sort_by(|a, b| a.total_cmp(b));
-    let med = v[v.len() / 2];
-    // Median absolute deviation: robust to the odd slow run.
-    let mut dev: Vec<f64> = v.iter().map(|x| (x - med).abs()).collect();
-    dev.sort_by(|a, b| a.total_cmp(b));
-    (med, dev[dev.len() / 2])
-}
-
 fn main() -> ExitCode {
     let o = match parse() {
         Ok(o) => o,
@@ -218,11 +209,11 @@ fn run(o: &Options) -> Result<bool, RunError> {
         );
         let mut gpu_medians = Vec::new();
         for (kind, s, verified, g, w) in &table {
-            let (wm, wd) = median_and_spread(w.clone());
+            let (wm, wd) = scheduler::stats::median_and_mad(&w);
             let (gcol, rate) = if g.is_empty() {
                 ("n/a".to_string(), "n/a".to_string())
             } else {
-                let (gm, gd) = median_and_spread(g.clone());
+                let (gm, gd) = scheduler::stats::median_and_mad(&g);
                 gpu_medians.push((kind.name(), gm));
                 (
                     format!("{gm:.3} ± {gd:.3}"),

@@ -465,24 +465,16 @@ impl Megakernel {
                     CONSUMED => {}
                     EMPTY => {
                         let empties = flags.iter().filter(|&&f| f == EMPTY).count();
-                        return Err(RunError::Device(
-                            format!(
-                                "queue `{}` slot {i} was reserved but never published: protocol violation \
-                             ({empties} such slots; reserve {reserved}, head {}, count {}, budget {}, capacity {})",
-                                self.program.procs[q].proc.name,
-                                ctrl[layout::q(q, Q_HEAD)],
-                                ctrl[layout::q(q, Q_COUNT)] as i32,
-                                ctrl[layout::q(q, Q_BUDGET)],
-                                d.layout.capacity[q]
-                            ) + &format!(
-                                " all: {:?}",
-                                (0..nq)
-                                    .map(|q| (0..8)
-                                        .map(|k| ctrl[layout::q(q, k)])
-                                        .collect::<Vec<_>>())
-                                    .collect::<Vec<_>>()
-                            ),
-                        ));
+                        return Err(RunError::Device(format!(
+                            "queue `{}` slot {i} was reserved but never published: protocol \
+                             violation ({empties} such slots; reserve {reserved}, head {}, \
+                             count {}, budget {}, capacity {})",
+                            self.program.procs[q].proc.name,
+                            ctrl[layout::q(q, Q_HEAD)],
+                            ctrl[layout::q(q, Q_COUNT)] as i32,
+                            ctrl[layout::q(q, Q_BUDGET)],
+                            d.layout.capacity[q]
+                        )));
                     }
                     _ => {
                         live[q].extend_from_slice(&slots[i * w..(i + 1) * w]);

@@ -295,20 +295,7 @@ impl TreeRun {
                 label: Some("tree"),
                 entries: &program.user.layout,
             });
-        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("tree"),
-            layout: &layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: out.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: cfg.as_entire_binding(),
-                },
-            ],
-        });
+        let bind = gpu.bind_buffers("tree", &layout, &[&out, &cfg]);
         Ok(TreeRun {
             declared_children: params.max_children(),
             params,
