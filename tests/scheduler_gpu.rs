@@ -249,3 +249,24 @@ fn a_queue_that_cannot_hold_live_work_reports_overflow() {
         }
     }
 }
+
+#[test]
+fn a_queue_memory_budget_is_kept_or_reported_as_overflow() {
+    let gpu = gpu();
+    let params = small_tree(11);
+    let reference = params.reference();
+    let run = TreeRun::new(&gpu, params).unwrap();
+    for kind in StrategyKind::ALL {
+        let s = Scheduler::new(&gpu, &run.program, kind, 1 << 12).unwrap();
+        // Far too small for the live work: an overflow, never a silently shorter run.
+        match run.run_within(&gpu, &s, Some(64)) {
+            Err(RunError::QueueOverflow { .. }) => {}
+            other => panic!("{kind:?}: expected an overflow under 64 bytes, got {other:?}"),
+        }
+        // A budget that fits: the result is complete and the storage stayed inside it.
+        let budget = 1 << 20;
+        let (stats, result) = run.run_within(&gpu, &s, Some(budget)).unwrap();
+        assert!(stats.queue_bytes <= budget, "{kind:?}: {stats:?}");
+        assert_eq!(result, reference, "{kind:?}");
+    }
+}

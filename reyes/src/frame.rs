@@ -48,8 +48,42 @@ pub struct Frame {
     pub max_eye_splits: u32,
     pub n_lights: u32,
     pub seed: u32,
-    pub pad0: u32,
-    pub pad1: u32,
+    /// The screen bucket a run renders; the sample buffer holds only its pixels.
+    pub tile_x0: u32,
+    pub tile_y0: u32,
+    pub tile_w: u32,
+    pub tile_h: u32,
+}
+
+impl Frame {
+    /// This frame restricted to one bucket.
+    pub fn with_tile(&self, t: Tile) -> Frame {
+        Frame {
+            tile_x0: t.x0,
+            tile_y0: t.y0,
+            tile_w: t.w,
+            tile_h: t.h,
+            ..*self
+        }
+    }
+
+    pub fn whole_image(&self) -> Tile {
+        Tile {
+            x0: 0,
+            y0: 0,
+            w: self.width,
+            h: self.height,
+        }
+    }
+}
+
+/// A screen-space bucket: pixels `x0..x0 + w`, `y0..y0 + h`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tile {
+    pub x0: u32,
+    pub y0: u32,
+    pub w: u32,
+    pub h: u32,
 }
 
 #[repr(C)]
@@ -99,6 +133,9 @@ pub struct RenderOptions {
     pub max_depth: u32,
     pub max_eye_splits: u32,
     pub seed: u32,
+    /// Bytes of working memory (sample buffer plus queues) a frame may use; beyond it the
+    /// frame renders in screen buckets.
+    pub memory_budget: Option<u64>,
 }
 
 impl Default for RenderOptions {
@@ -113,6 +150,7 @@ impl Default for RenderOptions {
             max_depth: 24,
             max_eye_splits: 10,
             seed: 0x5eed,
+            memory_budget: None,
         }
     }
 }
@@ -125,6 +163,8 @@ pub struct FrameData {
     pub lights: Vec<GpuLight>,
     pub patch_info: Vec<PatchInfo>,
     pub items: Vec<PatchItem>,
+    /// See [`RenderOptions::memory_budget`].
+    pub memory_budget: Option<u64>,
 }
 
 /// Largest image side accepted (the sample buffer must also fit the adapter; checked there).
@@ -164,8 +204,10 @@ impl FrameData {
             max_eye_splits: o.max_eye_splits.min(255),
             n_lights: lights.len() as u32,
             seed: o.seed,
-            pad0: 0,
-            pad1: 0,
+            tile_x0: 0,
+            tile_y0: 0,
+            tile_w: width,
+            tile_h: height,
         };
         Ok(FrameData {
             frame,
@@ -178,6 +220,7 @@ impl FrameData {
                 .enumerate()
                 .map(|(i, p)| root_item(i as u32, p))
                 .collect(),
+            memory_budget: o.memory_budget,
         })
     }
 }
@@ -289,6 +332,8 @@ mod tests {
                 ("bound_px", offset_of!(Frame, bound_px)),
                 ("n_lights", offset_of!(Frame, n_lights)),
                 ("seed", offset_of!(Frame, seed)),
+                ("tile_x0", offset_of!(Frame, tile_x0)),
+                ("tile_h", offset_of!(Frame, tile_h)),
             ],
         );
         check(

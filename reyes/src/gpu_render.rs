@@ -2,10 +2,11 @@
 //! own grid, so micropolygons never leave workgroup memory) registered as procedures, run by
 //! either strategy, then a resolve pass from sub-samples to pixels.
 
-use crate::frame::{FrameData, Material, PatchItem};
+use crate::buckets;
+use crate::frame::{Frame, FrameData, Material, PatchItem};
 use crate::image::FrameImage;
 use crate::shaders;
-use crate::stages::COUNTERS;
+use crate::stages::{C_MAX_DEPTH, COUNTERS};
 use scheduler::pipeline::storage_entry;
 use scheduler::timing::PassTimer;
 use scheduler::{
@@ -48,18 +49,23 @@ pub fn program() -> Result<Program, RunError> {
     Program::new(vec![bound, splitu, splitv, diceshade], user)
 }
 
-/// What one GPU frame produced and cost.
+/// What one GPU frame produced and cost; with several buckets, run statistics are summed
+/// (peaks are maxima).
 pub struct GpuFrame {
     pub image: FrameImage,
     pub counters: [u64; COUNTERS],
     pub run: RunStats,
-    /// GPU time of the resolve pass, when timestamps exist.
+    /// GPU time of the resolve passes, when timestamps exist.
     pub resolve_gpu_ms: Option<f64>,
-    /// Bytes of the sample buffer.
+    /// Bytes of the sample buffer (one bucket's).
     pub sample_bytes: u64,
+    /// Screen buckets rendered, and how many were cut in four after their queues overflowed.
+    pub buckets: u32,
+    pub buckets_recut: u32,
+    /// Largest working memory of one bucket: sample buffer plus queue storage.
+    pub peak_working_bytes: u64,
     pub wall_ms: f64,
 }
-
 pub struct GpuRenderer {
     pub program: Program,
     pub scheduler: Scheduler,
@@ -96,17 +102,15 @@ impl GpuRenderer {
         })
     }
 
+    /// Renders a frame; under `data.memory_budget` in screen buckets (see [`crate::buckets`]).
     pub fn render(&self, gpu: &Gpu, data: &FrameData) -> Result<GpuFrame, RunError> {
         let start = Instant::now();
         let f = &data.frame;
-        let pixels = f.width as u64 * f.height as u64;
-        let spp = (f.spp_x * f.spp_y) as u64;
         let upload = |label: &str, bytes: &[u8]| -> Result<wgpu::Buffer, RunError> {
             let b = gpu.storage_buffer(label, (bytes.len() as u64).div_ceil(4).max(1))?;
             gpu.queue.write_buffer(&b, 0, bytes);
             Ok(b)
         };
-        let frame = upload("frame", bytemuck::bytes_of(f))?;
         let mut materials = data.materials.clone();
         if materials.is_empty() {
             materials.push(Material::zeroed());
@@ -114,52 +118,134 @@ impl GpuRenderer {
         let materials = upload("materials", bytemuck::cast_slice(&materials))?;
         let lights = upload("lights", bytemuck::cast_slice(&data.lights))?;
         let infos = upload("patch info", bytemuck::cast_slice(&data.patch_info))?;
-        let samples = gpu.storage_buffer("samples", pixels * spp * 2)?;
+        let mut todo = buckets::plan(f, data.memory_budget);
+        todo.reverse();
+        let per_pixel = buckets::sample_bytes_per_pixel(f);
+        let largest = todo.iter().map(|t| t.w as u64 * t.h as u64).max().unwrap();
+        let samples = gpu.storage_buffer("samples", largest * per_pixel / 4)?;
+        let frame_buf = gpu.storage_buffer("frame", (size_of::<Frame>() / 4) as u64)?;
         let counters = gpu.storage_buffer("counters", COUNTERS as u64)?;
         let bind = gpu.bind_buffers(
             "reyes scene",
             &self.user_layout,
-            &[&frame, &materials, &lights, &infos, &samples, &counters],
+            &[&frame_buf, &materials, &lights, &infos, &samples, &counters],
         );
-        let seeds = [Seed::new::<PatchItem>("bound", &data.items)];
-        let run = self.scheduler.run(gpu, &seeds, Some(&bind))?;
-        let (image, resolve_gpu_ms) = self.resolve(gpu, f.width, f.height, spp as u32, &samples)?;
-        let c = gpu.read_words(&counters, 0, COUNTERS as u64)?;
-        let mut counters = [0u64; COUNTERS];
-        for (d, s) in counters.iter_mut().zip(c) {
-            *d = s as u64;
+        let pixels = f.width as u64 * f.height as u64;
+        let rgba = gpu.storage_buffer("rgba", pixels * 4)?;
+        let depth = gpu.storage_buffer("depth", pixels)?;
+        let mut out = GpuFrame {
+            image: FrameImage::default(),
+            counters: [0; COUNTERS],
+            run: RunStats::default(),
+            resolve_gpu_ms: Some(0.0),
+            sample_bytes: largest * per_pixel,
+            buckets: 0,
+            buckets_recut: 0,
+            peak_working_bytes: 0,
+            wall_ms: 0.0,
+        };
+        while let Some(tile) = todo.pop() {
+            let tile_frame = f.with_tile(tile);
+            let items: Vec<PatchItem> = match data.memory_budget {
+                None => data.items.clone(),
+                Some(_) => (data.items.iter())
+                    .filter(|i| buckets::may_reach(f, i, tile))
+                    .copied()
+                    .collect(),
+            };
+            let tile_sample_bytes = tile.w as u64 * tile.h as u64 * per_pixel;
+            let queue_budget = data
+                .memory_budget
+                .map(|b| b.saturating_sub(tile_sample_bytes));
+            gpu.queue
+                .write_buffer(&frame_buf, 0, bytemuck::bytes_of(&tile_frame));
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            enc.clear_buffer(&samples, 0, Some(tile_sample_bytes));
+            enc.clear_buffer(&counters, 0, None);
+            gpu.queue.submit([enc.finish()]);
+            let seeds = [Seed::new::<PatchItem>("bound", &items)];
+            let run = match self
+                .scheduler
+                .run_within(gpu, &seeds, Some(&bind), queue_budget)
+            {
+                Err(RunError::QueueOverflow { .. }) if data.memory_budget.is_some() => {
+                    if let Some(quarters) = buckets::quarter(tile) {
+                        out.buckets_recut += 1;
+                        todo.extend(quarters.into_iter().rev());
+                        continue;
+                    }
+                    return Err(RunError::QueueOverflow {
+                        queue: format!(
+                            "a {}x{} px bucket at ({}, {}) under the memory budget of {} bytes",
+                            tile.w,
+                            tile.h,
+                            tile.x0,
+                            tile.y0,
+                            data.memory_budget.unwrap()
+                        ),
+                        capacity: queue_budget.unwrap_or(0),
+                        needed_more_than: queue_budget.unwrap_or(0),
+                    });
+                }
+                r => r?,
+            };
+            let resolve_ms = self.resolve(gpu, &tile_frame, &samples, &rgba, &depth)?;
+            out.resolve_gpu_ms = out.resolve_gpu_ms.zip(resolve_ms).map(|(a, b)| a + b);
+            for (k, v) in gpu.read_words(&counters, 0, COUNTERS as u64)?.into_iter().enumerate() {
+                if k == C_MAX_DEPTH {
+                    out.counters[k] = out.counters[k].max(v as u64);
+                } else {
+                    out.counters[k] += v as u64;
+                }
+            }
+            out.peak_working_bytes = out.peak_working_bytes.max(tile_sample_bytes + run.queue_bytes);
+            if out.buckets == 0 {
+                out.run = run;
+            } else {
+                out.run.absorb(&run);
+            }
+            out.buckets += 1;
         }
-        Ok(GpuFrame {
-            image,
-            counters,
-            run,
-            resolve_gpu_ms,
-            sample_bytes: pixels * spp * 8,
-            wall_ms: start.elapsed().as_secs_f64() * 1e3,
-        })
+        let words = gpu.read_words(&rgba, 0, pixels * 4)?;
+        let z = gpu.read_words(&depth, 0, pixels)?;
+        let floats: &[f32] = bytemuck::cast_slice(&words);
+        out.image = FrameImage {
+            width: f.width,
+            height: f.height,
+            rgba: floats.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect(),
+            depth: z.into_iter().map(f32::from_bits).collect(),
+        };
+        out.wall_ms = start.elapsed().as_secs_f64() * 1e3;
+        Ok(out)
     }
 
+    /// Resolves one bucket's samples into the image buffers; its GPU ms when timed.
     fn resolve(
         &self,
         gpu: &Gpu,
-        width: u32,
-        height: u32,
-        spp: u32,
+        f: &Frame,
         samples: &wgpu::Buffer,
-    ) -> Result<(FrameImage, Option<f64>), RunError> {
-        let pixels = width as u64 * height as u64;
+        rgba: &wgpu::Buffer,
+        depth: &wgpu::Buffer,
+    ) -> Result<Option<f64>, RunError> {
+        let pixels = f.tile_w as u64 * f.tile_h as u64;
         let groups = pixels.div_ceil(256) as u32;
         let (gx, gy) = (groups.min(32768), groups.div_ceil(32768));
-        let params = gpu.storage_buffer("resolve params", 4)?;
-        gpu.queue.write_buffer(
-            &params,
+        let params = [
+            f.tile_w,
+            f.tile_h,
+            f.spp_x * f.spp_y,
+            gx * 256,
+            f.width,
+            f.tile_x0,
+            f.tile_y0,
             0,
-            bytemuck::cast_slice(&[width, height, spp, gx * 256]),
-        );
-        let rgba = gpu.storage_buffer("rgba", pixels * 4)?;
-        let depth = gpu.storage_buffer("depth", pixels)?;
+        ];
+        let params_buf = gpu.storage_buffer("resolve params", params.len() as u64)?;
+        gpu.queue
+            .write_buffer(&params_buf, 0, bytemuck::cast_slice(&params));
         let layout = self.resolve.get_bind_group_layout(0);
-        let bind = gpu.bind_buffers("resolve", &layout, &[&params, samples, &rgba, &depth]);
+        let bind = gpu.bind_buffers("resolve", &layout, &[&params_buf, samples, rgba, depth]);
         let mut timer = PassTimer::new(gpu);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         {
@@ -173,17 +259,8 @@ impl GpuRenderer {
         }
         timer.resolve(&mut enc);
         gpu.queue.submit([enc.finish()]);
-        let words = gpu.read_words(&rgba, 0, pixels * 4)?;
-        let z = gpu.read_words(&depth, 0, pixels)?;
         timer.collect(gpu)?;
-        let floats: Vec<f32> = bytemuck::cast_slice(&words).to_vec();
-        let image = FrameImage {
-            width,
-            height,
-            rgba: floats.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect(),
-            depth: z.into_iter().map(f32::from_bits).collect(),
-        };
-        Ok((image, timer.total_ms()))
+        Ok(timer.total_ms())
     }
 }
 

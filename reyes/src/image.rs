@@ -7,7 +7,7 @@ use std::path::Path;
 
 /// Straight (not premultiplied) linear RGBA with coverage as alpha, and the nearest depth per
 /// pixel (3e38 where the background shows).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct FrameImage {
     pub width: u32,
     pub height: u32,

@@ -55,6 +55,10 @@ pub fn frame_stats(data: &FrameData, g: &GpuFrame, adapter: &str, warnings: &[St
         "peak_queue_bytes": peak_queue_bytes,
         "queue_bytes_allocated": g.run.queue_bytes,
         "sample_bytes": g.sample_bytes,
+        "memory_budget": data.memory_budget,
+        "buckets": g.buckets,
+        "buckets_recut": g.buckets_recut,
+        "peak_working_bytes": g.peak_working_bytes,
         "warnings": warnings,
     })
 }

@@ -54,6 +54,28 @@ impl QueueLayout {
             .collect()
     }
 
+    /// Lowers `limits` so that all queues together fit in `budget` bytes, shared equally between
+    /// queues, when each slot costs `words_copies` copies of its item's words plus one flag
+    /// word (the megakernel keeps one copy, multi-pass three). Lets a caller bound a run's
+    /// queue memory; a run that needs more reports [`RunError::QueueOverflow`].
+    pub fn within_budget(
+        program: &Program,
+        limits: Vec<u32>,
+        budget: Option<u64>,
+        words_copies: u64,
+    ) -> Vec<u32> {
+        let Some(budget) = budget else { return limits };
+        let share = budget / program.queue_count().max(1) as u64;
+        limits
+            .into_iter()
+            .zip(&program.procs)
+            .map(|(l, p)| {
+                let slot_bytes = 4 * (p.words() as u64 * words_copies + 1);
+                (share / slot_bytes).min(l as u64).max(1) as u32
+            })
+            .collect()
+    }
+
     /// Per-queue seed items (words back to back), validated against the program.
     pub fn seed_items(program: &Program, seeds: &[Seed]) -> Result<Vec<Vec<u32>>, RunError> {
         let mut per_queue = vec![Vec::new(); program.queue_count()];

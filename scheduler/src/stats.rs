@@ -28,6 +28,31 @@ pub struct RunStats {
     pub wall_ms: f64,
 }
 
+impl RunStats {
+    /// Adds another run of the same program (e.g. the next screen bucket): counts and times
+    /// add up, peaks and allocated bytes keep the maximum.
+    pub fn absorb(&mut self, o: &RunStats) {
+        let add = |a: &mut Vec<u64>, b: &[u64], f: fn(u64, u64) -> u64| {
+            a.resize(a.len().max(b.len()), 0);
+            for (x, y) in a.iter_mut().zip(b) {
+                *x = f(*x, *y);
+            }
+        };
+        add(&mut self.executed, &o.executed, |x, y| x + y);
+        add(&mut self.peak_occupancy, &o.peak_occupancy, u64::max);
+        self.rounds += o.rounds;
+        self.batches += o.batches;
+        self.idle_polls += o.idle_polls;
+        self.launches += o.launches;
+        self.abandoned += o.abandoned;
+        self.queue_growths += o.queue_growths;
+        self.queue_bytes = self.queue_bytes.max(o.queue_bytes);
+        self.workgroups = self.workgroups.max(o.workgroups);
+        self.gpu_ms = self.gpu_ms.zip(o.gpu_ms).map(|(a, b)| a + b);
+        self.wall_ms += o.wall_ms;
+    }
+}
+
 /// Median and median absolute deviation (the spread measure robust to the odd slow run) of
 /// repeated timings; the median of an even count is the mean of the middle two.
 pub fn median_and_mad(v: &[f64]) -> (f64, f64) {

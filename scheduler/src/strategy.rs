@@ -86,9 +86,22 @@ impl Scheduler {
         seeds: &[Seed],
         user: Option<&wgpu::BindGroup>,
     ) -> Result<RunStats, RunError> {
+        self.run_within(gpu, seeds, user, None)
+    }
+
+    /// [`Scheduler::run`] with the queue storage bounded by `max_queue_bytes` (all queues
+    /// together, shared equally): work that does not fit is a [`RunError::QueueOverflow`],
+    /// never dropped, so a caller can split its work (e.g. screen buckets) and run again.
+    pub fn run_within(
+        &self,
+        gpu: &Gpu,
+        seeds: &[Seed],
+        user: Option<&wgpu::BindGroup>,
+        max_queue_bytes: Option<u64>,
+    ) -> Result<RunStats, RunError> {
         match self {
-            Scheduler::Megakernel(m) => m.run(gpu, seeds, user),
-            Scheduler::Multipass(m) => m.run(gpu, seeds, user),
+            Scheduler::Megakernel(m) => m.run(gpu, seeds, user, max_queue_bytes),
+            Scheduler::Multipass(m) => m.run(gpu, seeds, user, max_queue_bytes),
         }
     }
 }

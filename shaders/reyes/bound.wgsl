@@ -43,7 +43,10 @@ fn bound_execute(item: PatchItem, inv: Invocation) {
     var lo = pts[0].xy;
     var hi = pts[0].xy;
     for (var k = 1u; k < 16u; k++) { lo = min(lo, pts[k].xy); hi = max(hi, pts[k].xy); }
-    if hi.x < 0.0 || hi.y < 0.0 || lo.x > f32(frame.width) || lo.y > f32(frame.height) {
+    let t0 = vec2<f32>(f32(frame.tile_x0), f32(frame.tile_y0)) - CULL_MARGIN_PX;
+    let t1 = vec2<f32>(f32(frame.tile_x0 + frame.tile_w), f32(frame.tile_y0 + frame.tile_h))
+        + CULL_MARGIN_PX;
+    if any(hi < t0) || any(lo > t1) {
         atomicAdd(&counters[C_CULL_OFFSCREEN], 1u);
         return;
     }
@@ -108,6 +111,7 @@ fn dice_decision(lu: f32, lv: f32, extent: vec2<f32>) -> vec3<u32> {
 // error of a segment of parameter length h is |C''| h^2 / 8, and a camera-space distance d at
 // depth >= zmin spans at most 2 d f / zmin pixels inside a 90 degree view. Micropolygons are
 // grown by this much so that T-junction gaps between grids diced at different rates close.
+// Capped at MAX_DILATE_PX (a grid that coarse is far above any sane micropolygon size).
 fn crack_dilation(cp: ptr<function, array<f32, 48>>, nu: u32, nv: u32, zmin: f32) -> f32 {
     var m = 0.0;
     for (var e = 0u; e < 4u; e++) {
@@ -124,5 +128,5 @@ fn crack_dilation(cp: ptr<function, array<f32, 48>>, nu: u32, nv: u32, zmin: f32
         m = max(m, c2 / (8.0 * n * n));
     }
     let slack = 2.0 * (1.0 + max(f32(frame.width), f32(frame.height)) / frame.focal);
-    return m * frame.focal / zmin * slack + 1.0e-3;
+    return min(m * frame.focal / zmin * slack + 1.0e-3, MAX_DILATE_PX);
 }

@@ -20,8 +20,12 @@ struct Frame {
     max_eye_splits: u32,
     n_lights: u32,
     seed: u32,
-    pad0: u32,
-    pad1: u32,
+    // The screen bucket this run renders (the whole image without a memory budget); the
+    // sample buffer holds only its pixels.
+    tile_x0: u32,
+    tile_y0: u32,
+    tile_w: u32,
+    tile_h: u32,
 }
 
 struct Material {
@@ -67,6 +71,12 @@ const C_MICROPOLYGONS: u32 = 4u;
 const C_MAX_DEPTH: u32 = 5u;
 const C_EYE_SPLITS: u32 = 6u;
 const C_BACKFACE: u32 = 7u;        // micropolygons culled as back-facing (Sides 1)
+
+// Bound culls only what lies this far outside the bucket, so that a micropolygon grown by its
+// crack dilation (at most MAX_DILATE_PX) never reaches a sample of a bucket that culled it:
+// bucketed and whole-frame renders give the same samples.
+const MAX_DILATE_PX: f32 = 2.0;
+const CULL_MARGIN_PX: f32 = 3.0;
 
 fn cp_point(cp: ptr<function, array<f32, 48>>, i: u32) -> vec3<f32> {
     return vec3<f32>((*cp)[3u * i], (*cp)[3u * i + 1u], (*cp)[3u * i + 2u]);

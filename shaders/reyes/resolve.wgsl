@@ -2,8 +2,18 @@
 // covered sub-samples (in linear light) and gives coverage as alpha, and the nearest depth.
 // Rust twin: reyes/src/stages/resolve.rs.
 
-// `row` = threads per row of workgroups (the dispatch is 2D for large images).
-struct ResolveParams { width: u32, height: u32, spp: u32, row: u32 }
+// One bucket's samples (`width` x `height` pixels) into the image at (x0, y0), `image_width`
+// wide. `row` = threads per row of workgroups (the dispatch is 2D for large images).
+struct ResolveParams {
+    width: u32,
+    height: u32,
+    spp: u32,
+    row: u32,
+    image_width: u32,
+    x0: u32,
+    y0: u32,
+    pad: u32,
+}
 
 @group(0) @binding(0) var<storage, read> params: ResolveParams;
 // The sample keys as (low, high) words.
@@ -40,6 +50,8 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     var c = vec3<f32>(0.0);
     if covered > 0u { c = sum / f32(covered); }
-    rgba[pixel] = vec4<f32>(c, f32(covered) / f32(params.spp));
-    depth[pixel] = zmin;
+    let out = (params.y0 + pixel / params.width) * params.image_width + params.x0
+        + pixel % params.width;
+    rgba[out] = vec4<f32>(c, f32(covered) / f32(params.spp));
+    depth[out] = zmin;
 }

@@ -48,13 +48,18 @@ fn sample_micropolygon(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, g
         return;
     }
     let color = average_color(ca, cb, cc, cd);
-    let lo = max(min(min(a.xy, b.xy), min(c.xy, d.xy)) - vec2<f32>(grow), vec2<f32>(0.0));
-    let hi = min(max(max(a.xy, b.xy), max(c.xy, d.xy)) + vec2<f32>(grow),
-                 vec2<f32>(f32(frame.width), f32(frame.height)) - vec2<f32>(1.0e-3));
-    if any(hi < lo) { return; }
+    let lo = min(min(a.xy, b.xy), min(c.xy, d.xy)) - vec2<f32>(grow);
+    let hi = max(max(a.xy, b.xy), max(c.xy, d.xy)) + vec2<f32>(grow);
+    // Pixels of this bucket under the bound; the sample test below does not depend on the
+    // bucket, so bucketed and whole-frame renders agree sample for sample.
+    let t0 = vec2<u32>(frame.tile_x0, frame.tile_y0);
+    let t1 = t0 + vec2<u32>(frame.tile_w, frame.tile_h);
+    if !(all(hi >= vec2<f32>(t0)) && all(lo < vec2<f32>(t1))) { return; }
+    let p0 = vec2<u32>(max(lo, vec2<f32>(t0)));
+    let p1 = min(vec2<u32>(min(hi, vec2<f32>(t1))), t1 - vec2<u32>(1u));
     let spp = frame.spp_x * frame.spp_y;
-    for (var py = u32(lo.y); py <= u32(hi.y); py++) {
-        for (var px = u32(lo.x); px <= u32(hi.x); px++) {
+    for (var py = p0.y; py <= p1.y; py++) {
+        for (var px = p0.x; px <= p1.x; px++) {
             for (var sy = 0u; sy < frame.spp_y; sy++) {
                 for (var sx = 0u; sx < frame.spp_x; sx++) {
                     let q = sample_position(px, py, sx, sy);
@@ -63,7 +68,7 @@ fn sample_micropolygon(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, g
                     if z < 0.0 { z = triangle_depth(a, c, d, q, grow); }
                     if z < 0.0 { continue; }
                     let key = (u64(~bitcast<u32>(z)) << 32u) | u64(color);
-                    let idx = (py * frame.width + px) * spp + sy * frame.spp_x + sx;
+                    let idx = ((py - t0.y) * frame.tile_w + px - t0.x) * spp + sy * frame.spp_x + sx;
                     atomicMax(&samples[idx], key);
                 }
             }

@@ -4,6 +4,10 @@ use super::{cp_point, project};
 use crate::frame::{Frame, PatchItem};
 use glam::Vec2;
 
+/// See `MAX_DILATE_PX` and `CULL_MARGIN_PX` in common.wgsl: bucketed renders stay exact.
+pub const MAX_DILATE_PX: f32 = 2.0;
+pub const CULL_MARGIN_PX: f32 = 3.0;
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Cull {
     /// Wholly in front of the near plane or behind the far plane.
@@ -63,7 +67,10 @@ pub fn bound(item: &PatchItem, f: &Frame) -> Decision {
     }
     let lo = pts.iter().fold(pts[0].0, |a, p| a.min(p.0));
     let hi = pts.iter().fold(pts[0].0, |a, p| a.max(p.0));
-    if hi.x < 0.0 || hi.y < 0.0 || lo.x > f.width as f32 || lo.y > f.height as f32 {
+    let t0 = Vec2::new(f.tile_x0 as f32, f.tile_y0 as f32) - CULL_MARGIN_PX;
+    let t1 = Vec2::new((f.tile_x0 + f.tile_w) as f32, (f.tile_y0 + f.tile_h) as f32)
+        + CULL_MARGIN_PX;
+    if hi.x < t0.x || hi.y < t0.y || lo.x > t1.x || lo.y > t1.y {
         return Decision::Cull(Cull::Offscreen);
     }
     let (mut lu, mut lv) = (0f32, 0f32);
@@ -146,5 +153,5 @@ pub fn crack_dilation(f: &Frame, cp: &[f32; 48], nu: u32, nv: u32, zmin: f32) ->
         m = m.max(c2 / (8.0 * n * n));
     }
     let slack = 2.0 * (1.0 + (f.width.max(f.height) as f32) / f.focal);
-    m * f.focal / zmin * slack + 1.0e-3
+    (m * f.focal / zmin * slack + 1.0e-3).min(MAX_DILATE_PX)
 }

@@ -65,15 +65,21 @@ pub fn sample_micropolygon(
     }
     let color = average_color(c);
     let xy = q.map(|v| Vec2::new(v[0], v[1]));
-    let lo = (xy[0].min(xy[1]).min(xy[2].min(xy[3])) - Vec2::splat(grow)).max(Vec2::ZERO);
-    let hi = (xy[0].max(xy[1]).max(xy[2].max(xy[3])) + Vec2::splat(grow))
-        .min(Vec2::new(f.width as f32, f.height as f32) - Vec2::splat(1.0e-3));
-    if hi.x < lo.x || hi.y < lo.y {
+    let lo = xy[0].min(xy[1]).min(xy[2].min(xy[3])) - Vec2::splat(grow);
+    let hi = xy[0].max(xy[1]).max(xy[2].max(xy[3])) + Vec2::splat(grow);
+    let (t0, t1) = (
+        [f.tile_x0, f.tile_y0],
+        [f.tile_x0 + f.tile_w, f.tile_y0 + f.tile_h],
+    );
+    let inside = |k: usize| hi[k] >= t0[k] as f32 && lo[k] < t1[k] as f32;
+    if !(inside(0) && inside(1)) {
         return true;
     }
+    let p0 = |k: usize| lo[k].max(t0[k] as f32) as u32;
+    let p1 = |k: usize| (hi[k].min(t1[k] as f32) as u32).min(t1[k] - 1);
     let spp = f.spp_x * f.spp_y;
-    for py in lo.y as u32..=hi.y as u32 {
-        for px in lo.x as u32..=hi.x as u32 {
+    for py in p0(1)..=p1(1) {
+        for px in p0(0)..=p1(0) {
             for sy in 0..f.spp_y {
                 for sx in 0..f.spp_x {
                     let s = sample_position(f, px, py, sx, sy);
@@ -87,7 +93,8 @@ pub fn sample_micropolygon(
                     if z < 0.0 {
                         continue;
                     }
-                    let idx = ((py * f.width + px) * spp + sy * f.spp_x + sx) as usize;
+                    let pixel = (py - t0[1]) * f.tile_w + px - t0[0];
+                    let idx = (pixel * spp + sy * f.spp_x + sx) as usize;
                     samples[idx] = samples[idx].max(sample_key(z, color));
                 }
             }

@@ -292,22 +292,29 @@ impl Megakernel {
             .write_buffer(&dq.ctrl, 0, bytemuck::cast_slice(&ctrl));
     }
 
-    /// Runs the program to completion from `seeds`. `user` is bind group 1, if the program has one.
+    /// Runs the program to completion from `seeds`. `user` is bind group 1, if the program has
+    /// one. `max_queue_bytes` bounds the queue storage (slots and flags) of this run.
     pub fn run(
         &self,
         gpu: &Gpu,
         seeds: &[Seed],
         user: Option<&wgpu::BindGroup>,
+        max_queue_bytes: Option<u64>,
     ) -> Result<RunStats, RunError> {
         self.kernels.check_user_group(user)?;
         let workgroups = self.workgroups(gpu, user)?;
         let start = Instant::now();
         let nq = self.program.queue_count();
         let mut live = QueueLayout::seed_items(&self.program, seeds)?;
-        let max_cap = QueueLayout::capacity_limits(
+        let max_cap = QueueLayout::within_budget(
             &self.program,
-            gpu.max_binding_bytes(),
-            self.config.max_capacity,
+            QueueLayout::capacity_limits(
+                &self.program,
+                gpu.max_binding_bytes(),
+                self.config.max_capacity,
+            ),
+            max_queue_bytes,
+            1,
         );
         let mut capacity: Vec<u32> = (0..nq)
             .map(|q| {

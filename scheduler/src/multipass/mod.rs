@@ -208,21 +208,29 @@ impl Multipass {
         }
     }
 
+    /// Runs the program to completion from `seeds`; `max_queue_bytes` bounds the item, emit
+    /// and flag storage of this run.
     pub fn run(
         &self,
         gpu: &Gpu,
         seeds: &[Seed],
         user: Option<&wgpu::BindGroup>,
+        max_queue_bytes: Option<u64>,
     ) -> Result<RunStats, RunError> {
         self.kernels.check_user_group(user)?;
         let start = Instant::now();
         let nq = self.program.queue_count();
         let mut live = QueueLayout::seed_items(&self.program, seeds)?;
         // Reduce and scatter dispatch one workgroup per SCAN_BLOCK slots, at most 65,535.
-        let max_cap = QueueLayout::capacity_limits(
+        let max_cap = QueueLayout::within_budget(
             &self.program,
-            gpu.max_binding_bytes(),
-            self.config.max_capacity.min(65_535 * SCAN_BLOCK),
+            QueueLayout::capacity_limits(
+                &self.program,
+                gpu.max_binding_bytes(),
+                self.config.max_capacity.min(65_535 * SCAN_BLOCK),
+            ),
+            max_queue_bytes,
+            3,
         );
         let mut capacity: Vec<u32> = (0..nq)
             .map(|q| {

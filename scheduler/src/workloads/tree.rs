@@ -325,6 +325,16 @@ impl TreeRun {
         gpu: &Gpu,
         scheduler: &Scheduler,
     ) -> Result<(RunStats, TreeResult), RunError> {
+        self.run_within(gpu, scheduler, None)
+    }
+
+    /// [`TreeRun::run`] with the queue storage bounded (see [`Scheduler::run_within`]).
+    pub fn run_within(
+        &self,
+        gpu: &Gpu,
+        scheduler: &Scheduler,
+        max_queue_bytes: Option<u64>,
+    ) -> Result<(RunStats, TreeResult), RunError> {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&self.out, 0, None);
         gpu.queue.submit([enc.finish()]);
@@ -338,7 +348,7 @@ impl TreeRun {
         ];
         gpu.queue
             .write_buffer(&self.cfg, 0, bytemuck::cast_slice(&cfg));
-        let stats = scheduler.run(gpu, &self.params.seeds(), Some(&self.bind))?;
+        let stats = scheduler.run_within(gpu, &self.params.seeds(), Some(&self.bind), max_queue_bytes)?;
         let words = gpu.read_words(&self.out, 0, (BUCKETS * 4) as u64)?;
         let mut r = TreeResult {
             branches: stats.executed[0],
