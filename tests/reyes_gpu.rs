@@ -266,3 +266,27 @@ fn a_memory_budget_renders_in_buckets_to_the_same_image() {
         );
     }
 }
+
+#[test]
+fn one_sided_patches_facing_away_are_culled_in_bound_like_the_cpu_pipeline() {
+    let mut scene = scene::builtin_teapot();
+    for p in &mut scene.patches {
+        p.two_sided = false;
+    }
+    let data = FrameData::new(&scene, &small(120, 90)).unwrap();
+    let cpu = render_cpu(&data);
+    let g = renderer(StrategyKind::Megakernel)
+        .render(gpu(), &data)
+        .unwrap();
+    eprintln!(
+        "patches culled as back-facing: {}, micropolygons: {}",
+        g.counters[stages::C_CULL_BACKFACE],
+        g.counters[stages::C_BACKFACE]
+    );
+    // The teapot's far side faces away: whole patches go in Bound, before any split or dice.
+    assert!(g.counters[stages::C_CULL_BACKFACE] > 0);
+    assert_eq!(g.counters, cpu.counters);
+    assert_eq!(g.run.executed.as_slice(), cpu.executed.as_slice());
+    let (max, over) = compare(&g.image, &cpu.image);
+    assert!(over < 0.002, "{:.3}% differ (max {max})", over * 100.0);
+}

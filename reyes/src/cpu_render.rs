@@ -2,7 +2,7 @@
 //! stack. The order of work differs from the GPU's, which cannot change the image: every sample
 //! keeps the maximum of its keys.
 
-use crate::frame::FrameData;
+use crate::frame::{FrameData, PatchItem};
 use crate::image::FrameImage;
 use crate::stages::{self, bound::Cull, bound::Decision};
 
@@ -20,15 +20,54 @@ pub fn render_cpu(data: &FrameData) -> CpuRender {
     let mut samples = vec![0u64; (f.width * f.height * spp) as usize];
     let mut counters = [0u64; stages::COUNTERS];
     let mut executed = [0u64; 4];
+    walk(data, &mut counters, &mut executed, |item, counters| {
+        let (mps, culled) = stages::dice_shade::dice_shade(item, data, &mut samples);
+        counters[stages::C_MICROPOLYGONS] += mps as u64;
+        counters[stages::C_BACKFACE] += culled as u64;
+    });
+    let (rgba, depth) = stages::resolve::resolve(&samples, f.width, f.height, spp);
+    CpuRender {
+        image: FrameImage {
+            width: f.width,
+            height: f.height,
+            rgba,
+            depth,
+        },
+        counters,
+        executed,
+    }
+}
+
+/// The grids the pipeline dices, with Bound's rates and dilation filled in: the same items
+/// the GPU dices (the decisions are the same f32 code), without shading or sampling. What
+/// the accuracy metrics measure.
+pub fn diced_items(data: &FrameData) -> Vec<PatchItem> {
+    let mut items = Vec::new();
+    walk(data, &mut [0; stages::COUNTERS], &mut [0; 4], |item, _| {
+        items.push(*item)
+    });
+    items
+}
+
+/// Runs Bound and the splits to completion, counting as the GPU does, and hands every grid
+/// to be diced to `dice`.
+fn walk(
+    data: &FrameData,
+    counters: &mut [u64; stages::COUNTERS],
+    executed: &mut [u64; 4],
+    mut dice: impl FnMut(&PatchItem, &mut [u64; stages::COUNTERS]),
+) {
+    let f = &data.frame;
     let mut work: Vec<_> = data.items.clone();
     while let Some(item) = work.pop() {
         executed[0] += 1;
-        match stages::bound::bound(&item, f) {
+        match stages::bound::bound(&item, f, &data.patch_info[item.patch_id as usize]) {
             Decision::Cull(c) => {
                 counters[match c {
                     Cull::Clip => stages::C_CULL_CLIP,
                     Cull::Offscreen => stages::C_CULL_OFFSCREEN,
                     Cull::Near => stages::C_CULL_NEAR,
+                    Cull::Backface => stages::C_CULL_BACKFACE,
                 }] += 1
             }
             Decision::Split { along_u, item, eye } => {
@@ -46,21 +85,8 @@ pub fn render_cpu(data: &FrameData) -> CpuRender {
                 counters[stages::C_MAX_DEPTH] =
                     counters[stages::C_MAX_DEPTH].max(item.splits() as u64);
                 executed[3] += 1;
-                let (mps, culled) = stages::dice_shade::dice_shade(&item, data, &mut samples);
-                counters[stages::C_MICROPOLYGONS] += mps as u64;
-                counters[stages::C_BACKFACE] += culled as u64;
+                dice(&item, counters);
             }
         }
-    }
-    let (rgba, depth) = stages::resolve::resolve(&samples, f.width, f.height, spp);
-    CpuRender {
-        image: FrameImage {
-            width: f.width,
-            height: f.height,
-            rgba,
-            depth,
-        },
-        counters,
-        executed,
     }
 }

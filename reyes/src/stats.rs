@@ -32,6 +32,7 @@ pub fn frame_stats(data: &FrameData, g: &GpuFrame, adapter: &str, warnings: &[St
             "clip": c[s::C_CULL_CLIP],
             "offscreen": c[s::C_CULL_OFFSCREEN],
             "near_plane": c[s::C_CULL_NEAR],
+            "backface_patches": c[s::C_CULL_BACKFACE],
             "backface_micropolygons": c[s::C_BACKFACE],
         },
         "depth_limited": c[s::C_DEPTH_LIMIT],

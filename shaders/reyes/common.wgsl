@@ -71,6 +71,7 @@ const C_MICROPOLYGONS: u32 = 4u;
 const C_MAX_DEPTH: u32 = 5u;
 const C_EYE_SPLITS: u32 = 6u;
 const C_BACKFACE: u32 = 7u;        // micropolygons culled as back-facing (Sides 1)
+const C_CULL_BACKFACE: u32 = 8u;   // patches culled in Bound as back-facing everywhere
 
 // Bound culls only what lies this far outside the bucket, so that a micropolygon grown by its
 // crack dilation (at most MAX_DILATE_PX) never reaches a sample of a bucket that culled it:

@@ -13,19 +13,33 @@ fn sample_position(px: u32, py: u32, sx: u32, sy: u32) -> vec2<f32> {
         / vec2<f32>(f32(frame.spp_x), f32(frame.spp_y));
 }
 
-// Depth at q if q is inside triangle (a, b, c) grown by `grow` pixels; negative otherwise.
-fn triangle_depth(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, q: vec2<f32>, grow: f32) -> f32 {
-    let area = cross2(b.xy - a.xy, c.xy - a.xy);
-    if abs(area) < 1.0e-12 { return -1.0; }
-    let s = sign(area);
-    let wa = s * cross2(c.xy - b.xy, q - b.xy);
-    let wb = s * cross2(a.xy - c.xy, q - c.xy);
-    let wc = s * cross2(b.xy - a.xy, q - a.xy);
-    if wa < -grow * distance(b.xy, c.xy) || wb < -grow * distance(a.xy, c.xy)
-        || wc < -grow * distance(a.xy, b.xy) {
-        return -1.0;
-    }
-    return (wa * a.z + wb * b.z + wc * c.z) / abs(area);
+// A triangle of a micropolygon with what its inside test needs, computed once per triangle:
+// the signed area and each edge's threshold for growing it by `grow` pixels.
+struct Triangle {
+    a: vec3<f32>,
+    b: vec3<f32>,
+    c: vec3<f32>,
+    area: f32,
+    // -grow * length of the edge opposite a, b, c.
+    ga: f32,
+    gb: f32,
+    gc: f32,
+}
+
+fn triangle_setup(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, grow: f32) -> Triangle {
+    return Triangle(a.xyz, b.xyz, c.xyz, cross2(b.xy - a.xy, c.xy - a.xy),
+        -grow * distance(b.xy, c.xy), -grow * distance(a.xy, c.xy), -grow * distance(a.xy, b.xy));
+}
+
+// Depth at q if q is inside the grown triangle; negative otherwise.
+fn triangle_depth(t: Triangle, q: vec2<f32>) -> f32 {
+    if abs(t.area) < 1.0e-12 { return -1.0; }
+    let s = sign(t.area);
+    let wa = s * cross2(t.c.xy - t.b.xy, q - t.b.xy);
+    let wb = s * cross2(t.a.xy - t.c.xy, q - t.c.xy);
+    let wc = s * cross2(t.b.xy - t.a.xy, q - t.a.xy);
+    if wa < t.ga || wb < t.gb || wc < t.gc { return -1.0; }
+    return (wa * t.a.z + wb * t.b.z + wc * t.c.z) / abs(t.area);
 }
 
 fn average_color(a: u32, b: u32, c: u32, d: u32) -> u32 {
@@ -58,14 +72,16 @@ fn sample_micropolygon(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, g
     let p0 = vec2<u32>(max(lo, vec2<f32>(t0)));
     let p1 = min(vec2<u32>(min(hi, vec2<f32>(t1))), t1 - vec2<u32>(1u));
     let spp = frame.spp_x * frame.spp_y;
+    let abc = triangle_setup(a, b, c, grow);
+    let acd = triangle_setup(a, c, d, grow);
     for (var py = p0.y; py <= p1.y; py++) {
         for (var px = p0.x; px <= p1.x; px++) {
             for (var sy = 0u; sy < frame.spp_y; sy++) {
                 for (var sx = 0u; sx < frame.spp_x; sx++) {
                     let q = sample_position(px, py, sx, sy);
                     if any(q < lo) || any(q > hi) { continue; }
-                    var z = triangle_depth(a, b, c, q, grow);
-                    if z < 0.0 { z = triangle_depth(a, c, d, q, grow); }
+                    var z = triangle_depth(abc, q);
+                    if z < 0.0 { z = triangle_depth(acd, q); }
                     if z < 0.0 { continue; }
                     let key = (u64(~bitcast<u32>(z)) << 32u) | u64(color);
                     let idx = ((py - t0.y) * frame.tile_w + px - t0.x) * spp + sy * frame.spp_x + sx;

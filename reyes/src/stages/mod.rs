@@ -20,6 +20,7 @@ pub const C_MICROPOLYGONS: usize = 4;
 pub const C_MAX_DEPTH: usize = 5;
 pub const C_EYE_SPLITS: usize = 6;
 pub const C_BACKFACE: usize = 7;
+pub const C_CULL_BACKFACE: usize = 8;
 pub const COUNTERS: usize = 16;
 
 pub(crate) fn cp_point(cp: &[f32; 48], i: usize) -> Vec3 {

@@ -16,25 +16,48 @@ pub fn sample_position(f: &Frame, px: u32, py: u32, sx: u32, sy: u32) -> Vec2 {
         + (Vec2::new(sx as f32, sy as f32) + j) / Vec2::new(f.spp_x as f32, f.spp_y as f32)
 }
 
-fn triangle_depth(a: [f32; 4], b: [f32; 4], c: [f32; 4], q: Vec2, grow: f32) -> f32 {
-    let (pa, pb, pc) = (
-        Vec2::new(a[0], a[1]),
-        Vec2::new(b[0], b[1]),
-        Vec2::new(c[0], c[1]),
-    );
-    let area = cross2(pb - pa, pc - pa);
-    if area.abs() < 1.0e-12 {
+/// `Triangle` in sample.wgsl: the inside test's per-triangle values, computed once.
+struct Triangle {
+    a: [f32; 4],
+    b: [f32; 4],
+    c: [f32; 4],
+    area: f32,
+    /// -grow * length of the edge opposite a, b, c.
+    g: [f32; 3],
+}
+
+fn xy(p: [f32; 4]) -> Vec2 {
+    Vec2::new(p[0], p[1])
+}
+
+fn triangle_setup(a: [f32; 4], b: [f32; 4], c: [f32; 4], grow: f32) -> Triangle {
+    let (pa, pb, pc) = (xy(a), xy(b), xy(c));
+    Triangle {
+        a,
+        b,
+        c,
+        area: cross2(pb - pa, pc - pa),
+        g: [
+            -grow * pb.distance(pc),
+            -grow * pa.distance(pc),
+            -grow * pa.distance(pb),
+        ],
+    }
+}
+
+fn triangle_depth(t: &Triangle, q: Vec2) -> f32 {
+    if t.area.abs() < 1.0e-12 {
         return -1.0;
     }
-    let s = area.signum();
+    let (pa, pb, pc) = (xy(t.a), xy(t.b), xy(t.c));
+    let s = t.area.signum();
     let wa = s * cross2(pc - pb, q - pb);
     let wb = s * cross2(pa - pc, q - pc);
     let wc = s * cross2(pb - pa, q - pa);
-    if wa < -grow * pb.distance(pc) || wb < -grow * pa.distance(pc) || wc < -grow * pa.distance(pb)
-    {
+    if wa < t.g[0] || wb < t.g[1] || wc < t.g[2] {
         return -1.0;
     }
-    (wa * a[2] + wb * b[2] + wc * c[2]) / area.abs()
+    (wa * t.a[2] + wb * t.b[2] + wc * t.c[2]) / t.area.abs()
 }
 
 fn average_color(c: [u32; 4]) -> u32 {
@@ -78,6 +101,8 @@ pub fn sample_micropolygon(
     let p0 = |k: usize| lo[k].max(t0[k] as f32) as u32;
     let p1 = |k: usize| (hi[k].min(t1[k] as f32) as u32).min(t1[k] - 1);
     let spp = f.spp_x * f.spp_y;
+    let abc = triangle_setup(q[0], q[1], q[2], grow);
+    let acd = triangle_setup(q[0], q[2], q[3], grow);
     for py in p0(1)..=p1(1) {
         for px in p0(0)..=p1(0) {
             for sy in 0..f.spp_y {
@@ -86,9 +111,9 @@ pub fn sample_micropolygon(
                     if s.x < lo.x || s.y < lo.y || s.x > hi.x || s.y > hi.y {
                         continue;
                     }
-                    let mut z = triangle_depth(q[0], q[1], q[2], s, grow);
+                    let mut z = triangle_depth(&abc, s);
                     if z < 0.0 {
-                        z = triangle_depth(q[0], q[2], q[3], s, grow);
+                        z = triangle_depth(&acd, s);
                     }
                     if z < 0.0 {
                         continue;
