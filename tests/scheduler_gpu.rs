@@ -270,3 +270,32 @@ fn a_queue_memory_budget_is_kept_or_reported_as_overflow() {
         assert_eq!(result, reference, "{kind:?}");
     }
 }
+
+#[test]
+fn multipass_stage_timing_keeps_results_and_splits_the_time_by_procedure() {
+    let gpu = gpu();
+    let params = small_tree(5);
+    let reference = params.reference();
+    let run = TreeRun::new(&gpu, params).unwrap();
+    let s = Scheduler::multipass(
+        &gpu,
+        &run.program,
+        MultipassConfig {
+            stage_timing: true,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let (stats, result) = run.run(&gpu, &s).unwrap();
+    assert_eq!(result, reference);
+    if gpu.timestamps {
+        let nq = run.program.queue_count();
+        assert_eq!(stats.stage_gpu_ms.len(), nq + 1, "{stats:?}");
+        assert!(stats.stage_gpu_ms.iter().all(|&t| t >= 0.0));
+        let sum: f64 = stats.stage_gpu_ms.iter().sum();
+        assert!((sum - stats.gpu_ms.unwrap()).abs() < 1e-9);
+    } else {
+        eprintln!("adapter has no timestamp queries: only the results are checked");
+        assert!(stats.stage_gpu_ms.is_empty());
+    }
+}

@@ -24,6 +24,9 @@ pub struct RunStats {
     pub workgroups: u32,
     /// GPU time from timestamp queries, when the adapter has them.
     pub gpu_ms: Option<f64>,
+    /// Multi-pass with stage timing: GPU ms per procedure (program order), then the queue
+    /// work (planning, scan and compaction). Empty when not measured.
+    pub stage_gpu_ms: Vec<f64>,
     /// Host wall time: upload, all submissions, read-backs.
     pub wall_ms: f64,
 }
@@ -40,6 +43,12 @@ impl RunStats {
         };
         add(&mut self.executed, &o.executed, |x, y| x + y);
         add(&mut self.peak_occupancy, &o.peak_occupancy, u64::max);
+        let mut stage = std::mem::take(&mut self.stage_gpu_ms);
+        stage.resize(stage.len().max(o.stage_gpu_ms.len()), 0.0);
+        for (x, y) in stage.iter_mut().zip(&o.stage_gpu_ms) {
+            *x += y;
+        }
+        self.stage_gpu_ms = stage;
         self.rounds += o.rounds;
         self.batches += o.batches;
         self.idle_polls += o.idle_polls;

@@ -66,3 +66,84 @@ impl PassTimer {
         self.set.as_ref().map(|_| self.total_ns / 1e6)
     }
 }
+
+/// Times many passes per submission and adds each pass's time to its stage, so that a
+/// strategy that runs stages as separate dispatches (multi-pass) can report GPU time per
+/// procedure. Each timed pass costs a pass boundary, so this is opt-in.
+pub struct StageTimer {
+    set: Option<wgpu::QuerySet>,
+    resolved: wgpu::Buffer,
+    period_ns: f64,
+    capacity: u32,
+    /// Stage of each pass timed since the last collect.
+    pending: std::cell::RefCell<Vec<usize>>,
+    pub stage_ns: Vec<f64>,
+}
+
+impl StageTimer {
+    /// `stages` buckets of time; at most `passes` timed passes between collects.
+    pub fn new(gpu: &Gpu, stages: usize, passes: u32) -> StageTimer {
+        let set = gpu.timestamps.then(|| {
+            gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("stage timer"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2 * passes,
+            })
+        });
+        let resolved = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("stage timestamps"),
+            size: 16 * passes as u64,
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        StageTimer {
+            set,
+            resolved,
+            period_ns: gpu.queue.get_timestamp_period() as f64,
+            capacity: passes,
+            pending: Default::default(),
+            stage_ns: vec![0.0; stages],
+        }
+    }
+
+    /// Timestamp writes for the next pass, counted to `stage`.
+    pub fn writes(&self, stage: usize) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        let mut p = self.pending.borrow_mut();
+        let i = p.len() as u32;
+        assert!(i < self.capacity, "StageTimer: more passes than its capacity");
+        p.push(stage);
+        self.set
+            .as_ref()
+            .map(|set| wgpu::ComputePassTimestampWrites {
+                query_set: set,
+                beginning_of_pass_write_index: Some(2 * i),
+                end_of_pass_write_index: Some(2 * i + 1),
+            })
+    }
+
+    pub fn resolve(&self, enc: &mut wgpu::CommandEncoder) {
+        let n = self.pending.borrow().len() as u32;
+        if let (Some(set), true) = (&self.set, n > 0) {
+            enc.resolve_query_set(set, 0..2 * n, &self.resolved, 0);
+        }
+    }
+
+    /// Reads the passes since the last collect back into their stages.
+    pub fn collect(&mut self, gpu: &Gpu) -> Result<(), RunError> {
+        let stages = std::mem::take(&mut *self.pending.borrow_mut());
+        if self.set.is_some() && !stages.is_empty() {
+            let bytes = gpu.read_buffer(&self.resolved, 0, 16 * stages.len() as u64)?;
+            let t: &[u64] = bytemuck::cast_slice(&bytes);
+            for (k, s) in stages.into_iter().enumerate() {
+                self.stage_ns[s] += t[2 * k + 1].saturating_sub(t[2 * k]) as f64 * self.period_ns;
+            }
+        }
+        Ok(())
+    }
+
+    pub fn stage_ms(&self) -> Option<Vec<f64>> {
+        self.set
+            .as_ref()
+            .map(|_| self.stage_ns.iter().map(|n| n / 1e6).collect())
+    }
+}

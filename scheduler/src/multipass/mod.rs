@@ -16,7 +16,7 @@ use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
 use crate::queue_layout::QueueLayout;
 use crate::stats::RunStats;
-use crate::timing::PassTimer;
+use crate::timing::{PassTimer, StageTimer};
 
 #[derive(Debug, Clone)]
 pub struct MultipassConfig {
@@ -25,6 +25,9 @@ pub struct MultipassConfig {
     pub max_rounds: u32,
     pub initial_capacity: u32,
     pub max_capacity: u32,
+    /// Time each procedure's dispatches as their own passes ([`RunStats::stage_gpu_ms`]);
+    /// the extra pass boundaries cost a little, so it is off for benchmarks of the whole.
+    pub stage_timing: bool,
 }
 
 impl Default for MultipassConfig {
@@ -34,6 +37,7 @@ impl Default for MultipassConfig {
             max_rounds: 100_000,
             initial_capacity: 1 << 16,
             max_capacity: 1 << 26,
+            stage_timing: false,
         }
     }
 }
@@ -169,6 +173,10 @@ impl Multipass {
             .write_buffer(&d.ctrl, 0, bytemuck::cast_slice(&ctrl));
     }
 
+    /// Encodes `rounds` rounds: plan, every procedure's items, then the scan and compaction of
+    /// what they emitted. With `stages`, each of those phases is its own timed pass (counted to
+    /// its procedure, or to the last stage for plan and compaction); else one pass.
+    #[allow(clippy::too_many_arguments)]
     fn encode_rounds(
         &self,
         enc: &mut wgpu::CommandEncoder,
@@ -176,27 +184,31 @@ impl Multipass {
         rounds: u32,
         first_round: u64,
         timer: &PassTimer,
+        stages: Option<&StageTimer>,
         user: Option<&wgpu::BindGroup>,
     ) {
         let nq = self.program.queue_count();
         let p = &self.kernels.pipelines;
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("multipass rounds"),
-            timestamp_writes: timer.writes(),
-        });
-        if let Some(u) = user {
-            pass.set_bind_group(1, u, &[]);
-        }
-        pass.set_bind_group(2, &d.plan_bind, &[]);
-        let args = |slot: usize| (slot * 12) as u64;
-        for r in 0..rounds as usize {
-            pass.set_bind_group(0, &d.bind[(first_round as usize + r) % 2], &[]);
-            pass.set_pipeline(&p[0]);
-            pass.dispatch_workgroups(1, 1, 1);
-            for q in 0..nq {
-                pass.set_pipeline(&p[1 + q]);
-                pass.dispatch_workgroups_indirect(&d.indirect, args(q));
+        let begin = |enc: &mut wgpu::CommandEncoder, round: usize, stage: usize| {
+            let writes = match stages {
+                Some(st) => st.writes(stage),
+                None => timer.writes(),
+            };
+            let mut pass = enc
+                .begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("multipass rounds"),
+                    timestamp_writes: writes,
+                })
+                .forget_lifetime();
+            if let Some(u) = user {
+                pass.set_bind_group(1, u, &[]);
             }
+            pass.set_bind_group(2, &d.plan_bind, &[]);
+            pass.set_bind_group(0, &d.bind[(first_round as usize + round) % 2], &[]);
+            pass
+        };
+        let args = |slot: usize| (slot * 12) as u64;
+        let encode_compaction = |pass: &mut wgpu::ComputePass| {
             for t in 0..nq {
                 pass.set_pipeline(&p[1 + nq + t]);
                 pass.dispatch_workgroups_indirect(&d.indirect, args(nq + t));
@@ -205,6 +217,32 @@ impl Multipass {
                 pass.set_pipeline(&p[1 + 3 * nq + t]);
                 pass.dispatch_workgroups_indirect(&d.indirect, args(nq + t));
             }
+        };
+        if stages.is_some() {
+            for r in 0..rounds as usize {
+                let mut pass = begin(enc, r, nq);
+                pass.set_pipeline(&p[0]);
+                pass.dispatch_workgroups(1, 1, 1);
+                drop(pass);
+                for q in 0..nq {
+                    let mut pass = begin(enc, r, q);
+                    pass.set_pipeline(&p[1 + q]);
+                    pass.dispatch_workgroups_indirect(&d.indirect, args(q));
+                }
+                encode_compaction(&mut begin(enc, r, nq));
+            }
+            return;
+        }
+        let mut pass = begin(enc, 0, 0);
+        for r in 0..rounds as usize {
+            pass.set_bind_group(0, &d.bind[(first_round as usize + r) % 2], &[]);
+            pass.set_pipeline(&p[0]);
+            pass.dispatch_workgroups(1, 1, 1);
+            for q in 0..nq {
+                pass.set_pipeline(&p[1 + q]);
+                pass.dispatch_workgroups_indirect(&d.indirect, args(q));
+            }
+            encode_compaction(&mut pass);
         }
     }
 
@@ -252,6 +290,11 @@ impl Multipass {
             ..Default::default()
         };
         let mut timer = PassTimer::new(gpu);
+        let rounds_per_submit = self.config.rounds_per_submit.max(1);
+        let mut stage_timer = self
+            .config
+            .stage_timing
+            .then(|| StageTimer::new(gpu, nq + 1, rounds_per_submit * (nq as u32 + 2)));
         let mut encoded = 0u64;
         // Rounds encoded since the last upload: round r reads items[r % 2].
         let mut since_upload = 0u64;
@@ -269,13 +312,28 @@ impl Multipass {
             }
             let rounds = self.config.rounds_per_submit.max(1);
             let mut enc = gpu.device.create_command_encoder(&Default::default());
-            self.encode_rounds(&mut enc, &d, rounds, since_upload, &timer, user);
+            self.encode_rounds(
+                &mut enc,
+                &d,
+                rounds,
+                since_upload,
+                &timer,
+                stage_timer.as_ref(),
+                user,
+            );
             timer.resolve(&mut enc);
+            if let Some(st) = &stage_timer {
+                st.resolve(&mut enc);
+            }
             gpu.queue.submit([enc.finish()]);
             encoded += rounds as u64;
             since_upload += rounds as u64;
             let ctrl = gpu.read_words(&d.ctrl, 0, ctrl_words(nq) as u64)?;
-            timer.collect(gpu)?;
+            if let Some(st) = &mut stage_timer {
+                st.collect(gpu)?;
+            } else {
+                timer.collect(gpu)?;
+            }
             let error = ctrl[g(nq, G_ERROR)];
             let (a, b) = (ctrl[g(nq, G_ERR_A)] as usize, ctrl[g(nq, G_ERR_B)]);
             if error == ERR_EMIT {
@@ -323,6 +381,10 @@ impl Multipass {
         }
         stats.queue_bytes = d.layout.total_words * 4 * 3 + d.layout.total_slots * 4;
         stats.gpu_ms = timer.total_ms();
+        if let Some(ms) = stage_timer.and_then(|st| st.stage_ms()) {
+            stats.gpu_ms = Some(ms.iter().sum());
+            stats.stage_gpu_ms = ms;
+        }
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
         *self.cache.lock().unwrap() = Some(d);
         Ok(stats)
