@@ -2,6 +2,8 @@
 //! bounded, split, diced, shaded and sampled on the GPU by either scheduling strategy, with a
 //! CPU twin of every stage as the reference.
 
+pub mod accuracy;
+pub mod buckets;
 pub mod cpu_render;
 pub mod frame;
 pub mod gpu_render;

@@ -139,6 +139,8 @@ struct Grid {
     /// Samples per row and per column.
     sw: usize,
     sh: usize,
+    /// Sample rows taken into account, `first..end` (all of them: `0..sh`).
+    rows: (usize, usize),
 }
 
 impl Grid {
@@ -151,11 +153,11 @@ impl Grid {
         DVec2::new(self.coord(kx), self.coord(ky))
     }
 
-    /// Sample indices in [lo, hi] along one axis of `count` samples (widened by BOX_SLACK).
-    fn axis(&self, lo: f64, hi: f64, count: usize) -> Option<RangeInclusive<usize>> {
+    /// Sample indices in [lo, hi] along one axis, among `first..end` (widened by BOX_SLACK).
+    fn axis(&self, lo: f64, hi: f64, first: usize, end: usize) -> Option<RangeInclusive<usize>> {
         let n = self.n as f64;
-        let a = ((lo - BOX_SLACK) * n - 0.5).ceil().max(0.0);
-        let b = ((hi + BOX_SLACK) * n - 0.5).floor().min(count as f64 - 1.0);
+        let a = ((lo - BOX_SLACK) * n - 0.5).ceil().max(first as f64);
+        let b = ((hi + BOX_SLACK) * n - 0.5).floor().min(end as f64 - 1.0);
         // Written so that NaN bounds give None.
         if a <= b {
             Some(a as usize..=b as usize)
@@ -170,8 +172,8 @@ impl Grid {
         (lo, hi): (DVec2, DVec2),
     ) -> Option<(RangeInclusive<usize>, RangeInclusive<usize>)> {
         Some((
-            self.axis(lo.x, hi.x, self.sw)?,
-            self.axis(lo.y, hi.y, self.sh)?,
+            self.axis(lo.x, hi.x, 0, self.sw)?,
+            self.axis(lo.y, hi.y, self.rows.0, self.rows.1)?,
         ))
     }
 }
@@ -199,6 +201,7 @@ fn coverage_with(
         n: samples_per_axis,
         sw: width as usize * n,
         sh: height as usize * n,
+        rows: (0, height as usize * n),
     };
     let proj = Proj::new(scene, width, height);
     let threads = std::thread::available_parallelism()
@@ -208,11 +211,16 @@ fn coverage_with(
         let workers: Vec<_> = (0..threads)
             .map(|t| {
                 s.spawn(move || {
-                    let mut r = Raster::new(proj, grid, size_px, flat_px);
-                    for p in scene.patches.iter().skip(t).step_by(threads) {
-                        r.cell(&p.cp, 0);
+                    let mut bits = vec![0u64; (grid.sw * grid.sh).div_ceil(64)];
+                    let mut r =
+                        Raster::new(proj, grid, size_px, flat_px, |_: &Leaf, [kx, ky], _| {
+                            let k = ky * grid.sw + kx;
+                            bits[k / 64] |= 1 << (k % 64);
+                        });
+                    for (i, p) in scene.patches.iter().enumerate().skip(t).step_by(threads) {
+                        r.patch(i, &p.cp);
                     }
-                    r.bits
+                    bits
                 })
             })
             .collect();
@@ -248,32 +256,96 @@ fn coverage_with(
     }
 }
 
-/// One thread's state: the camera, the sample grid, its covered-sample bits and a scratch
-/// polygon.
-struct Raster {
+/// A leaf cell of the traversal, as passed to [`for_each_covered_sample`]'s visitor.
+#[derive(Clone, Copy, Debug)]
+pub struct Leaf<'a> {
+    /// Index of the patch in `scene.patches`.
+    pub patch: usize,
+    /// Parameter range of the cell in that patch: u0, u1, v0, v1.
+    pub uv: [f64; 4],
+    /// The cell's own control net (camera space), from exact de Casteljau halving.
+    pub cp: &'a [DVec3; 16],
+    /// The cell straddled a clipping plane and was filled as its clipped corner quad.
+    pub clipped: bool,
+}
+
+/// Calls `visit(leaf, [kx, ky], position)` for every sample of the regular
+/// `samples_per_axis`^2-per-pixel grid in sample rows `rows` (of `height * samples_per_axis`)
+/// that a leaf cell covers, in no particular order; a sample covered by several surfaces (or
+/// by two leaves on a shared boundary) is visited once per leaf. Single-threaded: callers
+/// split the rows between threads, which keeps each thread's per-sample state small. The
+/// result on any sample does not depend on `rows` (see the module doc: a curve piece whose
+/// box holds no sample cannot change the winding about a sample).
+pub fn for_each_covered_sample(
+    scene: &Scene,
+    width: u32,
+    height: u32,
+    samples_per_axis: u32,
+    rows: std::ops::Range<usize>,
+    visit: impl FnMut(&Leaf, [usize; 2], DVec2),
+) {
+    assert!(samples_per_axis > 0, "samples_per_axis must be positive");
+    let n = samples_per_axis as usize;
+    let sh = height as usize * n;
+    let grid = Grid {
+        n: samples_per_axis,
+        sw: width as usize * n,
+        sh,
+        rows: (rows.start.min(sh), rows.end.min(sh)),
+    };
+    let mut r = Raster::new(
+        Proj::new(scene, width, height),
+        grid,
+        SIZE_PX,
+        FLAT_PX,
+        visit,
+    );
+    for (i, p) in scene.patches.iter().enumerate() {
+        r.patch(i, &p.cp);
+    }
+}
+
+/// One thread's state: the camera, the sample grid, what to do with a covered sample, and
+/// the current patch, leaf and scratch polygon.
+struct Raster<V> {
     proj: Proj,
     grid: Grid,
     /// Leaf tolerances (pixels): box size and control-net flatness.
     size_px: f64,
     flat_px: f64,
-    bits: Vec<u64>,
+    visit: V,
+    patch: usize,
+    leaf_cp: [DVec3; 16],
+    leaf_uv: [f64; 4],
+    leaf_clipped: bool,
     poly: Vec<DVec2>,
 }
 
-impl Raster {
-    fn new(proj: Proj, grid: Grid, size_px: f64, flat_px: f64) -> Raster {
+impl<V: FnMut(&Leaf, [usize; 2], DVec2)> Raster<V> {
+    fn new(proj: Proj, grid: Grid, size_px: f64, flat_px: f64, visit: V) -> Raster<V> {
         Raster {
             proj,
             grid,
             size_px,
             flat_px,
-            bits: vec![0; (grid.sw * grid.sh).div_ceil(64)],
+            visit,
+            patch: 0,
+            leaf_cp: [DVec3::ZERO; 16],
+            leaf_uv: [0.0; 4],
+            leaf_clipped: false,
             poly: Vec::new(),
         }
     }
 
-    /// Culls, splits or fills one cell (a sub-patch, as its own Bezier control net).
-    fn cell(&mut self, cp: &[DVec3; 16], depth: u32) {
+    /// Traverses patch number `index`.
+    fn patch(&mut self, index: usize, cp: &[DVec3; 16]) {
+        self.patch = index;
+        self.cell(cp, [0.0, 1.0, 0.0, 1.0], 0);
+    }
+
+    /// Culls, splits or fills one cell (a sub-patch, as its own Bezier control net, covering
+    /// parameters `uv` = u0, u1, v0, v1 of its patch).
+    fn cell(&mut self, cp: &[DVec3; 16], uv: [f64; 4], depth: u32) {
         let (zmin, zmax) = cp
             .iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
@@ -283,7 +355,7 @@ impl Raster {
             return;
         }
         if !(self.proj.visible_z(zmin) && self.proj.visible_z(zmax)) {
-            return self.straddling(cp, depth);
+            return self.straddling(cp, uv, depth);
         }
         let q = cp.map(|p| self.proj.apply(p));
         let bbox = bounds(&q);
@@ -292,20 +364,30 @@ impl Raster {
         }
         let size = (bbox.1 - bbox.0).max_element();
         if depth >= MAX_DEPTH || (size < self.size_px && net_flatness(&q) < self.flat_px) {
-            return self.leaf(cp);
+            return self.leaf(cp, uv);
         }
-        let (a, b) = if net_extent_u(&q) >= net_extent_v(&q) {
-            split_u(cp)
+        self.split(cp, uv, depth, net_extent_u(&q) >= net_extent_v(&q));
+    }
+
+    /// Halves a cell along u (else v) and goes on with both halves.
+    fn split(&mut self, cp: &[DVec3; 16], uv: [f64; 4], depth: u32, along_u: bool) {
+        let [u0, u1, v0, v1] = uv;
+        let (a, b, ua, ub) = if along_u {
+            let (a, b) = split_u(cp);
+            let um = (u0 + u1) * 0.5;
+            (a, b, [u0, um, v0, v1], [um, u1, v0, v1])
         } else {
-            split_v(cp)
+            let (a, b) = split_v(cp);
+            let vm = (v0 + v1) * 0.5;
+            (a, b, [u0, u1, v0, vm], [u0, u1, vm, v1])
         };
-        self.cell(&a, depth + 1);
-        self.cell(&b, depth + 1);
+        self.cell(&a, ua, depth + 1);
+        self.cell(&b, ub, depth + 1);
     }
 
     /// A cell partly outside the near..far slab: split until its visible bound is tiny,
     /// then fill its corner quad clipped to the slab.
-    fn straddling(&mut self, cp: &[DVec3; 16], depth: u32) {
+    fn straddling(&mut self, cp: &[DVec3; 16], uv: [f64; 4], depth: u32) {
         let Some(bbox) = self.clipped_bounds(cp) else {
             return;
         };
@@ -318,16 +400,11 @@ impl Raster {
             self.poly.clear();
             self.poly
                 .extend(clipped.iter().map(|&p| self.proj.apply(p)));
+            self.set_leaf(cp, uv, true);
             return self.fill();
         }
         // Alternate directions by depth: the parameter extent is what must shrink here.
-        let (a, b) = if depth.is_multiple_of(2) {
-            split_u(cp)
-        } else {
-            split_v(cp)
-        };
-        self.cell(&a, depth + 1);
-        self.cell(&b, depth + 1);
+        self.split(cp, uv, depth, depth.is_multiple_of(2));
     }
 
     /// Screen bound of the control hull clipped to the z slab: the hull's clipped vertices
@@ -352,7 +429,8 @@ impl Raster {
 
     /// Fills a leaf cell: its boundary loop (bottom, right, top, left curves, refined near
     /// samples) is the polygon.
-    fn leaf(&mut self, cp: &[DVec3; 16]) {
+    fn leaf(&mut self, cp: &[DVec3; 16], uv: [f64; 4]) {
+        self.set_leaf(cp, uv, false);
         self.poly.clear();
         let c = |i: [usize; 4]| i.map(|k| cp[k]);
         self.edge(c([0, 1, 2, 3]), 0);
@@ -379,7 +457,13 @@ impl Raster {
         }
     }
 
-    /// Marks the samples inside `self.poly` (non-zero winding, boundary inclusive).
+    fn set_leaf(&mut self, cp: &[DVec3; 16], uv: [f64; 4], clipped: bool) {
+        self.leaf_cp = *cp;
+        self.leaf_uv = uv;
+        self.leaf_clipped = clipped;
+    }
+
+    /// Visits the samples inside `self.poly` (non-zero winding, boundary inclusive).
     fn fill(&mut self) {
         if self.poly.len() < 3 {
             return;
@@ -387,11 +471,17 @@ impl Raster {
         let Some((xs, ys)) = self.grid.range(bounds(&self.poly)) else {
             return;
         };
+        let leaf = Leaf {
+            patch: self.patch,
+            uv: self.leaf_uv,
+            cp: &self.leaf_cp,
+            clipped: self.leaf_clipped,
+        };
         for ky in ys {
             for kx in xs.clone() {
-                if covers(&self.poly, self.grid.pos(kx, ky)) {
-                    let k = ky * self.grid.sw + kx;
-                    self.bits[k / 64] |= 1 << (k % 64);
+                let s = self.grid.pos(kx, ky);
+                if covers(&self.poly, s) {
+                    (self.visit)(&leaf, [kx, ky], s);
                 }
             }
         }
@@ -618,6 +708,7 @@ mod tests {
             n,
             sw: (w * n) as usize,
             sh: (h * n) as usize,
+            rows: (0, (h * n) as usize),
         };
         let inside = |s: DVec2| {
             let sides: Vec<f64> = (0..poly.len())

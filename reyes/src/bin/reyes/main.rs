@@ -1,6 +1,9 @@
 //! `reyes render [SCENE] [options]`: renders a RIB / Newell / BPT scene (default: the built-in
 //! Utah teapot) through the scheduler and writes a PNG; `--stats` writes what it did as JSON.
 
+mod measure;
+mod sweep;
+
 use reyes::frame::{FrameData, RenderOptions};
 use reyes::gpu_render::{GpuRenderer, required_features};
 use reyes::scene;
@@ -178,6 +181,20 @@ fn main() -> ExitCode {
     let mut args = std::env::args().skip(1);
     match args.next().as_deref() {
         Some("render") => {}
+        Some(cmd @ ("measure" | "sweep")) => {
+            let r = if cmd == "measure" {
+                measure::main(args)
+            } else {
+                sweep::main(args)
+            };
+            return r.map_or_else(
+                |e| {
+                    eprintln!("reyes {cmd}: {e}");
+                    ExitCode::FAILURE
+                },
+                |()| ExitCode::SUCCESS,
+            );
+        }
         _ => {
             eprintln!("{USAGE}");
             return ExitCode::from(2);

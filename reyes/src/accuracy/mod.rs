@@ -1,0 +1,9 @@
+//! Accuracy measurements of the renderer against f64 references.
+
+pub mod exact_image;
+pub mod geometry;
+pub mod image_error;
+pub mod measure;
+pub mod pareto;
+pub mod plot;
+pub mod surface;

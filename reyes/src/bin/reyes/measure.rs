@@ -1,0 +1,142 @@
+//! `reyes measure [SCENE] [render options] [--ref-samples N] [--reference-png OUT.png] [--json]`:
+//! renders on the GPU
+//! (one warm-up frame, then `--runs N` timed ones, median reported) and measures the frame
+//! against the exact surfaces (`reyes::accuracy`): geometric error and size of the
+//! micropolygons, PSNR and FLIP against an f64 reference render, pinholes.
+
+use reyes::accuracy::exact_image::{DEFAULT_SAMPLES_PER_AXIS, ReferenceImage, render_reference};
+use reyes::accuracy::geometry::geometry;
+use reyes::accuracy::image_error::image_error;
+use reyes::accuracy::measure::{Measurement, pinhole_count};
+use reyes::frame::FrameData;
+use reyes::gpu_render::{GpuFrame, GpuRenderer, required_features};
+use reyes::scene::{self, Scene};
+use reyes::stats::frame_stats;
+use scheduler::Gpu;
+use std::path::Path;
+
+pub const USAGE: &str = "usage: reyes measure [SCENE.rib|teapot|.bpt] [render options] \
+                         [--ref-samples N] [--reference-png OUT.png] [--json]";
+
+/// The scene named on the command line (none or `teapot`: the built-in teapot) and a short
+/// name for it.
+pub fn load_scene(path: Option<&Path>) -> Result<(Scene, String), String> {
+    match path {
+        None => Ok((scene::builtin_teapot(), "teapot".into())),
+        Some(p) if p.as_os_str() == "teapot" => Ok((scene::builtin_teapot(), "teapot".into())),
+        Some(p) => {
+            let s = scene::load(p).map_err(|e| e.to_string())?;
+            let name = p
+                .file_stem()
+                .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+            Ok((s, name))
+        }
+    }
+}
+
+/// Takes `flag VALUE` out of `args` (its last occurrence wins).
+pub fn take_value(args: &mut Vec<String>, flag: &str) -> Result<Option<String>, String> {
+    let mut value = None;
+    while let Some(i) = args.iter().position(|a| a == flag) {
+        if i + 1 >= args.len() {
+            return Err(format!("{flag} needs a value"));
+        }
+        value = Some(args.remove(i + 1));
+        args.remove(i);
+    }
+    Ok(value)
+}
+
+/// A warm-up frame, then `runs` timed frames; the last frame and the median GPU and wall
+/// times of the timed ones (GPU time: the scheduler run plus the resolve pass).
+pub fn timed_frames(
+    gpu: &Gpu,
+    renderer: &GpuRenderer,
+    data: &FrameData,
+    runs: u32,
+) -> Result<(GpuFrame, Vec<Option<f64>>, Vec<f64>), String> {
+    let mut frame = renderer.render(gpu, data).map_err(|e| e.to_string())?;
+    let (mut gpu_ms, mut wall_ms) = (Vec::new(), Vec::new());
+    for _ in 0..runs.max(1) {
+        frame = renderer.render(gpu, data).map_err(|e| e.to_string())?;
+        gpu_ms.push(
+            frame
+                .run
+                .gpu_ms
+                .zip(frame.resolve_gpu_ms)
+                .map(|(a, b)| a + b),
+        );
+        wall_ms.push(frame.wall_ms);
+    }
+    Ok((frame, gpu_ms, wall_ms))
+}
+
+pub fn main(args: impl Iterator<Item = String>) -> Result<(), String> {
+    let mut args: Vec<String> = args.collect();
+    let json = args.iter().any(|a| a == "--json");
+    args.retain(|a| a != "--json");
+    let ref_samples = match take_value(&mut args, "--ref-samples")? {
+        Some(v) => v
+            .parse::<u32>()
+            .ok()
+            .filter(|n| (1..=64).contains(n))
+            .ok_or(format!("--ref-samples: `{v}` is not 1..=64"))?,
+        None => DEFAULT_SAMPLES_PER_AXIS,
+    };
+    let reference_png = take_value(&mut args, "--reference-png")?;
+    let a = crate::parse(args.into_iter()).map_err(|e| format!("{e}\n{USAGE}"))?;
+    if a.cpu {
+        return Err("measure times the GPU renderer; --cpu does not apply".into());
+    }
+    let (scene, name) = load_scene(a.scene.as_deref())?;
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    let data = FrameData::new(&scene, &a.options)?;
+    let gpu = Gpu::from_env_requiring(required_features()).map_err(|e| e.to_string())?;
+    let renderer = GpuRenderer::new(&gpu, a.strategy).map_err(|e| e.to_string())?;
+    let (frame, gpu_ms, wall_ms) = timed_frames(&gpu, &renderer, &data, a.runs)?;
+    let mut stats = frame_stats(&data, &frame, &gpu.adapter_name(), &scene.warnings);
+    let gpu_ms: Vec<f64> = gpu_ms.into_iter().flatten().collect();
+    if !gpu_ms.is_empty() {
+        stats["gpu_ms"] = scheduler::stats::median_and_mad(&gpu_ms).0.into();
+    }
+    stats["wall_ms"] = scheduler::stats::median_and_mad(&wall_ms).0.into();
+    if let Some(p) = &a.out {
+        frame.image.write_png(p)?;
+    }
+    let (w, h) = (data.frame.width, data.frame.height);
+    let reference: ReferenceImage = render_reference(&scene, w, h, ref_samples);
+    if let Some(p) = &reference_png {
+        reference.image.write_png(Path::new(p))?;
+    }
+    let t = std::time::Instant::now();
+    let geom = geometry(&scene, &data);
+    let geometry_ms = t.elapsed().as_secs_f64() * 1e3;
+    let t = std::time::Instant::now();
+    let img = image_error(&reference.image, &frame.image);
+    let image_ms = t.elapsed().as_secs_f64() * 1e3;
+    let m = Measurement {
+        scene: &name,
+        stats: &stats,
+        geometry: &geom,
+        image: &img,
+        pinholes: pinhole_count(&frame.image, &reference),
+        reference: &reference,
+    };
+    let mut out = m.json();
+    out["runs"] = a.runs.max(1).into();
+    out["metrics_cpu_ms"] = serde_json::json!({
+        "reference": reference.cpu_ms,
+        "geometry": geometry_ms,
+        "image_error": image_ms,
+    });
+    if json {
+        println!("{out}");
+    } else {
+        for (k, v) in out.as_object().unwrap() {
+            println!("{k:>32}: {v}");
+        }
+    }
+    Ok(())
+}
