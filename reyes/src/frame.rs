@@ -183,6 +183,15 @@ impl FrameData {
         if !(1..=16).contains(&sx) || !(1..=16).contains(&sy) {
             return Err(format!("pixel samples {sx}x{sy}: each must be 1..=16"));
         }
+        // Sample indices are 32-bit in the shaders and in the CPU pipeline.
+        let subsamples = width as u64 * height as u64 * (sx * sy) as u64;
+        if subsamples > u32::MAX as u64 {
+            return Err(format!(
+                "image size {width}x{height} with {sx}x{sy} pixel samples needs {subsamples} \
+                 sub-samples, more than a 32-bit sample index reaches ({})",
+                u32::MAX
+            ));
+        }
         if !(1..=15).contains(&o.grid_max) || !(o.mp_size > 0.0) {
             return Err("grid_max must be 1..=15 and the micropolygon size positive".into());
         }

@@ -13,6 +13,7 @@ pub mod scene;
 pub mod shaders;
 pub mod stages;
 pub mod stats;
+pub mod warnings;
 
 /// Where the shared test scenes are (they may not be copied into the repository):
 /// `REYES_SHARED_DATA`, else `shared/data` next to the repository, else `/work/shared/data`.

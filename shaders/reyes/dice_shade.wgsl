@@ -1,23 +1,28 @@
 // DiceShade: 256 threads per grid. Each thread evaluates one grid point of the (nu+1) x (nv+1)
 // grid (position, normal from the patch derivatives, shaded colour) into workgroup memory; then
-// each thread samples one micropolygon (sample.wgsl). Rust twin: reyes/src/stages/dice.rs.
+// each thread samples one micropolygon (sample.wgsl). Rust twin: reyes/src/stages/dice_shade.rs.
 
-// Bernstein weights of degree 3 and their derivatives at t.
+// Bernstein weights of degree 3 at t.
 fn bern3(t: f32) -> vec4<f32> {
     let s = 1.0 - t;
     return vec4<f32>(s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t);
 }
-fn dbern3(t: f32) -> vec4<f32> {
+
+// Bernstein weights of degree 2 (the hodograph's basis).
+fn bern2(t: f32) -> vec3<f32> {
     let s = 1.0 - t;
-    return vec4<f32>(-3.0 * s * s, 3.0 * s * s - 6.0 * t * s, 6.0 * t * s - 3.0 * t * t, 3.0 * t * t);
+    return vec3<f32>(s * s, 2.0 * t * s, t * t);
 }
 
-// Position and the two tangents of the patch at (u, v) in its own [0,1]^2.
+// Position and the two tangents of the patch at (u, v) in its own [0,1]^2. The tangents come
+// from the hodograph (differences of neighbouring control points), so where control points
+// coincide (a collapsed edge) the tangent is exactly zero, not rounding noise of the size of
+// the coordinates that the degenerate-normal test below could not tell from a real tangent.
 fn eval_patch(cp: ptr<function, array<f32, 48>>, u: f32, v: f32) -> array<vec3<f32>, 3> {
     let bu = bern3(u);
     let bv = bern3(v);
-    let du = dbern3(u);
-    let dv = dbern3(v);
+    let hu = bern2(u);
+    let hv = bern2(v);
     var p = vec3<f32>(0.0);
     var pu = vec3<f32>(0.0);
     var pv = vec3<f32>(0.0);
@@ -25,23 +30,46 @@ fn eval_patch(cp: ptr<function, array<f32, 48>>, u: f32, v: f32) -> array<vec3<f
         for (var i = 0u; i < 4u; i++) {
             let c = cp_point(cp, 4u * j + i);
             p += c * (bu[i] * bv[j]);
-            pu += c * (du[i] * bv[j]);
-            pv += c * (bu[i] * dv[j]);
+            if i < 3u { pu += (cp_point(cp, 4u * j + i + 1u) - c) * (hu[i] * bv[j]); }
+            if j < 3u { pv += (cp_point(cp, 4u * j + i + 4u) - c) * (bu[i] * hv[j]); }
         }
     }
-    return array<vec3<f32>, 3>(p, pu, pv);
+    return array<vec3<f32>, 3>(p, 3.0 * pu, 3.0 * pv);
 }
 
-// The outside normal at (u, v). Where a tangent vanishes (a collapsed edge, e.g. the teapot
-// lid's apex) the normal is taken a little inside the patch, where it is the limit normal.
+// Largest control-net steps along u and v: 3 times these bound |Pu| and |Pv| on the patch.
+fn net_steps(cp: ptr<function, array<f32, 48>>) -> vec2<f32> {
+    var m = vec2<f32>(0.0);
+    for (var j = 0u; j < 4u; j++) {
+        for (var i = 0u; i < 3u; i++) {
+            m.x = max(m.x, distance(cp_point(cp, 4u * j + i + 1u), cp_point(cp, 4u * j + i)));
+            m.y = max(m.y, distance(cp_point(cp, 4u * i + j + 4u), cp_point(cp, 4u * i + j)));
+        }
+    }
+    return m;
+}
+
+// The outside normal at (u, v). Where it is degenerate (a tangent vanishes at a collapsed
+// edge, e.g. the teapot lid's apex; or the tangents are parallel, e.g. rows on one line) it is
+// taken a little inside the patch, where it is close to the limit normal: steps of 1e-3, 1e-2
+// and 1e-1 of the way to the centre until |Pu x Pv| is at least 1e-3 of its largest possible
+// value on the patch (9 |net steps|^2); a fixed relative test on |Pu| |Pv| would accept
+// tangents made of rounding noise. A patch with no tangent plane anywhere (all control points
+// equal) gets the direction to the eye.
 fn patch_normal(cp: ptr<function, array<f32, 48>>, u: f32, v: f32, flip: bool) -> vec3<f32> {
     let e = eval_patch(cp, u, v);
     var n = cross(e[1], e[2]);
-    let scale = dot(e[1], e[1]) * dot(e[2], e[2]);
-    if !(dot(n, n) > 1.0e-12 * scale) {
-        let inward = vec2<f32>(u, v) + (vec2<f32>(0.5) - vec2<f32>(u, v)) * 1.0e-3;
-        let f = eval_patch(cp, inward.x, inward.y);
+    let steps = net_steps(cp);
+    let least = 9.0e-3 * steps.x * steps.y;
+    var inward = 1.0e-3;
+    for (var k = 0u; k < 3u && !(length(n) > least); k++) {
+        let q = vec2<f32>(u, v) + (vec2<f32>(0.5) - vec2<f32>(u, v)) * inward;
+        let f = eval_patch(cp, q.x, q.y);
         n = cross(f[1], f[2]);
+        inward *= 10.0;
+    }
+    if !(dot(n, n) > 0.0) {
+        return select(-e[0], vec3<f32>(0.0, 0.0, -1.0), !(dot(e[0], e[0]) > 0.0));
     }
     return select(n, -n, flip);
 }

@@ -1,5 +1,6 @@
 //! Accuracy measurements of the renderer against f64 references.
 
+pub mod drift;
 pub mod exact_image;
 pub mod geometry;
 pub mod image_error;

@@ -951,15 +951,17 @@ impl Interp<'_> {
         };
         if let Some((k, p)) = cp.iter().enumerate().find(|(_, p)| !p.is_finite()) {
             return Err(a.err(format!(
-                "patch {index}: control point {k} is {} ({p})",
-                bad(p)
+                "patch {index}: control point {k} is {} ({})",
+                bad(p),
+                show_point(*p)
             )));
         }
         let cp = cp.map(|p| ctm.project_point3(p));
         if let Some((k, p)) = cp.iter().enumerate().find(|(_, p)| !p.is_finite()) {
             return Err(a.err(format!(
-                "patch {index}: control point {k} is {} in camera space ({p})",
-                bad(p)
+                "patch {index}: control point {k} is {} in camera space ({})",
+                bad(p),
+                show_point(*p)
             )));
         }
         let material = self.material();
@@ -1086,7 +1088,7 @@ impl Interp<'_> {
                     None => a.err(format!(
                         "point {k} of \"P\" is {} ({})",
                         nonfinite(pts[k]),
-                        pts[k]
+                        show_point(pts[k])
                     )),
                 },
             );
@@ -1142,14 +1144,28 @@ impl Interp<'_> {
     }
 }
 
+/// A point for an error message: `[x, y, z]` as `DVec3` prints it, except that huge
+/// coordinates (next to an overflow) are shown in exponent form instead of 300 digits.
+fn show_point(p: DVec3) -> String {
+    let c = |v: f64| {
+        if v.abs() < 1.0e15 || !v.is_finite() {
+            format!("{v}")
+        } else {
+            format!("{v:e}")
+        }
+    };
+    format!("[{}, {}, {}]", c(p.x), c(p.y), c(p.z))
+}
+
 fn nonfinite(p: DVec3) -> &'static str {
     if p.is_nan() { "NaN" } else { "infinite" }
 }
 
 fn bad_point(a: &Args, patch: usize, k: usize, p: DVec3) -> SceneError {
     a.err(format!(
-        "patch {patch}: point {k} of \"P\" is {} ({p})",
-        nonfinite(p)
+        "patch {patch}: point {k} of \"P\" is {} ({})",
+        nonfinite(p),
+        show_point(p)
     ))
 }
 

@@ -10,40 +10,68 @@ fn bern3(t: f32) -> [f32; 4] {
     [s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t]
 }
 
-fn dbern3(t: f32) -> [f32; 4] {
+fn bern2(t: f32) -> [f32; 3] {
     let s = 1.0 - t;
-    [
-        -3.0 * s * s,
-        3.0 * s * s - 6.0 * t * s,
-        6.0 * t * s - 3.0 * t * t,
-        3.0 * t * t,
-    ]
+    [s * s, 2.0 * t * s, t * t]
 }
 
-/// Position, d/du, d/dv of the patch at (u, v).
+/// Position, d/du, d/dv of the patch at (u, v). The tangents come from the hodograph
+/// (differences of neighbouring control points), so they are exactly zero where control
+/// points coincide (see `eval_patch` in dice_shade.wgsl).
 pub fn eval_patch(cp: &[f32; 48], u: f32, v: f32) -> [Vec3; 3] {
-    let (bu, bv, du, dv) = (bern3(u), bern3(v), dbern3(u), dbern3(v));
+    let (bu, bv, hu, hv) = (bern3(u), bern3(v), bern2(u), bern2(v));
     let (mut p, mut pu, mut pv) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
     for j in 0..4 {
         for i in 0..4 {
             let c = cp_point(cp, 4 * j + i);
             p += c * (bu[i] * bv[j]);
-            pu += c * (du[i] * bv[j]);
-            pv += c * (bu[i] * dv[j]);
+            if i < 3 {
+                pu += (cp_point(cp, 4 * j + i + 1) - c) * (hu[i] * bv[j]);
+            }
+            if j < 3 {
+                pv += (cp_point(cp, 4 * j + i + 4) - c) * (bu[i] * hv[j]);
+            }
         }
     }
-    [p, pu, pv]
+    [p, 3.0 * pu, 3.0 * pv]
 }
 
-/// The outside normal; at a vanishing tangent it is taken slightly inside the patch.
+/// Largest control-net steps along u and v (3 times these bound |Pu| and |Pv|).
+pub fn net_steps(cp: &[f32; 48]) -> [f32; 2] {
+    let mut m = [0f32; 2];
+    for j in 0..4 {
+        for i in 0..3 {
+            m[0] = m[0].max(cp_point(cp, 4 * j + i + 1).distance(cp_point(cp, 4 * j + i)));
+            m[1] = m[1].max(cp_point(cp, 4 * i + j + 4).distance(cp_point(cp, 4 * i + j)));
+        }
+    }
+    m
+}
+
+/// The outside normal. Where it is degenerate (a vanishing tangent at a collapsed edge, or
+/// parallel tangents) it is taken 1e-3, 1e-2, then 1e-1 of the way to the centre until
+/// |Pu x Pv| reaches 1e-3 of its largest possible value on the patch; with no tangent plane
+/// anywhere (all control points equal) it is the direction to the eye. See dice_shade.wgsl.
 pub fn patch_normal(cp: &[f32; 48], u: f32, v: f32, flip: bool) -> Vec3 {
     let e = eval_patch(cp, u, v);
     let mut n = e[1].cross(e[2]);
-    let scale = e[1].dot(e[1]) * e[2].dot(e[2]);
-    if !(n.dot(n) > 1.0e-12 * scale) {
-        let (iu, iv) = (u + (0.5 - u) * 1.0e-3, v + (0.5 - v) * 1.0e-3);
-        let f = eval_patch(cp, iu, iv);
+    let steps = net_steps(cp);
+    let least = 9.0e-3 * steps[0] * steps[1];
+    let mut inward = 1.0e-3f32;
+    let mut k = 0;
+    while k < 3 && !(n.length() > least) {
+        let (qu, qv) = (u + (0.5 - u) * inward, v + (0.5 - v) * inward);
+        let f = eval_patch(cp, qu, qv);
         n = f[1].cross(f[2]);
+        inward *= 10.0;
+        k += 1;
+    }
+    if !(n.dot(n) > 0.0) {
+        return if e[0].dot(e[0]) > 0.0 {
+            -e[0]
+        } else {
+            Vec3::new(0.0, 0.0, -1.0)
+        };
     }
     if flip { -n } else { n }
 }

@@ -1,6 +1,7 @@
 //! `reyes render [SCENE] [options]`: renders a RIB / Newell / BPT scene (default: the built-in
 //! Utah teapot) through the scheduler and writes a PNG; `--stats` writes what it did as JSON.
 
+mod drift;
 mod measure;
 mod sweep;
 
@@ -181,6 +182,15 @@ fn main() -> ExitCode {
     let mut args = std::env::args().skip(1);
     match args.next().as_deref() {
         Some("render") => {}
+        Some("drift") => {
+            return drift::main(args).map_or_else(
+                |e| {
+                    eprintln!("reyes drift: {e}");
+                    ExitCode::FAILURE
+                },
+                |()| ExitCode::SUCCESS,
+            );
+        }
         Some(cmd @ ("measure" | "sweep")) => {
             let r = if cmd == "measure" {
                 measure::main(args)

@@ -1,0 +1,93 @@
+//! `reyes drift [SCENE] [--width N --height N] [--paths N] [--seed N] [--json]`: how far the
+//! GPU's f32 splits drift from exact f64 subdivision, per split depth, in pixels (see
+//! `reyes::accuracy::drift`), and how deep the scene really splits (CPU pipeline).
+
+use reyes::accuracy::drift::{self, PathOptions};
+use reyes::cpu_render::render_cpu;
+use reyes::frame::{FrameData, RenderOptions};
+use reyes::scene;
+use std::path::PathBuf;
+
+pub const USAGE: &str = "usage: reyes drift [SCENE.rib|teapot|.bpt] [--width N] [--height N] \
+                         [--paths N] [--seed N] [--json]\n  (default size 1920x1080)";
+
+/// Runs the subcommand on the arguments after `drift`.
+pub fn main(args: impl Iterator<Item = String>) -> Result<(), String> {
+    let mut scene_path: Option<PathBuf> = None;
+    let (mut width, mut height) = (1920u32, 1080u32);
+    let mut o = PathOptions::default();
+    let mut as_json = false;
+    let mut it = args;
+    fn num<T: std::str::FromStr>(v: Option<String>, flag: &str) -> Result<T, String> {
+        let v = v.ok_or_else(|| format!("{flag} needs a value"))?;
+        v.parse()
+            .map_err(|_| format!("{flag}: `{v}` is not a valid number"))
+    }
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--width" => width = num(it.next(), "--width")?,
+            "--height" => height = num(it.next(), "--height")?,
+            "--paths" => o.random_paths = num(it.next(), "--paths")?,
+            "--seed" => o.seed = num(it.next(), "--seed")?,
+            "--json" => as_json = true,
+            "-h" | "--help" => return Err(USAGE.into()),
+            s if s.starts_with('-') => return Err(format!("unknown option `{s}`\n{USAGE}")),
+            s => scene_path = Some(PathBuf::from(s)),
+        }
+    }
+    let (scene, name) = match &scene_path {
+        None => (scene::builtin_teapot(), "teapot".to_string()),
+        Some(p) if p.as_os_str() == "teapot" => (scene::builtin_teapot(), "teapot".to_string()),
+        Some(p) => (
+            scene::load(p).map_err(|e| e.to_string())?,
+            p.display().to_string(),
+        ),
+    };
+    let options = RenderOptions {
+        width: Some(width),
+        height: Some(height),
+        ..Default::default()
+    };
+    let data = FrameData::new(&scene, &options)?;
+    // The depth the CPU pipeline reaches, and the same split tree walked with exact twins.
+    let cpu = render_cpu(&data);
+    let cpu_depth = cpu.counters[reyes::stages::C_MAX_DEPTH];
+    // Grids: the items of every dicing procedure (those after Bound, SplitU, SplitV).
+    let cpu_grids: u64 = cpu.executed[3..].iter().sum();
+    let tree = drift::tree_drift(&scene, &data);
+    if tree.max_depth as u64 != cpu_depth || tree.grids != cpu_grids {
+        return Err(format!(
+            "the split-tree walk disagrees with cpu_render: depth {} vs {cpu_depth}, grids {} vs {cpu_grids}",
+            tree.max_depth, tree.grids
+        ));
+    }
+    let rows = drift::path_drift(&scene, &data, &o);
+    if as_json {
+        let v = serde_json::json!({
+            "scene": name,
+            "width": width,
+            "height": height,
+            "random_paths_per_patch": o.random_paths,
+            "seed": o.seed,
+            "paths": rows.iter().map(|r| r.json()).collect::<Vec<_>>(),
+            "split_tree": tree.json(),
+        });
+        println!("{}", serde_json::to_string(&v).unwrap());
+        return Ok(());
+    }
+    println!(
+        "{name} at {width}x{height}: {} patches, {} paths each (2 alternating + {} random), \
+         distances in pixels",
+        scene.patches.len(),
+        2 + o.random_paths,
+        o.random_paths
+    );
+    println!("\nseeded split paths:");
+    print!("{}", drift::table(&rows));
+    println!(
+        "\nthe renderer's own split tree (cpu_render): max split depth {}, {} grids, {} depth-limited",
+        tree.max_depth, tree.grids, tree.depth_limited
+    );
+    print!("{}", drift::table(&tree.rows));
+    Ok(())
+}
