@@ -7,19 +7,26 @@ use crate::image::FrameImage;
 use crate::stages::{self, bound::Cull, bound::Decision};
 
 /// The image plus what each stage did, in the GPU's terms (`stages::C_*` counters; executed
-/// items per procedure: bound, splitu, splitv, diceshade).
+/// items per procedure: bound, splitu, splitv, diceshade, dicesmall).
 pub struct CpuRender {
     pub image: FrameImage,
     pub counters: [u64; stages::COUNTERS],
-    pub executed: [u64; 4],
+    pub executed: [u64; 5],
+}
+
+impl CpuRender {
+    /// Grids diced by either dice procedure.
+    pub fn grids(&self) -> u64 {
+        self.executed[3] + self.executed[4]
+    }
 }
 
 pub fn render_cpu(data: &FrameData) -> CpuRender {
     let f = &data.frame;
     let spp = f.spp_x * f.spp_y;
-    let mut samples = vec![0u64; (f.width * f.height * spp) as usize];
+    let mut samples = vec![0u64; f.width as usize * f.height as usize * spp as usize];
     let mut counters = [0u64; stages::COUNTERS];
-    let mut executed = [0u64; 4];
+    let mut executed = [0u64; 5];
     walk(data, &mut counters, &mut executed, |item, counters| {
         let (mps, culled) = stages::dice_shade::dice_shade(item, data, &mut samples);
         counters[stages::C_MICROPOLYGONS] += mps as u64;
@@ -43,7 +50,7 @@ pub fn render_cpu(data: &FrameData) -> CpuRender {
 /// the accuracy metrics measure.
 pub fn diced_items(data: &FrameData) -> Vec<PatchItem> {
     let mut items = Vec::new();
-    walk(data, &mut [0; stages::COUNTERS], &mut [0; 4], |item, _| {
+    walk(data, &mut [0; stages::COUNTERS], &mut [0; 5], |item, _| {
         items.push(*item)
     });
     items
@@ -54,7 +61,7 @@ pub fn diced_items(data: &FrameData) -> Vec<PatchItem> {
 fn walk(
     data: &FrameData,
     counters: &mut [u64; stages::COUNTERS],
-    executed: &mut [u64; 4],
+    executed: &mut [u64; 5],
     mut dice: impl FnMut(&PatchItem, &mut [u64; stages::COUNTERS]),
 ) {
     let f = &data.frame;
@@ -84,7 +91,7 @@ fn walk(
                 counters[stages::C_DEPTH_LIMIT] += depth_limited as u64;
                 counters[stages::C_MAX_DEPTH] =
                     counters[stages::C_MAX_DEPTH].max(item.splits() as u64);
-                executed[3] += 1;
+                executed[if stages::is_small_grid(&item) { 4 } else { 3 }] += 1;
                 dice(&item, counters);
             }
         }

@@ -53,6 +53,8 @@ pub struct Frame {
     pub tile_y0: u32,
     pub tile_w: u32,
     pub tile_h: u32,
+    /// 1: micropolygons grow by their crack bound; 0 only to show what that buys.
+    pub crack_dilation: u32,
 }
 
 impl Frame {
@@ -136,6 +138,8 @@ pub struct RenderOptions {
     /// Bytes of working memory (sample buffer plus queues) a frame may use; beyond it the
     /// frame renders in screen buckets.
     pub memory_budget: Option<u64>,
+    /// Grow micropolygons to close cracks (docs/reyes.md); off only for comparisons.
+    pub crack_dilation: bool,
 }
 
 impl Default for RenderOptions {
@@ -151,6 +155,7 @@ impl Default for RenderOptions {
             max_eye_splits: 10,
             seed: 0x5eed,
             memory_budget: None,
+            crack_dilation: true,
         }
     }
 }
@@ -217,6 +222,7 @@ impl FrameData {
             tile_y0: 0,
             tile_w: width,
             tile_h: height,
+            crack_dilation: o.crack_dilation as u32,
         };
         Ok(FrameData {
             frame,
@@ -343,6 +349,7 @@ mod tests {
                 ("seed", offset_of!(Frame, seed)),
                 ("tile_x0", offset_of!(Frame, tile_x0)),
                 ("tile_h", offset_of!(Frame, tile_h)),
+                ("crack_dilation", offset_of!(Frame, crack_dilation)),
             ],
         );
         check(

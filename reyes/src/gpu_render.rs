@@ -10,14 +10,14 @@ use crate::stages::{C_MAX_DEPTH, COUNTERS};
 use scheduler::pipeline::storage_entry;
 use scheduler::timing::PassTimer;
 use scheduler::{
-    Gpu, ItemType, Procedure, Program, RunError, RunStats, Scheduler, Seed, StrategyKind,
-    UserBindings,
+    Gpu, ItemType, MultipassConfig, Procedure, Program, RunError, RunStats, Scheduler, Seed,
+    StrategyKind, UserBindings,
 };
 use std::time::Instant;
 
 /// Procedure names, in registration order. The default queue policy gives the last the highest
 /// priority: dice before split, which keeps the queues short.
-pub const PROCEDURES: [&str; 4] = ["bound", "splitu", "splitv", "diceshade"];
+pub const PROCEDURES: [&str; 5] = ["bound", "splitu", "splitv", "diceshade", "dicesmall"];
 
 /// Device features the pipeline needs: 64-bit atomicMax for the depth-and-colour samples.
 pub fn required_features() -> wgpu::Features {
@@ -31,6 +31,7 @@ pub fn program() -> Result<Program, RunError> {
         .emits("splitu", 1)
         .emits("splitv", 1)
         .emits("diceshade", 1)
+        .emits("dicesmall", 1)
         .body(shaders::BOUND);
     let splitu = Procedure::new("splitu", item.clone(), 4)
         .emits("bound", 2)
@@ -39,14 +40,16 @@ pub fn program() -> Result<Program, RunError> {
     let splitv = Procedure::new("splitv", item.clone(), 4)
         .emits("bound", 2)
         .body("");
-    let diceshade = Procedure::new("diceshade", item, 256)
+    let diceshade = Procedure::new("diceshade", item.clone(), 256)
         .shared("vec4<f32>", 256)
         .body(shaders::DICE_SHADE);
+    // dicesmall_execute is defined in dice_shade.wgsl and shares diceshade_shared.
+    let dicesmall = Procedure::new("dicesmall", item, 64).body("");
     let user = UserBindings {
         wgsl: [shaders::COMMON, shaders::SHADE, shaders::SAMPLE].concat(),
         layout: (0..6).map(|b| storage_entry(b, b < 4)).collect(),
     };
-    Program::new(vec![bound, splitu, splitv, diceshade], user)
+    Program::new(vec![bound, splitu, splitv, diceshade, dicesmall], user)
 }
 
 /// What one GPU frame produced and cost; with several buckets, run statistics are summed
@@ -75,8 +78,31 @@ pub struct GpuRenderer {
 
 impl GpuRenderer {
     pub fn new(gpu: &Gpu, strategy: StrategyKind) -> Result<GpuRenderer, RunError> {
+        Self::with_stage_timing(gpu, strategy, false)
+    }
+
+    /// With `stage_timing`, multi-pass times each procedure's passes on their own
+    /// (`RunStats::stage_gpu_ms`); the megakernel interleaves its stages in one launch, where
+    /// only their sum can be timed.
+    pub fn with_stage_timing(
+        gpu: &Gpu,
+        strategy: StrategyKind,
+        stage_timing: bool,
+    ) -> Result<GpuRenderer, RunError> {
         let program = program()?;
-        let scheduler = Scheduler::new(gpu, &program, strategy, 1 << 14)?;
+        let initial_capacity = 1 << 14;
+        let scheduler = match strategy {
+            StrategyKind::Multipass => Scheduler::multipass(
+                gpu,
+                &program,
+                MultipassConfig {
+                    initial_capacity,
+                    stage_timing,
+                    ..Default::default()
+                },
+            )?,
+            _ => Scheduler::new(gpu, &program, strategy, initial_capacity)?,
+        };
         let user_layout = gpu
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -191,14 +217,20 @@ impl GpuRenderer {
             };
             let resolve_ms = self.resolve(gpu, &tile_frame, &samples, &rgba, &depth)?;
             out.resolve_gpu_ms = out.resolve_gpu_ms.zip(resolve_ms).map(|(a, b)| a + b);
-            for (k, v) in gpu.read_words(&counters, 0, COUNTERS as u64)?.into_iter().enumerate() {
+            for (k, v) in gpu
+                .read_words(&counters, 0, COUNTERS as u64)?
+                .into_iter()
+                .enumerate()
+            {
                 if k == C_MAX_DEPTH {
                     out.counters[k] = out.counters[k].max(v as u64);
                 } else {
                     out.counters[k] += v as u64;
                 }
             }
-            out.peak_working_bytes = out.peak_working_bytes.max(tile_sample_bytes + run.queue_bytes);
+            out.peak_working_bytes = out
+                .peak_working_bytes
+                .max(tile_sample_bytes + run.queue_bytes);
             if out.buckets == 0 {
                 out.run = run;
             } else {

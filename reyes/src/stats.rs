@@ -36,17 +36,14 @@ pub fn frame_stats(data: &FrameData, g: &GpuFrame, adapter: &str, warnings: &[St
             "backface_micropolygons": c[s::C_BACKFACE],
         },
         "depth_limited": c[s::C_DEPTH_LIMIT],
-        "grids_diced": ex[3],
+        "grids_diced": ex[3] + ex[4],
+        "grids_small": ex[4],
         "micropolygons": c[s::C_MICROPOLYGONS],
         "covered_pixels": covered,
         "micropolygons_per_covered_pixel": c[s::C_MICROPOLYGONS] as f64 / covered.max(1) as f64,
         "max_split_depth": c[s::C_MAX_DEPTH],
         "executed": PROCEDURES.iter().zip(ex).map(|(p, n)| (p.to_string(), json!(n))).collect::<serde_json::Map<_, _>>(),
-        "gpu_ms_per_stage": {
-            "note": "stages interleave inside one megakernel launch and share multi-pass rounds, so only their sum is timed",
-            "schedule": schedule_ms,
-            "resolve": g.resolve_gpu_ms,
-        },
+        "gpu_ms_per_stage": stage_times(g),
         "gpu_ms": total_ms,
         "wall_ms": g.wall_ms,
         "launches": g.run.launches,
@@ -62,4 +59,24 @@ pub fn frame_stats(data: &FrameData, g: &GpuFrame, adapter: &str, warnings: &[St
         "peak_working_bytes": g.peak_working_bytes,
         "warnings": warnings,
     })
+}
+
+/// GPU ms per stage: every procedure and the queue work when multi-pass timed them
+/// (`--stage-times`), else the scheduler run as one; the resolve pass always.
+fn stage_times(g: &GpuFrame) -> Value {
+    let mut m = serde_json::Map::new();
+    let per_stage = &g.run.stage_gpu_ms;
+    if per_stage.len() == PROCEDURES.len() + 1 {
+        for (name, ms) in PROCEDURES.iter().chain(&["queue_work"]).zip(per_stage) {
+            m.insert(name.to_string(), json!(ms));
+        }
+    } else {
+        m.insert("schedule".into(), json!(g.run.gpu_ms));
+        m.insert(
+            "note".into(),
+            json!("stages interleave inside one megakernel launch; multipass --stage-times times each procedure"),
+        );
+    }
+    m.insert("resolve".into(), json!(g.resolve_gpu_ms));
+    Value::Object(m)
 }

@@ -87,8 +87,12 @@ fn bound_execute(item: PatchItem, inv: Invocation) {
     atomicMax(&counters[C_MAX_DEPTH], depth);
     var g = item;
     g.rates = d.y | (d.z << 8u);
-    g.dilate = crack_dilation(&cp, d.y, d.z, zmin);
-    enqueue_diceshade(g);
+    g.dilate = select(0.0, crack_dilation(&cp, d.y, d.z, zmin), frame.crack_dilation != 0u);
+    if (d.y + 1u) * (d.z + 1u) <= SMALL_GRID_POINTS {
+        enqueue_dicesmall(g);
+    } else {
+        enqueue_diceshade(g);
+    }
 }
 
 // Sum of |P[i+1] - P[i]| over a row (step along u = 1) or column (step = 4), in camera space,

@@ -26,6 +26,8 @@ struct Frame {
     tile_y0: u32,
     tile_w: u32,
     tile_h: u32,
+    // 1: grow micropolygons by their crack bound (bound.wgsl); 0 only to show what it buys.
+    crack_dilation: u32,
 }
 
 struct Material {
@@ -77,6 +79,8 @@ const C_CULL_BACKFACE: u32 = 8u;   // patches culled in Bound as back-facing eve
 // crack dilation (at most MAX_DILATE_PX) never reaches a sample of a bucket that culled it:
 // bucketed and whole-frame renders give the same samples.
 const MAX_DILATE_PX: f32 = 2.0;
+// Grids of at most this many points go to DiceSmall (64 threads per grid).
+const SMALL_GRID_POINTS: u32 = 64u;
 const CULL_MARGIN_PX: f32 = 3.0;
 
 fn cp_point(cp: ptr<function, array<f32, 48>>, i: u32) -> vec3<f32> {

@@ -37,13 +37,15 @@ fn eval_patch(cp: ptr<function, array<f32, 48>>, u: f32, v: f32) -> array<vec3<f
     return array<vec3<f32>, 3>(p, 3.0 * pu, 3.0 * pv);
 }
 
-// Largest control-net steps along u and v: 3 times these bound |Pu| and |Pv| on the patch.
-fn net_steps(cp: ptr<function, array<f32, 48>>) -> vec2<f32> {
+// Squares of the largest control-net steps along u and v: 3 times the steps bound |Pu| and
+// |Pv| on the patch. (Squares: no square roots per grid point.)
+fn net_steps2(cp: ptr<function, array<f32, 48>>) -> vec2<f32> {
     var m = vec2<f32>(0.0);
     for (var j = 0u; j < 4u; j++) {
         for (var i = 0u; i < 3u; i++) {
-            m.x = max(m.x, distance(cp_point(cp, 4u * j + i + 1u), cp_point(cp, 4u * j + i)));
-            m.y = max(m.y, distance(cp_point(cp, 4u * i + j + 4u), cp_point(cp, 4u * i + j)));
+            let du = cp_point(cp, 4u * j + i + 1u) - cp_point(cp, 4u * j + i);
+            let dv = cp_point(cp, 4u * i + j + 4u) - cp_point(cp, 4u * i + j);
+            m = max(m, vec2<f32>(dot(du, du), dot(dv, dv)));
         }
     }
     return m;
@@ -56,13 +58,14 @@ fn net_steps(cp: ptr<function, array<f32, 48>>) -> vec2<f32> {
 // value on the patch (9 |net steps|^2); a fixed relative test on |Pu| |Pv| would accept
 // tangents made of rounding noise. A patch with no tangent plane anywhere (all control points
 // equal) gets the direction to the eye.
-fn patch_normal(cp: ptr<function, array<f32, 48>>, u: f32, v: f32, flip: bool) -> vec3<f32> {
-    let e = eval_patch(cp, u, v);
+// `e` is eval_patch at (u, v), which the caller has already computed.
+fn patch_normal(cp: ptr<function, array<f32, 48>>, e: array<vec3<f32>, 3>, u: f32, v: f32,
+                flip: bool) -> vec3<f32> {
     var n = cross(e[1], e[2]);
-    let steps = net_steps(cp);
-    let least = 9.0e-3 * steps.x * steps.y;
+    let steps2 = net_steps2(cp);
+    let least2 = 8.1e-5 * steps2.x * steps2.y;
     var inward = 1.0e-3;
-    for (var k = 0u; k < 3u && !(length(n) > least); k++) {
+    for (var k = 0u; k < 3u && !(dot(n, n) > least2); k++) {
         let q = vec2<f32>(u, v) + (vec2<f32>(0.5) - vec2<f32>(u, v)) * inward;
         let f = eval_patch(cp, q.x, q.y);
         n = cross(f[1], f[2]);
@@ -74,19 +77,26 @@ fn patch_normal(cp: ptr<function, array<f32, 48>>, u: f32, v: f32, flip: bool) -
     return select(n, -n, flip);
 }
 
-fn diceshade_execute(item: PatchItem, inv: Invocation) {
+// Two procedures dice: DiceShade with 256 threads per grid, and DiceSmall with 64 for grids of
+// at most 64 points (most grids of a finely split model), so that four small grids share a
+// workgroup instead of leaving three quarters of its threads idle. Both use diceshade_shared:
+// a workgroup step runs one procedure, and 4 x 64 = 256 points fit either way.
+fn diceshade_execute(item: PatchItem, inv: Invocation) { dice_grid(item, inv, 256u); }
+fn dicesmall_execute(item: PatchItem, inv: Invocation) { dice_grid(item, inv, 64u); }
+
+fn dice_grid(item: PatchItem, inv: Invocation, threads: u32) {
     var cp = item.cp;
     let nu = item.rates & 255u;
     let nv = (item.rates >> 8u) & 255u;
     let cols = nu + 1u;
     let t = inv.thread;
-    let base = inv.slot * 256u;
+    let base = inv.slot * threads;
     if inv.live && t < cols * (nv + 1u) {
         let u = f32(t % cols) / f32(nu);
         let v = f32(t / cols) / f32(nv);
         let info = patch_info[item.patch_id];
         let e = eval_patch(&cp, u, v);
-        let n = patch_normal(&cp, u, v, (info.flags & 1u) != 0u);
+        let n = patch_normal(&cp, e, u, v, (info.flags & 1u) != 0u);
         let c = shade(e[0], n, materials[info.material]);
         let back = dot(n, e[0]) > 0.0;
         let z = max(e[0].z, frame.near);

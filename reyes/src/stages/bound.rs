@@ -73,8 +73,8 @@ pub fn bound(item: &PatchItem, f: &Frame, info: &PatchInfo) -> Decision {
     let lo = pts.iter().fold(pts[0].0, |a, p| a.min(p.0));
     let hi = pts.iter().fold(pts[0].0, |a, p| a.max(p.0));
     let t0 = Vec2::new(f.tile_x0 as f32, f.tile_y0 as f32) - CULL_MARGIN_PX;
-    let t1 = Vec2::new((f.tile_x0 + f.tile_w) as f32, (f.tile_y0 + f.tile_h) as f32)
-        + CULL_MARGIN_PX;
+    let t1 =
+        Vec2::new((f.tile_x0 + f.tile_w) as f32, (f.tile_y0 + f.tile_h) as f32) + CULL_MARGIN_PX;
     if hi.x < t0.x || hi.y < t0.y || lo.x > t1.x || lo.y > t1.y {
         return Decision::Cull(Cull::Offscreen);
     }
@@ -98,7 +98,11 @@ pub fn bound(item: &PatchItem, f: &Frame, info: &PatchInfo) -> Decision {
     }
     let mut g = *item;
     g.rates = nu | nv << 8;
-    g.dilate = crack_dilation(f, cp, nu, nv, zmin);
+    g.dilate = if f.crack_dilation != 0 {
+        crack_dilation(f, cp, nu, nv, zmin)
+    } else {
+        0.0
+    };
     Decision::Dice {
         item: g,
         depth_limited: split != 0,
@@ -198,7 +202,14 @@ mod backface_tests {
 
     /// det[P, Pu, Pv] at (u, v) in f64, from the Bernstein form.
     fn det_at(cp: &[f32; 48], u: f64, v: f64) -> f64 {
-        let b = |t: f64| [(1. - t).powi(3), 3. * t * (1. - t).powi(2), 3. * t * t * (1. - t), t.powi(3)];
+        let b = |t: f64| {
+            [
+                (1. - t).powi(3),
+                3. * t * (1. - t).powi(2),
+                3. * t * t * (1. - t),
+                t.powi(3),
+            ]
+        };
         let db = |t: f64| {
             [
                 -3. * (1. - t).powi(2),
@@ -273,6 +284,9 @@ mod backface_tests {
                 }
             }
         }
-        assert!(culled > 100, "only {culled} of 800 culled: the test proves little");
+        assert!(
+            culled > 100,
+            "only {culled} of 800 culled: the test proves little"
+        );
     }
 }

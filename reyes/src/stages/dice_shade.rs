@@ -36,13 +36,15 @@ pub fn eval_patch(cp: &[f32; 48], u: f32, v: f32) -> [Vec3; 3] {
     [p, 3.0 * pu, 3.0 * pv]
 }
 
-/// Largest control-net steps along u and v (3 times these bound |Pu| and |Pv|).
-pub fn net_steps(cp: &[f32; 48]) -> [f32; 2] {
+/// Squares of the largest control-net steps along u and v (3 times the steps bound |Pu|
+/// and |Pv|).
+pub fn net_steps2(cp: &[f32; 48]) -> [f32; 2] {
     let mut m = [0f32; 2];
     for j in 0..4 {
         for i in 0..3 {
-            m[0] = m[0].max(cp_point(cp, 4 * j + i + 1).distance(cp_point(cp, 4 * j + i)));
-            m[1] = m[1].max(cp_point(cp, 4 * i + j + 4).distance(cp_point(cp, 4 * i + j)));
+            let du = cp_point(cp, 4 * j + i + 1) - cp_point(cp, 4 * j + i);
+            let dv = cp_point(cp, 4 * i + j + 4) - cp_point(cp, 4 * i + j);
+            m = [m[0].max(du.dot(du)), m[1].max(dv.dot(dv))];
         }
     }
     m
@@ -53,13 +55,17 @@ pub fn net_steps(cp: &[f32; 48]) -> [f32; 2] {
 /// |Pu x Pv| reaches 1e-3 of its largest possible value on the patch; with no tangent plane
 /// anywhere (all control points equal) it is the direction to the eye. See dice_shade.wgsl.
 pub fn patch_normal(cp: &[f32; 48], u: f32, v: f32, flip: bool) -> Vec3 {
-    let e = eval_patch(cp, u, v);
+    patch_normal_at(cp, eval_patch(cp, u, v), u, v, flip)
+}
+
+/// [`patch_normal`] given `e = eval_patch(cp, u, v)`, as DiceShade calls it.
+pub fn patch_normal_at(cp: &[f32; 48], e: [Vec3; 3], u: f32, v: f32, flip: bool) -> Vec3 {
     let mut n = e[1].cross(e[2]);
-    let steps = net_steps(cp);
-    let least = 9.0e-3 * steps[0] * steps[1];
+    let steps2 = net_steps2(cp);
+    let least2 = 8.1e-5 * steps2[0] * steps2[1];
     let mut inward = 1.0e-3f32;
     let mut k = 0;
-    while k < 3 && !(n.length() > least) {
+    while k < 3 && !(n.dot(n) > least2) {
         let (qu, qv) = (u + (0.5 - u) * inward, v + (0.5 - v) * inward);
         let f = eval_patch(cp, qu, qv);
         n = f[1].cross(f[2]);
@@ -87,7 +93,7 @@ pub fn dice(item: &PatchItem, data: &FrameData) -> (u32, u32, Vec<[f32; 4]>) {
         let u = (t % (nu + 1)) as f32 / nu as f32;
         let v = (t / (nu + 1)) as f32 / nv as f32;
         let e = eval_patch(&item.cp, u, v);
-        let n = patch_normal(&item.cp, u, v, info.flags & 1 != 0);
+        let n = patch_normal_at(&item.cp, e, u, v, info.flags & 1 != 0);
         let c = shade::shade(e[0], n, m, &data.lights);
         let back = n.dot(e[0]) > 0.0;
         let z = e[0].z.max(f.near);

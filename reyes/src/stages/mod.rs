@@ -23,6 +23,15 @@ pub const C_BACKFACE: usize = 7;
 pub const C_CULL_BACKFACE: usize = 8;
 pub const COUNTERS: usize = 16;
 
+/// `SMALL_GRID_POINTS` in common.wgsl: grids of at most this many points go to DiceSmall.
+pub const SMALL_GRID_POINTS: u32 = 64;
+
+/// Whether Bound sends this diced item to DiceSmall (64 threads) rather than DiceShade (256).
+pub fn is_small_grid(item: &crate::frame::PatchItem) -> bool {
+    let (nu, nv) = (item.rates & 255, (item.rates >> 8) & 255);
+    (nu + 1) * (nv + 1) <= SMALL_GRID_POINTS
+}
+
 pub(crate) fn cp_point(cp: &[f32; 48], i: usize) -> Vec3 {
     Vec3::new(cp[3 * i], cp[3 * i + 1], cp[3 * i + 2])
 }

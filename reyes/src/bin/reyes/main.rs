@@ -16,7 +16,8 @@ use std::process::ExitCode;
 const USAGE: &str =
     "usage: reyes render [SCENE.rib|teapot|.bpt] [-o OUT.png] [--strategy megakernel|multipass]
   [--stats OUT.json] [--float OUT.pfm] [--depth OUT.pfm] [--width N] [--height N]
-  [--samples N|NxM] [--mp-size PX] [--bound-px PX] [--max-depth N] [--runs N] [--cpu]";
+  [--samples N|NxM] [--mp-size PX] [--bound-px PX] [--max-depth N] [--memory-budget BYTES[K|M|G]]
+  [--no-crack-dilation] [--stage-times] [--runs N] [--cpu]";
 
 struct Args {
     scene: Option<PathBuf>,
@@ -27,6 +28,8 @@ struct Args {
     depth: Option<PathBuf>,
     runs: u32,
     cpu: bool,
+    /// Multi-pass: time each procedure's passes on their own.
+    stage_times: bool,
     options: RenderOptions,
 }
 
@@ -40,12 +43,29 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         depth: None,
         runs: 1,
         cpu: false,
+        stage_times: false,
         options: RenderOptions::default(),
     };
     fn num<T: std::str::FromStr>(v: Option<String>, flag: &str) -> Result<T, String> {
         let v = v.ok_or_else(|| format!("{flag} needs a value"))?;
         v.parse()
             .map_err(|_| format!("{flag}: `{v}` is not a valid number"))
+    }
+    /// A byte count with an optional binary suffix: 512K, 64M, 2G.
+    fn bytes(v: Option<String>, flag: &str) -> Result<u64, String> {
+        let v = v.ok_or_else(|| format!("{flag} needs a value"))?;
+        let (digits, shift) = match v.to_ascii_uppercase().chars().last() {
+            Some('K') => (&v[..v.len() - 1], 10),
+            Some('M') => (&v[..v.len() - 1], 20),
+            Some('G') => (&v[..v.len() - 1], 30),
+            _ => (&v[..], 0),
+        };
+        match digits.parse::<u64>() {
+            Ok(n) if n > 0 && n.leading_zeros() >= shift => Ok(n << shift),
+            _ => Err(format!(
+                "{flag}: `{v}` is not a positive byte count like 64M"
+            )),
+        }
     }
     while let Some(arg) = it.next() {
         match arg.as_str() {
@@ -72,7 +92,12 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
             "--bound-px" => a.options.bound_px = Some(num(it.next(), "--bound-px")?),
             "--max-depth" => a.options.max_depth = num(it.next(), "--max-depth")?,
             "--runs" => a.runs = num(it.next(), "--runs")?,
+            "--memory-budget" => {
+                a.options.memory_budget = Some(bytes(it.next(), "--memory-budget")?)
+            }
             "--cpu" => a.cpu = true,
+            "--no-crack-dilation" => a.options.crack_dilation = false,
+            "--stage-times" => a.stage_times = true,
             "-h" | "--help" => return Err(USAGE.into()),
             s if s.starts_with('-') => return Err(format!("unknown option `{s}`\n{USAGE}")),
             s => a.scene = Some(PathBuf::from(s)),
@@ -107,7 +132,13 @@ fn run(a: Args) -> Result<(), String> {
         return Ok(());
     }
     let gpu = Gpu::from_env_requiring(required_features()).map_err(|e| e.to_string())?;
-    let renderer = GpuRenderer::new(&gpu, a.strategy).map_err(|e| e.to_string())?;
+    if a.stage_times && a.strategy == StrategyKind::Megakernel {
+        eprintln!(
+            "warning: --stage-times: the megakernel's stages share one launch; only multipass times them apart"
+        );
+    }
+    let renderer = GpuRenderer::with_stage_timing(&gpu, a.strategy, a.stage_times)
+        .map_err(|e| e.to_string())?;
     // The first frame compiles pipelines and sizes the queues; with --runs N > 1 it is a
     // warm-up and the N frames after it are timed.
     let mut frame = renderer.render(&gpu, &data).map_err(|e| e.to_string())?;
@@ -126,15 +157,19 @@ fn run(a: Args) -> Result<(), String> {
         }
         times.push((gpu_ms, frame.wall_ms));
     }
-    let mut stats = frame_stats(&data, &frame, &gpu.adapter_name(), &scene.warnings);
-    stats["runs"] = run_summary(&times);
-    if frame.counters[reyes::stages::C_CULL_NEAR] > 0 {
-        eprintln!(
-            "warning: {} patch pieces still crossed the near plane after {} eye splits and were culled",
-            frame.counters[reyes::stages::C_CULL_NEAR],
-            data.frame.max_eye_splits
-        );
+    // Where the renderer gave up on something (near-plane culls, split limit, nothing drawn).
+    let frame_warnings = reyes::warnings::frame_warnings(&data, &frame.counters);
+    for w in &frame_warnings {
+        eprintln!("warning: {w}");
     }
+    let all_warnings: Vec<String> = scene
+        .warnings
+        .iter()
+        .chain(&frame_warnings)
+        .cloned()
+        .collect();
+    let mut stats = frame_stats(&data, &frame, &gpu.adapter_name(), &all_warnings);
+    stats["runs"] = run_summary(&times);
     frame.image.write_png(&out)?;
     if let Some(p) = &a.float {
         frame.image.write_pfm(p)?;
@@ -147,16 +182,30 @@ fn run(a: Args) -> Result<(), String> {
         std::fs::write(p, text + "\n").map_err(|e| format!("{}: {e}", p.display()))?;
     }
     eprintln!(
-        "wrote {} ({}x{}, {}: {} grids, {} micropolygons, GPU {} ms, wall {:.1} ms)",
+        "wrote {} ({}x{}, {}{}: {} grids, {} micropolygons, GPU {} ms, wall {:.1} ms)",
         out.display(),
         data.frame.width,
         data.frame.height,
         a.strategy.name(),
+        match frame.buckets {
+            1 => String::new(),
+            n => format!(
+                " in {n} buckets, {:.1} MiB working memory",
+                frame.peak_working_bytes as f64 / (1 << 20) as f64
+            ),
+        },
         stats["grids_diced"],
         stats["micropolygons"],
-        stats["gpu_ms"]
-            .as_f64()
-            .map_or("n/a".into(), |v| format!("{v:.3}")),
+        match (&stats["runs"]["gpu_ms"], stats["gpu_ms"].as_f64()) {
+            (serde_json::Value::Object(m), _) if a.runs > 1 => format!(
+                "{:.3} ± {:.3} (median ± MAD of {})",
+                m["median"].as_f64().unwrap_or(f64::NAN),
+                m["mad"].as_f64().unwrap_or(f64::NAN),
+                a.runs
+            ),
+            (_, Some(v)) => format!("{v:.3}"),
+            _ => "n/a".into(),
+        },
         frame.wall_ms
     );
     Ok(())
@@ -182,15 +231,6 @@ fn main() -> ExitCode {
     let mut args = std::env::args().skip(1);
     match args.next().as_deref() {
         Some("render") => {}
-        Some("drift") => {
-            return drift::main(args).map_or_else(
-                |e| {
-                    eprintln!("reyes drift: {e}");
-                    ExitCode::FAILURE
-                },
-                |()| ExitCode::SUCCESS,
-            );
-        }
         Some(cmd @ ("measure" | "sweep")) => {
             let r = if cmd == "measure" {
                 measure::main(args)
@@ -200,6 +240,15 @@ fn main() -> ExitCode {
             return r.map_or_else(
                 |e| {
                     eprintln!("reyes {cmd}: {e}");
+                    ExitCode::FAILURE
+                },
+                |()| ExitCode::SUCCESS,
+            );
+        }
+        Some("drift") => {
+            return drift::main(args).map_or_else(
+                |e| {
+                    eprintln!("reyes drift: {e}");
                     ExitCode::FAILURE
                 },
                 |()| ExitCode::SUCCESS,
