@@ -110,7 +110,10 @@ impl StageTimer {
     pub fn writes(&self, stage: usize) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
         let mut p = self.pending.borrow_mut();
         let i = p.len() as u32;
-        assert!(i < self.capacity, "StageTimer: more passes than its capacity");
+        assert!(
+            i < self.capacity,
+            "StageTimer: more passes than its capacity"
+        );
         p.push(stage);
         self.set
             .as_ref()

@@ -348,7 +348,8 @@ impl TreeRun {
         ];
         gpu.queue
             .write_buffer(&self.cfg, 0, bytemuck::cast_slice(&cfg));
-        let stats = scheduler.run_within(gpu, &self.params.seeds(), Some(&self.bind), max_queue_bytes)?;
+        let stats =
+            scheduler.run_within(gpu, &self.params.seeds(), Some(&self.bind), max_queue_bytes)?;
         let words = gpu.read_words(&self.out, 0, (BUCKETS * 4) as u64)?;
         let mut r = TreeResult {
             branches: stats.executed[0],
