@@ -74,6 +74,47 @@ pub struct GpuRenderer {
     pub scheduler: Scheduler,
     user_layout: wgpu::BindGroupLayout,
     resolve: wgpu::ComputePipeline,
+    /// The last frame's per-frame buffers, reused by the next frame of the same size, so
+    /// that a frame allocates nothing large (a 1080p frame's samples are 66 MB).
+    frame_buffers: std::sync::Mutex<Option<FrameBuffers>>,
+}
+
+/// Frames rendered back to back before any is timed, so that clocks, caches and allocations
+/// settle. (It does not remove the slow mode of some H100 processes recorded in
+/// docs/results.md, whose cause is still open.)
+pub const WARM_UP: std::time::Duration = std::time::Duration::from_secs(1);
+
+/// Timed frames of one setting: the last frame, and each timed frame's GPU ms (scheduler
+/// run plus resolve, when timestamps exist) and wall ms.
+pub struct TimedFrames {
+    pub last: GpuFrame,
+    pub gpu_ms: Vec<Option<f64>>,
+    pub wall_ms: Vec<f64>,
+}
+
+/// Buffers every frame of one size needs: samples of the largest bucket, the frame constants,
+/// counters, and the resolved image.
+struct FrameBuffers {
+    /// (sample words, pixels)
+    size: (u64, u64),
+    samples: wgpu::Buffer,
+    frame: wgpu::Buffer,
+    counters: wgpu::Buffer,
+    rgba: wgpu::Buffer,
+    depth: wgpu::Buffer,
+}
+
+impl FrameBuffers {
+    fn new(gpu: &Gpu, size: (u64, u64)) -> Result<FrameBuffers, RunError> {
+        Ok(FrameBuffers {
+            size,
+            samples: gpu.storage_buffer("samples", size.0)?,
+            frame: gpu.storage_buffer("frame", (size_of::<Frame>() / 4) as u64)?,
+            counters: gpu.storage_buffer("counters", COUNTERS as u64)?,
+            rgba: gpu.storage_buffer("rgba", size.1 * 4)?,
+            depth: gpu.storage_buffer("depth", size.1)?,
+        })
+    }
 }
 
 impl GpuRenderer {
@@ -125,6 +166,7 @@ impl GpuRenderer {
             scheduler,
             user_layout,
             resolve,
+            frame_buffers: Default::default(),
         })
     }
 
@@ -148,17 +190,26 @@ impl GpuRenderer {
         todo.reverse();
         let per_pixel = buckets::sample_bytes_per_pixel(f);
         let largest = todo.iter().map(|t| t.w as u64 * t.h as u64).max().unwrap();
-        let samples = gpu.storage_buffer("samples", largest * per_pixel / 4)?;
-        let frame_buf = gpu.storage_buffer("frame", (size_of::<Frame>() / 4) as u64)?;
-        let counters = gpu.storage_buffer("counters", COUNTERS as u64)?;
+        let pixels = f.width as u64 * f.height as u64;
+        let mut cache = self.frame_buffers.lock().unwrap();
+        let size = (largest * per_pixel / 4, pixels);
+        if cache.as_ref().is_none_or(|b| b.size != size) {
+            *cache = None; // the old buffers go before the new ones are made
+            *cache = Some(FrameBuffers::new(gpu, size)?);
+        }
+        let FrameBuffers {
+            samples,
+            frame: frame_buf,
+            counters,
+            rgba,
+            depth,
+            ..
+        } = cache.as_ref().unwrap();
         let bind = gpu.bind_buffers(
             "reyes scene",
             &self.user_layout,
-            &[&frame_buf, &materials, &lights, &infos, &samples, &counters],
+            &[frame_buf, &materials, &lights, &infos, samples, counters],
         );
-        let pixels = f.width as u64 * f.height as u64;
-        let rgba = gpu.storage_buffer("rgba", pixels * 4)?;
-        let depth = gpu.storage_buffer("depth", pixels)?;
         let mut out = GpuFrame {
             image: FrameImage::default(),
             counters: [0; COUNTERS],
@@ -184,10 +235,10 @@ impl GpuRenderer {
                 .memory_budget
                 .map(|b| b.saturating_sub(tile_sample_bytes));
             gpu.queue
-                .write_buffer(&frame_buf, 0, bytemuck::bytes_of(&tile_frame));
+                .write_buffer(frame_buf, 0, bytemuck::bytes_of(&tile_frame));
             let mut enc = gpu.device.create_command_encoder(&Default::default());
-            enc.clear_buffer(&samples, 0, Some(tile_sample_bytes));
-            enc.clear_buffer(&counters, 0, None);
+            enc.clear_buffer(samples, 0, Some(tile_sample_bytes));
+            enc.clear_buffer(counters, 0, None);
             gpu.queue.submit([enc.finish()]);
             let seeds = [Seed::new::<PatchItem>("bound", &items)];
             let run = match self
@@ -215,7 +266,7 @@ impl GpuRenderer {
                 }
                 r => r?,
             };
-            let resolve_ms = self.resolve(gpu, &tile_frame, &samples, &rgba, &depth)?;
+            let resolve_ms = self.resolve(gpu, &tile_frame, samples, rgba, depth)?;
             out.resolve_gpu_ms = out.resolve_gpu_ms.zip(resolve_ms).map(|(a, b)| a + b);
             for (k, v) in gpu
                 .read_words(&counters, 0, COUNTERS as u64)?
@@ -238,8 +289,8 @@ impl GpuRenderer {
             }
             out.buckets += 1;
         }
-        let words = gpu.read_words(&rgba, 0, pixels * 4)?;
-        let z = gpu.read_words(&depth, 0, pixels)?;
+        let words = gpu.read_words(rgba, 0, pixels * 4)?;
+        let z = gpu.read_words(depth, 0, pixels)?;
         let floats: &[f32] = bytemuck::cast_slice(&words);
         out.image = FrameImage {
             width: f.width,
@@ -249,6 +300,32 @@ impl GpuRenderer {
         };
         out.wall_ms = start.elapsed().as_secs_f64() * 1e3;
         Ok(out)
+    }
+
+    /// Renders for [`WARM_UP`] (at least one frame: it also compiles pipelines and sizes the
+    /// queues), then `runs` frames back to back, timing each.
+    pub fn timed_frames(
+        &self,
+        gpu: &Gpu,
+        data: &FrameData,
+        runs: u32,
+    ) -> Result<TimedFrames, RunError> {
+        let start = Instant::now();
+        let mut last = self.render(gpu, data)?;
+        while start.elapsed() < WARM_UP {
+            last = self.render(gpu, data)?;
+        }
+        let (mut gpu_ms, mut wall_ms) = (Vec::new(), Vec::new());
+        for _ in 0..runs.max(1) {
+            last = self.render(gpu, data)?;
+            gpu_ms.push(last.run.gpu_ms.zip(last.resolve_gpu_ms).map(|(a, b)| a + b));
+            wall_ms.push(last.wall_ms);
+        }
+        Ok(TimedFrames {
+            last,
+            gpu_ms,
+            wall_ms,
+        })
     }
 
     /// Resolves one bucket's samples into the image buffers; its GPU ms when timed.

@@ -47,6 +47,7 @@ pub fn frame_stats(data: &FrameData, g: &GpuFrame, adapter: &str, warnings: &[St
         "gpu_ms": total_ms,
         "wall_ms": g.wall_ms,
         "launches": g.run.launches,
+        "workgroups": g.run.workgroups,
         "rounds": g.run.rounds,
         "queue_growths": g.run.queue_growths,
         "peak_queue_items": g.run.peak_occupancy,

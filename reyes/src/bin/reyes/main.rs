@@ -139,24 +139,28 @@ fn run(a: Args) -> Result<(), String> {
     }
     let renderer = GpuRenderer::with_stage_timing(&gpu, a.strategy, a.stage_times)
         .map_err(|e| e.to_string())?;
-    // The first frame compiles pipelines and sizes the queues; with --runs N > 1 it is a
-    // warm-up and the N frames after it are timed.
-    let mut frame = renderer.render(&gpu, &data).map_err(|e| e.to_string())?;
-    let mut times = Vec::new();
-    for i in 0..a.runs {
-        if a.runs > 1 {
-            frame = renderer.render(&gpu, &data).map_err(|e| e.to_string())?;
+    // One frame makes the image; with --runs N > 1, N frames are timed after a warm-up
+    // (GpuRenderer::timed_frames).
+    let (frame, times) = if a.runs > 1 {
+        let t = renderer
+            .timed_frames(&gpu, &data, a.runs)
+            .map_err(|e| e.to_string())?;
+        for (i, (g, w)) in t.gpu_ms.iter().zip(&t.wall_ms).enumerate() {
+            eprintln!("run {i}: GPU {g:?} ms, wall {w:.2} ms");
         }
-        let gpu_ms = frame
-            .run
+        let times = t
             .gpu_ms
-            .zip(frame.resolve_gpu_ms)
-            .map(|(x, y)| x + y);
-        if a.runs > 1 {
-            eprintln!("run {i}: GPU {gpu_ms:?} ms, wall {:.2} ms", frame.wall_ms);
-        }
-        times.push((gpu_ms, frame.wall_ms));
-    }
+            .iter()
+            .copied()
+            .zip(t.wall_ms.iter().copied())
+            .collect();
+        (t.last, times)
+    } else {
+        let f = renderer.render(&gpu, &data).map_err(|e| e.to_string())?;
+        let gpu_ms = f.run.gpu_ms.zip(f.resolve_gpu_ms).map(|(x, y)| x + y);
+        let wall_ms = f.wall_ms;
+        (f, vec![(gpu_ms, wall_ms)])
+    };
     // Where the renderer gave up on something (near-plane culls, split limit, nothing drawn).
     let frame_warnings = reyes::warnings::frame_warnings(&data, &frame.counters);
     for w in &frame_warnings {

@@ -47,28 +47,17 @@ pub fn take_value(args: &mut Vec<String>, flag: &str) -> Result<Option<String>, 
     Ok(value)
 }
 
-/// A warm-up frame, then `runs` timed frames; the last frame and the median GPU and wall
-/// times of the timed ones (GPU time: the scheduler run plus the resolve pass).
+/// [`GpuRenderer::timed_frames`]: the last frame and each timed frame's GPU and wall ms.
 pub fn timed_frames(
     gpu: &Gpu,
     renderer: &GpuRenderer,
     data: &FrameData,
     runs: u32,
 ) -> Result<(GpuFrame, Vec<Option<f64>>, Vec<f64>), String> {
-    let mut frame = renderer.render(gpu, data).map_err(|e| e.to_string())?;
-    let (mut gpu_ms, mut wall_ms) = (Vec::new(), Vec::new());
-    for _ in 0..runs.max(1) {
-        frame = renderer.render(gpu, data).map_err(|e| e.to_string())?;
-        gpu_ms.push(
-            frame
-                .run
-                .gpu_ms
-                .zip(frame.resolve_gpu_ms)
-                .map(|(a, b)| a + b),
-        );
-        wall_ms.push(frame.wall_ms);
-    }
-    Ok((frame, gpu_ms, wall_ms))
+    let t = renderer
+        .timed_frames(gpu, data, runs)
+        .map_err(|e| e.to_string())?;
+    Ok((t.last, t.gpu_ms, t.wall_ms))
 }
 
 pub fn main(args: impl Iterator<Item = String>) -> Result<(), String> {

@@ -243,14 +243,15 @@ pub fn main(args: impl Iterator<Item = String>) -> Result<(), String> {
                         front_flip: false,
                     };
                     eprintln!(
-                        "{short} {} {} {}x{}: {:.3} ms, geom max {:.3} px, pinholes {}",
+                        "{short} {} {} {}x{}: {:.3} ms, geom max {:.3} px, pinholes {}, {} workgroups",
                         row.strategy,
                         dicing.label(),
                         spp.0,
                         spp.1,
                         row.cost(),
                         row.geom.err_max_px,
-                        row.pinholes
+                        row.pinholes,
+                        frame.run.workgroups
                     );
                     rows.push((row, image));
                 }
