@@ -231,42 +231,31 @@ fn run_summary(times: &[(Option<f64>, f64)]) -> serde_json::Value {
     })
 }
 
+/// The subcommands, for `reyes` without one.
+const COMMANDS: &str = "usage: reyes COMMAND [options]
+  render   render a scene to PNG (the built-in teapot without a file)
+  measure  a frame's geometric and image error against the exact surfaces, as JSON
+  sweep    speed against error over quality settings: CSV, markdown and a plot
+  drift    f32 split drift against f64 over 0-24 split levels
+`reyes COMMAND --help` for each";
+
 fn main() -> ExitCode {
     let mut args = std::env::args().skip(1);
-    match args.next().as_deref() {
-        Some("render") => {}
-        Some(cmd @ ("measure" | "sweep")) => {
-            let r = if cmd == "measure" {
-                measure::main(args)
-            } else {
-                sweep::main(args)
-            };
-            return r.map_or_else(
-                |e| {
-                    eprintln!("reyes {cmd}: {e}");
-                    ExitCode::FAILURE
-                },
-                |()| ExitCode::SUCCESS,
-            );
-        }
-        Some("drift") => {
-            return drift::main(args).map_or_else(
-                |e| {
-                    eprintln!("reyes drift: {e}");
-                    ExitCode::FAILURE
-                },
-                |()| ExitCode::SUCCESS,
-            );
-        }
+    let cmd = args.next().unwrap_or_default();
+    let result = match cmd.as_str() {
+        "render" => parse(args).and_then(run),
+        "measure" => measure::main(args),
+        "sweep" => sweep::main(args),
+        "drift" => drift::main(args),
         _ => {
-            eprintln!("{USAGE}");
+            eprintln!("{COMMANDS}");
             return ExitCode::from(2);
         }
-    }
-    match parse(args).and_then(run) {
+    };
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("reyes: {e}");
+            eprintln!("reyes {cmd}: {e}");
             ExitCode::FAILURE
         }
     }

@@ -1,6 +1,6 @@
 //! `reyes measure [SCENE] [render options] [--ref-samples N] [--reference-png OUT.png] [--json]`:
 //! renders on the GPU
-//! (one warm-up frame, then `--runs N` timed ones, median reported) and measures the frame
+//! (1 s of warm-up frames, then `--runs N` timed ones, median reported) and measures the frame
 //! against the exact surfaces (`reyes::accuracy`): geometric error and size of the
 //! micropolygons, PSNR and FLIP against an f64 reference render, pinholes.
 
