@@ -7,40 +7,20 @@ use reyes::accuracy::geometry::geometry;
 use reyes::accuracy::image_error::image_error;
 use reyes::accuracy::measure::pinhole_count;
 use reyes::frame::{FrameData, RenderOptions};
-use reyes::gpu_render::{GpuRenderer, required_features};
 use reyes::scene::{self, Scene};
 use reyes::stages::C_MICROPOLYGONS;
-use scheduler::{Gpu, StrategyKind};
+use scheduler::StrategyKind;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use std::sync::OnceLock;
 
-fn gpu() -> &'static Gpu {
-    static GPU: OnceLock<Gpu> = OnceLock::new();
-    GPU.get_or_init(|| {
-        Gpu::from_env_requiring(required_features())
-            .unwrap_or_else(|e| panic!("GPU tests need an adapter with 64-bit atomics: {e}"))
-    })
-}
-
-fn renderer() -> &'static GpuRenderer {
-    static R: OnceLock<GpuRenderer> = OnceLock::new();
-    R.get_or_init(|| GpuRenderer::new(gpu(), StrategyKind::Megakernel).unwrap())
-}
+mod common;
+use common::{gpu, renderer, small};
 
 const BLOB: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/closed_blob.rib");
 
 fn blob() -> Scene {
     scene::load(Path::new(BLOB)).unwrap()
-}
-
-fn small(w: u32, h: u32) -> RenderOptions {
-    RenderOptions {
-        width: Some(w),
-        height: Some(h),
-        ..Default::default()
-    }
 }
 
 /// The metrics measure the GPU's micropolygons: the CPU twin's grids, which the geometry
@@ -59,7 +39,9 @@ fn gpu_frame_against_the_exact_reference() {
             ..small(w, h)
         };
         let data = FrameData::new(&s, &o).unwrap();
-        let g = renderer().render(gpu(), &data).unwrap();
+        let g = renderer(StrategyKind::Megakernel)
+            .render(gpu(), &data)
+            .unwrap();
         let geom = geometry(&s, &data);
         assert_eq!(geom.micropolygons, g.counters[C_MICROPOLYGONS]);
         assert!(geom.err_max_px < 0.5, "{geom:?}");
@@ -84,7 +66,10 @@ fn a_hole_in_the_render_is_counted() {
     let (w, h) = (64, 48);
     let reference = render_reference(&s, w, h, 4);
     let data = FrameData::new(&s, &small(w, h)).unwrap();
-    let mut img = renderer().render(gpu(), &data).unwrap().image;
+    let mut img = renderer(StrategyKind::Megakernel)
+        .render(gpu(), &data)
+        .unwrap()
+        .image;
     assert_eq!(pinhole_count(&img, &reference), 0);
     let c = (h / 2 * w + w / 2) as usize;
     img.rgba[c][3] = 0.75;

@@ -3,54 +3,14 @@
 
 use reyes::cpu_render::render_cpu;
 use reyes::frame::{FrameData, RenderOptions};
-use reyes::gpu_render::{GpuRenderer, required_features};
 use reyes::image::FrameImage;
 use reyes::scene::{self, Scene};
 use reyes::stages;
-use scheduler::{Gpu, StrategyKind};
+use scheduler::StrategyKind;
 use std::path::Path;
-use std::sync::OnceLock;
 
-fn gpu() -> &'static Gpu {
-    static GPU: OnceLock<Gpu> = OnceLock::new();
-    GPU.get_or_init(|| {
-        Gpu::from_env_requiring(required_features())
-            .unwrap_or_else(|e| panic!("GPU tests need an adapter with 64-bit atomics: {e}"))
-    })
-}
-
-fn renderer(kind: StrategyKind) -> &'static GpuRenderer {
-    static MK: OnceLock<GpuRenderer> = OnceLock::new();
-    static MP: OnceLock<GpuRenderer> = OnceLock::new();
-    let cell = if kind == StrategyKind::Megakernel {
-        &MK
-    } else {
-        &MP
-    };
-    cell.get_or_init(|| GpuRenderer::new(gpu(), kind).unwrap())
-}
-
-fn small(w: u32, h: u32) -> RenderOptions {
-    RenderOptions {
-        width: Some(w),
-        height: Some(h),
-        ..Default::default()
-    }
-}
-
-/// Largest per-channel difference (colour in sRGB 8-bit steps, alpha in 1/255) and the share
-/// of pixels differing by more than 2 steps.
-fn compare(a: &FrameImage, b: &FrameImage) -> (u8, f64) {
-    let (x, y) = (a.rgba8(), b.rgba8());
-    let d: Vec<u8> = x
-        .chunks(4)
-        .zip(y.chunks(4))
-        .map(|(p, q)| (0..4).map(|c| p[c].abs_diff(q[c])).max().unwrap())
-        .collect();
-    let max = d.iter().copied().max().unwrap_or(0);
-    let over = d.iter().filter(|&&v| v > 2).count() as f64 / d.len() as f64;
-    (max, over)
-}
+mod common;
+use common::{compare, gpu, renderer, small};
 
 fn data_dir() -> std::path::PathBuf {
     reyes::shared_data_dir()

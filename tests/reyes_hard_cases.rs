@@ -8,14 +8,16 @@
 use glam::{DVec3, Vec3};
 use reyes::cpu_render::render_cpu;
 use reyes::frame::{FrameData, PatchItem, RenderOptions};
-use reyes::gpu_render::{GpuFrame, GpuRenderer, required_features};
+use reyes::gpu_render::GpuFrame;
 use reyes::image::FrameImage;
 use reyes::scene::{self, Scene, eval_bezier};
 use reyes::stages::{self, dice_shade::patch_normal};
 use reyes::warnings::frame_warnings;
-use scheduler::{Gpu, StrategyKind};
+use scheduler::StrategyKind;
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
+
+mod common;
+use common::{compare, gpu, renderer};
 
 // ---------------------------------------------------------------------------------------------
 // The scene files.
@@ -389,25 +391,6 @@ fn load_err(name: &str) -> String {
 // ---------------------------------------------------------------------------------------------
 // Rendering and the checks every case gets.
 
-fn gpu() -> &'static Gpu {
-    static GPU: OnceLock<Gpu> = OnceLock::new();
-    GPU.get_or_init(|| {
-        Gpu::from_env_requiring(required_features())
-            .unwrap_or_else(|e| panic!("GPU tests need an adapter with 64-bit atomics: {e}"))
-    })
-}
-
-fn renderer(kind: StrategyKind) -> &'static GpuRenderer {
-    static MK: OnceLock<GpuRenderer> = OnceLock::new();
-    static MP: OnceLock<GpuRenderer> = OnceLock::new();
-    let cell = if kind == StrategyKind::Megakernel {
-        &MK
-    } else {
-        &MP
-    };
-    cell.get_or_init(|| GpuRenderer::new(gpu(), kind).unwrap())
-}
-
 const MK: &[StrategyKind] = &[StrategyKind::Megakernel];
 const BOTH: &[StrategyKind] = &[StrategyKind::Megakernel, StrategyKind::Multipass];
 
@@ -419,20 +402,6 @@ const QUEUE_BYTES_BOUND: u64 = 2048 * std::mem::size_of::<PatchItem>() as u64;
 /// Longest a 64x48 frame may take on lavapipe before we call it a hang (the scheduler's waits
 /// are bounded, so a hang would show as a very slow run or an error).
 const WALL_MS_BOUND: f64 = 60_000.0;
-
-/// Largest per-channel difference (sRGB 8-bit steps) and the share of pixels differing by more
-/// than 2 steps.
-fn compare(a: &FrameImage, b: &FrameImage) -> (u8, f64) {
-    let (x, y) = (a.rgba8(), b.rgba8());
-    let d: Vec<u8> = x
-        .chunks(4)
-        .zip(y.chunks(4))
-        .map(|(p, q)| (0..4).map(|c| p[c].abs_diff(q[c])).max().unwrap())
-        .collect();
-    let max = d.iter().copied().max().unwrap_or(0);
-    let over = d.iter().filter(|&&v| v > 2).count() as f64 / d.len() as f64;
-    (max, over)
-}
 
 /// Grids diced: the items of every procedure after Bound, SplitU and SplitV.
 fn grids(executed: &[u64]) -> u64 {

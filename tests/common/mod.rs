@@ -1,0 +1,53 @@
+//! What the Reyes GPU test files share: one adapter and one renderer per strategy for the
+//! whole test binary (pipelines compile once), small render options, and the image comparison
+//! against the CPU twin. The adapter comes from the environment like wgpu's own tests; none is
+//! a failure, never a skip.
+
+#![allow(dead_code)] // each test binary uses its own subset
+
+use reyes::frame::RenderOptions;
+use reyes::gpu_render::{GpuRenderer, required_features};
+use reyes::image::FrameImage;
+use scheduler::{Gpu, StrategyKind};
+use std::sync::OnceLock;
+
+pub fn gpu() -> &'static Gpu {
+    static GPU: OnceLock<Gpu> = OnceLock::new();
+    GPU.get_or_init(|| {
+        Gpu::from_env_requiring(required_features())
+            .unwrap_or_else(|e| panic!("GPU tests need an adapter with 64-bit atomics: {e}"))
+    })
+}
+
+pub fn renderer(kind: StrategyKind) -> &'static GpuRenderer {
+    static MK: OnceLock<GpuRenderer> = OnceLock::new();
+    static MP: OnceLock<GpuRenderer> = OnceLock::new();
+    let cell = if kind == StrategyKind::Megakernel {
+        &MK
+    } else {
+        &MP
+    };
+    cell.get_or_init(|| GpuRenderer::new(gpu(), kind).unwrap())
+}
+
+pub fn small(w: u32, h: u32) -> RenderOptions {
+    RenderOptions {
+        width: Some(w),
+        height: Some(h),
+        ..Default::default()
+    }
+}
+
+/// Largest per-channel difference (colour in sRGB 8-bit steps, alpha in 1/255) and the share
+/// of pixels differing by more than 2 steps.
+pub fn compare(a: &FrameImage, b: &FrameImage) -> (u8, f64) {
+    let (x, y) = (a.rgba8(), b.rgba8());
+    let d: Vec<u8> = x
+        .chunks(4)
+        .zip(y.chunks(4))
+        .map(|(p, q)| (0..4).map(|c| p[c].abs_diff(q[c])).max().unwrap())
+        .collect();
+    let max = d.iter().copied().max().unwrap_or(0);
+    let over = d.iter().filter(|&&v| v > 2).count() as f64 / d.len() as f64;
+    (max, over)
+}
