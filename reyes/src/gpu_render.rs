@@ -79,10 +79,10 @@ pub struct GpuRenderer {
     frame_buffers: std::sync::Mutex<Option<FrameBuffers>>,
 }
 
-/// Frames rendered back to back before any is timed, so that clocks, caches and allocations
-/// settle. (It does not remove the slow mode of some H100 processes recorded in
-/// docs/results.md, whose cause is still open.)
-pub const WARM_UP: std::time::Duration = std::time::Duration::from_secs(1);
+/// Full GPU load before frames are timed (`scheduler::clocks::raise_clocks`): frames alone,
+/// a few ms of GPU work between host read-backs, leave an H100 that has idled at its idle
+/// clock.
+pub const WARM_UP: std::time::Duration = std::time::Duration::from_millis(500);
 
 /// Timed frames of one setting: the last frame, and each timed frame's GPU ms (scheduler
 /// run plus resolve, when timestamps exist) and wall ms.
@@ -302,19 +302,17 @@ impl GpuRenderer {
         Ok(out)
     }
 
-    /// Renders for [`WARM_UP`] (at least one frame: it also compiles pipelines and sizes the
-    /// queues), then `runs` frames back to back, timing each.
+    /// Renders one frame (it compiles pipelines and sizes the queues), raises the GPU's clocks
+    /// for [`WARM_UP`], renders one more frame, then `runs` frames back to back, timing each.
     pub fn timed_frames(
         &self,
         gpu: &Gpu,
         data: &FrameData,
         runs: u32,
     ) -> Result<TimedFrames, RunError> {
-        let start = Instant::now();
+        self.render(gpu, data)?;
+        scheduler::clocks::raise_clocks(gpu, WARM_UP)?;
         let mut last = self.render(gpu, data)?;
-        while start.elapsed() < WARM_UP {
-            last = self.render(gpu, data)?;
-        }
         let (mut gpu_ms, mut wall_ms) = (Vec::new(), Vec::new());
         for _ in 0..runs.max(1) {
             last = self.render(gpu, data)?;

@@ -8,6 +8,7 @@
 //!
 //! The queue protocol and its correctness argument are in `docs/scheduler.md`.
 
+pub mod clocks;
 pub mod error;
 pub mod gpu;
 pub mod megakernel;

@@ -149,6 +149,7 @@ fn run(o: &Options) -> Result<bool, RunError> {
             )?,
         };
         tree.run(&gpu, &scheduler)?; // warm-up: first-use costs are not the strategy's
+        scheduler::clocks::raise_clocks(&gpu, std::time::Duration::from_millis(500))?;
         let (mut gpu_ms, mut wall_ms) = (Vec::new(), Vec::new());
         let mut last = None;
         for run in 0..o.runs {

@@ -1,6 +1,6 @@
 //! `reyes measure [SCENE] [render options] [--ref-samples N] [--reference-png OUT.png] [--json]`:
 //! renders on the GPU
-//! (1 s of warm-up frames, then `--runs N` timed ones, median reported) and measures the frame
+//! (a warm-up frame, 0.5 s of full GPU load (clocks), one more frame, then `--runs N` timed ones, median reported) and measures the frame
 //! against the exact surfaces (`reyes::accuracy`): geometric error and size of the
 //! micropolygons, PSNR and FLIP against an f64 reference render, pinholes.
 

@@ -364,7 +364,7 @@ fn markdown(rows: &[Row], c: &Config, adapter: &str, command: &str, elapsed: f64
     };
     writeln!(
         s,
-        "Adapter: {adapter}. Image {}x{}. Each setting: 1 s of warm-up frames, then {} timed frames; \
+        "Adapter: {adapter}. Image {}x{}. Each setting: a warm-up frame, 0.5 s of full GPU load (clocks), one more frame, then {} timed frames; \
          time is the median ± MAD of {timed} (scheduler run plus resolve). Reference: \
          {n}x{n} samples per pixel on the exact surfaces. Sweep took {elapsed:.0} s.\n\n\
          Command: `{command}`\n\n\
