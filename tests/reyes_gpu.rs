@@ -10,7 +10,7 @@ use scheduler::StrategyKind;
 use std::path::Path;
 
 mod common;
-use common::{compare, gpu, renderer, small};
+use common::{compare, coverage_disagreement, gpu, renderer, small};
 
 fn data_dir() -> std::path::PathBuf {
     reyes::shared_data_dir()
@@ -129,17 +129,6 @@ fn patches_behind_the_eye_are_split_then_culled_and_the_frame_stays_finite() {
         mk.counters[stages::C_CULL_NEAR],
         cpu.counters[stages::C_CULL_NEAR]
     );
-}
-
-/// Share of pixels where GPU coverage and exact coverage disagree by more than half a pixel.
-fn coverage_disagreement(img: &FrameImage, exact: &reyes::reference::Coverage) -> f64 {
-    let bad = img
-        .rgba
-        .iter()
-        .zip(&exact.frac)
-        .filter(|(p, e)| (p[3] - **e).abs() > 0.5)
-        .count();
-    bad as f64 / img.rgba.len() as f64
 }
 
 #[test]

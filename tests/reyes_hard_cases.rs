@@ -17,7 +17,7 @@ use scheduler::StrategyKind;
 use std::path::{Path, PathBuf};
 
 mod common;
-use common::{compare, gpu, renderer};
+use common::{compare, coverage_disagreement, gpu, renderer};
 
 // ---------------------------------------------------------------------------------------------
 // The scene files.
@@ -497,17 +497,6 @@ fn render_checked(name: &str, s: &Scene, o: &RenderOptions, kinds: &[StrategyKin
 
 fn scene_size() -> RenderOptions {
     RenderOptions::default()
-}
-
-/// Share of pixels where coverage and the exact f64 coverage disagree by more than half a pixel.
-fn coverage_disagreement(img: &FrameImage, exact: &reyes::reference::Coverage) -> f64 {
-    let bad = img
-        .rgba
-        .iter()
-        .zip(&exact.frac)
-        .filter(|(p, e)| (p[3] - **e).abs() > 0.5)
-        .count();
-    bad as f64 / img.rgba.len() as f64
 }
 
 fn alpha_area(img: &FrameImage) -> f64 {

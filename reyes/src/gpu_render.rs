@@ -150,17 +150,7 @@ impl GpuRenderer {
                 label: Some("reyes scene"),
                 entries: &program.user.layout,
             });
-        let module = gpu.shader("reyes resolve", shaders::RESOLVE)?;
-        let resolve = gpu
-            .device
-            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("reyes resolve"),
-                layout: None,
-                module: &module,
-                entry_point: Some("resolve"),
-                compilation_options: Default::default(),
-                cache: None,
-            });
+        let resolve = gpu.compute_pipeline("reyes resolve", shaders::RESOLVE, "resolve")?;
         Ok(GpuRenderer {
             program,
             scheduler,
@@ -223,8 +213,8 @@ impl GpuRenderer {
         };
         while let Some(tile) = todo.pop() {
             let tile_frame = f.with_tile(tile);
-            let items: Vec<PatchItem> = match data.memory_budget {
-                None => data.items.clone(),
+            let items: std::borrow::Cow<[PatchItem]> = match data.memory_budget {
+                None => (&data.items[..]).into(),
                 Some(_) => (data.items.iter())
                     .filter(|i| buckets::may_reach(f, i, tile))
                     .copied()
@@ -245,7 +235,11 @@ impl GpuRenderer {
                 .scheduler
                 .run_within(gpu, &seeds, Some(&bind), queue_budget)
             {
-                Err(RunError::QueueOverflow { .. }) if data.memory_budget.is_some() => {
+                Err(RunError::QueueOverflow {
+                    queue,
+                    capacity,
+                    needed_more_than,
+                }) if data.memory_budget.is_some() => {
                     if let Some(quarters) = buckets::quarter(tile) {
                         out.buckets_recut += 1;
                         todo.extend(quarters.into_iter().rev());
@@ -253,15 +247,15 @@ impl GpuRenderer {
                     }
                     return Err(RunError::QueueOverflow {
                         queue: format!(
-                            "a {}x{} px bucket at ({}, {}) under the memory budget of {} bytes",
+                            "{queue} (in a {}x{} px bucket at ({}, {}), the smallest, under a memory budget of {} bytes)",
                             tile.w,
                             tile.h,
                             tile.x0,
                             tile.y0,
                             data.memory_budget.unwrap()
                         ),
-                        capacity: queue_budget.unwrap_or(0),
-                        needed_more_than: queue_budget.unwrap_or(0),
+                        capacity,
+                        needed_more_than,
                     });
                 }
                 r => r?,

@@ -27,17 +27,7 @@ pub fn raise_clocks(gpu: &Gpu, duration: Duration) -> Result<(), RunError> {
     if gpu.info.device_type == wgpu::DeviceType::Cpu {
         return Ok(());
     }
-    let module = gpu.shader("raise clocks", BUSY)?;
-    let pipeline = gpu
-        .device
-        .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("raise clocks"),
-            layout: None,
-            module: &module,
-            entry_point: Some("busy"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+    let pipeline = gpu.compute_pipeline("raise clocks", BUSY, "busy")?;
     let sink = gpu.storage_buffer("raise clocks sink", 1)?;
     let bind = gpu.bind_buffers("raise clocks", &pipeline.get_bind_group_layout(0), &[&sink]);
     let start = Instant::now();

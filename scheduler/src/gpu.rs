@@ -223,4 +223,25 @@ impl Gpu {
                 source: wgpu::ShaderSource::Wgsl(source.into()),
             }))
     }
+
+    /// A compute pipeline of one entry point of a WGSL source, its layout derived from the
+    /// shader (bind group 0 from `get_bind_group_layout(0)`).
+    pub fn compute_pipeline(
+        &self,
+        label: &str,
+        source: &str,
+        entry: &str,
+    ) -> Result<wgpu::ComputePipeline, RunError> {
+        let module = self.shader(label, source)?;
+        Ok(self
+            .device
+            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(label),
+                layout: None,
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            }))
+    }
 }

@@ -51,3 +51,15 @@ pub fn compare(a: &FrameImage, b: &FrameImage) -> (u8, f64) {
     let over = d.iter().filter(|&&v| v > 2).count() as f64 / d.len() as f64;
     (max, over)
 }
+
+/// Share of pixels where coverage (alpha) and the exact f64 coverage disagree by more than half
+/// a pixel.
+pub fn coverage_disagreement(img: &FrameImage, exact: &reyes::reference::Coverage) -> f64 {
+    let bad = img
+        .rgba
+        .iter()
+        .zip(&exact.frac)
+        .filter(|(p, e)| (p[3] - **e).abs() > 0.5)
+        .count();
+    bad as f64 / img.rgba.len() as f64
+}

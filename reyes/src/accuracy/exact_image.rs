@@ -18,12 +18,12 @@
 //! filter: on an edge pixel the covered fraction is off by at most about 1/(2n) (axis-aligned
 //! edge), 1/16 at the default n = 8, and smaller for slanted edges.
 
+use super::parallel::in_chunks;
 use super::surface::{back_facing, eval, scene_lights, shade};
 use crate::image::FrameImage;
 use crate::reference::exact::{Coverage, Leaf, for_each_covered_sample};
 use crate::scene::Scene;
 use glam::{DVec2, DVec3};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Samples per pixel axis of the reference unless told otherwise (64 per pixel).
 pub const DEFAULT_SAMPLES_PER_AXIS: u32 = 8;
@@ -75,33 +75,13 @@ pub fn render_reference(
     let start = std::time::Instant::now();
     let (w, h, n) = (width as usize, height as usize, samples_per_axis as usize);
     let lights = scene_lights(scene);
-    let next = AtomicUsize::new(0);
-    let threads = std::thread::available_parallelism().map_or(1, |t| t.get());
-    let bands: Vec<(usize, Vec<[f32; 4]>, Vec<f32>, u64, u64)> = std::thread::scope(|s| {
-        let workers: Vec<_> = (0..threads)
-            .map(|_| {
-                s.spawn(|| {
-                    let mut out = Vec::new();
-                    loop {
-                        let y0 = next.fetch_add(BAND_ROWS, Ordering::Relaxed);
-                        if y0 >= h {
-                            break out;
-                        }
-                        let y1 = (y0 + BAND_ROWS).min(h);
-                        out.push(band(scene, &lights, width, height, n, y0, y1));
-                    }
-                })
-            })
-            .collect();
-        workers
-            .into_iter()
-            .flat_map(|t| t.join().expect("reference worker panicked"))
-            .collect()
+    let bands = in_chunks(h, BAND_ROWS, |rows| {
+        band(scene, &lights, width, height, n, rows.start, rows.end)
     });
     let mut rgba = vec![[0f32; 4]; w * h];
     let mut depth = vec![3.0e38f32; w * h];
     let (mut unconverged, mut covered) = (0, 0);
-    for (y0, c, d, un, cov) in bands {
+    for (_, (y0, c, d, un, cov)) in bands {
         rgba[y0 * w..y0 * w + c.len()].copy_from_slice(&c);
         depth[y0 * w..y0 * w + d.len()].copy_from_slice(&d);
         unconverged += un;

@@ -15,6 +15,7 @@
 //! surface: an upper bound of the distance to the surface. Only micropolygons that are drawn
 //! count: on screen, not culled as back-facing, in front of the near plane.
 
+use super::parallel::in_chunks;
 use super::surface::eval;
 use crate::cpu_render::diced_items;
 use crate::frame::{FrameData, PatchItem};
@@ -22,7 +23,6 @@ use crate::reference::project;
 use crate::scene::Scene;
 use crate::stages::dice_shade::dice;
 use glam::DVec2;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct GeometryStats {
@@ -53,33 +53,16 @@ const POINTS: [(f64, f64); 7] = [
 pub fn geometry(scene: &Scene, data: &FrameData) -> GeometryStats {
     let items = diced_items(data);
     let threads = std::thread::available_parallelism().map_or(1, |t| t.get());
-    let chunk = items.len().div_ceil(threads * 16).max(1);
-    let next = AtomicUsize::new(0);
-    let parts: Vec<Part> = std::thread::scope(|s| {
-        let workers: Vec<_> = (0..threads)
-            .map(|_| {
-                s.spawn(|| {
-                    let mut part = Part::default();
-                    loop {
-                        let at = next.fetch_add(chunk, Ordering::Relaxed);
-                        if at >= items.len() {
-                            break part;
-                        }
-                        for item in &items[at..(at + chunk).min(items.len())] {
-                            measure_item(scene, data, item, &mut part);
-                        }
-                    }
-                })
-            })
-            .collect();
-        workers
-            .into_iter()
-            .map(|w| w.join().expect("geometry worker panicked"))
-            .collect()
+    let parts = in_chunks(items.len(), items.len().div_ceil(threads * 16), |range| {
+        let mut part = Part::default();
+        for item in &items[range] {
+            measure_item(scene, data, item, &mut part);
+        }
+        part
     });
     let mut errs: Vec<f64> = Vec::new();
     let (mut edge_max, mut area_sum): (f64, f64) = (0.0, 0.0);
-    for p in parts {
+    for (_, p) in parts {
         errs.extend(p.errs);
         edge_max = edge_max.max(p.edge_max);
         area_sum += p.area_sum;
@@ -101,7 +84,7 @@ pub fn geometry(scene: &Scene, data: &FrameData) -> GeometryStats {
     }
 }
 
-/// One thread's results.
+/// One chunk's results.
 #[derive(Default)]
 struct Part {
     /// Largest error of each micropolygon.

@@ -82,25 +82,8 @@ pub fn srgb8_errors(
     width: u32,
     height: u32,
 ) -> Vec<ImageError> {
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let threads = std::thread::available_parallelism().map_or(1, |t| t.get());
-    let mut out: Vec<(usize, ImageError)> = std::thread::scope(|s| {
-        let workers: Vec<_> = (0..threads.min(tests.len()))
-            .map(|_| {
-                s.spawn(|| {
-                    let mut mine = Vec::new();
-                    loop {
-                        let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                        let Some(t) = tests.get(k) else { break mine };
-                        mine.push((k, srgb8_error(reference, t, width, height)));
-                    }
-                })
-            })
-            .collect();
-        workers
-            .into_iter()
-            .flat_map(|w| w.join().expect("image error worker panicked"))
-            .collect()
+    let mut out = super::parallel::in_chunks(tests.len(), 1, |k| {
+        srgb8_error(reference, &tests[k.start], width, height)
     });
     out.sort_by_key(|e| e.0);
     out.into_iter().map(|e| e.1).collect()

@@ -5,6 +5,7 @@ pub mod exact_image;
 pub mod geometry;
 pub mod image_error;
 pub mod measure;
+pub mod parallel;
 pub mod pareto;
 pub mod plot;
 pub mod surface;

@@ -245,10 +245,7 @@ impl Canvas {
     /// 8x8 glyphs scaled by `scale`; bit k of a glyph row is column k.
     fn text(&mut self, x: i32, y: i32, s: &str, c: [u8; 3], scale: i32) {
         for (i, ch) in s.chars().enumerate() {
-            let glyph = font8x8::legacy::BASIC_LEGACY
-                .get(ch as usize)
-                .copied()
-                .unwrap_or(font8x8::legacy::BASIC_LEGACY[b'?' as usize]);
+            let glyph = glyph(ch);
             for (row, bits) in glyph.iter().enumerate() {
                 for col in 0..8 {
                     if bits >> col & 1 == 1 {
@@ -263,10 +260,7 @@ impl Canvas {
     /// Text rotated a quarter turn anticlockwise (reads bottom to top), ending at y.
     fn text_up(&mut self, x: i32, y: i32, s: &str, c: [u8; 3]) {
         for (i, ch) in s.chars().enumerate() {
-            let glyph = font8x8::legacy::BASIC_LEGACY
-                .get(ch as usize)
-                .copied()
-                .unwrap_or(font8x8::legacy::BASIC_LEGACY[b'?' as usize]);
+            let glyph = glyph(ch);
             for (row, bits) in glyph.iter().enumerate() {
                 for col in 0..8 {
                     if bits >> col & 1 == 1 {
@@ -344,6 +338,14 @@ impl Canvas {
             }
         }
     }
+}
+
+/// The 8x8 bitmap of `ch` (`?` outside ASCII).
+fn glyph(ch: char) -> [u8; 8] {
+    font8x8::legacy::BASIC_LEGACY
+        .get(ch as usize)
+        .copied()
+        .unwrap_or(font8x8::legacy::BASIC_LEGACY[b'?' as usize])
 }
 
 #[cfg(test)]

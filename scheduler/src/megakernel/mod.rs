@@ -42,8 +42,6 @@ pub enum QueuePolicy {
 /// samples its micropolygons in nested loops) this keeps an invocation's total loop
 /// iterations far below lavapipe's cumulative 65,535 cut.
 pub const LAVAPIPE_MAX_ITERATIONS: u32 = 96;
-/// Co-residency probes run before the first launch; the largest count is used.
-const PROBES: u32 = 4;
 /// Polls of a flag per wait on lavapipe (the polls count against the same cut).
 pub const LAVAPIPE_SPIN_LIMIT: u32 = 64;
 
@@ -177,16 +175,10 @@ impl Megakernel {
             let Workgroups::Probe { max } = self.config.workgroups else {
                 unreachable!()
             };
-            // The probe can only undercount (a workgroup that starts after another gave up
-            // spinning is not counted), e.g. while a GPU that was idle is still raising its
-            // clocks; a frame then runs with a fraction of the workgroups. Take the best of
-            // a few probes.
-            let mut best = 0;
-            for _ in 0..PROBES {
-                best = best.max(self.probe(gpu, max.max(1), user)?);
-            }
-            self.workgroups
-                .store(best, std::sync::atomic::Ordering::Relaxed);
+            self.workgroups.store(
+                self.probe(gpu, max.max(1), user)?,
+                std::sync::atomic::Ordering::Relaxed,
+            );
         }
         Ok(self.workgroups.load(std::sync::atomic::Ordering::Relaxed))
     }
