@@ -112,3 +112,31 @@ fn bad_options_are_clear_errors() {
     }
     assert!(!dir.join("teapot.png").exists());
 }
+
+/// The field input `empty-world.rib` (a world with nothing drawable): every way of rendering it
+/// writes an image of the requested size with alpha 0, warns that nothing was drawn, and exits
+/// 0. It used to panic in wgpu's validation on both GPU strategies. Needs the GPU (lavapipe).
+#[test]
+fn an_empty_world_renders_an_empty_image_with_a_warning() {
+    let scene = reyes::shared_data_dir().join("field/empty-world.rib");
+    assert!(scene.is_file(), "{} is missing", scene.display());
+    let dir = scratch("empty");
+    let scene = scene.to_str().unwrap();
+    for way in [
+        &["--strategy", "megakernel"][..],
+        &["--strategy", "multipass"],
+        &["--memory-budget", "64K"],
+        &["--cpu"],
+    ] {
+        let out = dir.join("empty.png");
+        let _ = std::fs::remove_file(&out);
+        let mut args = vec![scene, "-o", "empty.png"];
+        args.extend_from_slice(way);
+        let (ok, err) = reyes(&dir, &args);
+        assert!(ok, "{way:?}: {err}");
+        assert!(err.contains("nothing was drawn"), "{way:?}: {err}");
+        let img = image::open(&out).unwrap().to_rgba8();
+        assert_eq!(img.dimensions(), (320, 240), "{way:?}");
+        assert!(img.pixels().all(|p| p[3] == 0), "{way:?}: not transparent");
+    }
+}

@@ -73,7 +73,6 @@ fn walk(
                 counters[match c {
                     Cull::Clip => stages::C_CULL_CLIP,
                     Cull::Offscreen => stages::C_CULL_OFFSCREEN,
-                    Cull::Near => stages::C_CULL_NEAR,
                     Cull::Backface => stages::C_CULL_BACKFACE,
                 }] += 1
             }
@@ -89,6 +88,8 @@ fn walk(
                 depth_limited,
             } => {
                 counters[stages::C_DEPTH_LIMIT] += depth_limited as u64;
+                counters[stages::C_NEAR_CLIPPED] +=
+                    (item.rates & stages::NEAR_CLIP_GRID != 0) as u64;
                 counters[stages::C_MAX_DEPTH] =
                     counters[stages::C_MAX_DEPTH].max(item.splits() as u64);
                 executed[if stages::is_small_grid(&item) { 4 } else { 3 }] += 1;

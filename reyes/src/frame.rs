@@ -133,6 +133,8 @@ pub struct RenderOptions {
     /// Most segments per grid side (grid points = segments + 1 <= 16).
     pub grid_max: u32,
     pub max_depth: u32,
+    /// Most of an item's splits made because it crosses the near plane (each is also one of
+    /// `max_depth`); a piece that reaches it is diced and clipped, never dropped.
     pub max_eye_splits: u32,
     pub seed: u32,
     /// Bytes of working memory (sample buffer plus queues) a frame may use; beyond it the
@@ -152,7 +154,7 @@ impl Default for RenderOptions {
             bound_px: None,
             grid_max: 15,
             max_depth: 24,
-            max_eye_splits: 10,
+            max_eye_splits: 24,
             seed: 0x5eed,
             memory_budget: None,
             crack_dilation: true,

@@ -3,7 +3,7 @@
 //! either strategy, then a resolve pass from sub-samples to pixels.
 
 use crate::buckets;
-use crate::frame::{Frame, FrameData, Material, PatchItem};
+use crate::frame::{Frame, FrameData, PatchItem};
 use crate::image::FrameImage;
 use crate::shaders;
 use crate::stages::{C_MAX_DEPTH, COUNTERS};
@@ -164,18 +164,10 @@ impl GpuRenderer {
     pub fn render(&self, gpu: &Gpu, data: &FrameData) -> Result<GpuFrame, RunError> {
         let start = Instant::now();
         let f = &data.frame;
-        let upload = |label: &str, bytes: &[u8]| -> Result<wgpu::Buffer, RunError> {
-            let b = gpu.storage_buffer(label, (bytes.len() as u64).div_ceil(4).max(1))?;
-            gpu.queue.write_buffer(&b, 0, bytes);
-            Ok(b)
-        };
-        let mut materials = data.materials.clone();
-        if materials.is_empty() {
-            materials.push(Material::zeroed());
-        }
-        let materials = upload("materials", bytemuck::cast_slice(&materials))?;
-        let lights = upload("lights", bytemuck::cast_slice(&data.lights))?;
-        let infos = upload("patch info", bytemuck::cast_slice(&data.patch_info))?;
+        // Each table holds at least one element, also for an empty scene (Gpu::upload).
+        let materials = gpu.upload("materials", &data.materials)?;
+        let lights = gpu.upload("lights", &data.lights)?;
+        let infos = gpu.upload("patch info", &data.patch_info)?;
         let mut todo = buckets::plan(f, data.memory_budget);
         todo.reverse();
         let per_pixel = buckets::sample_bytes_per_pixel(f);
@@ -364,5 +356,3 @@ impl GpuRenderer {
         Ok(timer.total_ms())
     }
 }
-
-use bytemuck::Zeroable;

@@ -31,11 +31,11 @@ pub fn frame_stats(data: &FrameData, g: &GpuFrame, adapter: &str, warnings: &[St
         "culls": {
             "clip": c[s::C_CULL_CLIP],
             "offscreen": c[s::C_CULL_OFFSCREEN],
-            "near_plane": c[s::C_CULL_NEAR],
             "backface_patches": c[s::C_CULL_BACKFACE],
             "backface_micropolygons": c[s::C_BACKFACE],
         },
         "depth_limited": c[s::C_DEPTH_LIMIT],
+        "near_clipped_grids": c[s::C_NEAR_CLIPPED],
         "grids_diced": ex[3] + ex[4],
         "grids_small": ex[4],
         "micropolygons": c[s::C_MICROPOLYGONS],

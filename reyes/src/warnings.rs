@@ -1,6 +1,6 @@
-//! The warnings of a rendered frame: where the renderer gave up on part of the scene (pieces
-//! still crossing the near plane after the allowed eye splits, grids diced at the split limit)
-//! or drew nothing at all. Read from the stage counters, so the GPU and CPU pipelines give the
+//! The warnings of a rendered frame: where the renderer gave up on part of the scene (grids
+//! diced at the split limit) or drew nothing at all. (Pieces still crossing the near plane after
+//! the allowed eye splits are not among them: they are diced and clipped, nothing is lost.) Read from the stage counters, so the GPU and CPU pipelines give the
 //! same messages.
 
 use crate::frame::FrameData;
@@ -10,15 +10,6 @@ use crate::stages::{self as s, COUNTERS};
 pub fn frame_warnings(data: &FrameData, counters: &[u64; COUNTERS]) -> Vec<String> {
     let f = &data.frame;
     let mut out = Vec::new();
-    let near = counters[s::C_CULL_NEAR];
-    if near > 0 {
-        out.push(format!(
-            "{near} patch pieces still crossed the near plane (z = {}) after {} eye splits and \
-             were culled",
-            f.near,
-            f.max_eye_splits.min(f.max_depth)
-        ));
-    }
     let limited = counters[s::C_DEPTH_LIMIT];
     if limited > 0 {
         out.push(format!(
@@ -27,14 +18,20 @@ pub fn frame_warnings(data: &FrameData, counters: &[u64; COUNTERS]) -> Vec<Strin
             f.max_depth
         ));
     }
-    if !data.items.is_empty() && counters[s::C_MICROPOLYGONS] == 0 {
+    if data.items.is_empty() {
+        out.push(
+            "nothing was drawn: the world holds no patch (none was given, or every primitive \
+             was skipped)"
+                .to_string(),
+        );
+    } else if counters[s::C_MICROPOLYGONS] == 0 {
         out.push(format!(
             "nothing was drawn: all {} patches were culled ({} pieces outside the near/far \
-             range, {} off screen, {} at the near plane)",
+             range, {} off screen, {} facing away)",
             data.items.len(),
             counters[s::C_CULL_CLIP],
             counters[s::C_CULL_OFFSCREEN],
-            near
+            counters[s::C_CULL_BACKFACE]
         ));
     }
     out
@@ -52,12 +49,22 @@ mod tests {
         let mut c = [0u64; COUNTERS];
         c[s::C_MICROPOLYGONS] = 100;
         assert!(frame_warnings(&data, &c).is_empty());
-        c[s::C_CULL_NEAR] = 3;
+        c[s::C_NEAR_CLIPPED] = 3;
+        assert!(
+            frame_warnings(&data, &c).is_empty(),
+            "near-clipped grids lose nothing"
+        );
         c[s::C_DEPTH_LIMIT] = 2;
         let w = frame_warnings(&data, &c);
-        assert_eq!(w.len(), 2);
-        assert!(w[0].starts_with("3 patch pieces still crossed the near plane"));
-        assert!(w[1].starts_with("2 grids reached the split limit (max_depth 24)"));
+        assert_eq!(w.len(), 1);
+        assert!(w[0].starts_with("2 grids reached the split limit (max_depth 24)"));
+        let empty = FrameData {
+            items: Vec::new(),
+            ..data.clone()
+        };
+        let w = frame_warnings(&empty, &[0; COUNTERS]);
+        assert_eq!(w.len(), 1);
+        assert!(w[0].starts_with("nothing was drawn: the world holds no patch"));
         c = [0; COUNTERS];
         c[s::C_CULL_OFFSCREEN] = 32;
         let w = frame_warnings(&data, &c);

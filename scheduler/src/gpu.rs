@@ -4,6 +4,7 @@
 //! Environment: `WGPU_ADAPTER_NAME` (substring of the adapter name), `WGPU_BACKEND`
 //! (e.g. `vulkan`), `WGPU_POWER_PREF`. No adapter is a loud error, never a silent skip.
 
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use crate::error::RunError;
@@ -24,6 +25,10 @@ pub struct Gpu {
     /// Timestamp queries at pass boundaries are available: runs report GPU time.
     pub timestamps: bool,
     pub timeout: Duration,
+    /// wgpu errors not captured by an error scope (validation, out of memory), in order. wgpu's
+    /// default handler panics; this device records them instead and [`Gpu::wait`] reports the
+    /// first as [`RunError::Device`], so a bad dispatch is an error of the run, never a panic.
+    uncaptured: Arc<Mutex<Vec<String>>>,
 }
 
 impl Gpu {
@@ -83,7 +88,15 @@ impl Gpu {
             ..Default::default()
         }))
         .map_err(|e| RunError::NoAdapter(format!("request_device on {}: {e}", info.name)))?;
+        let uncaptured = Arc::new(Mutex::new(Vec::new()));
+        let sink = uncaptured.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            sink.lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .push(e.to_string());
+        }));
         Ok(Gpu {
+            uncaptured,
             coherent: features.contains(wgpu::Features::MEMORY_DECORATION_COHERENT),
             timestamps: features.contains(wgpu::Features::TIMESTAMP_QUERY),
             adapter,
@@ -99,12 +112,17 @@ impl Gpu {
         format!("{} ({:?})", self.info.name, self.info.backend)
     }
 
-    /// Waits for all submitted work, bounded by `self.timeout`.
+    /// Waits for all submitted work, bounded by `self.timeout`. A wgpu error recorded since
+    /// the last wait (see [`Gpu::take_error`]) is returned as [`RunError::Device`].
     pub fn wait(&self, what: &str) -> Result<(), RunError> {
-        match self.device.poll(wgpu::PollType::Wait {
+        let polled = self.device.poll(wgpu::PollType::Wait {
             submission_index: None,
             timeout: Some(self.timeout),
-        }) {
+        });
+        if let Some(e) = self.take_error() {
+            return Err(RunError::Device(format!("{what}: {e}")));
+        }
+        match polled {
             Ok(_) => Ok(()),
             Err(wgpu::PollError::Timeout) => Err(RunError::Timeout {
                 what: what.to_string(),
@@ -112,6 +130,15 @@ impl Gpu {
             }),
             Err(e) => Err(RunError::Device(format!("{what}: {e}"))),
         }
+    }
+
+    /// The first wgpu error recorded since the last call (the rest are dropped with it: they
+    /// usually follow from the first).
+    pub fn take_error(&self) -> Option<String> {
+        let mut errors = self.uncaptured.lock().unwrap_or_else(|p| p.into_inner());
+        let first = errors.first().cloned();
+        errors.clear();
+        first
     }
 
     /// Copies `size` bytes of `src` from `offset` to the host; bounded wait.
@@ -188,6 +215,23 @@ impl Gpu {
                 | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         }))
+    }
+
+    /// A storage buffer holding `items`, sized for at least one `T`: a binding of an array of
+    /// `T` must hold one element even when the data is empty (an empty scene, a bucket no
+    /// patch reaches), or wgpu rejects the dispatch.
+    pub fn upload<T: bytemuck::Pod>(
+        &self,
+        label: &str,
+        items: &[T],
+    ) -> Result<wgpu::Buffer, RunError> {
+        let bytes = (items.len().max(1) * size_of::<T>()) as u64;
+        let buffer = self.storage_buffer(label, bytes.div_ceil(4))?;
+        if !items.is_empty() {
+            self.queue
+                .write_buffer(&buffer, 0, bytemuck::cast_slice(items));
+        }
+        Ok(buffer)
     }
 
     /// A bind group of whole storage buffers at bindings 0, 1, 2, ... in order.

@@ -37,28 +37,60 @@ fn bound_execute(item: PatchItem, inv: Invocation) {
     }
     let depth = item.depth & 255u;
     let eye = (item.depth >> 8u) & 255u;
+    let t0 = vec2<f32>(f32(frame.tile_x0), f32(frame.tile_y0)) - CULL_MARGIN_PX;
+    let t1 = vec2<f32>(f32(frame.tile_x0 + frame.tile_w), f32(frame.tile_y0 + frame.tile_h))
+        + CULL_MARGIN_PX;
     if zmin < frame.near {
-        // Crossing the near plane: no screen bound exists. Split a bounded number of times.
-        if eye >= frame.max_eye_splits || depth >= frame.max_depth {
-            atomicAdd(&counters[C_CULL_NEAR], 1u);
+        // Crossing the near plane: only the part in front can be seen, and its screen bound
+        // decides whether anything of it reaches the bucket.
+        let vis = near_visible_bound(&cp);
+        if any(vis[1] < t0) || any(vis[0] > t1) {
+            atomicAdd(&counters[C_CULL_OFFSCREEN], 1u);
             return;
         }
-        var e = item;
-        e.depth = item.depth + 256u;
-        atomicAdd(&counters[C_EYE_SPLITS], 1u);
-        if polygon_length(&cp, 1u, 4u) >= polygon_length(&cp, 4u, 1u) {
-            enqueue_splitu(e);
+        // Split while what can be seen of it spans more of the image than one finest grid
+        // should: its micropolygons then stay small where they are seen. (The image, not the
+        // bucket: decisions that do not depend on the bucket keep bucketed images exact.)
+        let seen = min(vis[1], vec2<f32>(f32(frame.width), f32(frame.height)) + CULL_MARGIN_PX)
+            - max(vis[0], vec2<f32>(-CULL_MARGIN_PX));
+        let grid_px = select(f32(frame.grid_max) * frame.mp_size, frame.bound_px,
+            frame.bound_px > 0.0);
+        if max(seen.x, seen.y) > grid_px && eye < frame.max_eye_splits && depth < frame.max_depth {
+            var e = item;
+            e.depth = item.depth + 256u;
+            atomicAdd(&counters[C_EYE_SPLITS], 1u);
+            if polygon_length(&cp, 1u, 4u) >= polygon_length(&cp, 4u, 1u) {
+                enqueue_splitu(e);
+            } else {
+                enqueue_splitv(e);
+            }
+            return;
+        }
+        // Dice at the finest grid and clip each micropolygon against the near plane in camera
+        // space (sample.wgsl), as rasterizers clip triangles.
+        atomicAdd(&counters[C_NEAR_CLIPPED], 1u);
+        atomicMax(&counters[C_MAX_DEPTH], depth);
+        var g = item;
+        g.rates = frame.grid_max | (frame.grid_max << 8u) | NEAR_CLIP_GRID;
+        // The dilation bound at the nearest front control point, not at the near plane (where
+        // it would always be the cap): what lies nearer is a sliver whose chord error is
+        // seen only in a few pixels at the view axis (docs/reyes.md, near plane).
+        var zfront = zmax;
+        for (var k = 0u; k < 16u; k++) {
+            if pts[k].z >= frame.near { zfront = min(zfront, pts[k].z); }
+        }
+        g.dilate = select(0.0, crack_dilation(&cp, frame.grid_max, frame.grid_max, zfront),
+            frame.crack_dilation != 0u);
+        if (frame.grid_max + 1u) * (frame.grid_max + 1u) <= SMALL_GRID_POINTS {
+            enqueue_dicesmall(g);
         } else {
-            enqueue_splitv(e);
+            enqueue_diceshade(g);
         }
         return;
     }
     var lo = pts[0].xy;
     var hi = pts[0].xy;
     for (var k = 1u; k < 16u; k++) { lo = min(lo, pts[k].xy); hi = max(hi, pts[k].xy); }
-    let t0 = vec2<f32>(f32(frame.tile_x0), f32(frame.tile_y0)) - CULL_MARGIN_PX;
-    let t1 = vec2<f32>(f32(frame.tile_x0 + frame.tile_w), f32(frame.tile_y0 + frame.tile_h))
-        + CULL_MARGIN_PX;
     if any(hi < t0) || any(lo > t1) {
         atomicAdd(&counters[C_CULL_OFFSCREEN], 1u);
         return;
@@ -93,6 +125,33 @@ fn bound_execute(item: PatchItem, inv: Invocation) {
     } else {
         enqueue_diceshade(g);
     }
+}
+
+// Screen bound (lo, hi) of the part of the patch in front of the near plane. The patch lies in
+// the convex hull of its control points; the part of that hull with z >= near is the hull of
+// the front control points and of the points where segments from a front to a behind control
+// point cross the plane; and perspective projection maps a convex set in front of the eye onto
+// the convex hull of its vertices' projections. Coordinates may be huge (a point at the near
+// plane far off the view axis), never NaN: near > 0.
+fn near_visible_bound(cp: ptr<function, array<f32, 48>>) -> array<vec2<f32>, 2> {
+    var lo = vec2<f32>(3.0e38);
+    var hi = vec2<f32>(-3.0e38);
+    for (var a = 0u; a < 16u; a++) {
+        let p = cp_point(cp, a);
+        if p.z < frame.near { continue; }
+        let s = project(p);
+        lo = min(lo, s);
+        hi = max(hi, s);
+        for (var b = 0u; b < 16u; b++) {
+            let q = cp_point(cp, b);
+            if q.z >= frame.near { continue; }
+            let x = p + (q - p) * ((p.z - frame.near) / (p.z - q.z));
+            let c = project(vec3<f32>(x.xy, frame.near));
+            lo = min(lo, c);
+            hi = max(hi, c);
+        }
+    }
+    return array<vec2<f32>, 2>(lo, hi);
 }
 
 // Sum of |P[i+1] - P[i]| over a row (step along u = 1) or column (step = 4), in camera space,

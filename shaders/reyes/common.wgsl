@@ -67,7 +67,7 @@ struct PatchInfo {
 
 const C_CULL_CLIP: u32 = 0u;       // wholly in front of near or behind far
 const C_CULL_OFFSCREEN: u32 = 1u;  // screen bound misses the image
-const C_CULL_NEAR: u32 = 2u;       // still crossing the near plane after max_eye_splits
+const C_NEAR_CLIPPED: u32 = 2u;    // grids diced with near-plane clipping (crossing after max_eye_splits)
 const C_DEPTH_LIMIT: u32 = 3u;     // diced at max_depth although it wanted another split
 const C_MICROPOLYGONS: u32 = 4u;
 const C_MAX_DEPTH: u32 = 5u;
@@ -79,6 +79,9 @@ const C_CULL_BACKFACE: u32 = 8u;   // patches culled in Bound as back-facing eve
 // crack dilation (at most MAX_DILATE_PX) never reaches a sample of a bucket that culled it:
 // bucketed and whole-frame renders give the same samples.
 const MAX_DILATE_PX: f32 = 2.0;
+// Bit of PatchItem.rates: the grid crosses the near plane, so DiceShade keeps its points in
+// camera space and sampling clips each micropolygon that crosses (sample.wgsl).
+const NEAR_CLIP_GRID: u32 = 0x10000u;
 // Grids of at most this many points go to DiceSmall (64 threads per grid).
 const SMALL_GRID_POINTS: u32 = 64u;
 const CULL_MARGIN_PX: f32 = 3.0;

@@ -99,9 +99,14 @@ fn dice_grid(item: PatchItem, inv: Invocation, threads: u32) {
         let n = patch_normal(&cp, e, u, v, (info.flags & 1u) != 0u);
         let c = shade(e[0], n, materials[info.material]);
         let back = dot(n, e[0]) > 0.0;
-        let z = max(e[0].z, frame.near);
-        let s = project(vec3<f32>(e[0].xy, z));
-        diceshade_shared[base + t] = vec4<f32>(s, z, bitcast<f32>(pack_color(c, back)));
+        let color = bitcast<f32>(pack_color(c, back));
+        if (item.rates & NEAR_CLIP_GRID) != 0u {
+            // Crosses the near plane: camera space, projected after clipping (sample.wgsl).
+            diceshade_shared[base + t] = vec4<f32>(e[0], color);
+        } else {
+            let z = max(e[0].z, frame.near);
+            diceshade_shared[base + t] = vec4<f32>(project(vec3<f32>(e[0].xy, z)), z, color);
+        }
     }
     workgroupBarrier();
     if !inv.live { return; }
@@ -110,11 +115,14 @@ fn dice_grid(item: PatchItem, inv: Invocation, threads: u32) {
         let i = t % nu;
         let j = t / nu;
         let two_sided = (patch_info[item.patch_id].flags & 2u) != 0u;
-        sample_micropolygon(
-            diceshade_shared[base + j * cols + i],
-            diceshade_shared[base + j * cols + i + 1u],
-            diceshade_shared[base + (j + 1u) * cols + i + 1u],
-            diceshade_shared[base + (j + 1u) * cols + i],
-            item.dilate, two_sided);
+        let a = diceshade_shared[base + j * cols + i];
+        let b = diceshade_shared[base + j * cols + i + 1u];
+        let c = diceshade_shared[base + (j + 1u) * cols + i + 1u];
+        let d = diceshade_shared[base + (j + 1u) * cols + i];
+        if (item.rates & NEAR_CLIP_GRID) != 0u {
+            sample_near_clipped(a, b, c, d, item.dilate, two_sided);
+        } else {
+            sample_micropolygon(a, b, c, d, item.dilate, two_sided);
+        }
     }
 }

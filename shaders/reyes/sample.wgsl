@@ -51,6 +51,13 @@ fn average_color(a: u32, b: u32, c: u32, d: u32) -> u32 {
     return out;
 }
 
+// Keeps the nearest of the keys written to sub-sample (sx, sy) of pixel (px, py) of the bucket.
+fn write_sample(px: u32, py: u32, sx: u32, sy: u32, z: f32, color: u32) {
+    let key = (u64(~bitcast<u32>(z)) << 32u) | u64(color);
+    let pixel = (py - frame.tile_y0) * frame.tile_w + px - frame.tile_x0;
+    atomicMax(&samples[pixel * frame.spp_x * frame.spp_y + sy * frame.spp_x + sx], key);
+}
+
 fn sample_micropolygon(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, grow: f32, two_sided: bool) {
     let ca = bitcast<u32>(a.w);
     let cb = bitcast<u32>(b.w);
@@ -71,7 +78,6 @@ fn sample_micropolygon(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, g
     if !(all(hi >= vec2<f32>(t0)) && all(lo < vec2<f32>(t1))) { return; }
     let p0 = vec2<u32>(max(lo, vec2<f32>(t0)));
     let p1 = min(vec2<u32>(min(hi, vec2<f32>(t1))), t1 - vec2<u32>(1u));
-    let spp = frame.spp_x * frame.spp_y;
     let abc = triangle_setup(a, b, c, grow);
     let acd = triangle_setup(a, c, d, grow);
     for (var py = p0.y; py <= p1.y; py++) {
@@ -83,9 +89,128 @@ fn sample_micropolygon(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, g
                     var z = triangle_depth(abc, q);
                     if z < 0.0 { z = triangle_depth(acd, q); }
                     if z < 0.0 { continue; }
-                    let key = (u64(~bitcast<u32>(z)) << 32u) | u64(color);
-                    let idx = ((py - t0.y) * frame.tile_w + px - t0.x) * spp + sy * frame.spp_x + sx;
-                    atomicMax(&samples[idx], key);
+                    write_sample(px, py, sx, sy, z, color);
+                }
+            }
+        }
+    }
+}
+
+// Pixels beyond the image edge that clipped polygons keep: wider than Bound's cull margin plus
+// the largest crack dilation, so clipping never cuts what a bucket's samples could see.
+const GUARD_BAND_PX: f32 = 16.0;
+// Vertices a triangle can have after clipping by the near plane and four guard-band planes.
+const CLIPPED_MAX: u32 = 8u;
+
+// The clip planes (a, b, c, d): the part of camera space with a x + b y + c z + d >= 0 is kept.
+// 0: the near plane; 1-4: the image's sides grown by the guard band, through the eye.
+fn clip_plane(k: u32) -> vec4<f32> {
+    let gx = 0.5 * f32(frame.width) + GUARD_BAND_PX;
+    let gy = 0.5 * f32(frame.height) + GUARD_BAND_PX;
+    let f = frame.focal;
+    switch k {
+        case 0u: { return vec4<f32>(0.0, 0.0, 1.0, -frame.near); }
+        case 1u: { return vec4<f32>(f, 0.0, gx, 0.0); }
+        case 2u: { return vec4<f32>(-f, 0.0, gx, 0.0); }
+        case 3u: { return vec4<f32>(0.0, -f, gy, 0.0); }
+        default: { return vec4<f32>(0.0, f, gy, 0.0); }
+    }
+}
+
+// One Sutherland-Hodgman step: the part of convex polygon `poly` (n vertices) on the kept side
+// of `plane`; returns the new vertex count. An edge's crossing is computed from its kept end,
+// so the edge two triangles share is cut at the same point in both.
+fn clip_by_plane(poly: ptr<function, array<vec3<f32>, 8>>, n: u32, plane: vec4<f32>) -> u32 {
+    var out: array<vec3<f32>, 8>;
+    var m = 0u;
+    for (var i = 0u; i < n; i++) {
+        let p = (*poly)[i];
+        let q = (*poly)[(i + 1u) % n];
+        let dp = dot(plane.xyz, p) + plane.w;
+        let dq = dot(plane.xyz, q) + plane.w;
+        if dp >= 0.0 {
+            out[m] = p;
+            m++;
+            if dq < 0.0 { out[m] = p + (q - p) * (dp / (dp - dq)); m++; }
+        } else if dq >= 0.0 {
+            out[m] = q + (p - q) * (dq / (dq - dp));
+            m++;
+        }
+    }
+    *poly = out;
+    return m;
+}
+
+// A micropolygon of a grid that crosses the near plane, corners in camera space. One wholly in
+// front is projected and sampled like any other. Otherwise each of its triangles (abc, acd, the
+// split sample_micropolygon uses) is clipped in camera space against the near plane and the
+// image's guard band, as hardware rasterizers clip, and what is left is sampled as a fan.
+fn sample_near_clipped(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, grow: f32,
+                       two_sided: bool) {
+    if min(min(a.z, b.z), min(c.z, d.z)) >= frame.near {
+        sample_micropolygon(projected(a), projected(b), projected(c), projected(d), grow,
+            two_sided);
+        return;
+    }
+    let ca = bitcast<u32>(a.w);
+    let cb = bitcast<u32>(b.w);
+    let cc = bitcast<u32>(c.w);
+    let cd = bitcast<u32>(d.w);
+    if !two_sided && (ca & cb & cc & cd & (1u << 30u)) != 0u {
+        atomicAdd(&counters[C_BACKFACE], 1u);
+        return;
+    }
+    let color = average_color(ca, cb, cc, cd);
+    sample_clipped_triangle(a.xyz, b.xyz, c.xyz, grow, color);
+    sample_clipped_triangle(a.xyz, c.xyz, d.xyz, grow, color);
+}
+
+fn projected(p: vec4<f32>) -> vec4<f32> {
+    return vec4<f32>(project(p.xyz), p.z, p.w);
+}
+
+fn sample_clipped_triangle(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, grow: f32, color: u32) {
+    var poly: array<vec3<f32>, 8>;
+    poly[0] = a;
+    poly[1] = b;
+    poly[2] = c;
+    var n = 3u;
+    for (var k = 0u; k < 5u && n >= 3u; k++) {
+        n = clip_by_plane(&poly, n, clip_plane(k));
+        if k == 0u {
+            // Crossings of the near plane lie on it; rounding must not put them behind the eye.
+            for (var i = 0u; i < n; i++) { poly[i].z = max(poly[i].z, frame.near); }
+        }
+    }
+    if n < 3u { return; }
+    var s: array<vec4<f32>, 8>;
+    var lo = vec2<f32>(3.0e38);
+    var hi = vec2<f32>(-3.0e38);
+    for (var i = 0u; i < n; i++) {
+        s[i] = vec4<f32>(project(poly[i]), poly[i].z, 0.0);
+        lo = min(lo, s[i].xy);
+        hi = max(hi, s[i].xy);
+    }
+    // The fan (s0, s1, s2), (s0, s2, s3), ...
+    var fan: array<Triangle, 6>;
+    for (var i = 0u; i + 2u < n; i++) { fan[i] = triangle_setup(s[0], s[i + 1u], s[i + 2u], grow); }
+    lo -= vec2<f32>(grow);
+    hi += vec2<f32>(grow);
+    let t0 = vec2<u32>(frame.tile_x0, frame.tile_y0);
+    let t1 = t0 + vec2<u32>(frame.tile_w, frame.tile_h);
+    if !(all(hi >= vec2<f32>(t0)) && all(lo < vec2<f32>(t1))) { return; }
+    let p0 = vec2<u32>(max(lo, vec2<f32>(t0)));
+    let p1 = min(vec2<u32>(min(hi, vec2<f32>(t1))), t1 - vec2<u32>(1u));
+    for (var py = p0.y; py <= p1.y; py++) {
+        for (var px = p0.x; px <= p1.x; px++) {
+            for (var sy = 0u; sy < frame.spp_y; sy++) {
+                for (var sx = 0u; sx < frame.spp_x; sx++) {
+                    let q = sample_position(px, py, sx, sy);
+                    if any(q < lo) || any(q > hi) { continue; }
+                    var z = -1.0;
+                    for (var i = 0u; i + 2u < n && z < 0.0; i++) { z = triangle_depth(fan[i], q); }
+                    if z < 0.0 { continue; }
+                    write_sample(px, py, sx, sy, z, color);
                 }
             }
         }

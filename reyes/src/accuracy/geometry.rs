@@ -51,7 +51,12 @@ const POINTS: [(f64, f64); 7] = [
 
 /// Measures the micropolygons `data` dices for `scene` (the scene `data` was made from).
 pub fn geometry(scene: &Scene, data: &FrameData) -> GeometryStats {
-    let items = diced_items(data);
+    // Grids crossing the near plane keep camera-space points and are clipped when sampled;
+    // the metric measures projected micropolygons, which they do not have.
+    let items: Vec<PatchItem> = diced_items(data)
+        .into_iter()
+        .filter(|i| i.rates & crate::stages::NEAR_CLIP_GRID == 0)
+        .collect();
     let threads = std::thread::available_parallelism().map_or(1, |t| t.get());
     let parts = in_chunks(items.len(), items.len().div_ceil(threads * 16), |range| {
         let mut part = Part::default();

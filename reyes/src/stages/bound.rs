@@ -12,9 +12,8 @@ pub const CULL_MARGIN_PX: f32 = 3.0;
 pub enum Cull {
     /// Wholly in front of the near plane or behind the far plane.
     Clip,
+    /// Nothing of it (in front of the near plane) reaches the bucket.
     Offscreen,
-    /// Still crossing the near plane after the allowed eye splits.
-    Near,
     /// Back-facing at every point (one-sided surfaces only).
     Backface,
 }
@@ -29,6 +28,7 @@ pub enum Decision {
         eye: bool,
     },
     /// Dice with the rates and dilation filled in; `depth_limited` when it wanted another split.
+    /// A grid still crossing the near plane has [`super::NEAR_CLIP_GRID`] set in its rates.
     Dice {
         item: PatchItem,
         depth_limited: bool,
@@ -57,25 +57,53 @@ pub fn bound(item: &PatchItem, f: &Frame, info: &PatchInfo) -> Decision {
         return Decision::Cull(Cull::Backface);
     }
     let depth = item.splits();
+    let t0 = Vec2::new(f.tile_x0 as f32, f.tile_y0 as f32) - CULL_MARGIN_PX;
+    let t1 =
+        Vec2::new((f.tile_x0 + f.tile_w) as f32, (f.tile_y0 + f.tile_h) as f32) + CULL_MARGIN_PX;
+    let misses = |lo: Vec2, hi: Vec2| hi.x < t0.x || hi.y < t0.y || lo.x > t1.x || lo.y > t1.y;
     if zmin < f.near {
-        if item.eye_splits() >= f.max_eye_splits || depth >= f.max_depth {
-            return Decision::Cull(Cull::Near);
+        let (lo, hi) = near_visible_bound(f, cp);
+        if misses(lo, hi) {
+            return Decision::Cull(Cull::Offscreen);
         }
-        let mut e = *item;
-        e.depth += 256;
-        let along_u = polygon_length(cp, 1, 4) >= polygon_length(cp, 4, 1);
-        return Decision::Split {
-            along_u,
-            item: e,
-            eye: true,
+        // The image, not the bucket: see bound.wgsl.
+        let image = Vec2::new(f.width as f32, f.height as f32) + CULL_MARGIN_PX;
+        let seen = hi.min(image) - lo.max(Vec2::splat(-CULL_MARGIN_PX));
+        let grid_px = if f.bound_px > 0.0 {
+            f.bound_px
+        } else {
+            f.grid_max as f32 * f.mp_size
+        };
+        if seen.x.max(seen.y) > grid_px
+            && item.eye_splits() < f.max_eye_splits
+            && depth < f.max_depth
+        {
+            let mut e = *item;
+            e.depth += 256;
+            let along_u = polygon_length(cp, 1, 4) >= polygon_length(cp, 4, 1);
+            return Decision::Split {
+                along_u,
+                item: e,
+                eye: true,
+            };
+        }
+        let mut g = *item;
+        g.rates = f.grid_max | f.grid_max << 8 | super::NEAR_CLIP_GRID;
+        g.dilate = if f.crack_dilation != 0 {
+            // At the nearest front control point: see bound.wgsl.
+            let zfront = pts.iter().map(|p| p.1).filter(|&z| z >= f.near);
+            crack_dilation(f, cp, f.grid_max, f.grid_max, zfront.fold(zmax, f32::min))
+        } else {
+            0.0
+        };
+        return Decision::Dice {
+            item: g,
+            depth_limited: false,
         };
     }
     let lo = pts.iter().fold(pts[0].0, |a, p| a.min(p.0));
     let hi = pts.iter().fold(pts[0].0, |a, p| a.max(p.0));
-    let t0 = Vec2::new(f.tile_x0 as f32, f.tile_y0 as f32) - CULL_MARGIN_PX;
-    let t1 =
-        Vec2::new((f.tile_x0 + f.tile_w) as f32, (f.tile_y0 + f.tile_h) as f32) + CULL_MARGIN_PX;
-    if hi.x < t0.x || hi.y < t0.y || lo.x > t1.x || lo.y > t1.y {
+    if misses(lo, hi) {
         return Decision::Cull(Cull::Offscreen);
     }
     let (mut lu, mut lv) = (0f32, 0f32);
@@ -107,6 +135,33 @@ pub fn bound(item: &PatchItem, f: &Frame, info: &PatchInfo) -> Decision {
         item: g,
         depth_limited: split != 0,
     }
+}
+
+/// Screen bound (lo, hi) of the part of the patch in front of the near plane: the projections
+/// of the front control points and of the crossings of the near plane by segments from a front
+/// to a behind control point (`near_visible_bound` in bound.wgsl gives the argument).
+pub fn near_visible_bound(f: &Frame, cp: &[f32; 48]) -> (Vec2, Vec2) {
+    let (mut lo, mut hi) = (Vec2::splat(3.0e38), Vec2::splat(-3.0e38));
+    for a in 0..16 {
+        let p = cp_point(cp, a);
+        if p.z < f.near {
+            continue;
+        }
+        let s = Vec2::from(project(f, p));
+        lo = lo.min(s);
+        hi = hi.max(s);
+        for b in 0..16 {
+            let q = cp_point(cp, b);
+            if q.z >= f.near {
+                continue;
+            }
+            let x = p + (q - p) * ((p.z - f.near) / (p.z - q.z));
+            let c = Vec2::from(project(f, glam::Vec3::new(x.x, x.y, f.near)));
+            lo = lo.min(c);
+            hi = hi.max(c);
+        }
+    }
+    (lo, hi)
 }
 
 /// Whether every point of the patch is back-facing: `backfacing_terms` in bound.wgsl (the

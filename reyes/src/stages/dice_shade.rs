@@ -1,7 +1,8 @@
 //! Twin of `shaders/reyes/dice_shade.wgsl`: the grid of points with normals from the patch's
 //! derivatives, shaded; then every micropolygon sampled.
 
-use super::{cp_point, project, sample::sample_micropolygon, shade};
+use super::sample::{sample_micropolygon, sample_near_clipped};
+use super::{NEAR_CLIP_GRID, cp_point, project, shade};
 use crate::frame::{FrameData, PatchItem};
 use glam::Vec3;
 
@@ -82,7 +83,8 @@ pub fn patch_normal_at(cp: &[f32; 48], e: [Vec3; 3], u: f32, v: f32, flip: bool)
     if flip { -n } else { n }
 }
 
-/// Grid points (x, y in pixels, z, packed colour bits as f32), row-major, (nu+1) x (nv+1).
+/// Grid points (x, y in pixels, z, packed colour bits as f32), row-major, (nu+1) x (nv+1);
+/// for a grid marked [`NEAR_CLIP_GRID`], x, y, z in camera space (projected after clipping).
 pub fn dice(item: &PatchItem, data: &FrameData) -> (u32, u32, Vec<[f32; 4]>) {
     let f = &data.frame;
     let (nu, nv) = (item.rates & 255, (item.rates >> 8) & 255);
@@ -96,9 +98,14 @@ pub fn dice(item: &PatchItem, data: &FrameData) -> (u32, u32, Vec<[f32; 4]>) {
         let n = patch_normal_at(&item.cp, e, u, v, info.flags & 1 != 0);
         let c = shade::shade(e[0], n, m, &data.lights);
         let back = n.dot(e[0]) > 0.0;
-        let z = e[0].z.max(f.near);
-        let s = project(f, Vec3::new(e[0].x, e[0].y, z));
-        grid.push([s[0], s[1], z, f32::from_bits(shade::pack_color(c, back))]);
+        let color = f32::from_bits(shade::pack_color(c, back));
+        if item.rates & NEAR_CLIP_GRID != 0 {
+            grid.push([e[0].x, e[0].y, e[0].z, color]);
+        } else {
+            let z = e[0].z.max(f.near);
+            let s = project(f, Vec3::new(e[0].x, e[0].y, z));
+            grid.push([s[0], s[1], z, color]);
+        }
     }
     (nu, nv, grid)
 }
@@ -117,7 +124,12 @@ pub fn dice_shade(item: &PatchItem, data: &FrameData, samples: &mut [u64]) -> (u
             g[(j + 1) * cols + i + 1],
             g[(j + 1) * cols + i],
         ];
-        if !sample_micropolygon(q, item.dilate, two_sided, &data.frame, samples) {
+        let sample = if item.rates & NEAR_CLIP_GRID != 0 {
+            sample_near_clipped
+        } else {
+            sample_micropolygon
+        };
+        if !sample(q, item.dilate, two_sided, &data.frame, samples) {
             culled += 1;
         }
     }

@@ -14,7 +14,9 @@ use glam::Vec3;
 /// Counters the stages keep, indexed like `C_*` in `shaders/reyes/common.wgsl`.
 pub const C_CULL_CLIP: usize = 0;
 pub const C_CULL_OFFSCREEN: usize = 1;
-pub const C_CULL_NEAR: usize = 2;
+/// Grids diced with near-plane clipping: pieces still crossing the plane after the allowed
+/// eye splits.
+pub const C_NEAR_CLIPPED: usize = 2;
 pub const C_DEPTH_LIMIT: usize = 3;
 pub const C_MICROPOLYGONS: usize = 4;
 pub const C_MAX_DEPTH: usize = 5;
@@ -22,6 +24,10 @@ pub const C_EYE_SPLITS: usize = 6;
 pub const C_BACKFACE: usize = 7;
 pub const C_CULL_BACKFACE: usize = 8;
 pub const COUNTERS: usize = 16;
+
+/// `NEAR_CLIP_GRID` in common.wgsl: a bit of `PatchItem::rates` marking a grid that crosses the
+/// near plane; DiceShade keeps its points in camera space and sampling clips.
+pub const NEAR_CLIP_GRID: u32 = 0x10000;
 
 /// `SMALL_GRID_POINTS` in common.wgsl: grids of at most this many points go to DiceSmall.
 pub const SMALL_GRID_POINTS: u32 = 64;

@@ -2,7 +2,7 @@
 
 use super::reyes_hash;
 use crate::frame::Frame;
-use glam::Vec2;
+use glam::{Vec2, Vec3, Vec4};
 
 fn cross2(a: Vec2, b: Vec2) -> f32 {
     a.x * b.y - a.y * b.x
@@ -74,6 +74,13 @@ pub fn sample_key(z: f32, color: u32) -> u64 {
     ((!z.to_bits() as u64) << 32) | color as u64
 }
 
+/// Keeps the nearest key at sub-sample (sx, sy) of pixel (px, py) of the bucket.
+fn write_sample(f: &Frame, samples: &mut [u64], [px, py, sx, sy]: [u32; 4], z: f32, color: u32) {
+    let pixel = (py - f.tile_y0) * f.tile_w + px - f.tile_x0;
+    let idx = (pixel * f.spp_x * f.spp_y + sy * f.spp_x + sx) as usize;
+    samples[idx] = samples[idx].max(sample_key(z, color));
+}
+
 /// Samples quad `q` (a, b, c, d around); false when it was culled as back-facing.
 pub fn sample_micropolygon(
     q: [[f32; 4]; 4],
@@ -100,7 +107,6 @@ pub fn sample_micropolygon(
     }
     let p0 = |k: usize| lo[k].max(t0[k] as f32) as u32;
     let p1 = |k: usize| (hi[k].min(t1[k] as f32) as u32).min(t1[k] - 1);
-    let spp = f.spp_x * f.spp_y;
     let abc = triangle_setup(q[0], q[1], q[2], grow);
     let acd = triangle_setup(q[0], q[2], q[3], grow);
     for py in p0(1)..=p1(1) {
@@ -118,12 +124,143 @@ pub fn sample_micropolygon(
                     if z < 0.0 {
                         continue;
                     }
-                    let pixel = (py - t0[1]) * f.tile_w + px - t0[0];
-                    let idx = (pixel * spp + sy * f.spp_x + sx) as usize;
-                    samples[idx] = samples[idx].max(sample_key(z, color));
+                    write_sample(f, samples, [px, py, sx, sy], z, color);
                 }
             }
         }
     }
     true
+}
+
+/// `GUARD_BAND_PX` in sample.wgsl: clipped polygons keep this much beyond the image's edges.
+pub const GUARD_BAND_PX: f32 = 16.0;
+
+/// `clip_plane` in sample.wgsl: 0 the near plane, 1-4 the guard band's sides through the eye;
+/// (a, b, c, d) keeps a x + b y + c z + d >= 0.
+fn clip_plane(f: &Frame, k: usize) -> Vec4 {
+    let gx = 0.5 * f.width as f32 + GUARD_BAND_PX;
+    let gy = 0.5 * f.height as f32 + GUARD_BAND_PX;
+    let fo = f.focal;
+    match k {
+        0 => Vec4::new(0.0, 0.0, 1.0, -f.near),
+        1 => Vec4::new(fo, 0.0, gx, 0.0),
+        2 => Vec4::new(-fo, 0.0, gx, 0.0),
+        3 => Vec4::new(0.0, -fo, gy, 0.0),
+        _ => Vec4::new(0.0, fo, gy, 0.0),
+    }
+}
+
+/// `clip_by_plane` in sample.wgsl: one Sutherland-Hodgman step, crossings computed from the
+/// kept end of each edge.
+fn clip_by_plane(poly: &[Vec3], plane: Vec4) -> Vec<Vec3> {
+    let n = poly.len();
+    let mut out = Vec::with_capacity(n + 1);
+    for i in 0..n {
+        let (p, q) = (poly[i], poly[(i + 1) % n]);
+        let dp = plane.truncate().dot(p) + plane.w;
+        let dq = plane.truncate().dot(q) + plane.w;
+        if dp >= 0.0 {
+            out.push(p);
+            if dq < 0.0 {
+                out.push(p + (q - p) * (dp / (dp - dq)));
+            }
+        } else if dq >= 0.0 {
+            out.push(q + (p - q) * (dq / (dq - dp)));
+        }
+    }
+    out
+}
+
+/// `sample_near_clipped` in sample.wgsl: a micropolygon of a grid crossing the near plane, its
+/// corners in camera space; false when culled as back-facing.
+pub fn sample_near_clipped(
+    q: [[f32; 4]; 4],
+    grow: f32,
+    two_sided: bool,
+    f: &Frame,
+    samples: &mut [u64],
+) -> bool {
+    if q.iter().map(|v| v[2]).fold(f32::MAX, f32::min) >= f.near {
+        let projected = q.map(|v| {
+            let s = super::project(f, Vec3::new(v[0], v[1], v[2]));
+            [s[0], s[1], v[2], v[3]]
+        });
+        return sample_micropolygon(projected, grow, two_sided, f, samples);
+    }
+    let c = q.map(|v| v[3].to_bits());
+    if !two_sided && (c[0] & c[1] & c[2] & c[3] & (1 << 30)) != 0 {
+        return false;
+    }
+    let color = average_color(c);
+    let p = q.map(|v| Vec3::new(v[0], v[1], v[2]));
+    sample_clipped_triangle(&[p[0], p[1], p[2]], grow, color, f, samples);
+    sample_clipped_triangle(&[p[0], p[2], p[3]], grow, color, f, samples);
+    true
+}
+
+fn sample_clipped_triangle(tri: &[Vec3; 3], grow: f32, color: u32, f: &Frame, samples: &mut [u64]) {
+    let mut poly = tri.to_vec();
+    for k in 0..5 {
+        if poly.len() < 3 {
+            break;
+        }
+        poly = clip_by_plane(&poly, clip_plane(f, k));
+        if k == 0 {
+            for v in &mut poly {
+                v.z = v.z.max(f.near);
+            }
+        }
+    }
+    if poly.len() < 3 {
+        return;
+    }
+    let s: Vec<[f32; 4]> = poly
+        .iter()
+        .map(|&v| {
+            let p = super::project(f, v);
+            [p[0], p[1], v.z, 0.0]
+        })
+        .collect();
+    let (mut lo, mut hi) = (Vec2::splat(3.0e38), Vec2::splat(-3.0e38));
+    for v in &s {
+        lo = lo.min(xy(*v));
+        hi = hi.max(xy(*v));
+    }
+    lo -= Vec2::splat(grow);
+    hi += Vec2::splat(grow);
+    let fan: Vec<Triangle> = (0..s.len() - 2)
+        .map(|i| triangle_setup(s[0], s[i + 1], s[i + 2], grow))
+        .collect();
+    let (t0, t1) = (
+        [f.tile_x0, f.tile_y0],
+        [f.tile_x0 + f.tile_w, f.tile_y0 + f.tile_h],
+    );
+    let inside = |k: usize| hi[k] >= t0[k] as f32 && lo[k] < t1[k] as f32;
+    if !(inside(0) && inside(1)) {
+        return;
+    }
+    let p0 = |k: usize| lo[k].max(t0[k] as f32) as u32;
+    let p1 = |k: usize| (hi[k].min(t1[k] as f32) as u32).min(t1[k] - 1);
+    for py in p0(1)..=p1(1) {
+        for px in p0(0)..=p1(0) {
+            for sy in 0..f.spp_y {
+                for sx in 0..f.spp_x {
+                    let q = sample_position(f, px, py, sx, sy);
+                    if q.x < lo.x || q.y < lo.y || q.x > hi.x || q.y > hi.y {
+                        continue;
+                    }
+                    let mut z = -1.0;
+                    for t in &fan {
+                        if z >= 0.0 {
+                            break;
+                        }
+                        z = triangle_depth(t, q);
+                    }
+                    if z >= 0.0 {
+                        write_sample(f, samples, [px, py, sx, sy], z, color);
+                    }
+                }
+            }
+        }
+    }
 }

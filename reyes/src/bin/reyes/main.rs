@@ -127,6 +127,10 @@ fn run(a: Args) -> Result<(), String> {
     let data = FrameData::new(&scene, &a.options)?;
     if a.cpu {
         let r = reyes::cpu_render::render_cpu(&data);
+        // The CPU twin keeps the GPU's counters: the same frame warnings.
+        for w in reyes::warnings::frame_warnings(&data, &r.counters) {
+            eprintln!("warning: {w}");
+        }
         r.image.write_png(&out)?;
         eprintln!("wrote {} (CPU reference)", out.display());
         return Ok(());
