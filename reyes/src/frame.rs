@@ -18,8 +18,9 @@ pub struct PatchItem {
     pub depth: u32,
     /// Dice rates set by Bound: u in bits 0..7, v in bits 8..15.
     pub rates: u32,
-    /// Crack dilation in pixels, set by Bound.
-    pub dilate: f32,
+    /// Crack dilation of each boundary edge (v = 0, v = 1, u = 0, u = 1), set by Bound: 8 bits
+    /// each from bit 0, in steps of `MAX_DILATE_PX / 255` pixels (`stages::bound::crack_dilation`).
+    pub dilate: u32,
 }
 
 impl PatchItem {
@@ -303,7 +304,7 @@ fn root_item(id: u32, p: &Patch) -> PatchItem {
         patch_id: id,
         depth: 0,
         rates: 0,
-        dilate: 0.0,
+        dilate: 0,
     }
 }
 

@@ -79,7 +79,7 @@ fn bound_execute(item: PatchItem, inv: Invocation) {
         for (var k = 0u; k < 16u; k++) {
             if pts[k].z >= frame.near { zfront = min(zfront, pts[k].z); }
         }
-        g.dilate = select(0.0, crack_dilation(&cp, frame.grid_max, frame.grid_max, zfront),
+        g.dilate = select(0u, crack_dilation(&cp, frame.grid_max, frame.grid_max, zfront),
             frame.crack_dilation != 0u);
         if (frame.grid_max + 1u) * (frame.grid_max + 1u) <= SMALL_GRID_POINTS {
             enqueue_dicesmall(g);
@@ -119,7 +119,7 @@ fn bound_execute(item: PatchItem, inv: Invocation) {
     atomicMax(&counters[C_MAX_DEPTH], depth);
     var g = item;
     g.rates = d.y | (d.z << 8u);
-    g.dilate = select(0.0, crack_dilation(&cp, d.y, d.z, zmin), frame.crack_dilation != 0u);
+    g.dilate = select(0u, crack_dilation(&cp, d.y, d.z, zmin), frame.crack_dilation != 0u);
     if (d.y + 1u) * (d.z + 1u) <= SMALL_GRID_POINTS {
         enqueue_dicesmall(g);
     } else {
@@ -184,14 +184,17 @@ fn dice_decision(lu: f32, lv: f32, extent: vec2<f32>) -> vec3<u32> {
     return vec3<u32>(0u, u32(max(nu, 1.0)), u32(max(nv, 1.0)));
 }
 
-// Largest gap, in pixels, between a boundary curve of this patch and the chord polyline a
-// neighbour may use for it: |C''| <= 6 max|second difference| of the control points, the chord
-// error of a segment of parameter length h is |C''| h^2 / 8, and a camera-space distance d at
-// depth >= zmin spans at most 2 d f / zmin pixels inside a 90 degree view. Micropolygons are
-// grown by this much so that T-junction gaps between grids diced at different rates close.
-// Capped at MAX_DILATE_PX (a grid that coarse is far above any sane micropolygon size).
-fn crack_dilation(cp: ptr<function, array<f32, 48>>, nu: u32, nv: u32, zmin: f32) -> f32 {
-    var m = 0.0;
+// Largest gap, in pixels, between each boundary curve of this patch and the chord polyline a
+// neighbour may use for it: |C''| <= 6 max|second difference| of the curve's control points, the
+// chord error of a segment of parameter length h is |C''| h^2 / 8, and a camera-space distance
+// d at depth >= zmin spans at most 2 d f / zmin pixels inside a 90 degree view. Sampling grows
+// only the micropolygon edges on that boundary by this much (sample.wgsl), so that T-junction
+// gaps between grids diced at different rates close: a gap can exist only there. Packed 8 bits
+// per edge (v = 0, v = 1, u = 0, u = 1), rounded up; each at most MAX_DILATE_PX (a grid that
+// coarse is far above any sane micropolygon size), at least one step (float rounding).
+fn crack_dilation(cp: ptr<function, array<f32, 48>>, nu: u32, nv: u32, zmin: f32) -> u32 {
+    let slack = 2.0 * (1.0 + max(f32(frame.width), f32(frame.height)) / frame.focal);
+    var packed = 0u;
     for (var e = 0u; e < 4u; e++) {
         // Edges: rows 0 and 3 (along u), columns 0 and 3 (along v).
         let along_u = e < 2u;
@@ -203,10 +206,11 @@ fn crack_dilation(cp: ptr<function, array<f32, 48>>, nu: u32, nv: u32, zmin: f32
         let b2 = cp_point(cp, start + 2u * step);
         let b3 = cp_point(cp, start + 3u * step);
         let c2 = 6.0 * max(length(b0 - 2.0 * b1 + b2), length(b1 - 2.0 * b2 + b3));
-        m = max(m, c2 / (8.0 * n * n));
+        let px = c2 / (8.0 * n * n) * frame.focal / zmin * slack;
+        let q = clamp(ceil(px * (255.0 / MAX_DILATE_PX)), 1.0, 255.0);
+        packed |= u32(q) << (8u * e);
     }
-    let slack = 2.0 * (1.0 + max(f32(frame.width), f32(frame.height)) / frame.focal);
-    return min(m * frame.focal / zmin * slack + 1.0e-3, MAX_DILATE_PX);
+    return packed;
 }
 
 // Safe back-face cull. With the eye at the origin a point is back-facing when

@@ -79,6 +79,9 @@ const C_CULL_BACKFACE: u32 = 8u;   // patches culled in Bound as back-facing eve
 // crack dilation (at most MAX_DILATE_PX) never reaches a sample of a bucket that culled it:
 // bucketed and whole-frame renders give the same samples.
 const MAX_DILATE_PX: f32 = 2.0;
+// Edges inside a grid meet no T-junction; with dilation on they grow by this much only, so that
+// float rounding in two triangles' edge tests cannot leave a sample on a shared edge uncovered.
+const ROUNDING_DILATE_PX: f32 = 1.0e-3;
 // Bit of PatchItem.rates: the grid crosses the near plane, so DiceShade keeps its points in
 // camera space and sampling clips each micropolygon that crosses (sample.wgsl).
 const NEAR_CLIP_GRID: u32 = 0x10000u;

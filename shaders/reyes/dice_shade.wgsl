@@ -119,10 +119,11 @@ fn dice_grid(item: PatchItem, inv: Invocation, threads: u32) {
         let b = diceshade_shared[base + j * cols + i + 1u];
         let c = diceshade_shared[base + (j + 1u) * cols + i + 1u];
         let d = diceshade_shared[base + (j + 1u) * cols + i];
+        let grow = micropolygon_dilation(item.dilate, i, j, nu, nv);
         if (item.rates & NEAR_CLIP_GRID) != 0u {
-            sample_near_clipped(a, b, c, d, item.dilate, two_sided);
+            sample_near_clipped(a, b, c, d, grow, two_sided);
         } else {
-            sample_micropolygon(a, b, c, d, item.dilate, two_sided);
+            sample_micropolygon(a, b, c, d, grow, two_sided);
         }
     }
 }

@@ -10,6 +10,7 @@ struct PatchItem {
     depth: u32,
     // Set by Bound for DiceShade: segments in u (bits 0..7) and v (bits 8..15).
     rates: u32,
-    // Set by Bound: crack dilation in pixels (see docs/reyes.md, "No cracks").
-    dilate: f32,
+    // Set by Bound: crack dilation of each boundary edge (v = 0, v = 1, u = 0, u = 1), 8 bits
+    // each from bit 0, in steps of MAX_DILATE_PX / 255 (docs/reyes.md, "No cracks").
+    dilate: u32,
 }

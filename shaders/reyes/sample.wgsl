@@ -14,7 +14,7 @@ fn sample_position(px: u32, py: u32, sx: u32, sy: u32) -> vec2<f32> {
 }
 
 // A triangle of a micropolygon with what its inside test needs, computed once per triangle:
-// the signed area and each edge's threshold for growing it by `grow` pixels.
+// the signed area and each edge's threshold for growing it outward by that edge's pixels.
 struct Triangle {
     a: vec3<f32>,
     b: vec3<f32>,
@@ -26,9 +26,11 @@ struct Triangle {
     gc: f32,
 }
 
-fn triangle_setup(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, grow: f32) -> Triangle {
+// `grow`: pixels to grow the edges opposite a, b and c (bc, ca, ab).
+fn triangle_setup(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, grow: vec3<f32>) -> Triangle {
     return Triangle(a.xyz, b.xyz, c.xyz, cross2(b.xy - a.xy, c.xy - a.xy),
-        -grow * distance(b.xy, c.xy), -grow * distance(a.xy, c.xy), -grow * distance(a.xy, b.xy));
+        -grow.x * distance(b.xy, c.xy), -grow.y * distance(a.xy, c.xy),
+        -grow.z * distance(a.xy, b.xy));
 }
 
 // Depth at q if q is inside the grown triangle; negative otherwise.
@@ -58,7 +60,19 @@ fn write_sample(px: u32, py: u32, sx: u32, sy: u32, z: f32, color: u32) {
     atomicMax(&samples[pixel * frame.spp_x * frame.spp_y + sy * frame.spp_x + sx], key);
 }
 
-fn sample_micropolygon(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, grow: f32, two_sided: bool) {
+// Pixels to grow each edge of micropolygon (i, j) of an nu x nv grid by, (ab, bc, cd, da): its
+// boundary edges by the crack dilation Bound packed for that side of the grid, its inner edges
+// by ROUNDING_DILATE_PX; nothing when dilation is off (packed = 0).
+fn micropolygon_dilation(packed: u32, i: u32, j: u32, nu: u32, nv: u32) -> vec4<f32> {
+    let side = vec4<f32>(f32(packed & 255u), f32((packed >> 24u) & 255u),
+        f32((packed >> 8u) & 255u), f32((packed >> 16u) & 255u)) * (MAX_DILATE_PX / 255.0);
+    let inner = select(0.0, ROUNDING_DILATE_PX, packed != 0u);
+    return select(vec4<f32>(inner), side, vec4<bool>(j == 0u, i + 1u == nu, j + 1u == nv, i == 0u));
+}
+
+// `grow`: pixels to grow edges ab, bc, cd and da by (micropolygon_dilation); the diagonal ac,
+// inside the micropolygon, by the least of them.
+fn sample_micropolygon(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, grow: vec4<f32>, two_sided: bool) {
     let ca = bitcast<u32>(a.w);
     let cb = bitcast<u32>(b.w);
     let cc = bitcast<u32>(c.w);
@@ -69,8 +83,9 @@ fn sample_micropolygon(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, g
         return;
     }
     let color = average_color(ca, cb, cc, cd);
-    let lo = min(min(a.xy, b.xy), min(c.xy, d.xy)) - vec2<f32>(grow);
-    let hi = max(max(a.xy, b.xy), max(c.xy, d.xy)) + vec2<f32>(grow);
+    let g = max(max(grow.x, grow.y), max(grow.z, grow.w));
+    let lo = min(min(a.xy, b.xy), min(c.xy, d.xy)) - vec2<f32>(g);
+    let hi = max(max(a.xy, b.xy), max(c.xy, d.xy)) + vec2<f32>(g);
     // Pixels of this bucket under the bound; the sample test below does not depend on the
     // bucket, so bucketed and whole-frame renders agree sample for sample.
     let t0 = vec2<u32>(frame.tile_x0, frame.tile_y0);
@@ -78,8 +93,9 @@ fn sample_micropolygon(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, g
     if !(all(hi >= vec2<f32>(t0)) && all(lo < vec2<f32>(t1))) { return; }
     let p0 = vec2<u32>(max(lo, vec2<f32>(t0)));
     let p1 = min(vec2<u32>(min(hi, vec2<f32>(t1))), t1 - vec2<u32>(1u));
-    let abc = triangle_setup(a, b, c, grow);
-    let acd = triangle_setup(a, c, d, grow);
+    let diagonal = min(min(grow.x, grow.y), min(grow.z, grow.w));
+    let abc = triangle_setup(a, b, c, vec3<f32>(grow.y, diagonal, grow.x));
+    let acd = triangle_setup(a, c, d, vec3<f32>(grow.z, grow.w, diagonal));
     for (var py = p0.y; py <= p1.y; py++) {
         for (var px = p0.x; px <= p1.x; px++) {
             for (var sy = 0u; sy < frame.spp_y; sy++) {
@@ -145,7 +161,8 @@ fn clip_by_plane(poly: ptr<function, array<vec3<f32>, 8>>, n: u32, plane: vec4<f
 // front is projected and sampled like any other. Otherwise each of its triangles (abc, acd, the
 // split sample_micropolygon uses) is clipped in camera space against the near plane and the
 // image's guard band, as hardware rasterizers clip, and what is left is sampled as a fan.
-fn sample_near_clipped(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, grow: f32,
+// Every edge of the clipped polygons grows by the micropolygon's largest `grow` (a rare path).
+fn sample_near_clipped(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, grow: vec4<f32>,
                        two_sided: bool) {
     if min(min(a.z, b.z), min(c.z, d.z)) >= frame.near {
         sample_micropolygon(projected(a), projected(b), projected(c), projected(d), grow,
@@ -161,8 +178,9 @@ fn sample_near_clipped(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, g
         return;
     }
     let color = average_color(ca, cb, cc, cd);
-    sample_clipped_triangle(a.xyz, b.xyz, c.xyz, grow, color);
-    sample_clipped_triangle(a.xyz, c.xyz, d.xyz, grow, color);
+    let g = max(max(grow.x, grow.y), max(grow.z, grow.w));
+    sample_clipped_triangle(a.xyz, b.xyz, c.xyz, g, color);
+    sample_clipped_triangle(a.xyz, c.xyz, d.xyz, g, color);
 }
 
 fn projected(p: vec4<f32>) -> vec4<f32> {
@@ -193,7 +211,9 @@ fn sample_clipped_triangle(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, grow: f32, 
     }
     // The fan (s0, s1, s2), (s0, s2, s3), ...
     var fan: array<Triangle, 6>;
-    for (var i = 0u; i + 2u < n; i++) { fan[i] = triangle_setup(s[0], s[i + 1u], s[i + 2u], grow); }
+    for (var i = 0u; i + 2u < n; i++) {
+        fan[i] = triangle_setup(s[0], s[i + 1u], s[i + 2u], vec3<f32>(grow));
+    }
     lo -= vec2<f32>(grow);
     hi += vec2<f32>(grow);
     let t0 = vec2<u32>(frame.tile_x0, frame.tile_y0);

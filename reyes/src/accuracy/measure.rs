@@ -26,6 +26,8 @@ pub struct Measurement<'a> {
     pub geometry: &'a GeometryStats,
     pub image: &'a ImageError,
     pub pinholes: usize,
+    /// Covered area of the render: the sum of its alpha, in square pixels.
+    pub coverage_px: f64,
     pub reference: &'a ReferenceImage,
 }
 
@@ -60,6 +62,10 @@ impl Measurement<'_> {
             "psnr_db": if self.image.psnr_db.is_finite() { json!(self.image.psnr_db) } else { Value::Null },
             "flip_mean": self.image.flip_mean,
             "pinholes": self.pinholes,
+            // Grown or shrunk silhouettes show here: the render's covered area against the
+            // exact surfaces' (both in square pixels).
+            "coverage_px": self.coverage_px,
+            "reference_coverage_px": r.coverage.area(),
             "reference": {
                 "samples_per_pixel": [n, n],
                 "covered_samples": r.covered_samples,

@@ -94,7 +94,7 @@ pub fn bound(item: &PatchItem, f: &Frame, info: &PatchInfo) -> Decision {
             let zfront = pts.iter().map(|p| p.1).filter(|&z| z >= f.near);
             crack_dilation(f, cp, f.grid_max, f.grid_max, zfront.fold(zmax, f32::min))
         } else {
-            0.0
+            0
         };
         return Decision::Dice {
             item: g,
@@ -129,7 +129,7 @@ pub fn bound(item: &PatchItem, f: &Frame, info: &PatchInfo) -> Decision {
     g.dilate = if f.crack_dilation != 0 {
         crack_dilation(f, cp, nu, nv, zmin)
     } else {
-        0.0
+        0
     };
     Decision::Dice {
         item: g,
@@ -213,9 +213,12 @@ fn dice_decision(f: &Frame, lu: f32, lv: f32, extent: Vec2) -> (u32, u32, u32) {
     (0, nu.max(1.0) as u32, nv.max(1.0) as u32)
 }
 
-/// See `crack_dilation` in bound.wgsl and docs/reyes.md.
-pub fn crack_dilation(f: &Frame, cp: &[f32; 48], nu: u32, nv: u32, zmin: f32) -> f32 {
-    let mut m = 0f32;
+/// Crack dilation of each boundary edge, packed (v = 0, v = 1, u = 0, u = 1; 8 bits each in
+/// steps of `MAX_DILATE_PX / 255`, rounded up): see `crack_dilation` in bound.wgsl and
+/// docs/reyes.md.
+pub fn crack_dilation(f: &Frame, cp: &[f32; 48], nu: u32, nv: u32, zmin: f32) -> u32 {
+    let slack = 2.0 * (1.0 + (f.width.max(f.height) as f32) / f.focal);
+    let mut packed = 0;
     for e in 0..4 {
         let along_u = e < 2;
         let start = if along_u {
@@ -232,10 +235,11 @@ pub fn crack_dilation(f: &Frame, cp: &[f32; 48], nu: u32, nv: u32, zmin: f32) ->
             * (b[0] - 2.0 * b[1] + b[2])
                 .length()
                 .max((b[1] - 2.0 * b[2] + b[3]).length());
-        m = m.max(c2 / (8.0 * n * n));
+        let px = c2 / (8.0 * n * n) * f.focal / zmin * slack;
+        let q = (px * (255.0 / MAX_DILATE_PX)).ceil().clamp(1.0, 255.0);
+        packed |= (q as u32) << (8 * e);
     }
-    let slack = 2.0 * (1.0 + (f.width.max(f.height) as f32) / f.focal);
-    (m * f.focal / zmin * slack + 1.0e-3).min(MAX_DILATE_PX)
+    packed
 }
 
 #[cfg(test)]

@@ -1,7 +1,7 @@
 //! Twin of `shaders/reyes/dice_shade.wgsl`: the grid of points with normals from the patch's
 //! derivatives, shaded; then every micropolygon sampled.
 
-use super::sample::{sample_micropolygon, sample_near_clipped};
+use super::sample::{micropolygon_dilation, sample_micropolygon, sample_near_clipped};
 use super::{NEAR_CLIP_GRID, cp_point, project, shade};
 use crate::frame::{FrameData, PatchItem};
 use glam::Vec3;
@@ -129,7 +129,8 @@ pub fn dice_shade(item: &PatchItem, data: &FrameData, samples: &mut [u64]) -> (u
         } else {
             sample_micropolygon
         };
-        if !sample(q, item.dilate, two_sided, &data.frame, samples) {
+        let grow = micropolygon_dilation(item.dilate, i as u32, j as u32, nu, nv);
+        if !sample(q, grow, two_sided, &data.frame, samples) {
             culled += 1;
         }
     }

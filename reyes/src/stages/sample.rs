@@ -30,7 +30,8 @@ fn xy(p: [f32; 4]) -> Vec2 {
     Vec2::new(p[0], p[1])
 }
 
-fn triangle_setup(a: [f32; 4], b: [f32; 4], c: [f32; 4], grow: f32) -> Triangle {
+/// `grow`: pixels to grow the edges opposite a, b and c (bc, ca, ab).
+fn triangle_setup(a: [f32; 4], b: [f32; 4], c: [f32; 4], grow: [f32; 3]) -> Triangle {
     let (pa, pb, pc) = (xy(a), xy(b), xy(c));
     Triangle {
         a,
@@ -38,12 +39,30 @@ fn triangle_setup(a: [f32; 4], b: [f32; 4], c: [f32; 4], grow: f32) -> Triangle 
         c,
         area: cross2(pb - pa, pc - pa),
         g: [
-            -grow * pb.distance(pc),
-            -grow * pa.distance(pc),
-            -grow * pa.distance(pb),
+            -grow[0] * pb.distance(pc),
+            -grow[1] * pa.distance(pc),
+            -grow[2] * pa.distance(pb),
         ],
     }
 }
+
+/// `micropolygon_dilation` in sample.wgsl: pixels to grow edges ab, bc, cd, da of micropolygon
+/// (i, j) of an nu x nv grid: boundary edges by their side's packed crack dilation, inner edges
+/// by `ROUNDING_DILATE_PX`, nothing when dilation is off (`packed` = 0).
+pub fn micropolygon_dilation(packed: u32, i: u32, j: u32, nu: u32, nv: u32) -> [f32; 4] {
+    let side = |e: u32| ((packed >> (8 * e)) & 255) as f32 * (super::bound::MAX_DILATE_PX / 255.0);
+    let inner = if packed != 0 { ROUNDING_DILATE_PX } else { 0.0 };
+    let pick = |on_side: bool, e: u32| if on_side { side(e) } else { inner };
+    [
+        pick(j == 0, 0),
+        pick(i + 1 == nu, 3),
+        pick(j + 1 == nv, 1),
+        pick(i == 0, 2),
+    ]
+}
+
+/// `ROUNDING_DILATE_PX` in common.wgsl: the growth of edges inside a grid.
+pub const ROUNDING_DILATE_PX: f32 = 1.0e-3;
 
 fn triangle_depth(t: &Triangle, q: Vec2) -> f32 {
     if t.area.abs() < 1.0e-12 {
@@ -81,10 +100,11 @@ fn write_sample(f: &Frame, samples: &mut [u64], [px, py, sx, sy]: [u32; 4], z: f
     samples[idx] = samples[idx].max(sample_key(z, color));
 }
 
-/// Samples quad `q` (a, b, c, d around); false when it was culled as back-facing.
+/// Samples quad `q` (a, b, c, d around), its edges ab, bc, cd, da grown by `grow` pixels (the
+/// diagonal by the least of them); false when it was culled as back-facing.
 pub fn sample_micropolygon(
     q: [[f32; 4]; 4],
-    grow: f32,
+    grow: [f32; 4],
     two_sided: bool,
     f: &Frame,
     samples: &mut [u64],
@@ -95,8 +115,9 @@ pub fn sample_micropolygon(
     }
     let color = average_color(c);
     let xy = q.map(|v| Vec2::new(v[0], v[1]));
-    let lo = xy[0].min(xy[1]).min(xy[2].min(xy[3])) - Vec2::splat(grow);
-    let hi = xy[0].max(xy[1]).max(xy[2].max(xy[3])) + Vec2::splat(grow);
+    let g = grow[0].max(grow[1]).max(grow[2].max(grow[3]));
+    let lo = xy[0].min(xy[1]).min(xy[2].min(xy[3])) - Vec2::splat(g);
+    let hi = xy[0].max(xy[1]).max(xy[2].max(xy[3])) + Vec2::splat(g);
     let (t0, t1) = (
         [f.tile_x0, f.tile_y0],
         [f.tile_x0 + f.tile_w, f.tile_y0 + f.tile_h],
@@ -107,8 +128,9 @@ pub fn sample_micropolygon(
     }
     let p0 = |k: usize| lo[k].max(t0[k] as f32) as u32;
     let p1 = |k: usize| (hi[k].min(t1[k] as f32) as u32).min(t1[k] - 1);
-    let abc = triangle_setup(q[0], q[1], q[2], grow);
-    let acd = triangle_setup(q[0], q[2], q[3], grow);
+    let diagonal = grow[0].min(grow[1]).min(grow[2].min(grow[3]));
+    let abc = triangle_setup(q[0], q[1], q[2], [grow[1], diagonal, grow[0]]);
+    let acd = triangle_setup(q[0], q[2], q[3], [grow[2], grow[3], diagonal]);
     for py in p0(1)..=p1(1) {
         for px in p0(0)..=p1(0) {
             for sy in 0..f.spp_y {
@@ -175,7 +197,7 @@ fn clip_by_plane(poly: &[Vec3], plane: Vec4) -> Vec<Vec3> {
 /// corners in camera space; false when culled as back-facing.
 pub fn sample_near_clipped(
     q: [[f32; 4]; 4],
-    grow: f32,
+    grow: [f32; 4],
     two_sided: bool,
     f: &Frame,
     samples: &mut [u64],
@@ -193,8 +215,9 @@ pub fn sample_near_clipped(
     }
     let color = average_color(c);
     let p = q.map(|v| Vec3::new(v[0], v[1], v[2]));
-    sample_clipped_triangle(&[p[0], p[1], p[2]], grow, color, f, samples);
-    sample_clipped_triangle(&[p[0], p[2], p[3]], grow, color, f, samples);
+    let g = grow[0].max(grow[1]).max(grow[2].max(grow[3]));
+    sample_clipped_triangle(&[p[0], p[1], p[2]], g, color, f, samples);
+    sample_clipped_triangle(&[p[0], p[2], p[3]], g, color, f, samples);
     true
 }
 
@@ -229,7 +252,7 @@ fn sample_clipped_triangle(tri: &[Vec3; 3], grow: f32, color: u32, f: &Frame, sa
     lo -= Vec2::splat(grow);
     hi += Vec2::splat(grow);
     let fan: Vec<Triangle> = (0..s.len() - 2)
-        .map(|i| triangle_setup(s[0], s[i + 1], s[i + 2], grow))
+        .map(|i| triangle_setup(s[0], s[i + 1], s[i + 2], [grow; 3]))
         .collect();
     let (t0, t1) = (
         [f.tile_x0, f.tile_y0],

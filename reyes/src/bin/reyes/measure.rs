@@ -111,6 +111,7 @@ pub fn main(args: impl Iterator<Item = String>) -> Result<(), String> {
         geometry: &geom,
         image: &img,
         pinholes: pinhole_count(&frame.image, &reference),
+        coverage_px: frame.image.rgba.iter().map(|p| p[3] as f64).sum(),
         reference: &reference,
     };
     let mut out = m.json();
