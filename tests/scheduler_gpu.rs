@@ -71,6 +71,18 @@ fn stress_configs() -> Vec<(&'static str, MegakernelConfig)> {
             },
         ),
         (
+            // Launches end at their loop bound with room to spare: the live items go through the
+            // host compaction, not the growth one.
+            "roomy queues, very short launches",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(3),
+                max_iterations: 6,
+                spin_limit: 2,
+                initial_capacity: 1 << 15,
+                ..base.clone()
+            },
+        ),
+        (
             "oversubscribed",
             MegakernelConfig {
                 workgroups: Workgroups::Fixed(24),
@@ -96,6 +108,8 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
     let gpu = gpu();
     let mut rng = Lcg(0x5eed);
     let (mut runs, mut multi_launch, mut grown, mut abandoned) = (0, 0, 0, 0);
+    // Megakernel runs whose live items moved on the device (a growth) or through the host.
+    let (mut device_moved, mut host_moved) = (0, 0);
     for payload in [1u32, 62] {
         let shape = TreeParams {
             roots: 1,
@@ -171,20 +185,29 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
                 );
                 runs += 1;
                 // Multi-pass counts dispatches as launches; a relaunch is a megakernel matter.
-                multi_launch += (s.kind() == StrategyKind::Megakernel && stats.launches > 1) as u32;
+                let mk = s.kind() == StrategyKind::Megakernel;
+                multi_launch += (mk && stats.launches > 1) as u32;
+                device_moved += (mk && stats.queue_growths > 0) as u32;
+                host_moved += (mk && stats.submits > stats.launches) as u32;
                 grown += (stats.queue_growths > 0) as u32;
                 abandoned += (stats.abandoned > 0) as u32;
             }
         }
     }
     eprintln!(
-        "{runs} runs: {multi_launch} needed several launches, {grown} grew a queue, {abandoned} abandoned a wait"
+        "{runs} runs: {multi_launch} needed several launches, {grown} grew a queue, {abandoned} \
+         abandoned a wait; megakernel compactions: {device_moved} runs on the device, \
+         {host_moved} on the host"
     );
     assert!(runs >= 250, "only {runs} runs");
     // The hard paths must have been exercised, or this test proves little.
     assert!(
         multi_launch > 20 && grown > 20,
         "{multi_launch} multi-launch, {grown} grown"
+    );
+    assert!(
+        device_moved > 10 && host_moved > 10,
+        "compactions: {device_moved} on the device, {host_moved} on the host"
     );
 }
 
