@@ -14,6 +14,8 @@ const Q_PEAK: u32 = 4u;      // most items waiting at once
 const Q_EXECUTED: u32 = 5u;
 const Q_BATCHES: u32 = 6u;
 const Q_BLOCKED: u32 = 7u;   // 1 when a batch was refused for lack of room in this queue
+const Q_DEMAND: u32 = 8u;    // largest worst-case output to this queue of a batch refused for room
+// Q_KEPT = 9: written only by the device compaction (megakernel_compact.wgsl)
 fn gw(i: u32) -> u32 { return NQ * QSTRIDE + i; }
 const G_PENDING: u32 = 0u;   // items appended and neither processed nor abandoned in this launch
 const G_STOP: u32 = 1u;
@@ -27,6 +29,7 @@ const G_PROBE_STARTED: u32 = 8u;
 const G_PROBE_FINISHED: u32 = 9u;
 const G_PROBE_RESIDENT: u32 = 10u;
 const G_ITER_EXITS: u32 = 11u;
+// G_LOST = 12: written only by the device compaction (megakernel_compact.wgsl)
 
 const ERR_EMIT: u32 = 1u;
 
@@ -112,6 +115,11 @@ fn reserve_budget(q: u32, n: u32) -> bool {
             atomicSub(&ctrl[t * QSTRIDE + Q_BUDGET], need);
             release_budget(q, n, t);
             atomicStore(&ctrl[t * QSTRIDE + Q_BLOCKED], 1u);
+            // What the refused batch needed in every target, so the host can grow them all.
+            for (var u = 0u; u < NQ; u++) {
+                let eu = EMITS[q * NQ + u];
+                if eu > 0u { atomicMax(&ctrl[u * QSTRIDE + Q_DEMAND], n * eu); }
+            }
             sched_blocked = true;
             return false;
         }

@@ -20,7 +20,7 @@ fn small_tree(seed: u32) -> TreeParams {
 }
 
 #[test]
-fn tree_matches_cpu_reference_on_both_strategies() {
+fn tree_matches_cpu_reference_on_every_strategy() {
     let gpu = gpu();
     eprintln!("adapter: {}", gpu.adapter_name());
     let params = small_tree(7);
@@ -71,6 +71,18 @@ fn stress_configs() -> Vec<(&'static str, MegakernelConfig)> {
             },
         ),
         (
+            // Launches end at their loop bound with room to spare: the live items go through the
+            // host compaction, not the growth one.
+            "roomy queues, very short launches",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(3),
+                max_iterations: 6,
+                spin_limit: 2,
+                initial_capacity: 1 << 15,
+                ..base.clone()
+            },
+        ),
+        (
             "oversubscribed",
             MegakernelConfig {
                 workgroups: Workgroups::Fixed(24),
@@ -96,6 +108,8 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
     let gpu = gpu();
     let mut rng = Lcg(0x5eed);
     let (mut runs, mut multi_launch, mut grown, mut abandoned) = (0, 0, 0, 0);
+    // Megakernel runs whose live items moved on the device (a growth) or through the host.
+    let (mut device_moved, mut host_moved) = (0, 0);
     for payload in [1u32, 62] {
         let shape = TreeParams {
             roots: 1,
@@ -132,6 +146,14 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
             "multipass".into(),
             Scheduler::new(&gpu, &tree.program, StrategyKind::Multipass, 1 << 12).unwrap(),
         ));
+        schedulers.push((
+            "multipass-host, tiny queues".into(),
+            Scheduler::new(&gpu, &tree.program, StrategyKind::MultipassHost, 16).unwrap(),
+        ));
+        schedulers.push((
+            "multipass-host".into(),
+            Scheduler::new(&gpu, &tree.program, StrategyKind::MultipassHost, 1 << 12).unwrap(),
+        ));
         for _ in 0..25 {
             let fanout = if rng.below(3) == 0 {
                 Fanout::Fixed(1 + rng.below(2))
@@ -162,20 +184,30 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
                     params.describe()
                 );
                 runs += 1;
-                multi_launch += (stats.launches > 1) as u32;
+                // Multi-pass counts dispatches as launches; a relaunch is a megakernel matter.
+                let mk = s.kind() == StrategyKind::Megakernel;
+                multi_launch += (mk && stats.launches > 1) as u32;
+                device_moved += (mk && stats.queue_growths > 0) as u32;
+                host_moved += (mk && stats.submits > stats.launches) as u32;
                 grown += (stats.queue_growths > 0) as u32;
                 abandoned += (stats.abandoned > 0) as u32;
             }
         }
     }
     eprintln!(
-        "{runs} runs: {multi_launch} needed several launches, {grown} grew a queue, {abandoned} abandoned a wait"
+        "{runs} runs: {multi_launch} needed several launches, {grown} grew a queue, {abandoned} \
+         abandoned a wait; megakernel compactions: {device_moved} runs on the device, \
+         {host_moved} on the host"
     );
     assert!(runs >= 250, "only {runs} runs");
     // The hard paths must have been exercised, or this test proves little.
     assert!(
         multi_launch > 20 && grown > 20,
         "{multi_launch} multi-launch, {grown} grown"
+    );
+    assert!(
+        device_moved > 10 && host_moved > 10,
+        "compactions: {device_moved} on the device, {host_moved} on the host"
     );
 }
 
@@ -242,10 +274,88 @@ fn a_queue_that_cannot_hold_live_work_reports_overflow() {
         },
     )
     .unwrap();
-    for s in [mk, mp] {
+    let mph = Scheduler::multipass_host(
+        &gpu,
+        &program,
+        HostMultipassConfig {
+            initial_capacity: 8,
+            max_capacity: 8,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    for s in [mk, mp, mph] {
         match s.run(&gpu, &seeds, None) {
             Err(RunError::QueueOverflow { queue, .. }) => assert_eq!(queue, "sink"),
             other => panic!("expected an overflow of `sink`, got {other:?}"),
+        }
+    }
+}
+
+/// Growths a queue needs from 16 slots to hold `items` (what it must hold at most: every item
+/// the run ever put in it), plus two for a jump to a refused batch's worst case and rounding.
+fn growth_bound(stats: &RunStats) -> u64 {
+    stats
+        .executed
+        .iter()
+        .map(|&n| (n.max(16) as f64 / 16.0).log2().ceil() as u64 + 2)
+        .sum()
+}
+
+#[test]
+fn a_run_started_at_capacity_16_grows_geometrically_and_stays_exact() {
+    let gpu = gpu();
+    let params = TreeParams {
+        roots: 6,
+        max_depth: 10,
+        fanout: Fanout::Uniform(4),
+        work: 1,
+        payload_words: 2,
+        seed: 32,
+    };
+    let reference = params.reference();
+    let run = TreeRun::new(&gpu, params.clone()).unwrap();
+    for kind in StrategyKind::ALL {
+        let roomy = Scheduler::new(&gpu, &run.program, kind, 1 << 20).unwrap();
+        let (base, result) = run.run(&gpu, &roomy).unwrap();
+        assert_eq!(result, reference, "{kind:?} roomy");
+        assert_eq!(base.queue_growths, 0, "{kind:?}: {base:?}");
+        let tiny = Scheduler::new(&gpu, &run.program, kind, 16).unwrap();
+        for _ in 0..2 {
+            let (stats, result) = run.run(&gpu, &tiny).unwrap();
+            eprintln!(
+                "{kind:?}: {} launches, {} submits, {} growths, {} rounds (roomy: {} launches, \
+                 {} submits, {} rounds)",
+                stats.launches,
+                stats.submits,
+                stats.queue_growths,
+                stats.rounds,
+                base.launches,
+                base.submits,
+                base.rounds
+            );
+            assert_eq!(result, reference, "{kind:?}");
+            let growths = stats.queue_growths;
+            assert!(growths >= 1, "{kind:?} never grew from 16: {stats:?}");
+            assert!(growths <= growth_bound(&stats), "{kind:?}: {stats:?}");
+            match kind {
+                // Every launch that stopped for want of room grew before the next one; the
+                // roomy run's launches are the relaunches lavapipe's short loops need anyway.
+                StrategyKind::Megakernel => assert!(
+                    stats.launches <= 2 * (growths + 1) + 2 * base.launches,
+                    "{stats:?}"
+                ),
+                // A refused round costs one submission; the others run 16 rounds each.
+                StrategyKind::Multipass => assert!(
+                    stats.submits <= growths + stats.rounds.div_ceil(16) + 1,
+                    "{stats:?}"
+                ),
+                // Growth happens before a round, in its own submission: nothing extra.
+                StrategyKind::MultipassHost => {
+                    assert_eq!(stats.submits, stats.rounds, "{stats:?}");
+                    assert_eq!(stats.rounds, base.rounds, "{stats:?}");
+                }
+            }
         }
     }
 }

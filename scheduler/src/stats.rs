@@ -11,8 +11,15 @@ pub struct RunStats {
     /// Megakernel: batches run, and loop turns that found nothing to claim.
     pub batches: u64,
     pub idle_polls: u64,
-    /// Megakernel: launches (a launch ends early at its loop bound or when a queue needs room).
+    /// Kernel launches. Megakernel: persistent launches (a launch ends early at its loop bound or
+    /// when a queue needs room; the device compaction that may precede one is not counted).
+    /// Multi-pass (both): compute dispatches recorded, the device-driven variant's `mp_plan` and
+    /// empty indirect dispatches included, wgpu's own indirect-validation dispatches not.
     pub launches: u64,
+    /// Host round trips: submissions the host waited on. Megakernel: one per launch plus one per
+    /// host compaction; device-driven multi-pass: one per chunk of rounds; host-driven
+    /// multi-pass: one per round.
+    pub submits: u64,
     /// Megakernel: slots whose bounded wait ran out and were handed to the next launch.
     pub abandoned: u64,
     /// Queues grown because live work did not fit.
@@ -53,6 +60,7 @@ impl RunStats {
         self.batches += o.batches;
         self.idle_polls += o.idle_polls;
         self.launches += o.launches;
+        self.submits += o.submits;
         self.abandoned += o.abandoned;
         self.queue_growths += o.queue_growths;
         self.queue_bytes = self.queue_bytes.max(o.queue_bytes);

@@ -1,28 +1,42 @@
-//! One front door for both strategies, so workloads and benchmarks can name one and run it.
+//! One front door for every strategy, so workloads and benchmarks can name one and run it.
 
 use crate::error::RunError;
 use crate::gpu::Gpu;
 use crate::megakernel::{Megakernel, MegakernelConfig};
+use crate::multipass::host::{HostMultipass, HostMultipassConfig};
 use crate::multipass::{Multipass, MultipassConfig};
 use crate::program::{Program, Seed};
 use crate::stats::RunStats;
 
+/// The scheduling strategies, by the names the command lines and reports use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum StrategyKind {
+    /// `megakernel`: persistent workgroups pulling batches from on-device queues.
     Megakernel,
+    /// `multipass`: rounds planned on the device (indirect dispatches), scan/compact per target.
     Multipass,
+    /// `multipass-host`: rounds planned by the host from read-back counts (exact direct
+    /// dispatches), compaction fused into the producing pass.
+    MultipassHost,
 }
 
 impl StrategyKind {
-    pub const ALL: [StrategyKind; 2] = [StrategyKind::Megakernel, StrategyKind::Multipass];
+    /// Every strategy, in the order reports list them.
+    pub const ALL: [StrategyKind; 3] = [
+        StrategyKind::Megakernel,
+        StrategyKind::Multipass,
+        StrategyKind::MultipassHost,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
             StrategyKind::Megakernel => "megakernel",
             StrategyKind::Multipass => "multipass",
+            StrategyKind::MultipassHost => "multipass-host",
         }
     }
 
+    /// The strategy named `s` (as [`StrategyKind::name`] spells it), if any.
     pub fn parse(s: &str) -> Option<StrategyKind> {
         Self::ALL.into_iter().find(|k| k.name() == s)
     }
@@ -32,6 +46,7 @@ impl StrategyKind {
 pub enum Scheduler {
     Megakernel(Megakernel),
     Multipass(Multipass),
+    MultipassHost(HostMultipass),
 }
 
 impl Scheduler {
@@ -51,6 +66,16 @@ impl Scheduler {
         config: MultipassConfig,
     ) -> Result<Self, RunError> {
         Ok(Scheduler::Multipass(Multipass::new(gpu, program, config)?))
+    }
+
+    pub fn multipass_host(
+        gpu: &Gpu,
+        program: &Program,
+        config: HostMultipassConfig,
+    ) -> Result<Self, RunError> {
+        Ok(Scheduler::MultipassHost(HostMultipass::new(
+            gpu, program, config,
+        )?))
     }
 
     /// Compiles with default settings for `kind`, queues starting at `initial_capacity` slots.
@@ -77,6 +102,23 @@ impl Scheduler {
                     ..Default::default()
                 },
             ),
+            StrategyKind::MultipassHost => Self::multipass_host(
+                gpu,
+                program,
+                HostMultipassConfig {
+                    initial_capacity,
+                    ..Default::default()
+                },
+            ),
+        }
+    }
+
+    /// Which strategy this is.
+    pub fn kind(&self) -> StrategyKind {
+        match self {
+            Scheduler::Megakernel(_) => StrategyKind::Megakernel,
+            Scheduler::Multipass(_) => StrategyKind::Multipass,
+            Scheduler::MultipassHost(_) => StrategyKind::MultipassHost,
         }
     }
 
@@ -102,6 +144,7 @@ impl Scheduler {
         match self {
             Scheduler::Megakernel(m) => m.run(gpu, seeds, user, max_queue_bytes),
             Scheduler::Multipass(m) => m.run(gpu, seeds, user, max_queue_bytes),
+            Scheduler::MultipassHost(m) => m.run(gpu, seeds, user, max_queue_bytes),
         }
     }
 }

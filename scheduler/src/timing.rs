@@ -115,3 +115,63 @@ impl StageTimer {
             .map(|_| self.stage_ns.iter().map(|n| n / 1e6).collect())
     }
 }
+
+/// Times every pass of a run of many short submissions (relaunches, host-driven rounds) and
+/// reads the timestamps back only when its query set is full or the run ends, so timing costs
+/// no host wait per submission. `total_ms` is `None` when the adapter has no timestamp queries.
+pub struct RunTimer {
+    inner: StageTimer,
+    used: u32,
+    passes: u32,
+    full: bool,
+}
+
+impl RunTimer {
+    /// Up to `passes` timed passes between read-backs.
+    pub fn new(gpu: &Gpu, passes: u32) -> RunTimer {
+        let passes = passes.max(1);
+        RunTimer {
+            inner: StageTimer::new(gpu, 1, passes),
+            used: 0,
+            passes,
+            full: false,
+        }
+    }
+
+    /// Timestamp writes for the next pass.
+    pub fn writes(&mut self) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        self.used += 1;
+        self.inner.writes(0)
+    }
+
+    /// Call after the last pass of a submission, in its encoder: resolves the queries when the
+    /// set is full, so [`RunTimer::after_wait`] can read them once the submission finished.
+    pub fn end_submission(&mut self, enc: &mut wgpu::CommandEncoder) {
+        if self.used == self.passes {
+            self.inner.resolve(enc);
+            self.full = true;
+        }
+    }
+
+    /// Call after waiting for the submission: reads the timestamps back if the set was full.
+    pub fn after_wait(&mut self, gpu: &Gpu) -> Result<(), RunError> {
+        if self.full {
+            self.inner.collect(gpu)?;
+            self.used = 0;
+            self.full = false;
+        }
+        Ok(())
+    }
+
+    /// Reads the remaining timestamps (one submission and wait, only with timestamp queries)
+    /// and returns the GPU time of every timed pass.
+    pub fn finish(mut self, gpu: &Gpu) -> Result<Option<f64>, RunError> {
+        if self.used > 0 && gpu.timestamps {
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            self.inner.resolve(&mut enc);
+            gpu.queue.submit([enc.finish()]);
+            self.inner.collect(gpu)?;
+        }
+        Ok(self.inner.stage_ms().map(|ms| ms[0]))
+    }
+}

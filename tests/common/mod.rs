@@ -22,10 +22,11 @@ pub fn gpu() -> &'static Gpu {
 pub fn renderer(kind: StrategyKind) -> &'static GpuRenderer {
     static MK: OnceLock<GpuRenderer> = OnceLock::new();
     static MP: OnceLock<GpuRenderer> = OnceLock::new();
-    let cell = if kind == StrategyKind::Megakernel {
-        &MK
-    } else {
-        &MP
+    static MPH: OnceLock<GpuRenderer> = OnceLock::new();
+    let cell = match kind {
+        StrategyKind::Megakernel => &MK,
+        StrategyKind::Multipass => &MP,
+        StrategyKind::MultipassHost => &MPH,
     };
     cell.get_or_init(|| GpuRenderer::new(gpu(), kind).unwrap())
 }

@@ -147,6 +147,14 @@ fn run(o: &Options) -> Result<bool, RunError> {
                     ..Default::default()
                 },
             )?,
+            StrategyKind::MultipassHost => Scheduler::multipass_host(
+                &gpu,
+                &tree.program,
+                HostMultipassConfig {
+                    initial_capacity: o.capacity,
+                    ..Default::default()
+                },
+            )?,
         };
         tree.run(&gpu, &scheduler)?; // warm-up: first-use costs are not the strategy's
         scheduler::clocks::raise_clocks(&gpu, std::time::Duration::from_millis(500))?;

@@ -10,6 +10,10 @@ pub const Q_PEAK: usize = 4;
 pub const Q_EXECUTED: usize = 5;
 pub const Q_BATCHES: usize = 6;
 pub const Q_BLOCKED: usize = 7;
+/// Largest worst-case output to this queue of a batch refused for lack of room (in any queue).
+pub const Q_DEMAND: usize = 8;
+/// Items the device compaction kept in this queue (written only by `megakernel_compact.wgsl`).
+pub const Q_KEPT: usize = 9;
 
 pub const G_PENDING: usize = 0;
 pub const G_STOP: usize = 1;
@@ -23,6 +27,8 @@ pub const G_PROBE_STARTED: usize = 8;
 pub const G_PROBE_FINISHED: usize = 9;
 pub const G_PROBE_RESIDENT: usize = 10;
 pub const G_ITER_EXITS: usize = 11;
+/// Slots the device compaction found reserved but unpublished, or could not place.
+pub const G_LOST: usize = 12;
 pub const GLOBAL_WORDS: usize = 16;
 
 pub const ERR_EMIT: u32 = 1;
@@ -51,4 +57,48 @@ pub fn g(nq: usize, i: usize) -> usize {
 
 pub fn q(queue: usize, i: usize) -> usize {
     queue * QSTRIDE + i
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The value of `const NAME: u32 = Nu;` in the WGSL template.
+    fn wgsl_const(src: &str, name: &str) -> Option<usize> {
+        let line = src
+            .lines()
+            .find(|l| l.starts_with(&format!("const {name}: u32 = ")))?;
+        let v = line.split('=').nth(1)?.trim().split('u').next()?;
+        v.parse().ok()
+    }
+
+    #[test]
+    fn ctrl_words_match_the_shader() {
+        let src = super::super::wgsl::TEMPLATE;
+        for (name, host) in [
+            ("QSTRIDE", QSTRIDE),
+            ("Q_RESERVE", Q_RESERVE),
+            ("Q_HEAD", Q_HEAD),
+            ("Q_COUNT", Q_COUNT),
+            ("Q_BUDGET", Q_BUDGET),
+            ("Q_PEAK", Q_PEAK),
+            ("Q_EXECUTED", Q_EXECUTED),
+            ("Q_BATCHES", Q_BATCHES),
+            ("Q_BLOCKED", Q_BLOCKED),
+            ("Q_DEMAND", Q_DEMAND),
+            ("G_PENDING", G_PENDING),
+            ("G_STOP", G_STOP),
+            ("G_ERROR", G_ERROR),
+            ("G_ABANDONED", G_ABANDONED),
+            ("G_PROBE_RESIDENT", G_PROBE_RESIDENT),
+            ("G_ITER_EXITS", G_ITER_EXITS),
+            ("P_MAX_ITERS", P_MAX_ITERS),
+            ("P_BATCH_STEPS", P_BATCH_STEPS),
+        ] {
+            assert_eq!(wgsl_const(src, name), Some(host), "{name}");
+        }
+        // Words the compaction kernel writes are unused by the megakernel and inside ctrl.
+        assert!(Q_KEPT > Q_DEMAND && Q_KEPT < QSTRIDE);
+        assert!(G_LOST > G_ITER_EXITS && G_LOST < GLOBAL_WORDS);
+    }
 }

@@ -3,6 +3,7 @@
 //! with work left, the host compacts the queues (dropping consumed slots, keeping every live item),
 //! grows a queue that lacked room, and launches again. Protocol: `docs/scheduler.md`.
 
+mod compact;
 pub mod layout;
 pub mod wgsl;
 
@@ -10,13 +11,17 @@ use std::time::Instant;
 
 use layout::*;
 
+use compact::{CompactionPass, DeviceCompaction};
+
 use crate::error::RunError;
 use crate::gpu::Gpu;
+use crate::growth::grow;
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
 use crate::queue_layout::QueueLayout;
+use crate::readback::Readback;
 use crate::stats::RunStats;
-use crate::timing::PassTimer;
+use crate::timing::RunTimer;
 
 /// How many workgroups a launch has.
 #[derive(Debug, Clone, PartialEq)]
@@ -45,6 +50,11 @@ pub const LAVAPIPE_MAX_ITERATIONS: u32 = 96;
 /// Polls of a flag per wait on lavapipe (the polls count against the same cut).
 pub const LAVAPIPE_SPIN_LIMIT: u32 = 64;
 
+/// Growth factor of the queues after a launch that stopped for want of room: each such launch
+/// costs a relaunch (a host wait and new buffers), so growing fourfold instead of twofold halves
+/// their number, `log4(need / start)`, for at most 4x the needed memory (within the limit).
+pub const ROOM_GROWTH: u64 = 4;
+
 #[derive(Debug, Clone)]
 pub struct MegakernelConfig {
     pub workgroups: Workgroups,
@@ -59,7 +69,8 @@ pub struct MegakernelConfig {
     pub spin_limit: u32,
     /// Slots per queue at the start of a run (at least twice the seeds).
     pub initial_capacity: u32,
-    /// A queue grows by doubling up to this many slots; beyond it the run reports an overflow.
+    /// A queue grows (at least doubling, [`crate::growth::grow`]) up to this many slots; beyond
+    /// it the run reports an overflow.
     pub max_capacity: u32,
     pub max_launches: u32,
 }
@@ -90,6 +101,9 @@ pub struct Megakernel {
     priority: Vec<u32>,
     /// Buffers of the last run, reused when the next run needs the same layout.
     cache: std::sync::Mutex<Option<DeviceQueues>>,
+    /// The mapped buffer ctrl is read back through after each launch, kept between runs.
+    readback: std::sync::Mutex<Option<Readback>>,
+    compaction: DeviceCompaction,
 }
 
 /// Buffers of one queue layout.
@@ -98,7 +112,22 @@ struct DeviceQueues {
     ctrl: wgpu::Buffer,
     slots: wgpu::Buffer,
     flags: wgpu::Buffer,
+    /// Per-workgroup scratch; its size does not depend on the layout, so growth keeps it.
+    outbox: wgpu::Buffer,
     bind: wgpu::BindGroup,
+}
+
+/// How the next launch gets its live items.
+enum Start {
+    /// Written by the host (seeds, or what [`compact::host_compact`] kept).
+    Upload(Vec<Vec<u32>>),
+    /// Copied on the device from the previous launch's buffers, whose first `reserved[q]`
+    /// tickets hold `live[q]` published, unconsumed items per queue.
+    Compact {
+        old: DeviceQueues,
+        reserved: Vec<u32>,
+        live: Vec<u32>,
+    },
 }
 
 impl Megakernel {
@@ -166,6 +195,8 @@ impl Megakernel {
             ob_off,
             priority,
             cache: Default::default(),
+            readback: Default::default(),
+            compaction: DeviceCompaction::new(gpu)?,
         })
     }
 
@@ -190,7 +221,7 @@ impl Megakernel {
         let mut params = self.params(&layout);
         params[P_PROBE] = 1;
         params[P_SPIN] = 20_000;
-        let dq = self.device_queues(gpu, layout, &params, 1)?;
+        let dq = self.device_queues(gpu, layout, &params, 1, None)?;
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
@@ -230,12 +261,16 @@ impl Megakernel {
         layout: QueueLayout,
         params: &[u32],
         workgroups: u32,
+        outbox: Option<wgpu::Buffer>,
     ) -> Result<DeviceQueues, RunError> {
         let nq = self.program.queue_count();
         let ctrl = gpu.storage_buffer("ctrl", ctrl_words(nq) as u64)?;
         let slots = gpu.storage_buffer("slots", layout.total_words)?;
         let flags = gpu.storage_buffer("flags", layout.total_slots)?;
-        let outbox = gpu.storage_buffer("outbox", workgroups as u64 * self.outbox_stride as u64)?;
+        let outbox = match outbox {
+            Some(o) => o,
+            None => gpu.storage_buffer("outbox", workgroups as u64 * self.outbox_stride as u64)?,
+        };
         let params_buf = gpu.storage_buffer("params", params.len() as u64)?;
         gpu.queue
             .write_buffer(&params_buf, 0, bytemuck::cast_slice(params));
@@ -254,25 +289,35 @@ impl Megakernel {
             ctrl,
             slots,
             flags,
+            outbox,
             bind,
         })
     }
 
-    /// Writes live items (per queue, words back to back) as the whole queue state of a launch.
-    fn upload(&self, gpu: &Gpu, dq: &DeviceQueues, live: &[Vec<u32>]) {
+    /// Writes ctrl for a launch that starts with `counts[q]` seeds in the first slots of each
+    /// queue: reserve, count, budget and peak at the seed count, pending their sum, all else 0.
+    fn write_ctrl(&self, gpu: &Gpu, dq: &DeviceQueues, counts: &[u32]) {
         let nq = self.program.queue_count();
         let mut ctrl = vec![0u32; ctrl_words(nq)];
+        for (q, &n) in counts.iter().enumerate() {
+            for w in [Q_RESERVE, Q_COUNT, Q_BUDGET, Q_PEAK] {
+                ctrl[layout::q(q, w)] = n;
+            }
+        }
+        ctrl[g(nq, G_PENDING)] = counts.iter().sum();
+        gpu.queue
+            .write_buffer(&dq.ctrl, 0, bytemuck::cast_slice(&ctrl));
+    }
+
+    /// Writes live items (per queue, words back to back) as the whole queue state of a launch.
+    fn upload(&self, gpu: &Gpu, dq: &DeviceQueues, live: &[Vec<u32>]) {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&dq.flags, 0, None);
         gpu.queue.submit([enc.finish()]);
-        let mut pending = 0;
+        let mut counts = Vec::new();
         for (q, items) in live.iter().enumerate() {
             let n = (items.len() / dq.layout.words[q] as usize) as u32;
-            pending += n;
-            ctrl[layout::q(q, Q_RESERVE)] = n;
-            ctrl[layout::q(q, Q_COUNT)] = n;
-            ctrl[layout::q(q, Q_BUDGET)] = n;
-            ctrl[layout::q(q, Q_PEAK)] = n;
+            counts.push(n);
             if n > 0 {
                 gpu.queue.write_buffer(
                     &dq.slots,
@@ -287,9 +332,7 @@ impl Megakernel {
                 );
             }
         }
-        ctrl[g(nq, G_PENDING)] = pending;
-        gpu.queue
-            .write_buffer(&dq.ctrl, 0, bytemuck::cast_slice(&ctrl));
+        self.write_ctrl(gpu, dq, &counts);
     }
 
     /// Runs the program to completion from `seeds`. `user` is bind group 1, if the program has
@@ -303,9 +346,9 @@ impl Megakernel {
     ) -> Result<RunStats, RunError> {
         self.kernels.check_user_group(user)?;
         let workgroups = self.workgroups(gpu, user)?;
-        let start = Instant::now();
+        let start_time = Instant::now();
         let nq = self.program.queue_count();
-        let mut live = QueueLayout::seed_items(&self.program, seeds)?;
+        let live = QueueLayout::seed_items(&self.program, seeds)?;
         let max_cap = QueueLayout::within_budget(
             &self.program,
             QueueLayout::capacity_limits(
@@ -337,32 +380,56 @@ impl Megakernel {
             workgroups,
             ..Default::default()
         };
-        let mut timer = PassTimer::new(gpu);
+        let mut timer = RunTimer::new(gpu, 64);
+        let rb = self.readback.lock().unwrap().take();
+        let rb = rb.unwrap_or_else(|| Readback::new(gpu, "ctrl read-back", ctrl_words(nq) as u64));
         let mut dq: Option<DeviceQueues> = self.cache.lock().unwrap().take();
+        let mut start = Start::Upload(live);
         loop {
             let layout = QueueLayout::new(&self.program, capacity.clone())?;
             if dq.as_ref().is_none_or(|d| d.layout != layout) {
+                let outbox = match &start {
+                    Start::Compact { old, .. } => Some(old.outbox.clone()),
+                    Start::Upload(_) => None,
+                };
                 dq = Some(self.device_queues(
                     gpu,
                     layout.clone(),
                     &self.params(&layout),
                     workgroups,
+                    outbox,
                 )?);
             }
             let d = dq.as_ref().unwrap();
-            self.upload(gpu, d, &live);
             if stats.launches >= self.config.max_launches as u64 {
                 return Err(RunError::NoProgress(format!(
                     "work left after {} megakernel launches",
                     stats.launches
                 )));
             }
+            let compaction: Option<CompactionPass> = match &start {
+                Start::Upload(live) => {
+                    self.upload(gpu, d, live);
+                    None
+                }
+                Start::Compact {
+                    old,
+                    reserved,
+                    live,
+                } => {
+                    self.write_ctrl(gpu, d, live);
+                    Some(self.compaction.prepare(gpu, old, d, reserved)?)
+                }
+            };
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             {
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("megakernel"),
                     timestamp_writes: timer.writes(),
                 });
+                if let Some(c) = &compaction {
+                    self.compaction.record(&mut pass, c);
+                }
                 pass.set_pipeline(&self.kernels.pipelines[0]);
                 pass.set_bind_group(0, &d.bind, &[]);
                 if let Some(u) = user {
@@ -370,11 +437,16 @@ impl Megakernel {
                 }
                 pass.dispatch_workgroups(workgroups, 1, 1);
             }
-            timer.resolve(&mut enc);
+            rb.copy(&mut enc, &d.ctrl, 0, 0, ctrl_words(nq) as u64);
+            timer.end_submission(&mut enc);
             gpu.queue.submit([enc.finish()]);
-            let ctrl = gpu.read_words(&d.ctrl, 0, ctrl_words(nq) as u64)?;
-            timer.collect(gpu)?;
+            let ctrl = rb.read(gpu, ctrl_words(nq) as u64)?;
+            timer.after_wait(gpu)?;
             stats.launches += 1;
+            stats.submits += 1;
+            if let Start::Compact { live, .. } = &start {
+                compact::check(&self.program, &ctrl, live)?;
+            }
             if ctrl[g(nq, G_ERROR)] == ERR_EMIT {
                 let (p, t) = (ctrl[g(nq, G_ERR_A)] as usize, ctrl[g(nq, G_ERR_B)] as usize);
                 return Err(RunError::EmitLimit {
@@ -396,16 +468,38 @@ impl Megakernel {
             if ctrl[g(nq, G_PENDING)] == 0 && ctrl[g(nq, G_ABANDONED)] == 0 {
                 break;
             }
-            // Work is left: keep every published, unconsumed slot, in ticket order.
-            live = self.compact(gpu, d, &ctrl)?;
+            // Work is left. Live items per queue: every ticket reserved in this launch (seeds
+            // included) that did not run; the executed ones are exactly the consumed slots.
+            let reserved: Vec<u32> = (0..nq).map(|q| ctrl[layout::q(q, Q_RESERVE)]).collect();
+            let live: Vec<u32> = (0..nq)
+                .map(|q| reserved[q].saturating_sub(ctrl[layout::q(q, Q_EXECUTED)]))
+                .collect();
+            let expected = ctrl[g(nq, G_PENDING)] as u64 + ctrl[g(nq, G_ABANDONED)] as u64;
+            if live.iter().map(|&n| n as u64).sum::<u64>() != expected {
+                return Err(RunError::Device(format!(
+                    "queue accounting mismatch after a launch: {live:?} live by queue, \
+                     {expected} pending"
+                )));
+            }
+            // A launch that ran out of room costs a relaunch: its queues grow fourfold.
+            let out_of_room = (0..nq).any(|q| ctrl[layout::q(q, Q_BLOCKED)] != 0);
             let mut grew = false;
             // A queue at its limit that blocked a launch in which nothing ran; a blocked queue
             // is named before one that is merely full.
             let mut stuck: Option<(usize, u64, bool)> = None;
             for q in 0..nq {
-                let n = (live[q].len() / d.layout.words[q] as usize) as u32;
+                let n = live[q];
                 let blocked = ctrl[layout::q(q, Q_BLOCKED)] != 0;
-                if (blocked && progress == 0) || n > capacity[q] / 2 {
+                // Capacity bounds the tickets of one launch (seeds included). A queue grows
+                // before the next launch when it refused a batch for want of room, or when its
+                // tickets, or its live items plus the worst-case output to it of the largest
+                // refused batch (of any queue), passed half its capacity (the next launch, with
+                // more room elsewhere, would likely run out): at least doubling
+                // ([`ROOM_GROWTH`]-fold after a launch that ran out of room), straight to live +
+                // that worst case when more.
+                let demand = ctrl[layout::q(q, Q_DEMAND)] as u64;
+                let half = capacity[q] as u64 / 2;
+                if blocked || reserved[q] as u64 > half || n as u64 + demand > half {
                     if capacity[q] >= max_cap[q] {
                         // A blocked claim needed room beyond the whole capacity.
                         let needed = if blocked {
@@ -418,7 +512,9 @@ impl Megakernel {
                         }
                         continue;
                     }
-                    capacity[q] = capacity[q].saturating_mul(2).min(max_cap[q]);
+                    let factor = if out_of_room { ROOM_GROWTH } else { 1 };
+                    let need = (n as u64 + demand).max(factor * capacity[q] as u64);
+                    capacity[q] = grow(capacity[q], need, max_cap[q]);
                     stats.queue_growths += 1;
                     grew = true;
                 }
@@ -437,67 +533,27 @@ impl Megakernel {
                     ));
                 }
             }
+            start = if grew {
+                // New buffers; the live items move there on the device, in the next launch's pass.
+                Start::Compact {
+                    old: dq.take().expect("buffers of the launch"),
+                    reserved,
+                    live,
+                }
+            } else {
+                stats.submits += 1;
+                Start::Upload(compact::host_compact(gpu, &self.program, d, &ctrl)?)
+            };
         }
         stats.queue_bytes = dq
             .as_ref()
             .map_or(0, |d| d.layout.total_words * 4 + d.layout.total_slots * 4);
-        stats.gpu_ms = timer.total_ms();
-        stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
-        // Keep the device queues for the next run of the same size.
+        stats.gpu_ms = timer.finish(gpu)?;
+        stats.wall_ms = start_time.elapsed().as_secs_f64() * 1e3;
+        // Keep the device queues and the read-back buffer for the next run.
         *self.cache.lock().unwrap() = dq;
+        *self.readback.lock().unwrap() = Some(rb);
         Ok(stats)
-    }
-
-    /// Reads back each queue's reserved slots and keeps the published, unconsumed ones.
-    fn compact(
-        &self,
-        gpu: &Gpu,
-        d: &DeviceQueues,
-        ctrl: &[u32],
-    ) -> Result<Vec<Vec<u32>>, RunError> {
-        let nq = self.program.queue_count();
-        let mut live = vec![Vec::new(); nq];
-        let mut total_live = 0u64;
-        for q in 0..nq {
-            let reserved = ctrl[layout::q(q, Q_RESERVE)] as u64;
-            if reserved == 0 {
-                continue;
-            }
-            let w = d.layout.words[q] as usize;
-            let flags = gpu.read_words(&d.flags, d.layout.flag_base[q] as u64, reserved)?;
-            let slots =
-                gpu.read_words(&d.slots, d.layout.slot_base[q] as u64, reserved * w as u64)?;
-            for (i, f) in flags.iter().enumerate() {
-                match *f {
-                    CONSUMED => {}
-                    EMPTY => {
-                        let empties = flags.iter().filter(|&&f| f == EMPTY).count();
-                        return Err(RunError::Device(format!(
-                            "queue `{}` slot {i} was reserved but never published: protocol \
-                             violation ({empties} such slots; reserve {reserved}, head {}, \
-                             count {}, budget {}, capacity {})",
-                            self.program.procs[q].proc.name,
-                            ctrl[layout::q(q, Q_HEAD)],
-                            ctrl[layout::q(q, Q_COUNT)] as i32,
-                            ctrl[layout::q(q, Q_BUDGET)],
-                            d.layout.capacity[q]
-                        )));
-                    }
-                    _ => {
-                        live[q].extend_from_slice(&slots[i * w..(i + 1) * w]);
-                        total_live += 1;
-                    }
-                }
-            }
-        }
-        // Every item still pending or abandoned must be among the live slots, and nothing else.
-        let expected = ctrl[g(nq, G_PENDING)] as u64 + ctrl[g(nq, G_ABANDONED)] as u64;
-        if total_live != expected {
-            return Err(RunError::Device(format!(
-                "queue accounting mismatch after a launch: {total_live} live slots, {expected} pending"
-            )));
-        }
-        Ok(live)
     }
 }
 

@@ -1,8 +1,10 @@
 //! The multi-pass baseline (Patney & Owens 2008): rounds of one dispatch per procedure, then a
 //! scan/compact per target queue. Rounds are encoded in chunks and planned on the device; the
 //! host reads back only between chunks. A round whose outputs would not fit is refused on the
-//! device with its inputs intact; the host grows the queue and resumes.
+//! device with its inputs intact; the host grows every queue that lacked room and resumes.
+//! [`host`] is the host-driven variant: exact direct dispatches, one read-back per round.
 
+pub mod host;
 pub mod layout;
 pub mod wgsl;
 
@@ -12,6 +14,7 @@ use layout::*;
 
 use crate::error::RunError;
 use crate::gpu::Gpu;
+use crate::growth::grow;
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
 use crate::queue_layout::QueueLayout;
@@ -173,6 +176,37 @@ impl Multipass {
             .write_buffer(&d.ctrl, 0, bytemuck::cast_slice(&ctrl));
     }
 
+    /// Makes the `counts[q]` inputs in `from.items[parity]` the inputs of the next round in `to`
+    /// (parity 0), copied on the device: growth moves no item through the host.
+    fn move_inputs(
+        &self,
+        gpu: &Gpu,
+        from: &DeviceRounds,
+        parity: usize,
+        to: &DeviceRounds,
+        counts: &[u32],
+    ) {
+        let nq = self.program.queue_count();
+        let mut ctrl = vec![0u32; ctrl_words(nq)];
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        for (q, &n) in counts.iter().enumerate() {
+            ctrl[c(q, C_NEXT)] = n;
+            let bytes = n as u64 * from.layout.words[q] as u64 * 4;
+            if bytes > 0 {
+                enc.copy_buffer_to_buffer(
+                    &from.items[parity],
+                    from.layout.slot_base[q] as u64 * 4,
+                    &to.items[0],
+                    to.layout.slot_base[q] as u64 * 4,
+                    bytes,
+                );
+            }
+        }
+        gpu.queue
+            .write_buffer(&to.ctrl, 0, bytemuck::cast_slice(&ctrl));
+        gpu.queue.submit([enc.finish()]);
+    }
+
     /// Encodes `rounds` rounds: plan, every procedure's items, then the scan and compaction of
     /// what they emitted. With `stages`, each of those phases is its own timed pass (counted to
     /// its procedure, or to the last stage for plan and compaction); else one pass.
@@ -258,7 +292,7 @@ impl Multipass {
         self.kernels.check_user_group(user)?;
         let start = Instant::now();
         let nq = self.program.queue_count();
-        let mut live = QueueLayout::seed_items(&self.program, seeds)?;
+        let live = QueueLayout::seed_items(&self.program, seeds)?;
         // Reduce and scatter dispatch one workgroup per SCAN_BLOCK slots, at most 65,535.
         let max_cap = QueueLayout::within_budget(
             &self.program,
@@ -326,6 +360,8 @@ impl Multipass {
                 st.resolve(&mut enc);
             }
             gpu.queue.submit([enc.finish()]);
+            stats.submits += 1;
+            stats.launches += rounds as u64 * (1 + 4 * nq as u64);
             encoded += rounds as u64;
             since_upload += rounds as u64;
             let ctrl = gpu.read_words(&d.ctrl, 0, ctrl_words(nq) as u64)?;
@@ -350,32 +386,38 @@ impl Multipass {
                 break;
             }
             if halted {
-                // The refused round's inputs are intact in items[planned % 2]: grow and resume.
+                // The refused round's inputs are intact in items[planned % 2]. Every target whose
+                // worst case m did not fit grows and the inputs move to the new buffers on the
+                // device. A refusal costs a submission, so the growth leaves room for the round
+                // after as well: at least doubling, and at least 2 m.
                 self.accumulate(&mut stats, &ctrl);
-                if capacity[a] >= max_cap[a] {
-                    return Err(RunError::QueueOverflow {
-                        queue: self.program.procs[a].proc.name.clone(),
-                        capacity: capacity[a] as u64,
-                        needed_more_than: b as u64,
-                    });
+                let mut grown = capacity.clone();
+                for t in 0..nq {
+                    let m = ctrl[c(t, C_EMITS)] as u64;
+                    if m <= capacity[t] as u64 {
+                        continue;
+                    }
+                    if capacity[t] >= max_cap[t] {
+                        return Err(RunError::QueueOverflow {
+                            queue: self.program.procs[t].proc.name.clone(),
+                            capacity: capacity[t] as u64,
+                            needed_more_than: m,
+                        });
+                    }
+                    grown[t] = grow(capacity[t], 2 * m, max_cap[t]);
+                    stats.queue_growths += 1;
                 }
-                while capacity[a] < b && capacity[a] < max_cap[a] {
-                    capacity[a] = capacity[a].saturating_mul(2).min(max_cap[a]);
+                if grown == capacity {
+                    return Err(RunError::Device(format!(
+                        "multi-pass round refused although every target fits: {ctrl:?}"
+                    )));
                 }
-                stats.queue_growths += 1;
+                capacity = grown;
                 let parity = ctrl[g(nq, G_PLANNED)] as usize % 2;
-                live = (0..nq)
-                    .map(|q| {
-                        let w = d.layout.words[q] as u64;
-                        gpu.read_words(
-                            &d.items[parity],
-                            d.layout.slot_base[q] as u64,
-                            next[q] as u64 * w,
-                        )
-                    })
-                    .collect::<Result<_, _>>()?;
-                d = self.device_rounds(gpu, QueueLayout::new(&self.program, capacity.clone())?)?;
-                self.upload(gpu, &d, &live);
+                let new =
+                    self.device_rounds(gpu, QueueLayout::new(&self.program, capacity.clone())?)?;
+                self.move_inputs(gpu, &d, parity, &new, &next);
+                d = new;
                 since_upload = 0;
             }
         }

@@ -1,0 +1,354 @@
+//! The host-driven multi-pass baseline, as Patney & Owens (2008) ran theirs: after every round
+//! the host reads the per-queue counts back and launches exactly one dispatch, sized to its
+//! inputs, per non-empty procedure queue. Compaction is fused into the producing pass (each
+//! enqueue appends to the next round's input buffer with one atomic add), so a round is its
+//! procedure dispatches and nothing else: no indirect dispatch, no empty dispatch, no scan. The
+//! cost is one host round trip per round. Shader: `shaders/multipass_host.wgsl`; protocol and
+//! capacity rules: `docs/scheduler.md` section 5.2.
+
+use std::time::Instant;
+
+use crate::error::RunError;
+use crate::gpu::Gpu;
+use crate::growth::grow;
+use crate::pipeline::{Kernels, storage_entry};
+use crate::program::{Program, Seed};
+use crate::queue_layout::QueueLayout;
+use crate::readback::Readback;
+use crate::stats::RunStats;
+use crate::timing::RunTimer;
+
+pub const TEMPLATE: &str = include_str!("../../../shaders/multipass_host.wgsl");
+
+/// Words after the per-queue counts in each counts buffer (host twin of `H_*` in the shader).
+pub const H_ERROR: usize = 0;
+pub const H_ERR_A: usize = 1;
+pub const H_ERR_B: usize = 2;
+pub const ERR_EMIT: u32 = 1;
+pub const ERR_ROOM: u32 = 2;
+const EXTRA_WORDS: usize = 3;
+
+#[derive(Debug, Clone)]
+pub struct HostMultipassConfig {
+    /// Slots per queue at the start of a run (at least the seeds).
+    pub initial_capacity: u32,
+    /// A queue grows (at least doubling) up to this many slots; a round whose worst-case output
+    /// to a queue at this limit would not fit is a [`RunError::QueueOverflow`].
+    pub max_capacity: u32,
+    /// Rounds before the run gives up with [`RunError::NoProgress`].
+    pub max_rounds: u32,
+}
+
+impl Default for HostMultipassConfig {
+    fn default() -> Self {
+        HostMultipassConfig {
+            initial_capacity: 1 << 16,
+            max_capacity: 1 << 26,
+            max_rounds: 100_000,
+        }
+    }
+}
+
+pub struct HostMultipass {
+    program: Program,
+    config: HostMultipassConfig,
+    kernels: Kernels,
+    /// Buffers of the last run, reused when the next run starts with the same layout.
+    cache: std::sync::Mutex<Option<HostRounds>>,
+    /// The mapped buffer the counts come back through, kept between runs.
+    readback: std::sync::Mutex<Option<Readback>>,
+}
+
+/// Buffers of one queue layout: `items[p]` and `counts[p]` are the inputs of rounds of parity `p`
+/// and the outputs of the others.
+struct HostRounds {
+    layout: QueueLayout,
+    counts: [wgpu::Buffer; 2],
+    items: [wgpu::Buffer; 2],
+    /// bind[p]: reads counts[p] and items[p], appends to counts[1 - p] and items[1 - p].
+    bind: [wgpu::BindGroup; 2],
+}
+
+/// The WGSL of the host-driven multi-pass: shared program code, append-style enqueue
+/// functions, one entry point per procedure (`mp_host_<name>`), then the template.
+pub fn source(program: &Program) -> String {
+    let mut s = program.tables_wgsl();
+    s += &program.common_wgsl();
+    s += &program.execute_switch("mp_in");
+    let mut seen = Vec::new();
+    for p in &program.procs {
+        if !seen.contains(&p.layout.name) {
+            seen.push(p.layout.name.clone());
+            s += &crate::wgsl::load_store_fns(&p.layout, "mp_out");
+        }
+    }
+    let args = "@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>, \
+                @builtin(num_workgroups) nwg: vec3<u32>";
+    for (t, p) in program.procs.iter().enumerate() {
+        s += &format!(
+            "fn enqueue_{name}(item: {ty}) {{\n    if !sched_active {{ return; }}\n    \
+             let at = sched_append_slot({t}u);\n    if at == 0xffffffffu {{ return; }}\n    \
+             mp_out_store_{ty}(q_base({t}u) + at * WORDS[{t}u], item);\n}}\n\
+             @compute @workgroup_size(256) fn mp_host_{name}({args}) {{ run_procedure({t}u, lid, wid.x, nwg.x); }}\n",
+            name = p.proc.name,
+            ty = p.layout.name
+        );
+    }
+    s += TEMPLATE;
+    s
+}
+
+impl HostMultipass {
+    pub fn new(
+        gpu: &Gpu,
+        program: &Program,
+        config: HostMultipassConfig,
+    ) -> Result<HostMultipass, RunError> {
+        if program.queue_count() > 16 {
+            return Err(RunError::Program(
+                "the multi-pass strategy supports at most 16 procedures".into(),
+            ));
+        }
+        let entries: Vec<_> = (0..5).map(|b| storage_entry(b, b == 0 || b == 4)).collect();
+        let eps: Vec<String> = program
+            .procs
+            .iter()
+            .map(|p| format!("mp_host_{}", p.proc.name))
+            .collect();
+        let eps: Vec<&str> = eps.iter().map(|s| s.as_str()).collect();
+        let kernels = Kernels::new(
+            gpu,
+            program,
+            "multipass-host",
+            &source(program),
+            &entries,
+            &eps,
+            None,
+        )?;
+        Ok(HostMultipass {
+            program: program.clone(),
+            config,
+            kernels,
+            cache: Default::default(),
+            readback: Default::default(),
+        })
+    }
+
+    fn rounds_buffers(&self, gpu: &Gpu, layout: QueueLayout) -> Result<HostRounds, RunError> {
+        let nq = self.program.queue_count();
+        let count_words = (nq + EXTRA_WORDS) as u64;
+        let counts = [
+            gpu.storage_buffer("round counts a", count_words)?,
+            gpu.storage_buffer("round counts b", count_words)?,
+        ];
+        let items = [
+            gpu.storage_buffer("round items a", layout.total_words)?,
+            gpu.storage_buffer("round items b", layout.total_words)?,
+        ];
+        let mut params = vec![0u32; 4 * nq];
+        for q in 0..nq {
+            params[4 * q] = layout.capacity[q];
+            params[4 * q + 1] = layout.slot_base[q];
+        }
+        let params_buf = gpu.storage_buffer("round params", params.len() as u64)?;
+        gpu.queue
+            .write_buffer(&params_buf, 0, bytemuck::cast_slice(&params));
+        let bind = [0, 1].map(|p| {
+            self.kernels.bind_group0(
+                gpu,
+                &[
+                    (0, &counts[p]),
+                    (1, &counts[1 - p]),
+                    (2, &items[p]),
+                    (3, &items[1 - p]),
+                    (4, &params_buf),
+                ],
+            )
+        });
+        Ok(HostRounds {
+            layout,
+            counts,
+            items,
+            bind,
+        })
+    }
+
+    /// Runs the program to completion from `seeds`; `max_queue_bytes` bounds the item storage
+    /// of this run (two copies of every queue).
+    pub fn run(
+        &self,
+        gpu: &Gpu,
+        seeds: &[Seed],
+        user: Option<&wgpu::BindGroup>,
+        max_queue_bytes: Option<u64>,
+    ) -> Result<RunStats, RunError> {
+        self.kernels.check_user_group(user)?;
+        let start = Instant::now();
+        let nq = self.program.queue_count();
+        let live = QueueLayout::seed_items(&self.program, seeds)?;
+        // Two copies of the items per slot; within_budget adds a flag word, which this strategy
+        // does not have, so the budget is kept with a little to spare.
+        let max_cap = QueueLayout::within_budget(
+            &self.program,
+            QueueLayout::capacity_limits(
+                &self.program,
+                gpu.max_binding_bytes(),
+                self.config.max_capacity,
+            ),
+            max_queue_bytes,
+            2,
+        );
+        let mut n: Vec<u32> = (0..nq)
+            .map(|q| (live[q].len() / self.program.procs[q].words() as usize) as u32)
+            .collect();
+        if let Some(q) = (0..nq).find(|&q| n[q] > max_cap[q]) {
+            return Err(RunError::QueueOverflow {
+                queue: self.program.procs[q].proc.name.clone(),
+                capacity: max_cap[q] as u64,
+                needed_more_than: n[q] as u64,
+            });
+        }
+        let mut capacity: Vec<u32> = (0..nq)
+            .map(|q| {
+                self.config
+                    .initial_capacity
+                    .min(max_cap[q])
+                    .max(n[q])
+                    .max(1)
+            })
+            .collect();
+        let mut stats = RunStats {
+            strategy: "multipass-host".into(),
+            executed: vec![0; nq],
+            peak_occupancy: vec![0; nq],
+            ..Default::default()
+        };
+        let count_words = (nq + EXTRA_WORDS) as u64;
+        let rb = self.readback.lock().unwrap().take();
+        let rb = rb.unwrap_or_else(|| Readback::new(gpu, "round counts read-back", count_words));
+        let mut timer = RunTimer::new(gpu, 64);
+        let layout = QueueLayout::new(&self.program, capacity.clone())?;
+        let mut d = match self.cache.lock().unwrap().take() {
+            Some(d) if d.layout == layout => d,
+            _ => self.rounds_buffers(gpu, layout)?,
+        };
+        // Seeds: the inputs of the first round, at parity 0.
+        for (q, items) in live.iter().enumerate() {
+            if !items.is_empty() {
+                gpu.queue.write_buffer(
+                    &d.items[0],
+                    d.layout.slot_base[q] as u64 * 4,
+                    bytemuck::cast_slice(items),
+                );
+            }
+        }
+        gpu.queue
+            .write_buffer(&d.counts[0], 0, bytemuck::cast_slice(&n));
+        let mut par = 0;
+        while n.iter().any(|&k| k > 0) {
+            if stats.rounds >= self.config.max_rounds as u64 {
+                return Err(RunError::NoProgress(format!(
+                    "work left after {} host-driven multi-pass rounds",
+                    stats.rounds
+                )));
+            }
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            // Room for the round's worst case in every target, before it runs.
+            let mut grown = capacity.clone();
+            for (t, cap) in grown.iter_mut().enumerate() {
+                let m: u64 = (0..nq)
+                    .map(|p| n[p] as u64 * self.program.procs[p].emits[t] as u64)
+                    .sum();
+                if m > *cap as u64 {
+                    if *cap >= max_cap[t] {
+                        return Err(RunError::QueueOverflow {
+                            queue: self.program.procs[t].proc.name.clone(),
+                            capacity: *cap as u64,
+                            needed_more_than: m,
+                        });
+                    }
+                    *cap = grow(*cap, m, max_cap[t]);
+                    stats.queue_growths += 1;
+                }
+            }
+            if grown != capacity {
+                // New buffers; this round's inputs move there on the device, ahead of the round.
+                capacity = grown;
+                let new =
+                    self.rounds_buffers(gpu, QueueLayout::new(&self.program, capacity.clone())?)?;
+                for (q, &k) in n.iter().enumerate() {
+                    let bytes = k as u64 * d.layout.words[q] as u64 * 4;
+                    if bytes > 0 {
+                        enc.copy_buffer_to_buffer(
+                            &d.items[par],
+                            d.layout.slot_base[q] as u64 * 4,
+                            &new.items[0],
+                            new.layout.slot_base[q] as u64 * 4,
+                            bytes,
+                        );
+                    }
+                }
+                gpu.queue
+                    .write_buffer(&new.counts[0], 0, bytemuck::cast_slice(&n));
+                d = new;
+                par = 0;
+            }
+            enc.clear_buffer(&d.counts[1 - par], 0, None);
+            {
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("multipass-host round"),
+                    timestamp_writes: timer.writes(),
+                });
+                pass.set_bind_group(0, &d.bind[par], &[]);
+                if let Some(u) = user {
+                    pass.set_bind_group(1, u, &[]);
+                }
+                for (q, &k) in n.iter().enumerate() {
+                    if k == 0 {
+                        continue;
+                    }
+                    let per_step = self.program.procs[q].items_per_step;
+                    pass.set_pipeline(&self.kernels.pipelines[q]);
+                    pass.dispatch_workgroups(k.div_ceil(per_step).min(65_535), 1, 1);
+                    stats.launches += 1;
+                }
+            }
+            rb.copy(&mut enc, &d.counts[1 - par], 0, 0, count_words);
+            timer.end_submission(&mut enc);
+            gpu.queue.submit([enc.finish()]);
+            let out = rb.read(gpu, count_words)?;
+            timer.after_wait(gpu)?;
+            stats.submits += 1;
+            stats.rounds += 1;
+            for q in 0..nq {
+                stats.executed[q] += n[q] as u64;
+                stats.peak_occupancy[q] = stats.peak_occupancy[q].max(n[q] as u64);
+            }
+            let (a, b) = (out[nq + H_ERR_A] as usize, out[nq + H_ERR_B] as usize);
+            match out[nq + H_ERROR] {
+                0 => {}
+                ERR_EMIT => {
+                    return Err(RunError::EmitLimit {
+                        procedure: self.program.procs[a].proc.name.clone(),
+                        target: self.program.procs[b].proc.name.clone(),
+                        declared: self.program.procs[a].emits[b],
+                    });
+                }
+                e => {
+                    return Err(RunError::Device(format!(
+                        "host-driven multi-pass: error {e} (queue {a}, slot {b}): an append \
+                         past the capacity the host made room for"
+                    )));
+                }
+            }
+            n.copy_from_slice(&out[..nq]);
+            par = 1 - par;
+        }
+        stats.queue_bytes = d.layout.total_words * 4 * 2;
+        stats.gpu_ms = timer.finish(gpu)?;
+        stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
+        *self.cache.lock().unwrap() = Some(d);
+        *self.readback.lock().unwrap() = Some(rb);
+        Ok(stats)
+    }
+}

@@ -1,0 +1,106 @@
+//! Read-back of device results with one host wait: a reusable mapped buffer for the small
+//! per-launch or per-round counters, and a one-shot read of several buffer ranges together.
+
+use std::time::Duration;
+
+use crate::error::RunError;
+use crate::gpu::Gpu;
+
+/// A `MAP_READ` buffer of `words` u32 words, kept for a scheduler's lifetime, that the caller fills
+/// with [`Readback::copy`] in the same command encoder as the work it reads (so no extra
+/// submission) and reads with [`Readback::read`] after submitting (one bounded wait).
+pub struct Readback {
+    buf: wgpu::Buffer,
+    words: u64,
+}
+
+impl Readback {
+    pub fn new(gpu: &Gpu, label: &str, words: u64) -> Readback {
+        // Even, so that any prefix rounded up to 8 bytes stays inside.
+        let words = words.max(2).next_multiple_of(2);
+        Readback {
+            buf: gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: words * 4,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            words,
+        }
+    }
+
+    /// Records a copy of `words` words of `src` from word `src_word` to word `dst_word` here.
+    pub fn copy(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        src: &wgpu::Buffer,
+        src_word: u64,
+        dst_word: u64,
+        words: u64,
+    ) {
+        assert!(
+            dst_word + words <= self.words,
+            "Readback: copy past its end"
+        );
+        enc.copy_buffer_to_buffer(src, src_word * 4, &self.buf, dst_word * 4, words * 4);
+    }
+
+    /// The first `words` words, after the submission that copied them; waits at most
+    /// `gpu.timeout`.
+    pub fn read(&self, gpu: &Gpu, words: u64) -> Result<Vec<u32>, RunError> {
+        // Map ranges must be a multiple of 8 bytes long.
+        let bytes = (words.min(self.words) * 4)
+            .next_multiple_of(8)
+            .min(self.words * 4);
+        let slice = self.buf.slice(0..bytes);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        gpu.wait("reading counters back")?;
+        match rx.recv_timeout(Duration::from_secs(1)) {
+            Ok(Ok(())) => {}
+            Ok(Err(e)) => return Err(RunError::Device(format!("map_async: {e}"))),
+            Err(_) => return Err(RunError::Device("buffer map never completed".into())),
+        }
+        let out = {
+            let view = slice
+                .get_mapped_range()
+                .map_err(|e| RunError::Device(format!("mapped range: {e}")))?;
+            bytemuck::cast_slice::<u8, u32>(&view)[..words as usize].to_vec()
+        };
+        self.buf.unmap();
+        Ok(out)
+    }
+}
+
+/// Reads every `(buffer, first word, words)` range in one submission and one bounded wait.
+pub fn read_ranges(
+    gpu: &Gpu,
+    ranges: &[(&wgpu::Buffer, u64, u64)],
+) -> Result<Vec<Vec<u32>>, RunError> {
+    let total: u64 = ranges.iter().map(|r| r.2).sum();
+    if total == 0 {
+        return Ok(vec![Vec::new(); ranges.len()]);
+    }
+    let rb = Readback::new(gpu, "read ranges", total);
+    let mut enc = gpu.device.create_command_encoder(&Default::default());
+    let mut at = 0;
+    for &(buf, first, words) in ranges {
+        if words > 0 {
+            rb.copy(&mut enc, buf, first, at, words);
+        }
+        at += words;
+    }
+    gpu.queue.submit([enc.finish()]);
+    let all = rb.read(gpu, total)?;
+    let mut at = 0;
+    Ok(ranges
+        .iter()
+        .map(|r| {
+            let v = all[at..at + r.2 as usize].to_vec();
+            at += r.2 as usize;
+            v
+        })
+        .collect())
+}
