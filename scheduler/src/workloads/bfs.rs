@@ -9,7 +9,7 @@
 //!
 //! Relaxing a list of at most [`BfsParams::chunk_edges`] edges runs `atomicMin(&level[u],
 //! level + 1)` per neighbour `u` and emits `bfs_vertex { u, level + 1 }` when that lowered it.
-//! A longer list (R-MAT's hubs have degrees in the tens of thousands at scale 20) is cut into at
+//! A longer list (R-MAT's largest hub has degree 138,923 at scale 20) is cut into at
 //! most [`BfsParams::split`] `bfs_edges` items of equal length, which cut again until they are
 //! short: so each item's declared worst case stays `chunk_edges` vertices plus `split` slices,
 //! whatever the degree. With the megakernel, items of different levels run at once and a vertex
@@ -82,7 +82,12 @@ impl std::fmt::Debug for BfsParams {
 impl BfsParams {
     /// Generates the graph and picks the source: the first vertex with an edge at or after a
     /// position drawn from the seed (Graph500 draws sources among vertices with edges).
-    /// Defaults: 32-edge chunks, split 8, 8 threads per item.
+    /// Defaults: 16-edge chunks, split 8, 8 threads per item. Multi-pass reserves
+    /// `chunk_edges` output slots per item per round, and one round holds a whole BFS level
+    /// (the largest is about a third of the vertices: 337,025 of 2^20 at scale 20, seed 1), so
+    /// under its 65,535 × 1,024-slot queue cap chunk 16 fits up to scale 23 and chunk 8 scale
+    /// 24; beyond, multi-pass reports [`RunError::QueueOverflow`]. The megakernel reserves
+    /// per batch and has no such bound.
     pub fn new(rmat: RmatParams) -> Result<BfsParams, RunError> {
         let graph = Arc::new(rmat::generate(&rmat)?);
         let n = graph.vertices();
@@ -96,7 +101,7 @@ impl BfsParams {
             rmat,
             graph,
             source,
-            chunk_edges: 32,
+            chunk_edges: 16,
             split: 8,
             threads: 8,
         })
