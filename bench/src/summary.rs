@@ -236,7 +236,7 @@ pub fn why(mk: &Cell, best: &Cell, multipass: Option<&Cell>, cpu_adapter: bool) 
     if cpu_adapter {
         reasons.push(
             "the adapter is a CPU (lavapipe): the GPU strategies run emulated on the same cores \
-             as the CPU implementation, and the probe found few co-resident workgroups"
+             as the CPU implementation"
                 .to_string(),
         );
     }
