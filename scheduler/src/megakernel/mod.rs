@@ -214,8 +214,17 @@ impl Megakernel {
         Ok(self.workgroups.load(std::sync::atomic::Ordering::Relaxed))
     }
 
-    /// Counts workgroups that run at the same time (see `probe` in the shader).
+    /// Counts workgroups that run at the same time (see `probe` in the shader). A CPU adapter
+    /// (lavapipe) runs at most one workgroup per hardware thread at once, and runs the probe's
+    /// spinning workgroups one after another: probing more than that many only costs time
+    /// (seconds on two cores), so its `max` is capped there.
     fn probe(&self, gpu: &Gpu, max: u32, user: Option<&wgpu::BindGroup>) -> Result<u32, RunError> {
+        let max = if gpu.info.device_type == wgpu::DeviceType::Cpu {
+            let threads = std::thread::available_parallelism().map_or(1, |n| n.get() as u32);
+            max.min(threads)
+        } else {
+            max
+        };
         let nq = self.program.queue_count();
         let layout = QueueLayout::new(&self.program, vec![1; nq])?;
         let mut params = self.params(&layout);
