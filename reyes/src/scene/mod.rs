@@ -12,7 +12,6 @@ mod bpt;
 mod newell;
 mod nurbs;
 mod rib;
-mod rib_lexer;
 mod teapot;
 
 use glam::{DMat4, DVec3};
@@ -96,7 +95,7 @@ pub struct Patch {
     pub material: u32,
     /// True when the camera-space geometric normal dPdu x dPdv must be negated to get the
     /// surface's OUTSIDE normal as RenderMan defines it (`Orientation`/`ReverseOrientation`
-    /// versus the handedness of the current transform; see `rib.rs` for the derivation).
+    /// versus the handedness of the current transform; see `rib/mod.rs` for the derivation).
     pub flip_normal: bool,
     /// `Sides 2` (the default): both sides visible. `Sides 1`: back-facing parts are culled.
     pub two_sided: bool,
