@@ -23,11 +23,15 @@
 //!   uteapot.rib's teapot, a mirror image of Newell's data, faces inward; killeroo.rib's
 //!   mirroring camera `Transform` makes every patch flip, facing it outward.)
 //!
-//! One file per concern: [`lexer`] (bytes to tokens), [`syntax`] (tokens to requests and
-//! typed argument access), [`state`] (the graphics state and its stacks), [`requests`] (the
-//! one dispatch over request names), [`shading`] (surfaces, lights, the material table) and
-//! [`patches`] (the patch primitives and their conversion to Bezier patches).
+//! One file per concern: [`lexer`] (bytes to tokens), [`input`] (tokens to requests, through
+//! the scene file and the archives it reads), [`syntax`] (requests and typed access to their
+//! arguments), [`state`] (options, attributes and the block stack), [`requests`] (the one
+//! dispatch over request names), [`frames`] (frame and world blocks: the sequence of frames),
+//! [`shading`] (surfaces, lights, the material table) and [`patches`] (the patch primitives
+//! and their conversion to Bezier patches).
 
+mod frames;
+mod input;
 mod lexer;
 mod patches;
 mod requests;
@@ -37,44 +41,37 @@ mod syntax;
 #[cfg(test)]
 mod tests;
 
-use super::basis::Basis;
-use super::{Material, Scene, SceneError, SurfaceKind};
-use glam::{DMat4, DVec3};
-use lexer::tokenize;
-use state::{Attributes, Interp};
-use std::collections::{HashMap, HashSet};
-use syntax::Reader;
+pub use input::open_rib;
 
-/// Parses RIB text. `file` names the input in errors and warnings.
+use super::{FrameSequence, Scene, SceneError};
+use input::Reader;
+use state::Interp;
+use std::path::Path;
+
+/// Parses RIB text into its frames. `file` names the input in errors and warnings; archives
+/// (`ReadArchive`) are looked up beside it, then in the current directory.
+pub fn parse_rib_frames(text: &str, file: &str) -> Result<FrameSequence, SceneError> {
+    read(Reader::new(Box::new(text.as_bytes()), file, None))
+}
+
+/// Parses RIB text of one image: the first frame that can be rendered, with a warning when
+/// the file has several ([`FrameSequence::into_scene`]).
 pub fn parse_rib(text: &str, file: &str) -> Result<Scene, SceneError> {
-    let toks = tokenize(text.as_bytes(), file)?;
-    let eof_line = text.lines().count().max(1) as u32;
-    let mut reader = Reader {
-        file,
-        toks: toks.into_iter().peekable(),
-        eof_line,
-    };
-    let mut it = Interp {
-        file,
-        scene: Scene::default(),
-        attrs: Attributes {
-            ctm: DMat4::IDENTITY,
-            orientation_rh: false,
-            two_sided: true,
-            color: DVec3::ONE,
-            opacity: DVec3::ONE,
-            surface: Material::standard(SurfaceKind::Matte),
-            ubasis: Basis::BEZIER,
-            vbasis: Basis::BEZIER,
-        },
-        stack: Vec::new(),
-        world_to_camera: None,
-        world_seen: false,
-        warned: HashSet::new(),
-        materials: HashMap::new(),
-        current_material: None,
-        motion: None,
-    };
+    parse_rib_frames(text, file).map(FrameSequence::into_scene)
+}
+
+/// Reads a RIB file (gzip-compressed or not) into its frames, as a stream: the memory it
+/// needs is the scene's, not the file's. Errors name the file as `path` displays.
+pub fn load_rib(path: &Path) -> Result<FrameSequence, SceneError> {
+    let file = path.display().to_string();
+    let src =
+        open_rib(path).map_err(|e| SceneError::new(&file, 0, format!("cannot read file: {e}")))?;
+    read(Reader::new(src, &file, Some(path)))
+}
+
+/// Runs the requests of `reader` to its end.
+fn read(mut reader: Reader) -> Result<FrameSequence, SceneError> {
+    let mut it = Interp::new();
     while let Some(req) = reader.next_request()? {
         if req.name == "ObjectBegin" {
             it.warn_once(
@@ -87,14 +84,10 @@ pub fn parse_rib(text: &str, file: &str) -> Result<Scene, SceneError> {
                     Some(r) if r.name == "ObjectEnd" => break,
                     Some(_) => {}
                     None => {
-                        return Err(SceneError::new(
-                            file,
-                            eof_line,
-                            format!(
-                                "unexpected end of file inside `ObjectBegin` (line {})",
-                                req.line
-                            ),
-                        ));
+                        return Err(reader.eof_error(format!(
+                            "unexpected end of file inside `ObjectBegin` (line {})",
+                            req.line
+                        )));
                     }
                 }
             }
@@ -110,24 +103,21 @@ pub fn parse_rib(text: &str, file: &str) -> Result<Scene, SceneError> {
             }
             it.motion = Some(true);
         }
+        if req.name == "ReadArchive" {
+            reader.read_archive(&req)?;
+            continue;
+        }
         it.request(&req)?;
     }
-    if let Some((block, line, _)) = it.stack.last() {
-        return Err(SceneError::new(
-            file,
-            eof_line,
-            format!(
-                "unexpected end of file inside `{}` (line {line})",
-                block.begin()
-            ),
-        ));
+    if let Some(open) = it.stack.last() {
+        return Err(reader.eof_error(format!(
+            "unexpected end of file inside `{}` ({})",
+            open.block.begin(),
+            open.place(&reader.file())
+        )));
     }
-    if !it.world_seen {
-        return Err(SceneError::new(
-            file,
-            eof_line,
-            "no `WorldBegin` ... `WorldEnd` block in the file",
-        ));
+    if it.frames.is_empty() {
+        return Err(reader.eof_error("no `WorldBegin` ... `WorldEnd` block in the file"));
     }
-    Ok(it.scene)
+    Ok(it.finish())
 }

@@ -2,6 +2,7 @@
 //! of each piece to a bicubic Bezier patch (through the current `Basis` or the NURBS spans)
 //! and its transformation to camera space.
 
+use super::lexer::shown;
 use super::state::Interp;
 use super::syntax::{Arg, Args, Param, Request};
 use crate::scene::basis::{Basis, block_to_bezier};
@@ -9,7 +10,7 @@ use crate::scene::nurbs::{self, NuSurface};
 use crate::scene::{Patch, PatchSource, SceneError};
 use glam::{DMat4, DVec3};
 
-impl Interp<'_> {
+impl Interp {
     pub(super) fn geometry_ctm(&self, a: &Args) -> Result<DMat4, SceneError> {
         if self.world_to_camera.is_none() {
             return Err(a.err("geometry outside `WorldBegin` ... `WorldEnd`"));
@@ -51,6 +52,16 @@ impl Interp<'_> {
                 show_point(*p)
             )));
         }
+        // The renderer computes in f32: a point finite in f64 may not be there.
+        let beyond_f32 = |p: &DVec3| p.to_array().iter().any(|&x| !(x as f32).is_finite());
+        if let Some((k, p)) = cp.iter().enumerate().find(|(_, p)| beyond_f32(p)) {
+            return Err(a.err(format!(
+                "patch {index}: control point {k} is {} in camera space, beyond the f32 range \
+                 (±{:e}) the renderer computes in",
+                show_point(*p),
+                f32::MAX
+            )));
+        }
         let material = self.material();
         self.scene.patches.push(Patch {
             cp,
@@ -58,7 +69,7 @@ impl Interp<'_> {
             flip_normal: self.attrs.orientation_rh,
             two_sided: self.attrs.two_sided,
             source: PatchSource {
-                file: self.file.to_string(),
+                file: a.req.file.to_string(),
                 line: a.req.line,
                 index: index as u32,
             },
@@ -277,7 +288,8 @@ pub(super) fn patch_points(a: &Args, kind: &str) -> Result<usize, SceneError> {
         "bicubic" => Ok(16),
         "bilinear" => Ok(4),
         _ => Err(a.err(format!(
-            "patch type \"{kind}\" is not \"bicubic\" or \"bilinear\""
+            "patch type \"{}\" is not \"bicubic\" or \"bilinear\"",
+            shown(kind)
         ))),
     }
 }
@@ -287,7 +299,8 @@ pub(super) fn wrap_arg(a: &mut Args, what: &str) -> Result<bool, SceneError> {
         "periodic" => Ok(true),
         "nonperiodic" => Ok(false),
         w => Err(a.err(format!(
-            "{what} \"{w}\" is not \"periodic\" or \"nonperiodic\""
+            "{what} \"{}\" is not \"periodic\" or \"nonperiodic\"",
+            shown(w)
         ))),
     }
 }
@@ -336,7 +349,7 @@ pub(super) fn basis_arg(a: &mut Args, dir: &str) -> Result<Basis, SceneError> {
         Some(Arg::Str(_)) | Some(Arg::Strs(_)) => {
             let name = a.string(&what)?;
             Basis::by_name(name)
-                .ok_or_else(|| a.err(format!("unknown basis \"{name}\"")))?
+                .ok_or_else(|| a.err(format!("unknown basis \"{}\"", shown(name))))?
                 .matrix
         }
         _ => {

@@ -1,12 +1,13 @@
 //! Shading requests: `Surface` and `LightSource`, and the table of distinct materials the
 //! patches index.
 
+use super::lexer::shown;
 use super::state::Interp;
 use super::syntax::{Arg, Args, Request};
 use crate::scene::{Light, Material, SceneError, SurfaceKind};
 use glam::DVec3;
 
-impl Interp<'_> {
+impl Interp {
     pub(super) fn surface(&mut self, req: &Request, a: &mut Args) -> Result<(), SceneError> {
         let name = a.string("the shader name")?;
         let kind = match name {
@@ -15,7 +16,8 @@ impl Interp<'_> {
             "plastic" => SurfaceKind::Plastic,
             _ => {
                 let msg = format!(
-                    "skipped unsupported surface shader \"{name}\" (keeping the previous surface)"
+                    "skipped unsupported surface shader \"{}\" (keeping the previous surface)",
+                    shown(name)
                 );
                 self.warn_once(req, &format!("Surface \"{name}\""), &msg);
                 return Ok(());
@@ -31,6 +33,12 @@ impl Interp<'_> {
                 (SurfaceKind::Plastic, "specularcolor") => m.specular_color = p.vec3(a)?,
                 (_, other) => self.ignored_param(req, other),
             }
+        }
+        let values = [m.ka, m.kd, m.ks, m.roughness];
+        if values.iter().any(|v| !(*v as f32).is_finite())
+            || !m.specular_color.as_vec3().is_finite()
+        {
+            return Err(a.err("a shader parameter is beyond the f32 range the renderer shades in"));
         }
         self.attrs.surface = m;
         self.current_material = None;
@@ -51,7 +59,10 @@ impl Interp<'_> {
         }
         let params = a.params()?;
         if !matches!(name, "ambientlight" | "distantlight" | "pointlight") {
-            let msg = format!("skipped unsupported light shader \"{name}\" (no light added)");
+            let msg = format!(
+                "skipped unsupported light shader \"{}\" (no light added)",
+                shown(name)
+            );
             self.warn_once(req, &format!("LightSource \"{name}\""), &msg);
             return Ok(());
         }
@@ -88,6 +99,17 @@ impl Interp<'_> {
                 Light::Point { color, pos }
             }
         };
+        let (Light::Ambient { color } | Light::Distant { color, .. } | Light::Point { color, .. }) =
+            &light;
+        let pos = match &light {
+            Light::Point { pos, .. } => *pos,
+            _ => DVec3::ZERO,
+        };
+        if [*color, pos].iter().any(|v| !v.as_vec3().is_finite()) {
+            return Err(a.err(
+                "the light's color or position is beyond the f32 range the renderer computes in",
+            ));
+        }
         self.scene.lights.push(light);
         Ok(())
     }

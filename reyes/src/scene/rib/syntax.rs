@@ -1,10 +1,11 @@
-//! Requests as read: tokens grouped into a request name and its arguments ([`Reader`]), and
-//! a cursor over a request's arguments whose errors name the request and line ([`Args`]).
+//! Requests as read ([`Request`]: a name and its arguments, grouped by `super::input`), and
+//! a cursor over a request's arguments whose errors name the file, request and line
+//! ([`Args`]).
 
-use super::lexer::{Tok, Token};
-use super::requests::KNOWN;
+use super::lexer::shown;
 use crate::scene::SceneError;
 use glam::DVec3;
+use std::rc::Rc;
 
 /// One argument of a request.
 #[derive(Clone, Debug, PartialEq)]
@@ -19,7 +20,7 @@ impl Arg {
     pub(super) fn describe(&self) -> String {
         match self {
             Arg::Num(v) => format!("number {v}"),
-            Arg::Str(s) => format!("string \"{s}\""),
+            Arg::Str(s) => format!("string \"{}\"", shown(s)),
             Arg::Nums(v) => format!("array of {} numbers", v.len()),
             Arg::Strs(v) => format!("array of {} strings", v.len()),
         }
@@ -29,114 +30,14 @@ impl Arg {
 #[derive(Debug)]
 pub(super) struct Request {
     pub(super) name: String,
+    /// The file (or archive) the request is in, as errors name it.
+    pub(super) file: Rc<str>,
     pub(super) line: u32,
     pub(super) args: Vec<Arg>,
 }
 
 pub(super) fn is_identifier(w: &str) -> bool {
     w.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_')
-}
-
-/// Groups tokens into requests: a bare word followed by its arguments.
-pub(super) struct Reader<'a> {
-    pub(super) file: &'a str,
-    pub(super) toks: std::iter::Peekable<std::vec::IntoIter<Token>>,
-    pub(super) eof_line: u32,
-}
-
-impl<'a> Reader<'a> {
-    pub(super) fn err(&self, line: u32, msg: impl Into<String>) -> SceneError {
-        SceneError::new(self.file, line, msg)
-    }
-
-    pub(super) fn next_request(&mut self) -> Result<Option<Request>, SceneError> {
-        let Some(first) = self.toks.next() else {
-            return Ok(None);
-        };
-        let name = match first.tok {
-            Tok::Word(w) if is_identifier(&w) => w,
-            Tok::Word(w) => return Err(self.err(first.line, format!("unexpected `{w}`"))),
-            Tok::Num(v) => {
-                return Err(self.err(first.line, format!("expected a request, found number {v}")));
-            }
-            Tok::Str(s) => {
-                return Err(self.err(
-                    first.line,
-                    format!("expected a request, found string \"{s}\""),
-                ));
-            }
-            Tok::Open => return Err(self.err(first.line, "expected a request, found `[`")),
-            Tok::Close => return Err(self.err(first.line, "unexpected `]`")),
-        };
-        let known = KNOWN.contains(&name.as_str());
-        let mut args = Vec::new();
-        while let Some(t) = self.toks.peek() {
-            let line = t.line;
-            match &t.tok {
-                Tok::Word(w) if is_identifier(w) => break,
-                // Junk after an unknown request (`set -x`) belongs to it; after a known one
-                // it is an error.
-                Tok::Word(w) if known => {
-                    let msg = format!("`{name}`: unexpected `{w}` (not a number or string)");
-                    return Err(self.err(line, msg));
-                }
-                Tok::Word(_) => {
-                    self.toks.next();
-                }
-                Tok::Num(v) => {
-                    args.push(Arg::Num(*v));
-                    self.toks.next();
-                }
-                Tok::Str(s) => {
-                    args.push(Arg::Str(s.clone()));
-                    self.toks.next();
-                }
-                Tok::Close => return Err(self.err(line, "unexpected `]`")),
-                Tok::Open => {
-                    self.toks.next();
-                    args.push(self.array(line)?);
-                }
-            }
-        }
-        Ok(Some(Request {
-            name,
-            line: first.line,
-            args,
-        }))
-    }
-
-    pub(super) fn array(&mut self, open_line: u32) -> Result<Arg, SceneError> {
-        let mut nums = Vec::new();
-        let mut strs = Vec::new();
-        loop {
-            let Some(t) = self.toks.next() else {
-                return Err(self.err(
-                    self.eof_line,
-                    format!("unexpected end of file inside the array opened at line {open_line}"),
-                ));
-            };
-            match t.tok {
-                Tok::Close => break,
-                Tok::Num(v) => nums.push(v),
-                Tok::Str(s) => strs.push(s),
-                Tok::Open => return Err(self.err(t.line, "unexpected `[` inside an array")),
-                Tok::Word(w) => {
-                    return Err(self.err(
-                        t.line,
-                        format!("unexpected `{w}` inside an array (not a number or string)"),
-                    ));
-                }
-            }
-            if !nums.is_empty() && !strs.is_empty() {
-                return Err(self.err(t.line, "array mixes numbers and strings"));
-            }
-        }
-        Ok(if strs.is_empty() {
-            Arg::Nums(nums)
-        } else {
-            Arg::Strs(strs)
-        })
-    }
 }
 
 /// A parameter of a request's parameter list, name without inline type declaration.
@@ -148,14 +49,17 @@ pub(super) struct Param<'r> {
 /// Cursor over a request's arguments with error messages naming the request and line.
 pub(super) struct Args<'r> {
     pub(super) req: &'r Request,
-    pub(super) file: &'r str,
     pub(super) pos: usize,
 }
 
 impl<'r> Args<'r> {
+    pub(super) fn new(req: &'r Request) -> Args<'r> {
+        Args { req, pos: 0 }
+    }
+
     pub(super) fn err(&self, msg: impl std::fmt::Display) -> SceneError {
         SceneError::new(
-            self.file,
+            &self.req.file,
             self.req.line,
             format!("`{}`: {msg}", self.req.name),
         )
@@ -280,7 +184,7 @@ impl<'r> Args<'r> {
             let short = name.split_whitespace().last().unwrap_or("");
             let value = self
                 .peek()
-                .ok_or_else(|| self.err(format!("parameter \"{short}\" has no value")))?;
+                .ok_or_else(|| self.err(format!("parameter \"{}\" has no value", shown(short))))?;
             self.pos += 1;
             out.push(Param { name: short, value });
         }
@@ -302,7 +206,7 @@ impl Param<'_> {
             Arg::Nums(v) if v.len() == 1 && v[0].is_finite() => Ok(v[0]),
             other => Err(a.err(format!(
                 "parameter \"{}\" needs one finite number, found {}",
-                self.name,
+                shown(self.name),
                 other.describe()
             ))),
         }
@@ -315,7 +219,7 @@ impl Param<'_> {
             }
             other => Err(a.err(format!(
                 "parameter \"{}\" needs 3 finite numbers, found {}",
-                self.name,
+                shown(self.name),
                 other.describe()
             ))),
         }
@@ -327,7 +231,7 @@ impl Param<'_> {
             Arg::Num(v) => Ok(std::slice::from_ref(v)),
             other => Err(a.err(format!(
                 "parameter \"{}\" needs numbers, found {}",
-                self.name,
+                shown(self.name),
                 other.describe()
             ))),
         }

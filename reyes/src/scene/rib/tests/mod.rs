@@ -1,5 +1,8 @@
 //! Tests of the RIB interpreter, one file per concern like the interpreter's.
 
+mod archives;
+mod frames;
+mod hostile;
 mod patches;
 mod shading;
 mod state;

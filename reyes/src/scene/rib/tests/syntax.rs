@@ -6,7 +6,7 @@ use glam::DVec3;
 #[test]
 fn one_warning_per_skipped_request_kind() {
     let s = parse(&format!(
-        "set -x\nDisplay \"a\" \"file\" \"rgb\"\nDisplay \"b\" \"file\" \"rgb\"\nOption \"x\" \"y\" [1]\n{}",
+        "set -x\nHider \"hidden\"\nHider \"zbuffer\"\nOption \"x\" \"y\" [1]\n{}",
         world(
             "Attribute \"a\" \"b\" [1]\nAttribute \"c\" \"d\" [2]\nPatch \"bilinear\" \"P\" [0 0 0 1 0 0 0 1 0 1 1 0] \"Cs\" [1 0 0 0 1 0 0 0 1 1 1 1]"
         )
@@ -15,7 +15,7 @@ fn one_warning_per_skipped_request_kind() {
         s.warnings,
         vec![
             "t.rib:1: skipped unsupported request `set`",
-            "t.rib:2: skipped unsupported request `Display`",
+            "t.rib:2: skipped unsupported request `Hider`",
             "t.rib:4: skipped unsupported request `Option`",
             "t.rib:6: skipped unsupported request `Attribute`",
             "t.rib:8: ignored parameter \"Cs\" of `Patch`",
@@ -170,7 +170,14 @@ fn unbalanced_blocks() {
             .contains("`AttributeEnd` does not match `TransformBegin`")
     );
     assert!(err("FrameBegin 1 WorldBegin WorldEnd").contains("inside `FrameBegin`"));
-    assert!(err(&format!("{}{}", world(""), world(""))).contains("only one `WorldBegin`"));
+    assert!(err(&world("WorldBegin")).contains("world blocks do not nest"));
+    assert!(
+        err("FrameBegin 1 WorldBegin WorldEnd WorldBegin WorldEnd FrameEnd")
+            .contains("frame 1 already has a world block")
+    );
+    assert!(err("FrameBegin 1 FrameBegin 2").contains("frames do not nest"));
+    assert!(err("WorldBegin FrameBegin 2").contains("not allowed inside `WorldBegin`"));
+    assert!(err("FrameEnd").contains("without a matching `FrameBegin`"));
     assert!(err(QUAD).contains("outside `WorldBegin`"));
     assert!(err(&world("MotionEnd")).contains("without a matching `MotionBegin`"));
 }
