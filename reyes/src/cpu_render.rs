@@ -2,6 +2,7 @@
 //! stack. The order of work differs from the GPU's, which cannot change the image: every sample
 //! keeps the maximum of its keys.
 
+use crate::buckets;
 use crate::frame::{FrameData, PatchItem};
 use crate::image::FrameImage;
 use crate::stages::{self, bound::Cull, bound::Decision};
@@ -21,25 +22,56 @@ impl CpuRender {
     }
 }
 
+/// Renders `data` as the GPU does, in the same screen buckets under
+/// [`FrameData::memory_budget`] (`buckets::plan`), so the sample buffer held at once is one
+/// bucket's; the image does not depend on the buckets.
 pub fn render_cpu(data: &FrameData) -> CpuRender {
     let f = &data.frame;
     let spp = f.spp_x * f.spp_y;
-    let mut samples = vec![0u64; f.width as usize * f.height as usize * spp as usize];
+    let pixels = f.width as usize * f.height as usize;
+    let mut image = FrameImage {
+        width: f.width,
+        height: f.height,
+        rgba: vec![[0.0; 4]; pixels],
+        depth: vec![0.0; pixels],
+    };
     let mut counters = [0u64; stages::COUNTERS];
     let mut executed = [0u64; 5];
-    walk(data, &mut counters, &mut executed, |item, counters| {
-        let (mps, culled) = stages::dice_shade::dice_shade(item, data, &mut samples);
-        counters[stages::C_MICROPOLYGONS] += mps as u64;
-        counters[stages::C_BACKFACE] += culled as u64;
-    });
-    let (rgba, depth) = stages::resolve::resolve(&samples, f.width, f.height, spp);
+    for tile in buckets::plan(f, data.memory_budget) {
+        // Without a budget the one bucket is the whole image: `data` as it is.
+        let bucket = match data.memory_budget {
+            None => std::borrow::Cow::Borrowed(data),
+            Some(_) => std::borrow::Cow::Owned(FrameData {
+                frame: f.with_tile(tile),
+                materials: data.materials.clone(),
+                lights: data.lights.clone(),
+                patch_info: data.patch_info.clone(),
+                items: (data.items.iter())
+                    .filter(|i| buckets::may_reach(f, i, tile))
+                    .copied()
+                    .collect(),
+                memory_budget: data.memory_budget,
+            }),
+        };
+        let mut samples = vec![0u64; tile.w as usize * tile.h as usize * spp as usize];
+        walk(&bucket, &mut counters, &mut executed, |item, counters| {
+            let (mps, culled) = stages::dice_shade::dice_shade(item, &bucket, &mut samples);
+            counters[stages::C_MICROPOLYGONS] += mps as u64;
+            counters[stages::C_BACKFACE] += culled as u64;
+        });
+        let (rgba, depth) = stages::resolve::resolve(&samples, tile.w, tile.h, spp);
+        for row in 0..tile.h as usize {
+            let (src, dst) = (
+                row * tile.w as usize,
+                (tile.y0 as usize + row) * f.width as usize + tile.x0 as usize,
+            );
+            let n = tile.w as usize;
+            image.rgba[dst..dst + n].copy_from_slice(&rgba[src..src + n]);
+            image.depth[dst..dst + n].copy_from_slice(&depth[src..src + n]);
+        }
+    }
     CpuRender {
-        image: FrameImage {
-            width: f.width,
-            height: f.height,
-            rgba,
-            depth,
-        },
+        image,
         counters,
         executed,
     }
@@ -96,5 +128,42 @@ fn walk(
                 dice(&item, counters);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::RenderOptions;
+
+    /// Under a memory budget the CPU twin renders in the GPU's buckets, holding one bucket's
+    /// samples at a time, and makes the same image bit for bit.
+    #[test]
+    fn buckets_make_the_same_image() {
+        let scene = crate::scene::builtin_teapot();
+        let o = RenderOptions {
+            width: Some(80),
+            height: Some(60),
+            ..Default::default()
+        };
+        let whole = render_cpu(&FrameData::new(&scene, &o).unwrap());
+        let budget = Some(16 << 10);
+        let data = FrameData::new(
+            &scene,
+            &RenderOptions {
+                memory_budget: budget,
+                ..o
+            },
+        )
+        .unwrap();
+        assert!(buckets::plan(&data.frame, budget).len() > 4);
+        let cut = render_cpu(&data);
+        assert!(whole.image.rgba.iter().any(|p| p[3] > 0.0));
+        assert!(whole.image.rgba == cut.image.rgba, "rgba differs");
+        assert!(whole.image.depth == cut.image.depth, "depth differs");
+        assert_eq!(
+            whole.counters[stages::C_MICROPOLYGONS] > 0,
+            cut.counters[stages::C_MICROPOLYGONS] > 0
+        );
     }
 }

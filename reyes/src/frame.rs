@@ -178,6 +178,51 @@ pub struct FrameData {
 /// Largest image side accepted (the sample buffer must also fit the adapter; checked there).
 pub const MAX_IMAGE_SIDE: u32 = 16384;
 
+/// Most samples per pixel in x and in y (RenderMan's `PixelSamples`).
+pub const MAX_PIXEL_SAMPLES: u32 = 16;
+
+/// Smallest micropolygon edge accepted, in pixels: 256 micropolygons per pixel. Below it the
+/// work per patch grows without bound (each halving of the size quadruples the grids) while
+/// the image no longer changes; both paths would split every patch to `max_depth`.
+pub const MIN_MP_SIZE: f32 = 1.0 / 16.0;
+
+/// Most bytes of one frame buffer (the whole image's RGBA, and the sample buffer when the
+/// frame is not cut into buckets): 4 GiB - 1, the most a wgpu storage binding can hold on any
+/// backend (Vulkan's `maxStorageBufferRange` is 32-bit). The CPU twin is held to the same
+/// bound, so a frame the GPU must refuse is refused up front on both paths instead of
+/// allocating tens of GiB on the host.
+pub const MAX_FRAME_BUFFER_BYTES: u64 = u32::MAX as u64;
+
+/// Bytes of the RGBA image (f32 x 4 per pixel) of a `width` x `height` frame.
+pub fn image_bytes(width: u32, height: u32) -> u64 {
+    width as u64 * height as u64 * 16
+}
+
+/// Checks the options both render paths share that do not depend on the scene: the
+/// micropolygon size and the screen bound. Errors say which option and why.
+pub fn check_quality(o: &RenderOptions) -> Result<(), String> {
+    if !(1..=15).contains(&o.grid_max) {
+        return Err(format!("grid_max {} must be 1..=15", o.grid_max));
+    }
+    if !(o.mp_size.is_finite() && o.mp_size >= MIN_MP_SIZE) {
+        return Err(format!(
+            "micropolygon size {:?} px is not supported: it must be at least {MIN_MP_SIZE} px \
+             (256 micropolygons per pixel) and finite",
+            o.mp_size
+        ));
+    }
+    let min_bound = 15.0 * MIN_MP_SIZE;
+    if let Some(b) = o.bound_px
+        && !(b.is_finite() && b >= min_bound)
+    {
+        return Err(format!(
+            "screen bound {b:?} px is not supported: it must be at least {min_bound} px (grids \
+             of 15x15 micropolygons of at least {MIN_MP_SIZE} px) and finite"
+        ));
+    }
+    Ok(())
+}
+
 impl FrameData {
     pub fn new(scene: &Scene, o: &RenderOptions) -> Result<FrameData, String> {
         let width = o.width.unwrap_or(scene.width);
@@ -188,8 +233,11 @@ impl FrameData {
             ));
         }
         let (sx, sy) = o.pixel_samples.unwrap_or(scene.pixel_samples);
-        if !(1..=16).contains(&sx) || !(1..=16).contains(&sy) {
-            return Err(format!("pixel samples {sx}x{sy}: each must be 1..=16"));
+        let spp = 1..=MAX_PIXEL_SAMPLES;
+        if !spp.contains(&sx) || !spp.contains(&sy) {
+            return Err(format!(
+                "pixel samples {sx}x{sy}: each must be 1..={MAX_PIXEL_SAMPLES}"
+            ));
         }
         // Sample indices are 32-bit in the shaders and in the CPU pipeline.
         let subsamples = width as u64 * height as u64 * (sx * sy) as u64;
@@ -200,9 +248,23 @@ impl FrameData {
                 u32::MAX
             ));
         }
-        if !(1..=15).contains(&o.grid_max) || !(o.mp_size > 0.0) {
-            return Err("grid_max must be 1..=15 and the micropolygon size positive".into());
+        let limit = MAX_FRAME_BUFFER_BYTES;
+        let image = image_bytes(width, height);
+        if image > limit {
+            return Err(format!(
+                "image size {width}x{height} needs {image} bytes of RGBA, more than the {limit} \
+                 bytes (4 GiB) a frame buffer may hold"
+            ));
         }
+        let samples = subsamples * 8;
+        if samples > limit && o.memory_budget.is_none() {
+            return Err(format!(
+                "image size {width}x{height} with {sx}x{sy} pixel samples needs {samples} bytes \
+                 of samples, more than the {limit} bytes (4 GiB) a frame buffer may hold: give \
+                 --memory-budget to render it in buckets"
+            ));
+        }
+        check_quality(o)?;
         let fov = scene.camera.fov_deg.to_radians();
         let focal = width.min(height) as f64 / 2.0 / (fov / 2.0).tan();
         let lights = gpu_lights(scene);
@@ -395,5 +457,43 @@ mod tests {
                     .contains("image size")
             );
         }
+    }
+
+    /// The checks both render paths share: sizes that need a frame buffer no GPU binds,
+    /// micropolygons and screen bounds too small to bound the work.
+    #[test]
+    fn frame_buffers_and_quality_are_bounded() {
+        let scene = crate::scene::builtin_teapot();
+        let with = |f: &dyn Fn(&mut RenderOptions)| {
+            let mut o = RenderOptions::default();
+            f(&mut o);
+            FrameData::new(&scene, &o).map(|_| ())
+        };
+        let e = with(&|o| (o.width, o.height) = (Some(16384), Some(16384))).unwrap_err();
+        assert!(e.contains("needs 4294967296 bytes of RGBA"), "{e}");
+        let big = |o: &mut RenderOptions| (o.width, o.height) = (Some(16000), Some(16000));
+        let e = with(&big).unwrap_err();
+        assert!(
+            e.contains("bytes of samples") && e.contains("--memory-budget"),
+            "{e}"
+        );
+        assert!(
+            with(&|o| {
+                big(o);
+                o.memory_budget = Some(1 << 26);
+            })
+            .is_ok(),
+            "in buckets the sample buffer is one bucket's"
+        );
+        for mp in [1e-30, 0.06, f32::NAN, f32::INFINITY, 0.0, -1.0] {
+            let e = with(&|o| o.mp_size = mp).unwrap_err();
+            assert!(e.contains("micropolygon size"), "{mp}: {e}");
+        }
+        assert!(with(&|o| o.mp_size = MIN_MP_SIZE).is_ok());
+        let e = with(&|o| o.bound_px = Some(0.5)).unwrap_err();
+        assert!(e.contains("screen bound 0.5 px"), "{e}");
+        assert!(with(&|o| o.bound_px = Some(8.0)).is_ok());
+        let e = with(&|o| o.pixel_samples = Some((17, 1))).unwrap_err();
+        assert_eq!(e, "pixel samples 17x1: each must be 1..=16");
     }
 }

@@ -2,12 +2,13 @@
 //! Utah teapot) through the scheduler and writes a PNG; `--stats` writes what it did as JSON.
 
 mod drift;
+mod frames;
 mod measure;
 mod sweep;
 
 use reyes::frame::{FrameData, RenderOptions};
 use reyes::gpu_render::{GpuRenderer, required_features};
-use reyes::scene;
+use reyes::scene::{self, FrameRanges, FrameSequence, Scene};
 use reyes::stats::frame_stats;
 use scheduler::{Gpu, StrategyKind};
 use std::path::PathBuf;
@@ -17,7 +18,9 @@ const USAGE: &str =
     "usage: reyes render [SCENE.rib|teapot|.bpt] [-o OUT.png] [--strategy megakernel|multipass]
   [--stats OUT.json] [--float OUT.pfm] [--depth OUT.pfm] [--width N] [--height N]
   [--samples N|NxM] [--mp-size PX] [--bound-px PX] [--max-depth N] [--memory-budget BYTES[K|M|G]]
-  [--no-crack-dilation] [--stage-times] [--runs N] [--cpu]";
+  [--no-crack-dilation] [--stage-times] [--runs N] [--cpu] [--frames N|A-B|A,B,...]
+  A RIB file of several frames writes each frame's Display name into -o's folder, or
+  -o NAME.####.png (#### = the frame number; also for --stats, --float, --depth).";
 
 struct Args {
     scene: Option<PathBuf>,
@@ -30,6 +33,8 @@ struct Args {
     cpu: bool,
     /// Multi-pass: time each procedure's passes on their own.
     stage_times: bool,
+    /// `--frames`: which frames of a sequence to render (all when `None`).
+    frames: Option<FrameRanges>,
     options: RenderOptions,
 }
 
@@ -44,6 +49,7 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         runs: 1,
         cpu: false,
         stage_times: false,
+        frames: None,
         options: RenderOptions::default(),
     };
     fn num<T: std::str::FromStr>(v: Option<String>, flag: &str) -> Result<T, String> {
@@ -96,6 +102,10 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
                 a.options.memory_budget = Some(bytes(it.next(), "--memory-budget")?)
             }
             "--cpu" => a.cpu = true,
+            "--frames" => {
+                let v = it.next().ok_or("--frames needs a value")?;
+                a.frames = Some(FrameRanges::parse(&v)?);
+            }
             "--no-crack-dilation" => a.options.crack_dilation = false,
             "--stage-times" => a.stage_times = true,
             "-h" | "--help" => return Err(USAGE.into()),
@@ -106,35 +116,71 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
     Ok(a)
 }
 
-fn run(a: Args) -> Result<(), String> {
-    let (scene, name) = match &a.scene {
-        None => (scene::builtin_teapot(), "teapot".to_string()),
-        Some(p) if p.as_os_str() == "teapot" => (scene::builtin_teapot(), "teapot".to_string()),
+/// The scene file's frames (the built-in teapot: one) and its stem for default names.
+fn load_sequence(a: &Args) -> Result<(FrameSequence, String), String> {
+    Ok(match &a.scene {
+        None => (
+            FrameSequence::single(scene::builtin_teapot()),
+            "teapot".into(),
+        ),
+        Some(p) if p.as_os_str() == "teapot" => (
+            FrameSequence::single(scene::builtin_teapot()),
+            "teapot".into(),
+        ),
         Some(p) => (
-            scene::load(p).map_err(|e| e.to_string())?,
+            scene::load_frames(p).map_err(|e| e.to_string())?,
             p.file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or("out".into()),
         ),
-    };
-    for w in &scene.warnings {
+    })
+}
+
+/// Renders every selected frame of the scene; the whole file is read (and every output name
+/// decided) before the first frame renders, so a bad file writes nothing.
+fn run(a: Args) -> Result<(), String> {
+    let (seq, stem) = load_sequence(&a)?;
+    for w in &seq.warnings {
         eprintln!("warning: {w}");
     }
-    let out = a
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("{name}.png")));
-    let data = FrameData::new(&scene, &a.options)?;
-    if a.cpu {
-        let r = reyes::cpu_render::render_cpu(&data);
-        // The CPU twin keeps the GPU's counters: the same frame warnings.
-        for w in reyes::warnings::frame_warnings(&data, &r.counters) {
-            eprintln!("warning: {w}");
-        }
-        r.image.write_png(&out)?;
-        eprintln!("wrote {} (CPU reference)", out.display());
-        return Ok(());
+    let requested = frames::Requested {
+        out: a.out.as_deref(),
+        stats: a.stats.as_deref(),
+        float: a.float.as_deref(),
+        depth: a.depth.as_deref(),
+        stem: &stem,
+    };
+    let (jobs, skipped) = frames::plan(&seq, a.frames.as_ref(), &requested)?;
+    for w in &skipped {
+        eprintln!("warning: {w}");
     }
+    // Each frame's options are checked before any renders.
+    let data = jobs
+        .iter()
+        .map(|(i, _)| FrameData::new(&seq.frames[*i].scene, &a.options))
+        .collect::<Result<Vec<_>, _>>()?;
+    let gpu = match (a.cpu, jobs.is_empty()) {
+        (false, false) => Some(gpu_renderer(&a)?),
+        _ => None,
+    };
+    for ((i, outputs), data) in jobs.iter().zip(&data) {
+        if seq.frames.len() > 1 {
+            eprintln!("frame {}:", seq.frames[*i].number);
+        }
+        render_frame(
+            &a,
+            &seq.frames[*i].scene,
+            &seq.warnings,
+            data,
+            outputs,
+            gpu.as_ref(),
+        )?;
+    }
+    Ok(())
+}
+
+/// The GPU and its renderer, made once for all frames.
+fn gpu_renderer(a: &Args) -> Result<(Gpu, GpuRenderer), String> {
     let gpu = Gpu::from_env_requiring(required_features()).map_err(|e| e.to_string())?;
     if a.stage_times && a.strategy == StrategyKind::Megakernel {
         eprintln!(
@@ -143,11 +189,33 @@ fn run(a: Args) -> Result<(), String> {
     }
     let renderer = GpuRenderer::with_stage_timing(&gpu, a.strategy, a.stage_times)
         .map_err(|e| e.to_string())?;
+    Ok((gpu, renderer))
+}
+
+/// Renders one frame to its outputs, on the CPU twin when `gpu` is `None`.
+fn render_frame(
+    a: &Args,
+    scene: &Scene,
+    file_warnings: &[String],
+    data: &FrameData,
+    out: &frames::Outputs,
+    gpu: Option<&(Gpu, GpuRenderer)>,
+) -> Result<(), String> {
+    let Some((gpu, renderer)) = gpu else {
+        let r = reyes::cpu_render::render_cpu(data);
+        // The CPU twin keeps the GPU's counters: the same frame warnings.
+        for w in reyes::warnings::frame_warnings(data, &r.counters) {
+            eprintln!("warning: {w}");
+        }
+        r.image.write_png(&out.image)?;
+        eprintln!("wrote {} (CPU reference)", out.image.display());
+        return Ok(());
+    };
     // One frame makes the image; with --runs N > 1, N frames are timed after a warm-up
     // (GpuRenderer::timed_frames).
     let (frame, times) = if a.runs > 1 {
         let t = renderer
-            .timed_frames(&gpu, &data, a.runs)
+            .timed_frames(gpu, data, a.runs)
             .map_err(|e| e.to_string())?;
         for (i, (g, w)) in t.gpu_ms.iter().zip(&t.wall_ms).enumerate() {
             eprintln!("run {i}: GPU {g:?} ms, wall {w:.2} ms");
@@ -160,38 +228,38 @@ fn run(a: Args) -> Result<(), String> {
             .collect();
         (t.last, times)
     } else {
-        let f = renderer.render(&gpu, &data).map_err(|e| e.to_string())?;
+        let f = renderer.render(gpu, data).map_err(|e| e.to_string())?;
         let gpu_ms = f.run.gpu_ms.zip(f.resolve_gpu_ms).map(|(x, y)| x + y);
         let wall_ms = f.wall_ms;
         (f, vec![(gpu_ms, wall_ms)])
     };
     // Where the renderer gave up on something (near-plane culls, split limit, nothing drawn).
-    let frame_warnings = reyes::warnings::frame_warnings(&data, &frame.counters);
+    let frame_warnings = reyes::warnings::frame_warnings(data, &frame.counters);
     for w in &frame_warnings {
         eprintln!("warning: {w}");
     }
-    let all_warnings: Vec<String> = scene
-        .warnings
+    let all_warnings: Vec<String> = file_warnings
         .iter()
+        .chain(&scene.warnings)
         .chain(&frame_warnings)
         .cloned()
         .collect();
-    let mut stats = frame_stats(&data, &frame, &gpu.adapter_name(), &all_warnings);
+    let mut stats = frame_stats(data, &frame, &gpu.adapter_name(), &all_warnings);
     stats["runs"] = run_summary(&times);
-    frame.image.write_png(&out)?;
-    if let Some(p) = &a.float {
+    frame.image.write_png(&out.image)?;
+    if let Some(p) = &out.float {
         frame.image.write_pfm(p)?;
     }
-    if let Some(p) = &a.depth {
+    if let Some(p) = &out.depth {
         frame.image.write_depth(p)?;
     }
-    if let Some(p) = &a.stats {
+    if let Some(p) = &out.stats {
         let text = serde_json::to_string_pretty(&stats).unwrap();
         std::fs::write(p, text + "\n").map_err(|e| format!("{}: {e}", p.display()))?;
     }
     eprintln!(
         "wrote {} ({}x{}, {}{}: {} grids, {} micropolygons, GPU {} ms, wall {:.1} ms)",
-        out.display(),
+        out.image.display(),
         data.frame.width,
         data.frame.height,
         a.strategy.name(),

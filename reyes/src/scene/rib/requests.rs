@@ -1,0 +1,302 @@
+//! The one dispatch over request names, grouped as the RenderMan Interface Specification
+//! groups them: options, transformations, blocks (frame, world, attribute, transform),
+//! attributes, shading, geometry.
+//!
+//! Range checks of values the renderer limits (image size, pixel samples, clipping) happen
+//! here, where the error can name the file and line, not later in the renderer.
+
+use super::lexer::shown;
+use super::patches::basis_arg;
+use super::state::{Block, Interp};
+use super::syntax::{Args, Request};
+use crate::frame::{MAX_IMAGE_SIDE, MAX_PIXEL_SAMPLES};
+use crate::scene::{RI_EPSILON, SceneError};
+use glam::{DMat4, DVec3};
+
+/// Requests the interpreter understands; any other name is skipped with one warning.
+/// (`ReadArchive`, `ObjectBegin` and motion blocks are handled by the reading loop.)
+pub(super) const KNOWN: &[&str] = &[
+    "Format",
+    "PixelSamples",
+    "Projection",
+    "Clipping",
+    "Display",
+    "Identity",
+    "Transform",
+    "ConcatTransform",
+    "Translate",
+    "Rotate",
+    "Scale",
+    "WorldBegin",
+    "WorldEnd",
+    "FrameBegin",
+    "FrameEnd",
+    "AttributeBegin",
+    "AttributeEnd",
+    "TransformBegin",
+    "TransformEnd",
+    "Basis",
+    "Patch",
+    "PatchMesh",
+    "NuPatch",
+    "Color",
+    "Opacity",
+    "Surface",
+    "LightSource",
+    "Sides",
+    "Orientation",
+    "ReverseOrientation",
+    "ObjectBegin",
+    "ObjectEnd",
+    "MotionBegin",
+    "MotionEnd",
+    "ReadArchive",
+    "MakeShadow",
+];
+
+impl Interp {
+    pub(super) fn request(&mut self, req: &Request) -> Result<(), SceneError> {
+        let mut a = Args::new(req);
+        let a = &mut a;
+        match req.name.as_str() {
+            "Format" | "PixelSamples" | "Projection" | "Clipping" => self.option(req, a),
+            "Display" => self.display(req, a),
+            "Identity" | "Transform" | "ConcatTransform" | "Translate" | "Rotate" | "Scale" => {
+                self.transform(req, a)
+            }
+            "FrameBegin" => self.frame_begin(req, a),
+            "FrameEnd" => self.frame_end(req, a),
+            "WorldBegin" => self.world_begin(req, a),
+            "WorldEnd" => self.world_end(req, a),
+            "AttributeBegin" | "TransformBegin" => {
+                a.done()?;
+                let block = if req.name == "AttributeBegin" {
+                    Block::Attribute
+                } else {
+                    Block::Transform
+                };
+                self.push(block, req)
+            }
+            "AttributeEnd" => {
+                a.done()?;
+                self.pop(Block::Attribute, req)
+            }
+            "TransformEnd" => {
+                a.done()?;
+                self.pop(Block::Transform, req)
+            }
+            "Basis" | "Color" | "Opacity" | "Sides" | "Orientation" | "ReverseOrientation" => {
+                self.attribute(req, a)
+            }
+            "Surface" => self.surface(req, a),
+            "LightSource" => self.light(req, a),
+            "Patch" => self.patch(req, a),
+            "PatchMesh" => self.patch_mesh(req, a),
+            "NuPatch" => self.nu_patch(req, a),
+            "ObjectEnd" => Err(a.err("without a matching `ObjectBegin`")),
+            "MotionBegin" => {
+                if self.motion.is_some() {
+                    return Err(a.err("nested `MotionBegin`"));
+                }
+                self.warn_once(
+                    req,
+                    "MotionBegin",
+                    "motion blocks are not supported: using the first time sample of each",
+                );
+                self.motion = Some(false);
+                Ok(())
+            }
+            "MotionEnd" => Err(a.err("without a matching `MotionBegin`")),
+            "MakeShadow" => {
+                self.make_shadow(req);
+                Ok(())
+            }
+            _ => {
+                let msg = format!("skipped unsupported request `{}`", shown(&req.name));
+                self.warn_once(req, &req.name, &msg);
+                Ok(())
+            }
+        }
+    }
+
+    /// Format, PixelSamples, Projection, Clipping: options of the frame.
+    fn option(&mut self, req: &Request, a: &mut Args) -> Result<(), SceneError> {
+        let side = MAX_IMAGE_SIDE as usize;
+        match req.name.as_str() {
+            "Format" => {
+                let w = a.int("the x resolution", 1, side)?;
+                let h = a.int("the y resolution", 1, side)?;
+                let aspect = a.num("the pixel aspect ratio")?;
+                a.done()?;
+                if aspect <= 0.0 {
+                    return Err(a.err(format!(
+                        "the pixel aspect ratio must be positive, found {aspect}"
+                    )));
+                }
+                self.options.width = w as u32;
+                self.options.height = h as u32;
+            }
+            "PixelSamples" => {
+                let mut s = [0u32; 2];
+                let max = MAX_PIXEL_SAMPLES as f64;
+                for (k, slot) in s.iter_mut().enumerate() {
+                    let v = a.num(if k == 0 { "xsamples" } else { "ysamples" })?;
+                    if !(v > 0.0 && v <= max) {
+                        return Err(a.err(format!(
+                            "sample count {v} is not in (0, {max}] (the renderer's limit)"
+                        )));
+                    }
+                    *slot = v.ceil() as u32;
+                }
+                a.done()?;
+                self.options.pixel_samples = (s[0], s[1]);
+            }
+            "Projection" => {
+                if self.world_to_camera.is_some() {
+                    return Err(a.err("not allowed inside `WorldBegin` ... `WorldEnd`"));
+                }
+                let name = a.string("the projection type")?;
+                if name != "perspective" {
+                    return Err(a.err(format!(
+                        "projection \"{}\" is not supported (only \"perspective\")",
+                        shown(name)
+                    )));
+                }
+                for p in a.params()? {
+                    match p.name {
+                        "fov" => {
+                            let fov = p.num(a)?;
+                            if !(fov > 0.0 && fov < 180.0) {
+                                return Err(a.err(format!("fov {fov} is not in (0, 180)")));
+                            }
+                            self.options.camera.fov_deg = fov;
+                        }
+                        other => self.ignored_param(req, other),
+                    }
+                }
+                // The spec: the current transformation is reset after the projection.
+                self.set_ctm(DMat4::IDENTITY);
+            }
+            _ => {
+                let near = a.num("near")?;
+                let far = a.num("far")?;
+                a.done()?;
+                // The spec: near >= RI_EPSILON, far > near.
+                if !(near >= RI_EPSILON && far > near) {
+                    return Err(a.err(format!(
+                        "need {RI_EPSILON:e} <= near < far, found near {near} far {far}"
+                    )));
+                }
+                self.options.camera.near = near;
+                self.options.camera.far = far;
+            }
+        }
+        Ok(())
+    }
+
+    /// Identity, Transform, ConcatTransform, Translate, Rotate, Scale.
+    fn transform(&mut self, req: &Request, a: &mut Args) -> Result<(), SceneError> {
+        let m = match req.name.as_str() {
+            "Identity" => {
+                a.done()?;
+                self.set_ctm(self.world_to_camera.unwrap_or(DMat4::IDENTITY));
+                return Ok(());
+            }
+            "Transform" | "ConcatTransform" => {
+                let v = a.fixed(16, "the matrix")?;
+                a.done()?;
+                // Row-major row-vector matrix == column-major column-vector matrix.
+                let m = DMat4::from_cols_slice(&v);
+                if req.name == "Transform" {
+                    self.set_ctm(self.world_to_camera.unwrap_or(DMat4::IDENTITY) * m);
+                    return Ok(());
+                }
+                m
+            }
+            "Translate" => {
+                let v = a.fixed(3, "the offset")?;
+                a.done()?;
+                DMat4::from_translation(DVec3::from_slice(&v))
+            }
+            "Rotate" => {
+                let v = a.fixed(4, "angle and axis")?;
+                a.done()?;
+                crate::scene::rotation(v[0], DVec3::new(v[1], v[2], v[3]))
+                    .ok_or_else(|| a.err("the rotation axis is zero"))?
+            }
+            _ => {
+                let v = a.fixed(3, "the scale factors")?;
+                a.done()?;
+                DMat4::from_scale(DVec3::from_slice(&v))
+            }
+        };
+        self.concat(m);
+        Ok(())
+    }
+
+    /// Basis, Color, Opacity, Sides, Orientation, ReverseOrientation.
+    fn attribute(&mut self, req: &Request, a: &mut Args) -> Result<(), SceneError> {
+        match req.name.as_str() {
+            "Basis" => {
+                let ub = basis_arg(a, "u")?;
+                let vb = basis_arg(a, "v")?;
+                a.done()?;
+                self.attrs.ubasis = ub;
+                self.attrs.vbasis = vb;
+            }
+            "Color" | "Opacity" => {
+                let v = a.fixed(3, "the color")?;
+                a.done()?;
+                if let Some(x) = v.iter().find(|x| x.abs() > f32::MAX as f64) {
+                    return Err(a.err(format!(
+                        "{x:e} is beyond the f32 range the renderer shades in"
+                    )));
+                }
+                let c = DVec3::from_slice(&v);
+                if req.name == "Color" {
+                    self.attrs.color = c;
+                } else {
+                    self.attrs.opacity = c;
+                }
+                self.current_material = None;
+            }
+            "Sides" => {
+                let s = a.num("the number of sides")?;
+                a.done()?;
+                self.attrs.two_sided = match s {
+                    1.0 => false,
+                    2.0 => true,
+                    _ => return Err(a.err(format!("sides must be 1 or 2, found {s}"))),
+                };
+            }
+            "Orientation" => {
+                let o = a.string("the orientation")?;
+                a.done()?;
+                let coordsys_rh = self.attrs.ctm.determinant() < 0.0;
+                self.attrs.orientation_rh = match o {
+                    "lh" => false,
+                    "rh" => true,
+                    "outside" => coordsys_rh,
+                    "inside" => !coordsys_rh,
+                    _ => {
+                        return Err(a.err(format!(
+                            "orientation \"{}\" is not one of \"lh\", \"rh\", \"inside\", \"outside\"",
+                            shown(o)
+                        )));
+                    }
+                };
+            }
+            _ => {
+                a.done()?;
+                self.attrs.orientation_rh = !self.attrs.orientation_rh;
+            }
+        }
+        Ok(())
+    }
+
+    pub(super) fn ignored_param(&mut self, req: &Request, name: &str) {
+        let key = format!("{} \"{name}\"", req.name);
+        let msg = format!("ignored parameter \"{}\" of `{}`", shown(name), req.name);
+        self.warn_once(req, &key, &msg);
+    }
+}

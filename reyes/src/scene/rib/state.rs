@@ -1,0 +1,241 @@
+//! The graphics state: the options (image size, samples, camera, display: what a frame
+//! block saves), the current attributes (transform, orientation, shading, bases), the stack
+//! that `AttributeBegin`/`TransformBegin`/`WorldBegin`/`FrameBegin` save them on, and the
+//! interpreter that owns them together with the frames being built.
+
+use super::syntax::Request;
+use crate::scene::basis::Basis;
+use crate::scene::{Camera, Display, Material, Scene, SceneError, SceneFrame, SurfaceKind};
+use glam::{DMat4, DVec3};
+use std::collections::{HashMap, HashSet};
+use std::rc::Rc;
+
+/// Most blocks open at once (`AttributeBegin`, `TransformBegin`, ... inside each other).
+/// Real scenes nest tens deep; the bound keeps a hostile file's memory small (each level
+/// saves the attributes, about 700 bytes) and fails it at once.
+pub(super) const MAX_NESTING: usize = 1024;
+
+/// Attributes saved by `AttributeBegin` (and the other attribute-saving blocks).
+#[derive(Clone, Debug)]
+pub(super) struct Attributes {
+    /// Object to camera, column-vector convention.
+    pub(super) ctm: DMat4,
+    /// RenderMan's current orientation: true = right-handed.
+    pub(super) orientation_rh: bool,
+    pub(super) two_sided: bool,
+    pub(super) color: DVec3,
+    pub(super) opacity: DVec3,
+    /// Shader and its parameters; its color/opacity fields are unused (see above).
+    pub(super) surface: Material,
+    pub(super) ubasis: Basis,
+    pub(super) vbasis: Basis,
+}
+
+impl Default for Attributes {
+    /// RenderMan's initial attributes.
+    fn default() -> Self {
+        Attributes {
+            ctm: DMat4::IDENTITY,
+            orientation_rh: false,
+            two_sided: true,
+            color: DVec3::ONE,
+            opacity: DVec3::ONE,
+            surface: Material::standard(SurfaceKind::Matte),
+            ubasis: Basis::BEZIER,
+            vbasis: Basis::BEZIER,
+        }
+    }
+}
+
+/// The options a frame's image is made with; `FrameBegin` saves them and `FrameEnd`
+/// restores them, so options set before the first frame apply to every frame.
+#[derive(Clone, Debug)]
+pub(super) struct Options {
+    pub(super) width: u32,
+    pub(super) height: u32,
+    pub(super) pixel_samples: (u32, u32),
+    pub(super) camera: Camera,
+    pub(super) display: Option<Display>,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        let s = Scene::default();
+        Options {
+            width: s.width,
+            height: s.height,
+            pixel_samples: s.pixel_samples,
+            camera: s.camera,
+            display: None,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Block {
+    Frame,
+    World,
+    Attribute,
+    Transform,
+}
+
+impl Block {
+    pub(super) fn begin(self) -> &'static str {
+        match self {
+            Block::Frame => "FrameBegin",
+            Block::World => "WorldBegin",
+            Block::Attribute => "AttributeBegin",
+            Block::Transform => "TransformBegin",
+        }
+    }
+}
+
+/// One open block: where it began and the state it restores.
+pub(super) struct Saved {
+    pub(super) block: Block,
+    pub(super) file: Rc<str>,
+    pub(super) line: u32,
+    pub(super) attrs: Attributes,
+    /// The options, saved by `FrameBegin` only.
+    pub(super) options: Option<Box<Options>>,
+}
+
+impl Saved {
+    /// "line 3", or "a.rib:3" when the block began in another file than `here`.
+    pub(super) fn place(&self, here: &str) -> String {
+        if *self.file == *here {
+            format!("line {}", self.line)
+        } else {
+            format!("{}:{}", self.file, self.line)
+        }
+    }
+}
+
+/// The frame block being read.
+pub(super) struct OpenFrame {
+    pub(super) number: u32,
+    pub(super) line: u32,
+    /// Set by `MakeShadow`: the frame is a shadow-map pass.
+    pub(super) unsupported: Option<String>,
+    /// The frame's world, once its `WorldEnd` has been read.
+    pub(super) world: Option<SceneFrame>,
+}
+
+pub(super) struct Interp {
+    pub(super) options: Options,
+    pub(super) attrs: Attributes,
+    pub(super) stack: Vec<Saved>,
+    /// World-to-camera, saved at `WorldBegin`; `Some` only inside the world block.
+    pub(super) world_to_camera: Option<DMat4>,
+    /// The world being read: its patches, materials and lights (options are added at
+    /// `WorldEnd`). Lights given before `WorldBegin` go to the next world.
+    pub(super) scene: Scene,
+    pub(super) frame: Option<OpenFrame>,
+    /// Finished frames, in file order.
+    pub(super) frames: Vec<SceneFrame>,
+    /// The number of the next world outside a frame block.
+    pub(super) next_number: u32,
+    pub(super) warnings: Vec<String>,
+    pub(super) warned: HashSet<String>,
+    pub(super) materials: HashMap<(SurfaceKind, [u64; 13]), u32>,
+    /// Material of the current attributes, once looked up.
+    pub(super) current_material: Option<u32>,
+    /// Inside `MotionBegin`: whether the first (used) time sample has been seen.
+    pub(super) motion: Option<bool>,
+}
+
+impl Interp {
+    pub(super) fn new() -> Interp {
+        Interp {
+            options: Options::default(),
+            attrs: Attributes::default(),
+            stack: Vec::new(),
+            world_to_camera: None,
+            scene: Scene::default(),
+            frame: None,
+            frames: Vec::new(),
+            next_number: 1,
+            warnings: Vec::new(),
+            warned: HashSet::new(),
+            materials: HashMap::new(),
+            current_material: None,
+            motion: None,
+        }
+    }
+
+    pub(super) fn warn_once(&mut self, req: &Request, key: &str, msg: &str) {
+        if self.warned.insert(key.to_string()) {
+            self.warnings
+                .push(format!("{}:{}: {msg}", req.file, req.line));
+        }
+    }
+
+    /// Sets the CTM, flipping the current orientation when the handedness flips (spec).
+    pub(super) fn set_ctm(&mut self, m: DMat4) {
+        if (self.attrs.ctm.determinant() < 0.0) != (m.determinant() < 0.0) {
+            self.attrs.orientation_rh = !self.attrs.orientation_rh;
+        }
+        self.attrs.ctm = m;
+    }
+
+    pub(super) fn concat(&mut self, m: DMat4) {
+        self.set_ctm(self.attrs.ctm * m);
+    }
+
+    /// Opens a block, saving the attributes (and for a frame, the options). At most
+    /// [`MAX_NESTING`] blocks are open at once.
+    pub(super) fn push(&mut self, block: Block, req: &Request) -> Result<(), SceneError> {
+        if self.stack.len() >= MAX_NESTING {
+            return Err(SceneError::new(
+                &req.file,
+                req.line,
+                format!(
+                    "`{}`: blocks nested deeper than {MAX_NESTING} (the reader's limit; is an \
+                     `{}` missing?)",
+                    req.name,
+                    block.begin().replace("Begin", "End")
+                ),
+            ));
+        }
+        self.stack.push(Saved {
+            block,
+            file: req.file.clone(),
+            line: req.line,
+            attrs: self.attrs.clone(),
+            options: (block == Block::Frame).then(|| Box::new(self.options.clone())),
+        });
+        Ok(())
+    }
+
+    pub(super) fn pop(&mut self, block: Block, req: &Request) -> Result<(), SceneError> {
+        let Some(saved) = self.stack.pop() else {
+            return Err(SceneError::new(
+                &req.file,
+                req.line,
+                format!("`{}` without a matching `{}`", req.name, block.begin()),
+            ));
+        };
+        if saved.block != block {
+            return Err(SceneError::new(
+                &req.file,
+                req.line,
+                format!(
+                    "`{}` does not match `{}` at {}",
+                    req.name,
+                    saved.block.begin(),
+                    saved.place(&req.file)
+                ),
+            ));
+        }
+        if block == Block::Transform {
+            self.set_ctm(saved.attrs.ctm);
+        } else {
+            self.attrs = saved.attrs;
+            self.current_material = None;
+        }
+        if let Some(options) = saved.options {
+            self.options = *options;
+        }
+        Ok(())
+    }
+}
