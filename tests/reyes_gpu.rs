@@ -282,6 +282,45 @@ fn a_memory_budget_renders_in_buckets_to_the_same_image() {
     }
 }
 
+/// Under a budget so small that a bucket's patches do not fit the queues at once (the field
+/// report: `--memory-budget 64K --strategy multipass` failed with "capacity 16, needs 19"),
+/// every strategy splits the bucket's patches into batches and renders the image it renders
+/// without a budget, bit for bit.
+#[test]
+fn patches_that_do_not_fit_the_queues_render_in_batches_to_the_same_image() {
+    let scene = scene::builtin_teapot();
+    let whole = FrameData::new(&scene, &small(96, 72)).unwrap();
+    let tight = FrameData {
+        memory_budget: Some(64 << 10),
+        ..whole.clone()
+    };
+    let mut split = 0;
+    for kind in StrategyKind::ALL {
+        let r = renderer(kind);
+        let reference = r.render(gpu(), &whole).unwrap();
+        let b = r
+            .render(gpu(), &tight)
+            .unwrap_or_else(|e| panic!("{kind:?} under 64 KiB: {e}"));
+        eprintln!(
+            "{kind:?}: {} buckets, {} runs, {} batches split, {} working bytes",
+            b.buckets, b.runs, b.batches_split, b.peak_working_bytes
+        );
+        assert!(
+            b.image == reference.image,
+            "{kind:?}: batched image differs"
+        );
+        assert!(
+            b.peak_working_bytes <= 64 << 10,
+            "{kind:?}: over the budget"
+        );
+        split += b.batches_split;
+    }
+    assert!(
+        split > 0,
+        "no strategy needed batches: the test no longer tests them"
+    );
+}
+
 #[test]
 fn one_sided_patches_facing_away_are_culled_in_bound_like_the_cpu_pipeline() {
     let mut scene = scene::builtin_teapot();

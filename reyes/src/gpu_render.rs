@@ -65,6 +65,10 @@ pub struct GpuFrame {
     /// Screen buckets rendered, and how many were cut in four after their queues overflowed.
     pub buckets: u32,
     pub buckets_recut: u32,
+    /// Scheduler runs that finished (one per bucket, more where a bucket's patches were
+    /// split into batches), and batches split in two because their work did not fit.
+    pub runs: u32,
+    pub batches_split: u32,
     /// Largest working memory of one bucket: sample buffer plus queue storage.
     pub peak_working_bytes: u64,
     pub wall_ms: f64,
@@ -212,6 +216,8 @@ impl GpuRenderer {
             sample_bytes: largest * per_pixel,
             buckets: 0,
             buckets_recut: 0,
+            runs: 0,
+            batches_split: 0,
             peak_working_bytes: 0,
             wall_ms: 0.0,
         };
@@ -232,59 +238,81 @@ impl GpuRenderer {
                 .write_buffer(frame_buf, 0, bytemuck::bytes_of(&tile_frame));
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             enc.clear_buffer(samples, 0, Some(tile_sample_bytes));
-            enc.clear_buffer(counters, 0, None);
             gpu.queue.submit([enc.finish()]);
-            let seeds = [Seed::new::<PatchItem>("bound", &items)];
-            let run = match self
-                .scheduler
-                .run_within(gpu, &seeds, Some(&bind), queue_budget)
-            {
-                Err(RunError::QueueOverflow {
-                    queue,
-                    capacity,
-                    needed_more_than,
-                }) if data.memory_budget.is_some() => {
-                    if let Some(quarters) = buckets::quarter(tile) {
-                        out.buckets_recut += 1;
-                        todo.extend(quarters.into_iter().rev());
+            // The bucket's patches go in as one batch; a batch whose work does not fit the
+            // queues is halved and each half run on its own. Samples keep the nearest key
+            // (atomicMax), so batches, in any order and even a refused batch's partial work run
+            // again, give the same image bit for bit; counters are read per finished batch.
+            let mut batches = vec![0..items.len()];
+            let mut recut = false;
+            while let Some(batch) = batches.pop() {
+                let mut enc = gpu.device.create_command_encoder(&Default::default());
+                enc.clear_buffer(counters, 0, None);
+                gpu.queue.submit([enc.finish()]);
+                let seeds = [Seed::new::<PatchItem>("bound", &items[batch.clone()])];
+                let run = match self
+                    .scheduler
+                    .run_within(gpu, &seeds, Some(&bind), queue_budget)
+                {
+                    Err(RunError::QueueOverflow { .. }) if batch.len() > 1 => {
+                        let mid = batch.start + batch.len() / 2;
+                        batches.push(mid..batch.end);
+                        batches.push(batch.start..mid);
+                        out.batches_split += 1;
                         continue;
                     }
-                    return Err(RunError::QueueOverflow {
-                        queue: format!(
-                            "{queue} (in a {}x{} px bucket at ({}, {}), the smallest, under a memory budget of {} bytes)",
-                            tile.w,
-                            tile.h,
-                            tile.x0,
-                            tile.y0,
-                            data.memory_budget.unwrap()
-                        ),
+                    Err(RunError::QueueOverflow {
+                        queue,
                         capacity,
                         needed_more_than,
-                    });
+                    }) if data.memory_budget.is_some() => {
+                        if let Some(quarters) = buckets::quarter(tile) {
+                            out.buckets_recut += 1;
+                            todo.extend(quarters.into_iter().rev());
+                            recut = true;
+                            break;
+                        }
+                        return Err(RunError::QueueOverflow {
+                            queue: format!(
+                                "{queue} (one patch in a {}x{} px bucket at ({}, {}), the smallest, under a memory budget of {} bytes)",
+                                tile.w,
+                                tile.h,
+                                tile.x0,
+                                tile.y0,
+                                data.memory_budget.unwrap()
+                            ),
+                            capacity,
+                            needed_more_than,
+                        });
+                    }
+                    r => r?,
+                };
+                for (k, v) in gpu
+                    .read_words(counters, 0, COUNTERS as u64)?
+                    .into_iter()
+                    .enumerate()
+                {
+                    if k == C_MAX_DEPTH {
+                        out.counters[k] = out.counters[k].max(v as u64);
+                    } else {
+                        out.counters[k] += v as u64;
+                    }
                 }
-                r => r?,
-            };
+                out.peak_working_bytes = out
+                    .peak_working_bytes
+                    .max(tile_sample_bytes + run.queue_bytes);
+                if out.runs == 0 {
+                    out.run = run;
+                } else {
+                    out.run.absorb(&run);
+                }
+                out.runs += 1;
+            }
+            if recut {
+                continue;
+            }
             let resolve_ms = self.resolve(gpu, &tile_frame, samples, rgba, depth)?;
             out.resolve_gpu_ms = out.resolve_gpu_ms.zip(resolve_ms).map(|(a, b)| a + b);
-            for (k, v) in gpu
-                .read_words(&counters, 0, COUNTERS as u64)?
-                .into_iter()
-                .enumerate()
-            {
-                if k == C_MAX_DEPTH {
-                    out.counters[k] = out.counters[k].max(v as u64);
-                } else {
-                    out.counters[k] += v as u64;
-                }
-            }
-            out.peak_working_bytes = out
-                .peak_working_bytes
-                .max(tile_sample_bytes + run.queue_bytes);
-            if out.buckets == 0 {
-                out.run = run;
-            } else {
-                out.run.absorb(&run);
-            }
             out.buckets += 1;
         }
         let words = gpu.read_words(rgba, 0, pixels * 4)?;

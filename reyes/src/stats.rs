@@ -57,6 +57,8 @@ pub fn frame_stats(data: &FrameData, g: &GpuFrame, adapter: &str, warnings: &[St
         "memory_budget": data.memory_budget,
         "buckets": g.buckets,
         "buckets_recut": g.buckets_recut,
+        "scheduler_runs": g.runs,
+        "batches_split": g.batches_split,
         "peak_working_bytes": g.peak_working_bytes,
         "warnings": warnings,
     })

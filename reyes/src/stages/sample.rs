@@ -100,6 +100,45 @@ fn write_sample(f: &Frame, samples: &mut [u64], [px, py, sx, sy]: [u32; 4], z: f
     samples[idx] = samples[idx].max(sample_key(z, color));
 }
 
+/// The sampling loop of `sample_micropolygon` and `sample_clipped_triangle` in sample.wgsl:
+/// every sub-sample of the bucket inside the bound [lo, hi] whose `depth` is not negative keeps
+/// the nearest key.
+fn sample_under(
+    f: &Frame,
+    samples: &mut [u64],
+    lo: Vec2,
+    hi: Vec2,
+    color: u32,
+    depth: impl Fn(Vec2) -> f32,
+) {
+    let (t0, t1) = (
+        [f.tile_x0, f.tile_y0],
+        [f.tile_x0 + f.tile_w, f.tile_y0 + f.tile_h],
+    );
+    let inside = |k: usize| hi[k] >= t0[k] as f32 && lo[k] < t1[k] as f32;
+    if !(inside(0) && inside(1)) {
+        return;
+    }
+    let p0 = |k: usize| lo[k].max(t0[k] as f32) as u32;
+    let p1 = |k: usize| (hi[k].min(t1[k] as f32) as u32).min(t1[k] - 1);
+    for py in p0(1)..=p1(1) {
+        for px in p0(0)..=p1(0) {
+            for sy in 0..f.spp_y {
+                for sx in 0..f.spp_x {
+                    let q = sample_position(f, px, py, sx, sy);
+                    if q.x < lo.x || q.y < lo.y || q.x > hi.x || q.y > hi.y {
+                        continue;
+                    }
+                    let z = depth(q);
+                    if z >= 0.0 {
+                        write_sample(f, samples, [px, py, sx, sy], z, color);
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// Samples quad `q` (a, b, c, d around), its edges ab, bc, cd, da grown by `grow` pixels (the
 /// diagonal by the least of them); false when it was culled as back-facing.
 pub fn sample_micropolygon(
@@ -118,39 +157,13 @@ pub fn sample_micropolygon(
     let g = grow[0].max(grow[1]).max(grow[2].max(grow[3]));
     let lo = xy[0].min(xy[1]).min(xy[2].min(xy[3])) - Vec2::splat(g);
     let hi = xy[0].max(xy[1]).max(xy[2].max(xy[3])) + Vec2::splat(g);
-    let (t0, t1) = (
-        [f.tile_x0, f.tile_y0],
-        [f.tile_x0 + f.tile_w, f.tile_y0 + f.tile_h],
-    );
-    let inside = |k: usize| hi[k] >= t0[k] as f32 && lo[k] < t1[k] as f32;
-    if !(inside(0) && inside(1)) {
-        return true;
-    }
-    let p0 = |k: usize| lo[k].max(t0[k] as f32) as u32;
-    let p1 = |k: usize| (hi[k].min(t1[k] as f32) as u32).min(t1[k] - 1);
     let diagonal = grow[0].min(grow[1]).min(grow[2].min(grow[3]));
     let abc = triangle_setup(q[0], q[1], q[2], [grow[1], diagonal, grow[0]]);
     let acd = triangle_setup(q[0], q[2], q[3], [grow[2], grow[3], diagonal]);
-    for py in p0(1)..=p1(1) {
-        for px in p0(0)..=p1(0) {
-            for sy in 0..f.spp_y {
-                for sx in 0..f.spp_x {
-                    let s = sample_position(f, px, py, sx, sy);
-                    if s.x < lo.x || s.y < lo.y || s.x > hi.x || s.y > hi.y {
-                        continue;
-                    }
-                    let mut z = triangle_depth(&abc, s);
-                    if z < 0.0 {
-                        z = triangle_depth(&acd, s);
-                    }
-                    if z < 0.0 {
-                        continue;
-                    }
-                    write_sample(f, samples, [px, py, sx, sy], z, color);
-                }
-            }
-        }
-    }
+    sample_under(f, samples, lo, hi, color, |s| {
+        let z = triangle_depth(&abc, s);
+        if z < 0.0 { triangle_depth(&acd, s) } else { z }
+    });
     true
 }
 
@@ -254,36 +267,14 @@ fn sample_clipped_triangle(tri: &[Vec3; 3], grow: f32, color: u32, f: &Frame, sa
     let fan: Vec<Triangle> = (0..s.len() - 2)
         .map(|i| triangle_setup(s[0], s[i + 1], s[i + 2], [grow; 3]))
         .collect();
-    let (t0, t1) = (
-        [f.tile_x0, f.tile_y0],
-        [f.tile_x0 + f.tile_w, f.tile_y0 + f.tile_h],
-    );
-    let inside = |k: usize| hi[k] >= t0[k] as f32 && lo[k] < t1[k] as f32;
-    if !(inside(0) && inside(1)) {
-        return;
-    }
-    let p0 = |k: usize| lo[k].max(t0[k] as f32) as u32;
-    let p1 = |k: usize| (hi[k].min(t1[k] as f32) as u32).min(t1[k] - 1);
-    for py in p0(1)..=p1(1) {
-        for px in p0(0)..=p1(0) {
-            for sy in 0..f.spp_y {
-                for sx in 0..f.spp_x {
-                    let q = sample_position(f, px, py, sx, sy);
-                    if q.x < lo.x || q.y < lo.y || q.x > hi.x || q.y > hi.y {
-                        continue;
-                    }
-                    let mut z = -1.0;
-                    for t in &fan {
-                        if z >= 0.0 {
-                            break;
-                        }
-                        z = triangle_depth(t, q);
-                    }
-                    if z >= 0.0 {
-                        write_sample(f, samples, [px, py, sx, sy], z, color);
-                    }
-                }
+    sample_under(f, samples, lo, hi, color, |q| {
+        let mut z = -1.0;
+        for t in &fan {
+            if z >= 0.0 {
+                break;
             }
+            z = triangle_depth(t, q);
         }
-    }
+        z
+    });
 }
