@@ -15,6 +15,7 @@ pub mod clocks;
 pub mod error;
 pub mod gpu;
 pub mod growth;
+pub mod hash;
 pub mod megakernel;
 pub mod multipass;
 pub mod pipeline;

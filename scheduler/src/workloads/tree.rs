@@ -6,6 +6,7 @@
 
 use crate::error::RunError;
 use crate::gpu::Gpu;
+use crate::hash::{lowbias32 as hash, lowbias32_wgsl};
 use crate::procedure::{ItemType, Procedure};
 use crate::program::{Program, Seed, UserBindings};
 use crate::stats::RunStats;
@@ -72,16 +73,6 @@ pub struct TreeResult {
     pub leaves_folded: u64,
     pub leaf_sum: u32,
     pub leaf_xor: u32,
-}
-
-pub fn hash(x: u32) -> u32 {
-    let mut h = x;
-    h ^= h >> 16;
-    h = h.wrapping_mul(0x7feb_352d);
-    h ^= h >> 15;
-    h = h.wrapping_mul(0x846c_a68b);
-    h ^= h >> 16;
-    h
 }
 
 const BUCKETS: u32 = 256;
@@ -189,7 +180,8 @@ impl TreeParams {
                 "@group(1) @binding(0) var<storage, read_write> tree_out: array<atomic<u32>>;\n\
                  // Tree shape at run time, so one compiled program serves every tree of this payload size.\n\
                  @group(1) @binding(1) var<storage, read> tree_cfg: array<u32, 5>;\n\
-                 const TREE_P: u32 = {p}u;\n{}",
+                 const TREE_P: u32 = {p}u;\n{}{}",
+                lowbias32_wgsl("tree_hash"),
                 TREE_WGSL
             ),
             layout: vec![
@@ -229,12 +221,8 @@ impl TreeParams {
     }
 }
 
+// `tree_hash` is `crate::hash::lowbias32_wgsl`, the twin of the CPU reference's hash.
 const TREE_WGSL: &str = r#"
-fn tree_hash(x: u32) -> u32 {
-    var h = x;
-    h ^= h >> 16u; h *= 0x7feb352du; h ^= h >> 15u; h *= 0x846ca68bu; h ^= h >> 16u;
-    return h;
-}
 fn tree_children(id: u32, depth: u32) -> u32 {
     if depth >= tree_cfg[0] { return 0u; }
     if tree_cfg[2] == 1u { return tree_hash(id ^ tree_cfg[3]) % (tree_cfg[1] + 1u); }
