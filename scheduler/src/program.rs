@@ -2,6 +2,7 @@
 //! (item structs, bodies, user declarations, the procedure tables). Each strategy adds its own
 //! enqueue functions and driver loop around this.
 
+use crate::bindings::UserBindings;
 use crate::error::RunError;
 use crate::procedure::Procedure;
 use crate::wgsl::{self, StructLayout};
@@ -24,13 +25,6 @@ impl ProcInfo {
     pub fn words(&self) -> u32 {
         self.layout.words()
     }
-}
-
-/// User resources for bind group 1: WGSL declarations (and helpers) plus the layout entries.
-#[derive(Debug, Clone, Default)]
-pub struct UserBindings {
-    pub wgsl: String,
-    pub layout: Vec<wgpu::BindGroupLayoutEntry>,
 }
 
 #[derive(Debug, Clone)]

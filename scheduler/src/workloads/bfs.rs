@@ -26,10 +26,11 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use rayon::prelude::*;
 
 use super::rmat::{self, Csr, RmatParams};
+use crate::bindings::UserBindings;
 use crate::error::RunError;
 use crate::gpu::Gpu;
 use crate::procedure::{ItemType, Procedure};
-use crate::program::{Program, Seed, UserBindings};
+use crate::program::{Program, Seed};
 use crate::stats::RunStats;
 use crate::strategy::Scheduler;
 
@@ -177,9 +178,9 @@ impl BfsParams {
                  const BFS_SPLIT: u32 = {split}u;\n{RELAX_WGSL}"
             ),
             layout: vec![
-                crate::pipeline::storage_entry(0, true),
-                crate::pipeline::storage_entry(1, true),
-                crate::pipeline::storage_entry(2, false),
+                crate::bindings::storage_entry(0, true),
+                crate::bindings::storage_entry(1, true),
+                crate::bindings::storage_entry(2, false),
             ],
         };
         let vertex = Procedure::new("bfs_vertex", ItemType::new("BfsVertex", VERTEX_WGSL), t)
@@ -341,13 +342,9 @@ impl BfsRun {
         let program = params.program()?;
         let graph = upload_graph(gpu, &params)?;
         let level = gpu.storage_buffer("bfs level", params.graph().vertices() as u64)?;
-        let layout = gpu
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("bfs"),
-                entries: &program.user.layout,
-            });
-        let bind = gpu.bind_buffers("bfs", &layout, &[&graph.0, &graph.1, &level]);
+        let bind = program
+            .user
+            .bind_group(gpu, &[&graph.0, &graph.1, &level])?;
         Ok(BfsRun {
             params,
             program,

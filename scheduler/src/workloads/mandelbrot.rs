@@ -29,10 +29,11 @@
 //! entirely inside a rectangle with a uniform border); the preset views are ones where it does in
 //! both arithmetics, checked against the brute-force image.
 
+use crate::bindings::UserBindings;
 use crate::error::RunError;
 use crate::gpu::Gpu;
 use crate::procedure::{ItemType, Procedure};
-use crate::program::{Program, Seed, UserBindings};
+use crate::program::{Program, Seed};
 use crate::stats::RunStats;
 use crate::strategy::Scheduler;
 
@@ -339,9 +340,9 @@ impl MandelParams {
                  const MS_T: u32 = {MS_THREADS}u;\n{MS_WGSL}"
             ),
             layout: vec![
-                crate::pipeline::storage_entry(0, false),
-                crate::pipeline::storage_entry(1, true),
-                crate::pipeline::storage_entry(2, false),
+                crate::bindings::storage_entry(0, false),
+                crate::bindings::storage_entry(1, true),
+                crate::bindings::storage_entry(2, false),
             ],
         };
         let rect = Procedure::new("ms_rect", item.clone(), MS_THREADS)
@@ -501,13 +502,7 @@ impl MandelRun {
         )?;
         let cfg = gpu.storage_buffer("mandelbrot cfg", size_of::<MandelCfg>() as u64 / 4)?;
         let count = gpu.storage_buffer("mandelbrot counters", 2)?;
-        let layout = gpu
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("mandelbrot"),
-                entries: &program.user.layout,
-            });
-        let bind = gpu.bind_buffers("mandelbrot", &layout, &[&out, &cfg, &count]);
+        let bind = program.user.bind_group(gpu, &[&out, &cfg, &count])?;
         Ok(MandelRun {
             params,
             program,

@@ -4,11 +4,12 @@
 //! result), and leaves fold an order-independent checksum. Inner nodes run `branch`, childless
 //! nodes run `leaf`. A CPU reference gives exact item counts and the checksum.
 
+use crate::bindings::UserBindings;
 use crate::error::RunError;
 use crate::gpu::Gpu;
 use crate::hash::{lowbias32 as hash, lowbias32_wgsl};
 use crate::procedure::{ItemType, Procedure};
-use crate::program::{Program, Seed, UserBindings};
+use crate::program::{Program, Seed};
 use crate::stats::RunStats;
 use crate::strategy::Scheduler;
 
@@ -185,8 +186,8 @@ impl TreeParams {
                 TREE_WGSL
             ),
             layout: vec![
-                crate::pipeline::storage_entry(0, false),
-                crate::pipeline::storage_entry(1, true),
+                crate::bindings::storage_entry(0, false),
+                crate::bindings::storage_entry(1, true),
             ],
         };
         let branch = Procedure::new("branch", item.clone(), 1)
@@ -277,13 +278,7 @@ impl TreeRun {
         let program = params.program()?;
         let out = gpu.storage_buffer("tree out", (BUCKETS * 4) as u64)?;
         let cfg = gpu.storage_buffer("tree cfg", 5)?;
-        let layout = gpu
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("tree"),
-                entries: &program.user.layout,
-            });
-        let bind = gpu.bind_buffers("tree", &layout, &[&out, &cfg]);
+        let bind = program.user.bind_group(gpu, &[&out, &cfg])?;
         Ok(TreeRun {
             declared_children: params.max_children(),
             params,
