@@ -20,6 +20,7 @@ pub mod hash;
 pub mod megakernel;
 pub mod multipass;
 pub mod pipeline;
+pub mod probe;
 pub mod procedure;
 pub mod program;
 pub mod queue_layout;

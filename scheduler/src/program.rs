@@ -4,6 +4,7 @@
 
 use crate::bindings::UserBindings;
 use crate::error::RunError;
+use crate::probe::Part;
 use crate::procedure::Procedure;
 use crate::wgsl::{self, StructLayout};
 
@@ -89,18 +90,10 @@ impl Program {
             });
         }
         let program = Program { procs, user };
-        // Compile the shared part once on its own, so a body error names the body, not a strategy.
-        let probe = format!(
-            "{}\n{}\n@compute @workgroup_size(1) fn sched_probe() {{}}",
-            program.common_wgsl(),
-            (0..program.procs.len())
-                .map(|t| format!(
-                    "fn enqueue_{}(item: {}) {{}}\n",
-                    program.procs[t].proc.name, program.procs[t].layout.name
-                ))
-                .collect::<String>()
-        );
-        wgsl::validate("procedures", &probe)?;
+        // Compile the shared part once on its own, so that an error names the procedure and a
+        // line of its body, not a line of a strategy's generated shader; then check what naga
+        // parsed: every `<name>_execute`, enqueue targets against `.emits`, user bindings.
+        crate::probe::check(&program)?;
         Ok(program)
     }
 
@@ -112,40 +105,49 @@ impl Program {
         self.procs.iter().position(|p| p.proc.name == name)
     }
 
-    /// WGSL common to both strategies: item structs, `Invocation`, per-procedure workgroup
-    /// memory, user declarations, the bodies, and `sched_execute`, which runs queue `q`'s body on
-    /// the item stored at `base` of whatever word storage `load_prefix` names.
-    pub fn common_wgsl(&self) -> String {
-        let mut s = String::from(
+    /// WGSL common to both strategies: `Invocation`, item structs, per-procedure workgroup
+    /// memory, user declarations and the bodies, in that order.
+    pub(crate) fn common_wgsl(&self) -> String {
+        self.common_parts()
+            .into_iter()
+            .map(|(_, text)| text + "\n")
+            .collect()
+    }
+
+    /// [`Program::common_wgsl`] in parts, each with where it came from (for error reports).
+    pub(crate) fn common_parts(&self) -> Vec<(Part, String)> {
+        let mut parts = vec![(
+            Part::Generated,
             "struct Invocation {\n    // thread within the item, 0..threads_per_item\n    thread: u32,\n    \
              // item slot within the workgroup step, 0..items_per_step\n    slot: u32,\n    \
-             // false for padding slots at the end of a batch\n    live: bool,\n}\n",
-        );
+             // false for padding slots at the end of a batch\n    live: bool,\n}"
+                .to_string(),
+        )];
         let mut seen = Vec::new();
         for p in &self.procs {
             if !seen.contains(&p.layout.name) {
                 seen.push(p.layout.name.clone());
-                s += &p.proc.item.wgsl;
-                s += "\n";
+                parts.push((Part::Item(p.layout.name.clone()), p.proc.item.wgsl.clone()));
             }
         }
-        for p in &self.procs {
+        for (i, p) in self.procs.iter().enumerate() {
             if let Some(sh) = &p.proc.shared {
-                s += &format!(
-                    "var<workgroup> {}_shared: array<{}, {}>;\n",
-                    p.proc.name,
-                    sh.wgsl_type,
-                    sh.per_item * p.items_per_step
-                );
+                parts.push((
+                    Part::Shared(i),
+                    format!(
+                        "var<workgroup> {}_shared: array<{}, {}>;",
+                        p.proc.name,
+                        sh.wgsl_type,
+                        sh.per_item * p.items_per_step
+                    ),
+                ));
             }
         }
-        s += &self.user.wgsl;
-        s += "\n";
-        for p in &self.procs {
-            s += &p.proc.body;
-            s += "\n";
+        parts.push((Part::User, self.user.wgsl.clone()));
+        for (i, p) in self.procs.iter().enumerate() {
+            parts.push((Part::Body(i), p.proc.body.clone()));
         }
-        s
+        parts
     }
 
     /// `fn sched_execute(q, base, inv)`: loads the item at word `base` with `{prefix}_load_*`
