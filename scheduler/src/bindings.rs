@@ -2,7 +2,7 @@
 //! queues). A program declares them once, as WGSL plus layout entries; each run gets the
 //! matching `wgpu::BindGroup`.
 //!
-//! ```no_run
+//! ```
 //! # fn main() -> Result<(), scheduler::RunError> {
 //! use scheduler::{Gpu, UserBindings};
 //! let gpu = Gpu::from_env()?;

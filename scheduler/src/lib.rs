@@ -10,21 +10,22 @@
 //!   sized direct dispatches per round, compaction fused into the producing pass.
 //!
 //! The queue protocol and its correctness argument are in `docs/scheduler.md`.
+#![warn(missing_docs)]
 
 pub mod bindings;
 pub mod clocks;
 pub mod error;
 pub mod gpu;
-pub mod growth;
+mod growth;
 pub mod hash;
 pub mod megakernel;
 pub mod multipass;
-pub mod pipeline;
-pub mod probe;
+mod pipeline;
+mod probe;
 pub mod procedure;
 pub mod program;
-pub mod queue_layout;
-pub mod readback;
+mod queue_layout;
+mod readback;
 pub mod stats;
 pub mod strategy;
 pub mod timing;

@@ -11,10 +11,13 @@ use crate::wgsl::{self, StructLayout};
 /// Workgroup size of every scheduler kernel; threads per item divide it.
 pub const WORKGROUP_SIZE: u32 = 256;
 
-/// A procedure after validation: its queue index, item layout and resolved emit table.
+/// A procedure after validation: its declaration, item layout and resolved emit table. Its
+/// index in [`Program::procs`] is its queue index.
 #[derive(Debug, Clone)]
 pub struct ProcInfo {
+    /// The procedure as declared.
     pub proc: Procedure,
+    /// Its item struct's layout as naga computes it (size, offsets, every scalar).
     pub layout: StructLayout,
     /// Items one workgroup step runs: `WORKGROUP_SIZE / threads_per_item`.
     pub items_per_step: u32,
@@ -23,20 +26,41 @@ pub struct ProcInfo {
 }
 
 impl ProcInfo {
+    /// Words (u32) per item in a queue: the item struct's size / 4.
     pub fn words(&self) -> u32 {
         self.layout.words()
     }
 }
 
+/// Procedures registered together and validated, with the user's bind group 1: what every
+/// strategy compiles ([`crate::Scheduler::new`]). Cloning is cheap enough to keep one per
+/// scheduler.
 #[derive(Debug, Clone)]
 pub struct Program {
+    /// The procedures in registration order; a procedure's index is its queue index (the order
+    /// of [`crate::RunStats::executed`]).
     pub procs: Vec<ProcInfo>,
+    /// The user's resources (bind group 1).
     pub user: UserBindings,
 }
 
 impl Program {
-    /// Validates procedures: unique identifiers, known targets, threads per item a power of two
-    /// from 1 to 256, item structs that can travel in a queue, and bodies that compile.
+    /// Registers and validates `procedures` with the user resources `user`.
+    ///
+    /// Checks: at least one procedure; names are WGSL identifiers not starting with `sched_` or
+    /// `__`, without duplicates; threads per item a power of two from 1 to 256; `emits` targets
+    /// are procedures; item structs can travel in a queue (see [`ItemType`](crate::ItemType));
+    /// item structs, user WGSL and bodies compile together with stub `enqueue_*` functions;
+    /// every `<name>_execute(item: <Item>, inv: Invocation)` exists; no procedure calls
+    /// `enqueue_<t>` (directly or through helpers) for a target it did not declare with
+    /// [`Procedure::emits`]; every `@group(1)` variable has a layout entry of the same binding
+    /// and storage access.
+    ///
+    /// Errors: [`RunError::Program`]. A WGSL error names where it is: the procedure and the
+    /// line and column within its body (or the user WGSL, or the item struct), with the line.
+    /// User WGSL must also avoid the identifiers of the scheduler's generated code (`ctrl`,
+    /// `slots`, `NQ`, `Q_*`, `wg_*`, `mp_*`, ...); a clash there is reported by the strategy's
+    /// constructor.
     pub fn new(procedures: Vec<Procedure>, user: UserBindings) -> Result<Program, RunError> {
         if procedures.is_empty() {
             return Err(RunError::Program(
@@ -97,10 +121,12 @@ impl Program {
         Ok(program)
     }
 
+    /// Number of procedures, which is the number of queues.
     pub fn queue_count(&self) -> usize {
         self.procs.len()
     }
 
+    /// The queue index of procedure `name`, if registered.
     pub fn index_of(&self, name: &str) -> Option<usize> {
         self.procs.iter().position(|p| p.proc.name == name)
     }
@@ -152,7 +178,7 @@ impl Program {
 
     /// `fn sched_execute(q, base, inv)`: loads the item at word `base` with `{prefix}_load_*`
     /// (only for active invocations) and calls the body of procedure `q`.
-    pub fn execute_switch(&self, prefix: &str) -> String {
+    pub(crate) fn execute_switch(&self, prefix: &str) -> String {
         let mut s = String::new();
         let mut seen = Vec::new();
         for p in &self.procs {
@@ -174,7 +200,7 @@ impl Program {
     }
 
     /// Constant tables: queue count, threads per item, item words, emit table.
-    pub fn tables_wgsl(&self) -> String {
+    pub(crate) fn tables_wgsl(&self) -> String {
         let nq = self.procs.len();
         let list = |f: &dyn Fn(&ProcInfo) -> u32| {
             self.procs
@@ -210,15 +236,20 @@ fn is_identifier(s: &str) -> bool {
         && !s.starts_with("__")
 }
 
-/// Initial work: raw item words for one queue, by procedure name.
+/// Initial work: raw item words for one queue, by procedure name. Seeds of the same procedure
+/// are concatenated; a seed for an unknown procedure, or whose word count is not a multiple of
+/// the item's words, is a [`RunError::Program`] of the run.
 #[derive(Debug, Clone)]
 pub struct Seed {
+    /// The procedure whose queue the items start in.
     pub procedure: String,
     /// Items packed back to back, `words` per item, as the `#[repr(C)]` host twin lays them out.
     pub words: Vec<u32>,
 }
 
 impl Seed {
+    /// Items of `procedure` from their `#[repr(C)]` host twins (`T` must have the item
+    /// struct's size and layout; check it with [`crate::wgsl::struct_layout`]).
     pub fn new<T: bytemuck::Pod>(procedure: &str, items: &[T]) -> Self {
         Seed {
             procedure: procedure.into(),

@@ -41,7 +41,9 @@ pub const UNREACHED: u32 = u32::MAX;
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct BfsVertex {
+    /// The vertex.
     pub v: u32,
+    /// Its BFS level when it was emitted (hops from the source).
     pub level: u32,
 }
 
@@ -49,9 +51,13 @@ pub struct BfsVertex {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct BfsEdges {
+    /// The vertex whose list is cut.
     pub v: u32,
+    /// Its BFS level when the slice was emitted.
     pub level: u32,
+    /// First index into the CSR column array.
     pub begin: u32,
+    /// One past the last index.
     pub end: u32,
 }
 
@@ -113,14 +119,17 @@ impl BfsParams {
         Self::new(RmatParams::graph500(scale, seed))
     }
 
+    /// The graph's generator parameters.
     pub fn rmat(&self) -> &RmatParams {
         &self.rmat
     }
 
+    /// The graph, generated once by [`BfsParams::new`].
     pub fn graph(&self) -> &Csr {
         &self.graph
     }
 
+    /// One line of every parameter, for reports.
     pub fn describe(&self) -> String {
         format!(
             "rmat scale={} edge_factor={} seed={} vertices={} directed_edges={} source={} chunk={} split={} threads={}",
@@ -162,6 +171,8 @@ impl BfsParams {
         self.graph.traversed_edges(levels)
     }
 
+    /// The program: procedures `bfs_vertex` and `bfs_edges` with the graph and level array as
+    /// user bindings. Errors: [`RunError::Program`] for `chunk_edges == 0` or `split < 2`.
     pub fn program(&self) -> Result<Program, RunError> {
         let (t, chunk, split) = (self.threads, self.chunk_edges, self.split);
         if chunk == 0 || split < 2 {
@@ -329,7 +340,9 @@ pub(crate) fn initial_levels(params: &BfsParams) -> Vec<u32> {
 
 /// The BFS workload's GPU resources: the graph, the level array, and their bind group.
 pub struct BfsRun {
+    /// The search run.
     pub params: BfsParams,
+    /// Its program ([`BfsParams::program`]).
     pub program: Program,
     level: wgpu::Buffer,
     bind: wgpu::BindGroup,
@@ -338,6 +351,8 @@ pub struct BfsRun {
 }
 
 impl BfsRun {
+    /// Uploads the graph and builds the program. Errors: [`RunError::Program`] (see
+    /// [`BfsParams::program`]), [`RunError::Device`] when the graph passes the binding limit.
     pub fn new(gpu: &Gpu, params: BfsParams) -> Result<BfsRun, RunError> {
         let program = params.program()?;
         let graph = upload_graph(gpu, &params)?;

@@ -13,6 +13,7 @@ use crate::program::{Program, Seed};
 use crate::stats::RunStats;
 use crate::strategy::Scheduler;
 
+/// How many children an inner node has.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Fanout {
     /// Every inner node has exactly k children.
@@ -21,16 +22,20 @@ pub enum Fanout {
     Uniform(u32),
 }
 
+/// The shape of one synthetic tree.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TreeParams {
+    /// Root nodes (the seeds).
     pub roots: u32,
     /// Nodes at this depth have no children (roots are at depth 0).
     pub max_depth: u32,
+    /// Children per inner node.
     pub fanout: Fanout,
     /// Hash rounds per inner node: the per-item work cost.
     pub work: u32,
     /// Payload words per item (item size = 2 + payload words).
     pub payload_words: u32,
+    /// Varies the root ids and, with [`Fanout::Uniform`], every node's child count.
     pub seed: u32,
 }
 
@@ -53,6 +58,7 @@ impl TreeParams {
         }
     }
 
+    /// One line of every parameter, for reports.
     pub fn describe(&self) -> String {
         let f = match self.fanout {
             Fanout::Fixed(k) => format!("fixed:{k}"),
@@ -68,11 +74,15 @@ impl TreeParams {
 /// What a run of the tree produced: items per procedure and the leaf checksum.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct TreeResult {
+    /// Inner nodes executed (`branch` items).
     pub branches: u64,
+    /// Leaves executed (`leaf` items).
     pub leaves: u64,
     /// Leaves that reached the output buckets (must equal `leaves`).
     pub leaves_folded: u64,
+    /// Wrapping sum of every leaf's hash.
     pub leaf_sum: u32,
+    /// Xor of `hash(h)` over every leaf's hash `h`.
     pub leaf_xor: u32,
 }
 
@@ -166,6 +176,9 @@ impl TreeParams {
         r
     }
 
+    /// The program: `branch` (emits up to the fan-out to `branch` and to `leaf`) and `leaf`,
+    /// with the output buckets and run-time shape as user bindings. Errors:
+    /// [`RunError::Program`] for a payload outside `1..=254` words.
     pub fn program(&self) -> Result<Program, RunError> {
         let p = self.payload_words;
         if p == 0 || p > 254 {
@@ -198,6 +211,7 @@ impl TreeParams {
         Program::new(vec![branch, leaf], user)
     }
 
+    /// The roots, as seeds of `branch` (roots with children) and `leaf` (the others).
     pub fn seeds(&self) -> Vec<Seed> {
         let (mut branch, mut leaf) = (Vec::new(), Vec::new());
         for i in 0..self.roots {
@@ -264,7 +278,9 @@ fn leaf_execute(item: TreeNode, inv: Invocation) {
 
 /// The tree's GPU resources: its output buckets and their bind group.
 pub struct TreeRun {
+    /// The tree the next run walks.
     pub params: TreeParams,
+    /// Its program ([`TreeParams::program`]).
     pub program: Program,
     out: wgpu::Buffer,
     cfg: wgpu::Buffer,
@@ -274,6 +290,8 @@ pub struct TreeRun {
 }
 
 impl TreeRun {
+    /// Builds the program and the output buffers. Errors: [`RunError::Program`] (see
+    /// [`TreeParams::program`]), [`RunError::Device`] if a buffer cannot be made.
     pub fn new(gpu: &Gpu, params: TreeParams) -> Result<TreeRun, RunError> {
         let program = params.program()?;
         let out = gpu.storage_buffer("tree out", (BUCKETS * 4) as u64)?;
