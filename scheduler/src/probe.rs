@@ -1,7 +1,9 @@
 //! The validation probe of [`Program::new`]: the program's shared WGSL (item structs, user
 //! WGSL, bodies) compiled on its own with stub `enqueue_*` functions, so that an error is
 //! reported where the user wrote it (a procedure's body and a line of that body) rather than
-//! at a line of a strategy's generated shader. After naga has parsed and validated the probe,
+//! at a line of a strategy's generated shader. A bracket a part leaves unclosed (naga then
+//! stumbles at the next part) is reported in the part that opened it. After naga has parsed and
+//! validated the probe,
 //! its module is checked for what naga cannot know:
 //! - every procedure has `fn <name>_execute(item: <Item>, inv: Invocation)` with no result;
 //! - a procedure's execute function, and every function it calls, directly or not, calls
@@ -104,6 +106,68 @@ impl<'a> Probe<'a> {
         ))
     }
 
+    /// The first bracket (`{`, `(`, `[`) that a part the user wrote leaves unclosed, or a
+    /// closing one without its opener, described with its location. Comments are skipped.
+    fn unbalanced(&self) -> Option<String> {
+        for (part, start, end) in &self.parts {
+            if *part == Part::Generated {
+                continue;
+            }
+            let text = &self.text[*start..*end];
+            let bytes = text.as_bytes();
+            let mut open: Vec<(u8, usize)> = Vec::new();
+            let mut bad = None;
+            let mut i = 0;
+            while i < bytes.len() && bad.is_none() {
+                match bytes[i] {
+                    b'/' if bytes.get(i + 1) == Some(&b'/') => {
+                        i = text[i..].find('\n').map_or(bytes.len(), |n| i + n);
+                    }
+                    b'/' if bytes.get(i + 1) == Some(&b'*') => {
+                        // WGSL block comments nest.
+                        let mut depth = 0;
+                        while i < bytes.len() {
+                            if bytes[i..].starts_with(b"/*") {
+                                depth += 1;
+                                i += 2;
+                            } else if bytes[i..].starts_with(b"*/") {
+                                depth -= 1;
+                                i += 2;
+                                if depth == 0 {
+                                    break;
+                                }
+                            } else {
+                                i += 1;
+                            }
+                        }
+                        continue;
+                    }
+                    c @ (b'{' | b'(' | b'[') => open.push((c, i)),
+                    c @ (b'}' | b')' | b']') => {
+                        let opener = match c {
+                            b'}' => b'{',
+                            b')' => b'(',
+                            _ => b'[',
+                        };
+                        match open.pop() {
+                            Some((o, _)) if o == opener => {}
+                            _ => bad = Some((c, i, "has no opening bracket in it")),
+                        }
+                    }
+                    _ => {}
+                }
+                i += 1;
+            }
+            let bad = bad.or_else(|| open.first().map(|&(c, i)| (c, i, "is not closed in it")));
+            if let Some((c, i, what)) = bad {
+                let span = Span::new((start + i) as u32, (start + i + 1) as u32);
+                let (at, ..) = self.locate(span)?;
+                return Some(format!("{at}: this `{}` {what}", c as char));
+            }
+        }
+        None
+    }
+
     fn is_generated(&self, span: Span) -> bool {
         span.to_range()
             .and_then(|r| self.part_at(r.start))
@@ -164,7 +228,12 @@ pub(crate) fn check(program: &Program) -> Result<(), RunError> {
     let module = naga::front::wgsl::parse_str(&probe.text).map_err(|e| {
         let spans: Vec<(Span, String)> = e.labels().map(|(s, l)| (s, l.to_string())).collect();
         let notes: Vec<String> = e.notes().map(str::to_string).collect();
-        RunError::Program(probe.report(e.message(), &spans, &notes, false))
+        let report = probe.report(e.message(), &spans, &notes, false);
+        // An unclosed bracket makes naga report the next part's first line: name the part.
+        RunError::Program(match probe.unbalanced() {
+            Some(at) => format!("{at}\nnaga's error, which follows from it: {report}"),
+            None => report,
+        })
     })?;
     naga::valid::Validator::new(
         naga::valid::ValidationFlags::all(),
@@ -467,6 +536,20 @@ mod tests {
             "{m}"
         );
         assert!(m.contains("let b = a + ;"), "{m}");
+    }
+
+    #[test]
+    fn an_unclosed_brace_is_reported_in_its_own_body() {
+        // naga stumbles only at the next body's `fn`; the report must name `a`'s `{` (the
+        // `}` in the comment does not count).
+        let a = Procedure::new("a", word(), 1)
+            .body("fn a_execute(item: Word, inv: Invocation) {\n    let x = 1u; // }\n");
+        let m = error(vec![a, sink()], UserBindings::none());
+        assert!(
+            m.starts_with("procedure `a`, body line 1, column 43: this `{` is not closed"),
+            "{m}"
+        );
+        assert!(m.contains("naga's error"), "{m}");
     }
 
     #[test]
