@@ -3,8 +3,7 @@
 //! reported where the user wrote it (a procedure's body and a line of that body) rather than
 //! at a line of a strategy's generated shader. A bracket a part leaves unclosed (naga then
 //! stumbles at the next part) is reported in the part that opened it. After naga has parsed and
-//! validated the probe,
-//! its module is checked for what naga cannot know:
+//! validated the probe, its module is checked for what naga cannot know:
 //! - every procedure has `fn <name>_execute(item: <Item>, inv: Invocation)` with no result;
 //! - a procedure's execute function, and every function it calls, directly or not, calls
 //!   `enqueue_<t>` only for targets `t` the procedure declared with `.emits(t, n)`, `n > 0`
