@@ -409,3 +409,66 @@ fn multipass_stage_timing_keeps_results_and_splits_the_time_by_procedure() {
         assert!(stats.stage_gpu_ms.is_empty());
     }
 }
+
+/// `enqueue_*` adds one item per call by every thread, on every strategy: a 4-thread item whose
+/// threads each enqueue one child emits 4, one guarded by `inv.thread == 0u` emits 1, and the
+/// declared maximum counts the calls of all the item's threads together.
+#[test]
+fn every_thread_that_calls_enqueue_adds_an_item_on_every_strategy() {
+    let gpu = gpu();
+    let item = ItemType::new("Word", "struct Word { v: u32 }");
+    let fan_body = "fn fan_execute(item: Word, inv: Invocation) {\n\
+                    enqueue_sink(Word(item.v * 4u + inv.thread));\n\
+                    if inv.thread == 0u { enqueue_once(item); }\n}";
+    let program = |declared: u32| {
+        let fan = Procedure::new("fan", item.clone(), 4)
+            .emits("sink", declared)
+            .emits("once", 1)
+            .body(fan_body);
+        let sink = Procedure::new("sink", item.clone(), 1).body(
+            "fn sink_execute(item: Word, inv: Invocation) { if inv.live { atomicAdd(&seen[item.v], 1u); } }",
+        );
+        let once = Procedure::new("once", item.clone(), 1)
+            .body("fn once_execute(item: Word, inv: Invocation) {}");
+        let user = UserBindings::storage(
+            "@group(1) @binding(0) var<storage, read_write> seen: array<atomic<u32>>;",
+            &[(0, false)],
+        );
+        Program::new(vec![fan, sink, once], user).unwrap()
+    };
+    let n = 100u32;
+    let seeds = [Seed::new("fan", &(0..n).collect::<Vec<u32>>())];
+    let exact = program(4);
+    for kind in StrategyKind::ALL {
+        let seen = gpu.storage_buffer("seen", 4 * n as u64).unwrap();
+        let bind = exact.user.bind_group(&gpu, &[&seen]).unwrap();
+        let s = Scheduler::new(&gpu, &exact, kind, 64).unwrap();
+        let stats = s.run(&gpu, &seeds, Some(&bind)).unwrap();
+        assert_eq!(
+            stats.executed,
+            [n as u64, 4 * n as u64, n as u64],
+            "{kind:?}"
+        );
+        let counts = gpu.read_words(&seen, 0, 4 * n as u64).unwrap();
+        assert!(counts.iter().all(|&c| c == 1), "{kind:?}: {counts:?}");
+    }
+    // Declaring 3 for 4 threads' calls is an emit-limit error everywhere.
+    let short = program(3);
+    for kind in StrategyKind::ALL {
+        let seen = gpu.storage_buffer("seen", 4 * n as u64).unwrap();
+        let bind = short.user.bind_group(&gpu, &[&seen]).unwrap();
+        let s = Scheduler::new(&gpu, &short, kind, 64).unwrap();
+        match s.run(&gpu, &seeds, Some(&bind)) {
+            Err(RunError::EmitLimit {
+                procedure,
+                target,
+                declared,
+            }) => assert_eq!(
+                (procedure.as_str(), target.as_str(), declared),
+                ("fan", "sink", 3),
+                "{kind:?}"
+            ),
+            other => panic!("{kind:?}: expected an emit-limit error, got {other:?}"),
+        }
+    }
+}

@@ -7,11 +7,10 @@ use crate::frame::{Frame, FrameData, PatchItem};
 use crate::image::FrameImage;
 use crate::shaders;
 use crate::stages::{C_MAX_DEPTH, COUNTERS};
-use scheduler::pipeline::storage_entry;
 use scheduler::timing::PassTimer;
 use scheduler::{
     Gpu, ItemType, MultipassConfig, Procedure, Program, RunError, RunStats, Scheduler, Seed,
-    StrategyKind, UserBindings,
+    StrategyKind, UserBindings, storage_entry,
 };
 use std::time::Instant;
 

@@ -15,15 +15,21 @@ pub const DEFAULT_GPU_TIMEOUT: Duration = Duration::from_secs(120);
 
 /// An adapter, its device and queue, and what they can do.
 pub struct Gpu {
+    /// The adapter the device was opened on.
     pub adapter: wgpu::Adapter,
+    /// The device every buffer and pipeline of the scheduler lives on.
     pub device: wgpu::Device,
+    /// The device's queue.
     pub queue: wgpu::Queue,
+    /// The adapter's name, backend and type.
     pub info: wgpu::AdapterInfo,
     /// `@coherent` storage buffers are available, so queue payloads may use plain loads/stores.
     /// Without it the queue moves payload words with atomic loads/stores (always coherent).
     pub coherent: bool,
     /// Timestamp queries at pass boundaries are available: runs report GPU time.
     pub timestamps: bool,
+    /// Bound of every wait for the GPU ([`DEFAULT_GPU_TIMEOUT`] unless changed): a wait that
+    /// runs out is a [`RunError::Timeout`].
     pub timeout: Duration,
     /// wgpu errors not captured by an error scope (validation, out of memory), in order. wgpu's
     /// default handler panics; this device records them instead and [`Gpu::wait`] reports the
@@ -32,7 +38,8 @@ pub struct Gpu {
 }
 
 impl Gpu {
-    /// Opens the adapter named by the environment, or the default one.
+    /// Opens the adapter named by the environment, or the default one. Errors:
+    /// [`RunError::NoAdapter`], with what to install, when there is none.
     pub fn from_env() -> Result<Gpu, RunError> {
         Self::from_env_requiring(wgpu::Features::empty())
     }
@@ -56,7 +63,10 @@ impl Gpu {
         Self::from_adapter(adapter, features)
     }
 
-    /// Opens a device on `adapter` with the features the scheduler benefits from.
+    /// Opens a device on `adapter` with `required` features plus those the scheduler benefits
+    /// from when present (`MEMORY_DECORATION_COHERENT`, `TIMESTAMP_QUERY`), the adapter's
+    /// storage and workgroup-memory limits, and 256 invocations per workgroup. Errors:
+    /// [`RunError::NoAdapter`] when the adapter lacks `required` or `request_device` fails.
     pub fn from_adapter(adapter: wgpu::Adapter, required: wgpu::Features) -> Result<Gpu, RunError> {
         let info = adapter.get_info();
         let available = adapter.features();
@@ -141,7 +151,8 @@ impl Gpu {
         first
     }
 
-    /// Copies `size` bytes of `src` from `offset` to the host; bounded wait.
+    /// Copies `size` bytes of `src` (which needs `COPY_SRC` usage) from byte `offset` to the
+    /// host; one bounded wait. Errors: [`RunError::Timeout`], [`RunError::Device`].
     pub fn read_buffer(
         &self,
         src: &wgpu::Buffer,
@@ -179,7 +190,7 @@ impl Gpu {
         Ok(data)
     }
 
-    /// Reads `count` u32 words starting at word `offset`.
+    /// Reads `count` u32 words starting at word `offset` (as [`Gpu::read_buffer`]).
     pub fn read_words(
         &self,
         src: &wgpu::Buffer,
@@ -196,8 +207,9 @@ impl Gpu {
         l.max_storage_buffer_binding_size.min(l.max_buffer_size)
     }
 
-    /// A storage buffer of `words` u32 words (at least one), zeroed. A size beyond the device's
-    /// limits is an error naming the buffer, not a panic in wgpu's error handler.
+    /// A storage buffer of `words` u32 words (at least one), zeroed, with `STORAGE | COPY_DST |
+    /// COPY_SRC` usage. A size beyond the device's limits is a [`RunError::Device`] naming the
+    /// buffer, not a panic in wgpu's error handler.
     pub fn storage_buffer(&self, label: &str, words: u64) -> Result<wgpu::Buffer, RunError> {
         let bytes = words.max(1) * 4;
         if bytes > self.max_binding_bytes() {

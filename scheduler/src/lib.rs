@@ -10,30 +10,42 @@
 //!   sized direct dispatches per round, compaction fused into the producing pass.
 //!
 //! The queue protocol and its correctness argument are in `docs/scheduler.md`.
+#![warn(missing_docs)]
 
+pub mod bindings;
 pub mod clocks;
 pub mod error;
 pub mod gpu;
-pub mod growth;
+mod growth;
+pub mod hash;
 pub mod megakernel;
 pub mod multipass;
-pub mod pipeline;
+mod pipeline;
+mod probe;
 pub mod procedure;
 pub mod program;
-pub mod queue_layout;
-pub mod readback;
+mod queue_layout;
+mod readback;
 pub mod stats;
 pub mod strategy;
 pub mod timing;
 pub mod wgsl;
 pub mod workloads;
 
+/// The bytemuck this crate is built against: `#[derive(Pod, Zeroable)]` host twins of item
+/// structs go through it ([`Seed::new`], [`Gpu::upload`]).
+pub use bytemuck;
+/// The wgpu this crate is built against (30.x). Use `scheduler::wgpu::...` for the buffers and
+/// bind groups a run takes, so the versions always match without a dependency of your own.
+pub use wgpu;
+
+pub use bindings::{UserBindings, storage_entry};
 pub use error::RunError;
 pub use gpu::Gpu;
 pub use megakernel::{Megakernel, MegakernelConfig, QueuePolicy, Workgroups};
 pub use multipass::host::{HostMultipass, HostMultipassConfig};
 pub use multipass::{Multipass, MultipassConfig};
 pub use procedure::{ItemType, Procedure};
-pub use program::{Program, Seed, UserBindings};
+pub use program::{Program, Seed};
 pub use stats::RunStats;
 pub use strategy::{Scheduler, StrategyKind};

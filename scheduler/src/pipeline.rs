@@ -4,19 +4,7 @@ use crate::error::RunError;
 use crate::gpu::Gpu;
 use crate::program::Program;
 
-/// A compute-visible storage buffer binding.
-pub fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
+pub(crate) use crate::bindings::storage_entry;
 
 /// Group 0 (the scheduler's, from `entries`) and group 1 (the user's, if any), and one compute
 /// pipeline per entry point of `source`.
@@ -46,13 +34,7 @@ impl Kernels {
                 label: Some(label),
                 entries,
             });
-        let user = (!program.user.layout.is_empty()).then(|| {
-            gpu.device
-                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                    label: Some("user"),
-                    entries: &program.user.layout,
-                })
-        });
+        let user = program.user.bind_group_layout(gpu);
         let g2 = group2.map(|(entries, _)| {
             gpu.device
                 .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {

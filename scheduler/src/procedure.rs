@@ -6,15 +6,22 @@
 //! the item is zeroed, and enqueues are ignored; other side effects must check `inv.live`.
 //! Work is emitted only through generated functions `enqueue_<target>(item)`.
 
-/// A queue item type: a WGSL struct declaration (the host twin is a `#[repr(C)]` bytemuck type;
-/// see [`crate::wgsl::struct_layout`] for checking that they agree).
+/// A queue item type: a WGSL struct declaration. Items travel through the queues as
+/// `size / 4` u32 words in naga's storage layout (padding included); only 32-bit `u32`, `i32`,
+/// `f32` scalars, vectors, matrices, fixed-size arrays and nested structs can travel. The host
+/// twin is a `#[repr(C)]` bytemuck type; [`crate::wgsl::struct_layout`] reports the offsets to
+/// check it against.
 #[derive(Debug, Clone)]
 pub struct ItemType {
+    /// The struct's WGSL name, e.g. `TreeNode`.
     pub name: String,
+    /// The declaration, e.g. `struct TreeNode { id: u32, depth: u32 }` (other declarations it
+    /// needs may come along; an item type shared by several procedures is declared once).
     pub wgsl: String,
 }
 
 impl ItemType {
+    /// Item type `name` declared by `wgsl`.
     pub fn new(name: &str, wgsl: &str) -> Self {
         ItemType {
             name: name.into(),
@@ -28,24 +35,65 @@ impl ItemType {
 /// `[inv.slot * per_item, (inv.slot + 1) * per_item)`.
 #[derive(Debug, Clone)]
 pub struct SharedMemory {
+    /// The element type, e.g. `atomic<u32>` or `vec4<f32>`.
     pub wgsl_type: String,
+    /// Elements per item.
     pub per_item: u32,
 }
 
+/// One kind of work: an item type, the threads that run one item together, the most items
+/// one item may emit to each target, and a WGSL body.
+///
+/// ```
+/// use scheduler::{ItemType, Procedure};
+/// let node = ItemType::new("Node", "struct Node { id: u32, depth: u32 }");
+/// // Four threads per item; each thread enqueues one child, so one item emits up to 4.
+/// let split = Procedure::new("split", node, 4).emits("split", 4).body(
+///     "fn split_execute(item: Node, inv: Invocation) {
+///          if item.depth < 3u { enqueue_split(Node(item.id * 4u + inv.thread, item.depth + 1u)); }
+///      }",
+/// );
+/// assert_eq!(split.max_emits, [("split".to_string(), 4)]);
+/// ```
+///
+/// **The body** must define `fn <name>_execute(item: <Item>, inv: Invocation)` (in its own
+/// body, another procedure's or the user WGSL; [`crate::Program::new`] checks it). It runs on
+/// all `threads_per_item` threads of an item together, in workgroup-uniform control flow (so it
+/// may call `workgroupBarrier`), also for padding slots: `inv.live == false` there, the item is
+/// zeroed and enqueues are ignored; any other side effect must check `inv.live`.
+/// `Invocation { thread, slot, live }`: `thread` in `0..threads_per_item`, `slot` in
+/// `0..items_per_step` with `items_per_step = 256 / threads_per_item`.
+///
+/// **Emitting work.** `enqueue_<target>(item)` appends one item to `target`'s queue *for every
+/// call, by every thread*: in an item of several threads, a call made by each of them adds one
+/// item each (guard with `if inv.thread == 0u` for one item per item). All strategies behave
+/// alike here (megakernel, `multipass`, `multipass-host`). The declared maximum of
+/// [`Procedure::emits`] counts the calls of all the item's threads together; more is a
+/// [`crate::RunError::EmitLimit`] (the megakernel checks the total of a batch of items, the
+/// multi-pass strategies each item). Calling `enqueue_<target>` for a target not declared with
+/// `emits` is rejected by [`crate::Program::new`], also through helper functions.
 #[derive(Debug, Clone)]
 pub struct Procedure {
+    /// The procedure's name, a WGSL identifier not starting with `sched_` or `__`; its queue,
+    /// enqueue function (`enqueue_<name>`) and execute function (`<name>_execute`) derive from it.
     pub name: String,
+    /// The type of its items.
     pub item: ItemType,
     /// Threads that run one item together: a power of two from 1 to 256.
     pub threads_per_item: u32,
+    /// Workgroup memory per item, if any ([`Procedure::shared`]).
     pub shared: Option<SharedMemory>,
     /// Worst case items emitted to each target per executed item. Both strategies reserve output
     /// space from this before running a batch, which is how no queue can overflow mid-batch.
     pub max_emits: Vec<(String, u32)>,
+    /// The WGSL body ([`Procedure::body`]).
     pub body: String,
 }
 
 impl Procedure {
+    /// A procedure `name` on items of type `item`, run by `threads_per_item` threads per item
+    /// (a power of two from 1 to 256, checked by [`crate::Program::new`]), emitting nothing and
+    /// with an empty body until declared.
     pub fn new(name: &str, item: ItemType, threads_per_item: u32) -> Self {
         Procedure {
             name: name.into(),
@@ -57,12 +105,17 @@ impl Procedure {
         }
     }
 
-    /// Declares that one item may emit up to `max` items to procedure `target`.
+    /// Declares that one executed item may emit up to `max` items to procedure `target`, counting
+    /// the `enqueue_<target>` calls of all its threads. Repeated calls for one target add up.
     pub fn emits(mut self, target: &str, max: u32) -> Self {
         self.max_emits.push((target.into(), max));
         self
     }
 
+    /// Declares workgroup memory `var<workgroup> <name>_shared: array<wgsl_type, per_item *
+    /// items_per_step>`; item `inv.slot` owns elements `[slot * per_item, (slot + 1) * per_item)`.
+    /// The megakernel holds every procedure's array at once, so the sum counts against the
+    /// device's workgroup memory limit.
     pub fn shared(mut self, wgsl_type: &str, per_item: u32) -> Self {
         self.shared = Some(SharedMemory {
             wgsl_type: wgsl_type.into(),
@@ -71,6 +124,9 @@ impl Procedure {
         self
     }
 
+    /// Sets the WGSL body: `fn <name>_execute(item: <Item>, inv: Invocation)` and any helpers
+    /// (helper names share one module with every other body and the scheduler's code: prefix
+    /// them, e.g. with the procedure name).
     pub fn body(mut self, wgsl: &str) -> Self {
         self.body = wgsl.into();
         self

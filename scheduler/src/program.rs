@@ -2,17 +2,22 @@
 //! (item structs, bodies, user declarations, the procedure tables). Each strategy adds its own
 //! enqueue functions and driver loop around this.
 
+use crate::bindings::UserBindings;
 use crate::error::RunError;
+use crate::probe::Part;
 use crate::procedure::Procedure;
 use crate::wgsl::{self, StructLayout};
 
 /// Workgroup size of every scheduler kernel; threads per item divide it.
 pub const WORKGROUP_SIZE: u32 = 256;
 
-/// A procedure after validation: its queue index, item layout and resolved emit table.
+/// A procedure after validation: its declaration, item layout and resolved emit table. Its
+/// index in [`Program::procs`] is its queue index.
 #[derive(Debug, Clone)]
 pub struct ProcInfo {
+    /// The procedure as declared.
     pub proc: Procedure,
+    /// Its item struct's layout as naga computes it (size, offsets, every scalar).
     pub layout: StructLayout,
     /// Items one workgroup step runs: `WORKGROUP_SIZE / threads_per_item`.
     pub items_per_step: u32,
@@ -21,27 +26,41 @@ pub struct ProcInfo {
 }
 
 impl ProcInfo {
+    /// Words (u32) per item in a queue: the item struct's size / 4.
     pub fn words(&self) -> u32 {
         self.layout.words()
     }
 }
 
-/// User resources for bind group 1: WGSL declarations (and helpers) plus the layout entries.
-#[derive(Debug, Clone, Default)]
-pub struct UserBindings {
-    pub wgsl: String,
-    pub layout: Vec<wgpu::BindGroupLayoutEntry>,
-}
-
+/// Procedures registered together and validated, with the user's bind group 1: what every
+/// strategy compiles ([`crate::Scheduler::new`]). Cloning is cheap enough to keep one per
+/// scheduler.
 #[derive(Debug, Clone)]
 pub struct Program {
+    /// The procedures in registration order; a procedure's index is its queue index (the order
+    /// of [`crate::RunStats::executed`]).
     pub procs: Vec<ProcInfo>,
+    /// The user's resources (bind group 1).
     pub user: UserBindings,
 }
 
 impl Program {
-    /// Validates procedures: unique identifiers, known targets, threads per item a power of two
-    /// from 1 to 256, item structs that can travel in a queue, and bodies that compile.
+    /// Registers and validates `procedures` with the user resources `user`.
+    ///
+    /// Checks: at least one procedure; names are WGSL identifiers not starting with `sched_` or
+    /// `__`, without duplicates; threads per item a power of two from 1 to 256; `emits` targets
+    /// are procedures; item structs can travel in a queue (see [`ItemType`](crate::ItemType));
+    /// item structs, user WGSL and bodies compile together with stub `enqueue_*` functions;
+    /// every `<name>_execute(item: <Item>, inv: Invocation)` exists; no procedure calls
+    /// `enqueue_<t>` (directly or through helpers) for a target it did not declare with
+    /// [`Procedure::emits`]; every `@group(1)` variable has a layout entry of the same binding
+    /// and storage access.
+    ///
+    /// Errors: [`RunError::Program`]. A WGSL error names where it is: the procedure and the
+    /// line and column within its body (or the user WGSL, or the item struct), with the line.
+    /// User WGSL must also avoid the identifiers of the scheduler's generated code (`ctrl`,
+    /// `slots`, `NQ`, `Q_*`, `wg_*`, `mp_*`, ...); a clash there is reported by the strategy's
+    /// constructor.
     pub fn new(procedures: Vec<Procedure>, user: UserBindings) -> Result<Program, RunError> {
         if procedures.is_empty() {
             return Err(RunError::Program(
@@ -95,68 +114,71 @@ impl Program {
             });
         }
         let program = Program { procs, user };
-        // Compile the shared part once on its own, so a body error names the body, not a strategy.
-        let probe = format!(
-            "{}\n{}\n@compute @workgroup_size(1) fn sched_probe() {{}}",
-            program.common_wgsl(),
-            (0..program.procs.len())
-                .map(|t| format!(
-                    "fn enqueue_{}(item: {}) {{}}\n",
-                    program.procs[t].proc.name, program.procs[t].layout.name
-                ))
-                .collect::<String>()
-        );
-        wgsl::validate("procedures", &probe)?;
+        // Compile the shared part once on its own, so that an error names the procedure and a
+        // line of its body, not a line of a strategy's generated shader; then check what naga
+        // parsed: every `<name>_execute`, enqueue targets against `.emits`, user bindings.
+        crate::probe::check(&program)?;
         Ok(program)
     }
 
+    /// Number of procedures, which is the number of queues.
     pub fn queue_count(&self) -> usize {
         self.procs.len()
     }
 
+    /// The queue index of procedure `name`, if registered.
     pub fn index_of(&self, name: &str) -> Option<usize> {
         self.procs.iter().position(|p| p.proc.name == name)
     }
 
-    /// WGSL common to both strategies: item structs, `Invocation`, per-procedure workgroup
-    /// memory, user declarations, the bodies, and `sched_execute`, which runs queue `q`'s body on
-    /// the item stored at `base` of whatever word storage `load_prefix` names.
-    pub fn common_wgsl(&self) -> String {
-        let mut s = String::from(
+    /// WGSL common to both strategies: `Invocation`, item structs, per-procedure workgroup
+    /// memory, user declarations and the bodies, in that order.
+    pub(crate) fn common_wgsl(&self) -> String {
+        self.common_parts()
+            .into_iter()
+            .map(|(_, text)| text + "\n")
+            .collect()
+    }
+
+    /// [`Program::common_wgsl`] in parts, each with where it came from (for error reports).
+    pub(crate) fn common_parts(&self) -> Vec<(Part, String)> {
+        let mut parts = vec![(
+            Part::Generated,
             "struct Invocation {\n    // thread within the item, 0..threads_per_item\n    thread: u32,\n    \
              // item slot within the workgroup step, 0..items_per_step\n    slot: u32,\n    \
-             // false for padding slots at the end of a batch\n    live: bool,\n}\n",
-        );
+             // false for padding slots at the end of a batch\n    live: bool,\n}"
+                .to_string(),
+        )];
         let mut seen = Vec::new();
         for p in &self.procs {
             if !seen.contains(&p.layout.name) {
                 seen.push(p.layout.name.clone());
-                s += &p.proc.item.wgsl;
-                s += "\n";
+                parts.push((Part::Item(p.layout.name.clone()), p.proc.item.wgsl.clone()));
             }
         }
-        for p in &self.procs {
+        for (i, p) in self.procs.iter().enumerate() {
             if let Some(sh) = &p.proc.shared {
-                s += &format!(
-                    "var<workgroup> {}_shared: array<{}, {}>;\n",
-                    p.proc.name,
-                    sh.wgsl_type,
-                    sh.per_item * p.items_per_step
-                );
+                parts.push((
+                    Part::Shared(i),
+                    format!(
+                        "var<workgroup> {}_shared: array<{}, {}>;",
+                        p.proc.name,
+                        sh.wgsl_type,
+                        sh.per_item * p.items_per_step
+                    ),
+                ));
             }
         }
-        s += &self.user.wgsl;
-        s += "\n";
-        for p in &self.procs {
-            s += &p.proc.body;
-            s += "\n";
+        parts.push((Part::User, self.user.wgsl.clone()));
+        for (i, p) in self.procs.iter().enumerate() {
+            parts.push((Part::Body(i), p.proc.body.clone()));
         }
-        s
+        parts
     }
 
     /// `fn sched_execute(q, base, inv)`: loads the item at word `base` with `{prefix}_load_*`
     /// (only for active invocations) and calls the body of procedure `q`.
-    pub fn execute_switch(&self, prefix: &str) -> String {
+    pub(crate) fn execute_switch(&self, prefix: &str) -> String {
         let mut s = String::new();
         let mut seen = Vec::new();
         for p in &self.procs {
@@ -178,7 +200,7 @@ impl Program {
     }
 
     /// Constant tables: queue count, threads per item, item words, emit table.
-    pub fn tables_wgsl(&self) -> String {
+    pub(crate) fn tables_wgsl(&self) -> String {
         let nq = self.procs.len();
         let list = |f: &dyn Fn(&ProcInfo) -> u32| {
             self.procs
@@ -214,15 +236,20 @@ fn is_identifier(s: &str) -> bool {
         && !s.starts_with("__")
 }
 
-/// Initial work: raw item words for one queue, by procedure name.
+/// Initial work: raw item words for one queue, by procedure name. Seeds of the same procedure
+/// are concatenated; a seed for an unknown procedure, or whose word count is not a multiple of
+/// the item's words, is a [`RunError::Program`] of the run.
 #[derive(Debug, Clone)]
 pub struct Seed {
+    /// The procedure whose queue the items start in.
     pub procedure: String,
     /// Items packed back to back, `words` per item, as the `#[repr(C)]` host twin lays them out.
     pub words: Vec<u32>,
 }
 
 impl Seed {
+    /// Items of `procedure` from their `#[repr(C)]` host twins (`T` must have the item
+    /// struct's size and layout; check it with [`crate::wgsl::struct_layout`]).
     pub fn new<T: bytemuck::Pod>(procedure: &str, items: &[T]) -> Self {
         Seed {
             procedure: procedure.into(),

@@ -3,13 +3,15 @@
 /// Statistics of one run. Counters that do not apply to a strategy are zero.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct RunStats {
+    /// The strategy's name ([`crate::StrategyKind::name`]).
     pub strategy: String,
     /// Items executed, per procedure (program order).
     pub executed: Vec<u64>,
     /// Multi-pass: rounds that ran some work.
     pub rounds: u64,
-    /// Megakernel: batches run, and loop turns that found nothing to claim.
+    /// Megakernel: batches run.
     pub batches: u64,
+    /// Megakernel: loop turns that found nothing to claim.
     pub idle_polls: u64,
     /// Kernel launches. Megakernel: persistent launches (a launch ends early at its loop bound or
     /// when a queue needs room; the device compaction that may precede one is not counted).
@@ -28,6 +30,7 @@ pub struct RunStats {
     pub peak_occupancy: Vec<u64>,
     /// Bytes of queue storage allocated at the end of the run.
     pub queue_bytes: u64,
+    /// Megakernel: workgroups per launch (probed or configured).
     pub workgroups: u32,
     /// GPU time from timestamp queries, when the adapter has them.
     pub gpu_ms: Option<f64>,
@@ -87,6 +90,7 @@ pub fn median_and_mad(v: &[f64]) -> (f64, f64) {
 }
 
 impl RunStats {
+    /// Items executed, all procedures together.
     pub fn items(&self) -> u64 {
         self.executed.iter().sum()
     }

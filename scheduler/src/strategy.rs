@@ -28,6 +28,7 @@ impl StrategyKind {
         StrategyKind::MultipassHost,
     ];
 
+    /// The name command lines and reports use: `megakernel`, `multipass`, `multipass-host`.
     pub fn name(self) -> &'static str {
         match self {
             StrategyKind::Megakernel => "megakernel",
@@ -42,14 +43,34 @@ impl StrategyKind {
     }
 }
 
-/// A program compiled for one strategy, ready to run many times.
+/// A program compiled for one strategy, ready to run many times (buffers are kept between runs
+/// and regrown as needed).
+///
+/// ```
+/// # fn main() -> Result<(), scheduler::RunError> {
+/// use scheduler::{Gpu, ItemType, Procedure, Program, Scheduler, Seed, StrategyKind, UserBindings};
+/// let gpu = Gpu::from_env()?;
+/// let word = ItemType::new("Word", "struct Word { v: u32 }");
+/// let count = Procedure::new("count", word, 1)
+///     .emits("count", 1)
+///     .body("fn count_execute(item: Word, inv: Invocation) { if item.v > 0u { enqueue_count(Word(item.v - 1u)); } }");
+/// let program = Program::new(vec![count], UserBindings::none())?;
+/// let scheduler = Scheduler::new(&gpu, &program, StrategyKind::Megakernel, 1024)?;
+/// let stats = scheduler.run(&gpu, &[Seed::new("count", &[10u32, 20])], None)?;
+/// assert_eq!(stats.executed, [11 + 21]);
+/// # Ok(()) }
+/// ```
 pub enum Scheduler {
+    /// The persistent megakernel (`megakernel`).
     Megakernel(Megakernel),
+    /// The device-driven multi-pass baseline (`multipass`).
     Multipass(Multipass),
+    /// The host-driven multi-pass baseline (`multipass-host`).
     MultipassHost(HostMultipass),
 }
 
 impl Scheduler {
+    /// The megakernel with a full configuration ([`Megakernel::new`]).
     pub fn megakernel(
         gpu: &Gpu,
         program: &Program,
@@ -60,6 +81,7 @@ impl Scheduler {
         )?))
     }
 
+    /// The device-driven multi-pass with a full configuration ([`Multipass::new`]).
     pub fn multipass(
         gpu: &Gpu,
         program: &Program,
@@ -68,6 +90,7 @@ impl Scheduler {
         Ok(Scheduler::Multipass(Multipass::new(gpu, program, config)?))
     }
 
+    /// The host-driven multi-pass with a full configuration ([`HostMultipass::new`]).
     pub fn multipass_host(
         gpu: &Gpu,
         program: &Program,
@@ -78,7 +101,9 @@ impl Scheduler {
         )?))
     }
 
-    /// Compiles with default settings for `kind`, queues starting at `initial_capacity` slots.
+    /// Compiles with default settings for `kind`, queues starting at `initial_capacity` slots
+    /// (items) each. Errors: [`RunError::Program`] when the generated WGSL does not compile or
+    /// the program does not suit the strategy (more than 16 procedures for multi-pass).
     pub fn new(
         gpu: &Gpu,
         program: &Program,
@@ -122,6 +147,11 @@ impl Scheduler {
         }
     }
 
+    /// Runs the program to completion from `seeds`, with `user` as bind group 1 (`Some` exactly
+    /// when the program declares user bindings; see [`crate::UserBindings::bind_group`]). Blocks
+    /// until done; every wait is bounded by [`Gpu::timeout`]. Returns the run's statistics; user
+    /// results are in the user's buffers. Errors: every [`RunError`] but `NoAdapter`
+    /// (`docs/scheduler.md`, section 6); after an error the scheduler can run again.
     pub fn run(
         &self,
         gpu: &Gpu,

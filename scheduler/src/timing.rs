@@ -4,15 +4,20 @@ use crate::error::RunError;
 use crate::gpu::Gpu;
 
 /// Times passes one at a time: begin/end timestamps of a pass, resolved and read back with the
-/// pass's other results. `total_ms` is `None` when the adapter has no timestamp queries.
-/// A [`StageTimer`] of one stage and one pass between collects.
+/// pass's other results, summed over the passes timed. `total_ms` is `None` when the adapter
+/// has no timestamp queries ([`Gpu::timestamps`]).
+///
+/// Per pass: give [`PassTimer::writes`] to the pass descriptor's `timestamp_writes`, call
+/// [`PassTimer::resolve`] on the encoder after the pass, submit, then [`PassTimer::collect`].
 pub struct PassTimer(StageTimer);
 
 impl PassTimer {
+    /// A timer with a query set of two timestamps (none without timestamp queries).
     pub fn new(gpu: &Gpu) -> PassTimer {
         PassTimer(StageTimer::new(gpu, 1, 1))
     }
 
+    /// The timestamp writes for the pass's descriptor; `None` without timestamp queries.
     pub fn writes(&self) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
         self.0.writes(0)
     }
@@ -22,11 +27,13 @@ impl PassTimer {
         self.0.resolve(enc)
     }
 
-    /// Reads the last pass's time back and adds it to the total.
+    /// Reads the last pass's time back (one bounded wait) and adds it to the total. Errors:
+    /// [`RunError::Timeout`], [`RunError::Device`].
     pub fn collect(&mut self, gpu: &Gpu) -> Result<(), RunError> {
         self.0.collect(gpu)
     }
 
+    /// GPU milliseconds of every pass collected so far; `None` without timestamp queries.
     pub fn total_ms(&self) -> Option<f64> {
         self.0.stage_ms().map(|ms| ms[0])
     }
@@ -35,14 +42,14 @@ impl PassTimer {
 /// Times many passes per submission and adds each pass's time to its stage, so that a
 /// strategy that runs stages as separate dispatches (multi-pass) can report GPU time per
 /// procedure. Each timed pass costs a pass boundary, so this is opt-in.
-pub struct StageTimer {
+pub(crate) struct StageTimer {
     set: Option<wgpu::QuerySet>,
     resolved: wgpu::Buffer,
     period_ns: f64,
     capacity: u32,
     /// Stage of each pass timed since the last collect.
     pending: std::cell::RefCell<Vec<usize>>,
-    pub stage_ns: Vec<f64>,
+    stage_ns: Vec<f64>,
 }
 
 impl StageTimer {
@@ -119,7 +126,7 @@ impl StageTimer {
 /// Times every pass of a run of many short submissions (relaunches, host-driven rounds) and
 /// reads the timestamps back only when its query set is full or the run ends, so timing costs
 /// no host wait per submission. `total_ms` is `None` when the adapter has no timestamp queries.
-pub struct RunTimer {
+pub(crate) struct RunTimer {
     inner: StageTimer,
     used: u32,
     passes: u32,

@@ -4,7 +4,8 @@
 
 use crate::error::RunError;
 
-/// Parses and validates `source`; the error message carries naga's line/column report.
+/// Parses and validates `source` with naga (all capabilities); an error is a
+/// [`RunError::Program`] whose message starts with `label` and carries naga's line/column report.
 pub fn validate(label: &str, source: &str) -> Result<naga::Module, RunError> {
     let module = naga::front::wgsl::parse_str(source)
         .map_err(|e| RunError::Program(format!("{label}: {}", e.emit_to_string(source))))?;
@@ -21,21 +22,29 @@ pub fn validate(label: &str, source: &str) -> Result<naga::Module, RunError> {
 /// value (e.g. `.cp[3].x`), its word offset, and its scalar kind.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Leaf {
+    /// WGSL access path from the struct value, e.g. `.inner.a.x`.
     pub path: String,
+    /// Offset in u32 words from the start of the struct.
     pub word: u32,
+    /// The scalar's type.
     pub kind: ScalarKind,
 }
 
+/// The 32-bit scalar types an item can carry.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ScalarKind {
+    /// `u32`.
     U32,
+    /// `i32`.
     I32,
+    /// `f32`.
     F32,
 }
 
 /// The layout of a WGSL struct as naga computes it for storage buffers.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StructLayout {
+    /// The struct's WGSL name.
     pub name: String,
     /// Size in bytes (a multiple of the alignment, as `array<T>` strides it).
     pub size: u32,
@@ -46,12 +55,17 @@ pub struct StructLayout {
 }
 
 impl StructLayout {
+    /// Size in u32 words.
     pub fn words(&self) -> u32 {
         self.size / 4
     }
 }
 
-/// Reflects struct `name` declared in `source` (which may contain other declarations).
+/// Reflects struct `name` declared in `source` (which may contain other declarations), as
+/// naga lays it out in a storage buffer; check a `#[repr(C)]` host twin against `size` and
+/// `members`. Errors: [`RunError::Program`] if `source` does not parse, has no struct `name`,
+/// or the struct holds something that cannot travel in a queue (not a 32-bit scalar, vector,
+/// matrix, fixed-size array or struct of those).
 pub fn struct_layout(source: &str, name: &str) -> Result<StructLayout, RunError> {
     let module = naga::front::wgsl::parse_str(source).map_err(|e| {
         RunError::Program(format!(
@@ -190,7 +204,7 @@ fn flatten(
 
 /// Generates `fn {prefix}_load_{T}(base: u32) -> T` and `fn {prefix}_store_{T}(base: u32, v: T)`
 /// over the word accessors `{prefix}_load_word(i) -> u32` and `{prefix}_store_word(i, w)`.
-pub fn load_store_fns(layout: &StructLayout, prefix: &str) -> String {
+pub(crate) fn load_store_fns(layout: &StructLayout, prefix: &str) -> String {
     let t = &layout.name;
     let mut s = format!("fn {prefix}_load_{t}(base: u32) -> {t} {{\n    var v: {t};\n");
     for l in &layout.leaves {

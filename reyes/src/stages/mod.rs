@@ -53,5 +53,6 @@ pub(crate) fn project(f: &crate::frame::Frame, p: Vec3) -> [f32; 2] {
     ]
 }
 
-/// The sample-jitter hash: the scheduler's integer hash (its WGSL twin is `reyes_hash`).
-pub use scheduler::workloads::tree::hash as reyes_hash;
+/// The sample-jitter hash: Wellons's `lowbias32` (its WGSL twin is `reyes_hash` in
+/// `shaders/reyes/common.wgsl`).
+pub use scheduler::hash::lowbias32 as reyes_hash;

@@ -4,8 +4,8 @@
 //! grows a queue that lacked room, and launches again. Protocol: `docs/scheduler.md`.
 
 mod compact;
-pub mod layout;
-pub mod wgsl;
+pub(crate) mod layout;
+pub(crate) mod wgsl;
 
 use std::time::Instant;
 
@@ -28,7 +28,10 @@ use crate::timing::RunTimer;
 pub enum Workgroups {
     /// As many as the probe launch finds running at the same time, at most `max`. The default:
     /// a persistent workgroup must never wait on one that has not started.
-    Probe { max: u32 },
+    Probe {
+        /// Most workgroups the probe launches (and so the most it can report).
+        max: u32,
+    },
     /// Exactly this many (tests use it to oversubscribe on purpose; waits stay bounded).
     Fixed(u32),
 }
@@ -55,9 +58,12 @@ pub const LAVAPIPE_SPIN_LIMIT: u32 = 64;
 /// their number, `log4(need / start)`, for at most 4x the needed memory (within the limit).
 pub const ROOM_GROWTH: u64 = 4;
 
+/// Settings of [`Megakernel::new`]; [`Default`] gives the documented defaults.
 #[derive(Debug, Clone)]
 pub struct MegakernelConfig {
+    /// Workgroups per launch (default: probed, at most 4,096).
     pub workgroups: Workgroups,
+    /// Which queue a workgroup takes its next batch from (default: later procedures first).
     pub policy: QueuePolicy,
     /// Workgroup steps per claimed batch (a step runs 256 / threads_per_item items).
     pub batch_steps: u32,
@@ -69,9 +75,10 @@ pub struct MegakernelConfig {
     pub spin_limit: u32,
     /// Slots per queue at the start of a run (at least twice the seeds).
     pub initial_capacity: u32,
-    /// A queue grows (at least doubling, [`crate::growth::grow`]) up to this many slots; beyond
-    /// it the run reports an overflow.
+    /// A queue grows (at least doubling) up to this many slots, and never past its share of
+    /// the largest storage binding; beyond that the run reports [`RunError::QueueOverflow`].
     pub max_capacity: u32,
+    /// Launches per run before it stops with [`RunError::NoProgress`] (default 10,000).
     pub max_launches: u32,
 }
 
@@ -90,6 +97,9 @@ impl Default for MegakernelConfig {
     }
 }
 
+/// A program compiled for the persistent megakernel: one pipeline, queue buffers kept between
+/// runs, and the workgroup count (probed on the first run). Usually reached through
+/// [`crate::Scheduler`].
 pub struct Megakernel {
     program: Program,
     config: MegakernelConfig,
@@ -131,6 +141,13 @@ enum Start {
 }
 
 impl Megakernel {
+    /// Compiles `program` for the megakernel on `gpu`.
+    ///
+    /// On lavapipe (adapter name `llvmpipe`) `max_iterations` and `spin_limit` are lowered to
+    /// [`LAVAPIPE_MAX_ITERATIONS`] and [`LAVAPIPE_SPIN_LIMIT`]. Errors: [`RunError::Program`] for
+    /// `max_iterations` or `spin_limit` outside `1..=30000`, an unknown procedure name in
+    /// [`QueuePolicy::Priority`], or WGSL that does not compile with the generated code (e.g.
+    /// user WGSL that reuses a template identifier).
     pub fn new(
         gpu: &Gpu,
         program: &Program,
@@ -200,7 +217,8 @@ impl Megakernel {
         })
     }
 
-    /// Workgroups per launch, probing on first use.
+    /// Workgroups per launch, probing on first use (the probe launch needs the user's bind
+    /// group, as a run does). Errors: those of a run ([`RunError::Timeout`], [`RunError::Device`]).
     pub fn workgroups(&self, gpu: &Gpu, user: Option<&wgpu::BindGroup>) -> Result<u32, RunError> {
         if self.workgroups.load(std::sync::atomic::Ordering::Relaxed) == 0 {
             let Workgroups::Probe { max } = self.config.workgroups else {
@@ -345,7 +363,8 @@ impl Megakernel {
     }
 
     /// Runs the program to completion from `seeds`. `user` is bind group 1, if the program has
-    /// one. `max_queue_bytes` bounds the queue storage (slots and flags) of this run.
+    /// one. `max_queue_bytes` bounds the queue storage (slots and flags) of this run. Errors:
+    /// every [`RunError`] but `NoAdapter` (see `docs/scheduler.md`, section 6).
     pub fn run(
         &self,
         gpu: &Gpu,

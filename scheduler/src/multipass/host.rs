@@ -18,24 +18,25 @@ use crate::readback::Readback;
 use crate::stats::RunStats;
 use crate::timing::RunTimer;
 
-pub const TEMPLATE: &str = include_str!("../../../shaders/multipass_host.wgsl");
+pub(crate) const TEMPLATE: &str = include_str!("../../../shaders/multipass_host.wgsl");
 
-/// Words after the per-queue counts in each counts buffer (host twin of `H_*` in the shader).
-pub const H_ERROR: usize = 0;
-pub const H_ERR_A: usize = 1;
-pub const H_ERR_B: usize = 2;
-pub const ERR_EMIT: u32 = 1;
-pub const ERR_ROOM: u32 = 2;
+// Words after the per-queue counts in each counts buffer (host twin of `H_*` in the shader).
+const H_ERROR: usize = 0;
+const H_ERR_A: usize = 1;
+const H_ERR_B: usize = 2;
+const ERR_EMIT: u32 = 1;
+const ERR_ROOM: u32 = 2;
 const EXTRA_WORDS: usize = 3;
 
+/// Settings of [`HostMultipass::new`]; [`Default`] gives the documented defaults.
 #[derive(Debug, Clone)]
 pub struct HostMultipassConfig {
-    /// Slots per queue at the start of a run (at least the seeds).
+    /// Slots per queue at the start of a run (at least the seeds; default 65,536).
     pub initial_capacity: u32,
     /// A queue grows (at least doubling) up to this many slots; a round whose worst-case output
     /// to a queue at this limit would not fit is a [`RunError::QueueOverflow`].
     pub max_capacity: u32,
-    /// Rounds before the run gives up with [`RunError::NoProgress`].
+    /// Rounds before the run gives up with [`RunError::NoProgress`] (default 100,000).
     pub max_rounds: u32,
 }
 
@@ -49,6 +50,8 @@ impl Default for HostMultipassConfig {
     }
 }
 
+/// A program compiled for the host-driven multi-pass strategy: one pipeline per procedure,
+/// buffers kept between runs. Usually reached through [`crate::Scheduler`].
 pub struct HostMultipass {
     program: Program,
     config: HostMultipassConfig,
@@ -71,7 +74,7 @@ struct HostRounds {
 
 /// The WGSL of the host-driven multi-pass: shared program code, append-style enqueue
 /// functions, one entry point per procedure (`mp_host_<name>`), then the template.
-pub fn source(program: &Program) -> String {
+pub(crate) fn source(program: &Program) -> String {
     let mut s = program.tables_wgsl();
     s += &program.common_wgsl();
     s += &program.execute_switch("mp_in");
@@ -99,6 +102,9 @@ pub fn source(program: &Program) -> String {
 }
 
 impl HostMultipass {
+    /// Compiles `program` for the host-driven multi-pass on `gpu`. Errors:
+    /// [`RunError::Program`] for more than 16 procedures or WGSL that does not compile with the
+    /// generated code.
     pub fn new(
         gpu: &Gpu,
         program: &Program,
@@ -173,8 +179,9 @@ impl HostMultipass {
         })
     }
 
-    /// Runs the program to completion from `seeds`; `max_queue_bytes` bounds the item storage
-    /// of this run (two copies of every queue).
+    /// Runs the program to completion from `seeds`; `user` is bind group 1, if the program has
+    /// one; `max_queue_bytes` bounds the item storage of this run (two copies of every queue).
+    /// Errors: every [`RunError`] but `NoAdapter` (see `docs/scheduler.md`, section 6).
     pub fn run(
         &self,
         gpu: &Gpu,
@@ -334,10 +341,15 @@ impl HostMultipass {
                         declared: self.program.procs[a].emits[b],
                     });
                 }
+                ERR_ROOM => {
+                    return Err(RunError::Device(format!(
+                        "host-driven multi-pass: an append past the capacity the host made room \
+                         for (queue {a}, slot {b})"
+                    )));
+                }
                 e => {
                     return Err(RunError::Device(format!(
-                        "host-driven multi-pass: error {e} (queue {a}, slot {b}): an append \
-                         past the capacity the host made room for"
+                        "host-driven multi-pass: unknown error code {e} (words {a}, {b})"
                     )));
                 }
             }

@@ -5,8 +5,8 @@
 //! [`host`] is the host-driven variant: exact direct dispatches, one read-back per round.
 
 pub mod host;
-pub mod layout;
-pub mod wgsl;
+pub(crate) mod layout;
+pub(crate) mod wgsl;
 
 use std::time::Instant;
 
@@ -21,12 +21,20 @@ use crate::queue_layout::QueueLayout;
 use crate::stats::RunStats;
 use crate::timing::{PassTimer, StageTimer};
 
+/// Settings of [`Multipass::new`]; [`Default`] gives the documented defaults.
 #[derive(Debug, Clone)]
 pub struct MultipassConfig {
-    /// Rounds encoded per submission; the host checks for completion between chunks.
+    /// Rounds encoded per submission (default 16); the host checks for completion between
+    /// chunks.
     pub rounds_per_submit: u32,
+    /// Rounds encoded per run, empty ones included, before it stops with
+    /// [`RunError::NoProgress`] (default 100,000).
     pub max_rounds: u32,
+    /// Slots per queue at the start of a run (at least the seeds; default 65,536).
     pub initial_capacity: u32,
+    /// A queue grows (at least doubling) up to this many slots, and never past its share of the
+    /// largest storage binding or 65,535 × 1,024; a refused round whose target is at its limit is
+    /// a [`RunError::QueueOverflow`].
     pub max_capacity: u32,
     /// Time each procedure's dispatches as their own passes ([`RunStats::stage_gpu_ms`]);
     /// the extra pass boundaries cost a little, so it is off for benchmarks of the whole.
@@ -45,6 +53,8 @@ impl Default for MultipassConfig {
     }
 }
 
+/// A program compiled for the device-driven multi-pass strategy: one pipeline per procedure and
+/// per scan stage, buffers kept between runs. Usually reached through [`crate::Scheduler`].
 pub struct Multipass {
     program: Program,
     config: MultipassConfig,
@@ -64,6 +74,9 @@ struct DeviceRounds {
 }
 
 impl Multipass {
+    /// Compiles `program` for the device-driven multi-pass on `gpu`. Errors:
+    /// [`RunError::Program`] for more than 16 procedures (its workgroup memory holds a counter
+    /// per item and target) or WGSL that does not compile with the generated code.
     pub fn new(
         gpu: &Gpu,
         program: &Program,
@@ -280,8 +293,9 @@ impl Multipass {
         }
     }
 
-    /// Runs the program to completion from `seeds`; `max_queue_bytes` bounds the item, emit
-    /// and flag storage of this run.
+    /// Runs the program to completion from `seeds`; `user` is bind group 1, if the program has
+    /// one; `max_queue_bytes` bounds the item, emit and flag storage of this run. Errors: every
+    /// [`RunError`] but `NoAdapter` (see `docs/scheduler.md`, section 6).
     pub fn run(
         &self,
         gpu: &Gpu,

@@ -26,10 +26,11 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use rayon::prelude::*;
 
 use super::rmat::{self, Csr, RmatParams};
+use crate::bindings::UserBindings;
 use crate::error::RunError;
 use crate::gpu::Gpu;
 use crate::procedure::{ItemType, Procedure};
-use crate::program::{Program, Seed, UserBindings};
+use crate::program::{Program, Seed};
 use crate::stats::RunStats;
 use crate::strategy::Scheduler;
 
@@ -40,7 +41,9 @@ pub const UNREACHED: u32 = u32::MAX;
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct BfsVertex {
+    /// The vertex.
     pub v: u32,
+    /// Its BFS level when it was emitted (hops from the source).
     pub level: u32,
 }
 
@@ -48,9 +51,13 @@ pub struct BfsVertex {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct BfsEdges {
+    /// The vertex whose list is cut.
     pub v: u32,
+    /// Its BFS level when the slice was emitted.
     pub level: u32,
+    /// First index into the CSR column array.
     pub begin: u32,
+    /// One past the last index.
     pub end: u32,
 }
 
@@ -112,14 +119,17 @@ impl BfsParams {
         Self::new(RmatParams::graph500(scale, seed))
     }
 
+    /// The graph's generator parameters.
     pub fn rmat(&self) -> &RmatParams {
         &self.rmat
     }
 
+    /// The graph, generated once by [`BfsParams::new`].
     pub fn graph(&self) -> &Csr {
         &self.graph
     }
 
+    /// One line of every parameter, for reports.
     pub fn describe(&self) -> String {
         format!(
             "rmat scale={} edge_factor={} seed={} vertices={} directed_edges={} source={} chunk={} split={} threads={}",
@@ -161,6 +171,8 @@ impl BfsParams {
         self.graph.traversed_edges(levels)
     }
 
+    /// The program: procedures `bfs_vertex` and `bfs_edges` with the graph and level array as
+    /// user bindings. Errors: [`RunError::Program`] for `chunk_edges == 0` or `split < 2`.
     pub fn program(&self) -> Result<Program, RunError> {
         let (t, chunk, split) = (self.threads, self.chunk_edges, self.split);
         if chunk == 0 || split < 2 {
@@ -177,9 +189,9 @@ impl BfsParams {
                  const BFS_SPLIT: u32 = {split}u;\n{RELAX_WGSL}"
             ),
             layout: vec![
-                crate::pipeline::storage_entry(0, true),
-                crate::pipeline::storage_entry(1, true),
-                crate::pipeline::storage_entry(2, false),
+                crate::bindings::storage_entry(0, true),
+                crate::bindings::storage_entry(1, true),
+                crate::bindings::storage_entry(2, false),
             ],
         };
         let vertex = Procedure::new("bfs_vertex", ItemType::new("BfsVertex", VERTEX_WGSL), t)
@@ -328,7 +340,9 @@ pub(crate) fn initial_levels(params: &BfsParams) -> Vec<u32> {
 
 /// The BFS workload's GPU resources: the graph, the level array, and their bind group.
 pub struct BfsRun {
+    /// The search run.
     pub params: BfsParams,
+    /// Its program ([`BfsParams::program`]).
     pub program: Program,
     level: wgpu::Buffer,
     bind: wgpu::BindGroup,
@@ -337,17 +351,15 @@ pub struct BfsRun {
 }
 
 impl BfsRun {
+    /// Uploads the graph and builds the program. Errors: [`RunError::Program`] (see
+    /// [`BfsParams::program`]), [`RunError::Device`] when the graph passes the binding limit.
     pub fn new(gpu: &Gpu, params: BfsParams) -> Result<BfsRun, RunError> {
         let program = params.program()?;
         let graph = upload_graph(gpu, &params)?;
         let level = gpu.storage_buffer("bfs level", params.graph().vertices() as u64)?;
-        let layout = gpu
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("bfs"),
-                entries: &program.user.layout,
-            });
-        let bind = gpu.bind_buffers("bfs", &layout, &[&graph.0, &graph.1, &level]);
+        let bind = program
+            .user
+            .bind_group(gpu, &[&graph.0, &graph.1, &level])?;
         Ok(BfsRun {
             params,
             program,

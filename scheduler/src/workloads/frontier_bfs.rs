@@ -139,6 +139,7 @@ fn plan() {
 
 /// The frontier BFS's pipelines and buffers for one graph.
 pub struct FrontierBfs {
+    /// The graph and source searched.
     pub params: BfsParams,
     expand: wgpu::ComputePipeline,
     plan: wgpu::ComputePipeline,

@@ -29,10 +29,11 @@
 //! entirely inside a rectangle with a uniform border); the preset views are ones where it does in
 //! both arithmetics, checked against the brute-force image.
 
+use crate::bindings::UserBindings;
 use crate::error::RunError;
 use crate::gpu::Gpu;
 use crate::procedure::{ItemType, Procedure};
-use crate::program::{Program, Seed, UserBindings};
+use crate::program::{Program, Seed};
 use crate::stats::RunStats;
 use crate::strategy::Scheduler;
 
@@ -51,17 +52,22 @@ pub const MAX_ITERATIONS: u32 = 60_000;
 /// samples `c = (centre_re + (px - (W - 1) / 2) * scale, centre_im + ((H - 1) / 2 - py) * scale)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct View {
+    /// Real part of the image centre.
     pub centre_re: f32,
+    /// Imaginary part of the image centre.
     pub centre_im: f32,
     /// Complex-plane units per pixel.
     pub scale: f32,
 }
 
+/// One Mandelbrot image to compute: size, view, iteration limit, subdivision settings.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MandelParams {
-    /// Image size in pixels.
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
+    /// The part of the complex plane shown.
     pub view: View,
     /// Iteration limit: a pixel that has not escaped after this many iterations has this dwell.
     pub max_iterations: u32,
@@ -81,10 +87,15 @@ pub struct MandelParams {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct MandelRect {
+    /// Left column, in pixels.
     pub x: u32,
+    /// Top row, in pixels.
     pub y: u32,
+    /// Width in pixels.
     pub w: u32,
+    /// Height in pixels.
     pub h: u32,
+    /// The uniform border's dwell (`ms_fill` only; 0 otherwise).
     pub dwell: u32,
 }
 
@@ -95,15 +106,23 @@ const RECT_WGSL: &str = "struct MandelRect { x: u32, y: u32, w: u32, h: u32, dwe
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct MandelCfg {
+    /// [`MandelParams::width`].
     pub width: u32,
+    /// [`MandelParams::height`].
     pub height: u32,
+    /// [`MandelParams::max_iterations`].
     pub max_iterations: u32,
+    /// [`MandelParams::min_side`].
     pub min_side: u32,
-    /// `(width - 1) / 2` and `(height - 1) / 2`: the image centre in pixels.
+    /// `(width - 1) / 2`: the image centre's column, in pixels.
     pub half_w: f32,
+    /// `(height - 1) / 2`: the image centre's row, in pixels.
     pub half_h: f32,
+    /// [`View::scale`].
     pub scale: f32,
+    /// [`View::centre_re`].
     pub centre_re: f32,
+    /// [`View::centre_im`].
     pub centre_im: f32,
 }
 
@@ -113,8 +132,11 @@ const CFG_WGSL: &str = "struct MandelCfg { width: u32, height: u32, max_iteratio
 /// An escape-count image, row-major, `width * height` dwells.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct MandelImage {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
+    /// Escape iteration counts (`max_iterations` for points that did not escape), row-major.
     pub dwell: Vec<u32>,
 }
 
@@ -161,7 +183,9 @@ impl MsWork {
 /// A GPU run's output: the image (compared with [`MandelParams::reference`]) and the work counts.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct MandelResult {
+    /// The image the GPU wrote.
     pub image: MandelImage,
+    /// Items per procedure and pixel counters of the GPU run.
     pub work: MsWork,
 }
 
@@ -260,6 +284,7 @@ impl MandelParams {
         })
     }
 
+    /// One line of every parameter, for reports.
     pub fn describe(&self) -> String {
         format!(
             "{}x{} centre=({},{}) scale={:e} iterations={} min_side={} tile={} fma={}",
@@ -296,6 +321,7 @@ impl MandelParams {
         Ok(())
     }
 
+    /// The run-time configuration the GPU reads (group 1, binding 1).
     pub fn cfg(&self) -> MandelCfg {
         MandelCfg {
             width: self.width,
@@ -339,9 +365,9 @@ impl MandelParams {
                  const MS_T: u32 = {MS_THREADS}u;\n{MS_WGSL}"
             ),
             layout: vec![
-                crate::pipeline::storage_entry(0, false),
-                crate::pipeline::storage_entry(1, true),
-                crate::pipeline::storage_entry(2, false),
+                crate::bindings::storage_entry(0, false),
+                crate::bindings::storage_entry(1, true),
+                crate::bindings::storage_entry(2, false),
             ],
         };
         let rect = Procedure::new("ms_rect", item.clone(), MS_THREADS)
@@ -470,7 +496,9 @@ fn ms_pixels_execute(item: MandelRect, inv: Invocation) {
 /// The Mandelbrot workload's GPU resources: the image, its configuration, the pixel counters,
 /// and their bind group (group 1).
 pub struct MandelRun {
+    /// The image computed by the next run.
     pub params: MandelParams,
+    /// Its program ([`MandelParams::program`]).
     pub program: Program,
     out: wgpu::Buffer,
     cfg: wgpu::Buffer,
@@ -501,13 +529,7 @@ impl MandelRun {
         )?;
         let cfg = gpu.storage_buffer("mandelbrot cfg", size_of::<MandelCfg>() as u64 / 4)?;
         let count = gpu.storage_buffer("mandelbrot counters", 2)?;
-        let layout = gpu
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("mandelbrot"),
-                entries: &program.user.layout,
-            });
-        let bind = gpu.bind_buffers("mandelbrot", &layout, &[&out, &cfg, &count]);
+        let bind = program.user.bind_group(gpu, &[&out, &cfg, &count])?;
         Ok(MandelRun {
             params,
             program,

@@ -20,9 +20,13 @@ pub struct RmatParams {
     pub scale: u32,
     /// Undirected edges generated per vertex.
     pub edge_factor: u32,
+    /// Probability of the top-left quadrant at each recursion (Chakrabarti, Zhan & Faloutsos 2004).
     pub a: f64,
+    /// Probability of the top-right quadrant.
     pub b: f64,
+    /// Probability of the bottom-left quadrant.
     pub c: f64,
+    /// Seed of the [`SplitMix64`] stream; the same seed gives the same graph.
     pub seed: u64,
     /// Relabel vertices by a random permutation (as Graph500 does), so that vertex 0 is not the
     /// largest hub.
@@ -43,6 +47,7 @@ impl RmatParams {
         }
     }
 
+    /// `2^scale`.
     pub fn vertices(&self) -> u64 {
         1 << self.scale
     }
@@ -57,6 +62,7 @@ impl RmatParams {
 pub struct SplitMix64(pub u64);
 
 impl SplitMix64 {
+    /// The next 64 bits (the state advances by the golden-ratio increment).
     pub fn next_u64(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
         let mut z = self.0;
@@ -77,12 +83,14 @@ impl SplitMix64 {
 pub struct Csr {
     /// `vertices + 1` offsets into `col`.
     pub row: Vec<u32>,
+    /// Neighbour lists back to back (duplicates kept).
     pub col: Vec<u32>,
     /// Generated edges that were self-loops (not stored).
     pub self_loops: u64,
 }
 
 impl Csr {
+    /// Vertex count.
     pub fn vertices(&self) -> u32 {
         (self.row.len() - 1) as u32
     }
@@ -92,10 +100,12 @@ impl Csr {
         self.col.len() as u64
     }
 
+    /// Length of `v`'s neighbour list.
     pub fn degree(&self, v: u32) -> u32 {
         self.row[v as usize + 1] - self.row[v as usize]
     }
 
+    /// `v`'s neighbours, sorted.
     pub fn neighbours(&self, v: u32) -> &[u32] {
         &self.col[self.row[v as usize] as usize..self.row[v as usize + 1] as usize]
     }

@@ -4,14 +4,17 @@
 //! result), and leaves fold an order-independent checksum. Inner nodes run `branch`, childless
 //! nodes run `leaf`. A CPU reference gives exact item counts and the checksum.
 
+use crate::bindings::UserBindings;
 use crate::error::RunError;
 use crate::gpu::Gpu;
+use crate::hash::{lowbias32 as hash, lowbias32_wgsl};
 use crate::procedure::{ItemType, Procedure};
-use crate::program::{Program, Seed, UserBindings};
+use crate::program::{Program, Seed};
 use crate::stats::RunStats;
 use crate::strategy::Scheduler;
 use rayon::prelude::*;
 
+/// How many children an inner node has.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Fanout {
     /// Every inner node has exactly k children.
@@ -20,16 +23,20 @@ pub enum Fanout {
     Uniform(u32),
 }
 
+/// The shape of one synthetic tree.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TreeParams {
+    /// Root nodes (the seeds).
     pub roots: u32,
     /// Nodes at this depth have no children (roots are at depth 0).
     pub max_depth: u32,
+    /// Children per inner node.
     pub fanout: Fanout,
     /// Hash rounds per inner node: the per-item work cost.
     pub work: u32,
     /// Payload words per item (item size = 2 + payload words).
     pub payload_words: u32,
+    /// Varies the root ids and, with [`Fanout::Uniform`], every node's child count.
     pub seed: u32,
 }
 
@@ -120,6 +127,7 @@ impl TreeParams {
         }
     }
 
+    /// One line of every parameter, for reports.
     pub fn describe(&self) -> String {
         let f = match self.fanout {
             Fanout::Fixed(k) => format!("fixed:{k}"),
@@ -135,11 +143,15 @@ impl TreeParams {
 /// What a run of the tree produced: items per procedure and the leaf checksum.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct TreeResult {
+    /// Inner nodes executed (`branch` items).
     pub branches: u64,
+    /// Leaves executed (`leaf` items).
     pub leaves: u64,
     /// Leaves that reached the output buckets (must equal `leaves`).
     pub leaves_folded: u64,
+    /// Wrapping sum of every leaf's hash.
     pub leaf_sum: u32,
+    /// Xor of `hash(h)` over every leaf's hash `h`.
     pub leaf_xor: u32,
 }
 
@@ -172,16 +184,6 @@ impl TreeResult {
 /// Subtrees the parallel CPU walk aims to hand out per rayon thread (it expands the top of
 /// the tree breadth-first until it has them, so a few roots still spread over every core).
 const SUBTREES_PER_THREAD: usize = 64;
-
-pub fn hash(x: u32) -> u32 {
-    let mut h = x;
-    h ^= h >> 16;
-    h = h.wrapping_mul(0x7feb_352d);
-    h ^= h >> 15;
-    h = h.wrapping_mul(0x846c_a68b);
-    h ^= h >> 16;
-    h
-}
 
 const BUCKETS: u32 = 256;
 
@@ -345,6 +347,9 @@ impl TreeParams {
             .merge(done)
     }
 
+    /// The program: `branch` (emits up to the fan-out to `branch` and to `leaf`) and `leaf`,
+    /// with the output buckets and run-time shape as user bindings. Errors:
+    /// [`RunError::Program`] for a payload outside `1..=254` words.
     pub fn program(&self) -> Result<Program, RunError> {
         let p = self.payload_words;
         if p == 0 || p > 254 {
@@ -360,12 +365,13 @@ impl TreeParams {
                 "@group(1) @binding(0) var<storage, read_write> tree_out: array<atomic<u32>>;\n\
                  // Tree shape at run time, so one compiled program serves every tree of this payload size.\n\
                  @group(1) @binding(1) var<storage, read> tree_cfg: array<u32, 5>;\n\
-                 const TREE_P: u32 = {p}u;\n{}",
+                 const TREE_P: u32 = {p}u;\n{}{}",
+                lowbias32_wgsl("tree_hash"),
                 TREE_WGSL
             ),
             layout: vec![
-                crate::pipeline::storage_entry(0, false),
-                crate::pipeline::storage_entry(1, true),
+                crate::bindings::storage_entry(0, false),
+                crate::bindings::storage_entry(1, true),
             ],
         };
         let branch = Procedure::new("branch", item.clone(), 1)
@@ -376,6 +382,7 @@ impl TreeParams {
         Program::new(vec![branch, leaf], user)
     }
 
+    /// The roots, as seeds of `branch` (roots with children) and `leaf` (the others).
     pub fn seeds(&self) -> Vec<Seed> {
         let (mut branch, mut leaf) = (Vec::new(), Vec::new());
         for i in 0..self.roots {
@@ -400,12 +407,8 @@ impl TreeParams {
     }
 }
 
+// `tree_hash` is `crate::hash::lowbias32_wgsl`, the twin of the CPU reference's hash.
 const TREE_WGSL: &str = r#"
-fn tree_hash(x: u32) -> u32 {
-    var h = x;
-    h ^= h >> 16u; h *= 0x7feb352du; h ^= h >> 15u; h *= 0x846ca68bu; h ^= h >> 16u;
-    return h;
-}
 fn tree_children(id: u32, depth: u32) -> u32 {
     if depth >= tree_cfg[0] { return 0u; }
     if tree_cfg[2] == 1u { return tree_hash(id ^ tree_cfg[3]) % (tree_cfg[1] + 1u); }
@@ -446,7 +449,9 @@ fn leaf_execute(item: TreeNode, inv: Invocation) {
 
 /// The tree's GPU resources: its output buckets and their bind group.
 pub struct TreeRun {
+    /// The tree the next run walks.
     pub params: TreeParams,
+    /// Its program ([`TreeParams::program`]).
     pub program: Program,
     out: wgpu::Buffer,
     cfg: wgpu::Buffer,
@@ -456,17 +461,13 @@ pub struct TreeRun {
 }
 
 impl TreeRun {
+    /// Builds the program and the output buffers. Errors: [`RunError::Program`] (see
+    /// [`TreeParams::program`]), [`RunError::Device`] if a buffer cannot be made.
     pub fn new(gpu: &Gpu, params: TreeParams) -> Result<TreeRun, RunError> {
         let program = params.program()?;
         let out = gpu.storage_buffer("tree out", (BUCKETS * 4) as u64)?;
         let cfg = gpu.storage_buffer("tree cfg", 5)?;
-        let layout = gpu
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("tree"),
-                entries: &program.user.layout,
-            });
-        let bind = gpu.bind_buffers("tree", &layout, &[&out, &cfg]);
+        let bind = program.user.bind_group(gpu, &[&out, &cfg])?;
         Ok(TreeRun {
             declared_children: params.max_children(),
             params,
