@@ -69,6 +69,9 @@ pub struct GpuFrame {
     pub peak_working_bytes: u64,
     pub wall_ms: f64,
 }
+/// Queue slots a renderer's scheduler starts with (queues grow by doubling beyond).
+pub const INITIAL_CAPACITY: u32 = 1 << 14;
+
 pub struct GpuRenderer {
     pub program: Program,
     pub scheduler: Scheduler,
@@ -131,19 +134,28 @@ impl GpuRenderer {
         stage_timing: bool,
     ) -> Result<GpuRenderer, RunError> {
         let program = program()?;
-        let initial_capacity = 1 << 14;
         let scheduler = match strategy {
             StrategyKind::Multipass => Scheduler::multipass(
                 gpu,
                 &program,
                 MultipassConfig {
-                    initial_capacity,
+                    initial_capacity: INITIAL_CAPACITY,
                     stage_timing,
                     ..Default::default()
                 },
             )?,
-            _ => Scheduler::new(gpu, &program, strategy, initial_capacity)?,
+            _ => Scheduler::new(gpu, &program, strategy, INITIAL_CAPACITY)?,
         };
+        Self::from_scheduler(gpu, program, scheduler)
+    }
+
+    /// A renderer on a scheduler the caller compiled from [`program()`] with its own
+    /// configuration (e.g. another queue policy); [`INITIAL_CAPACITY`] is the usual start.
+    pub fn from_scheduler(
+        gpu: &Gpu,
+        program: Program,
+        scheduler: Scheduler,
+    ) -> Result<GpuRenderer, RunError> {
         let user_layout = gpu
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {

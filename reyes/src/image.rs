@@ -31,6 +31,21 @@ impl FrameImage {
             .collect()
     }
 
+    /// How far two images of the same size differ: the largest per-channel difference of
+    /// their 8-bit encodings ([`FrameImage::rgba8`]: colour in sRGB steps, alpha in 1/255) and
+    /// the share of pixels differing by more than 2 steps in some channel.
+    pub fn compare(&self, other: &FrameImage) -> (u8, f64) {
+        let (x, y) = (self.rgba8(), other.rgba8());
+        let d: Vec<u8> = x
+            .chunks(4)
+            .zip(y.chunks(4))
+            .map(|(p, q)| (0..4).map(|c| p[c].abs_diff(q[c])).max().unwrap())
+            .collect();
+        let max = d.iter().copied().max().unwrap_or(0);
+        let over = d.iter().filter(|&&v| v > 2).count() as f64 / d.len().max(1) as f64;
+        (max, over)
+    }
+
     /// Pixels with any coverage.
     pub fn covered_pixels(&self) -> usize {
         self.rgba.iter().filter(|p| p[3] > 0.0).count()

@@ -40,17 +40,9 @@ pub fn small(w: u32, h: u32) -> RenderOptions {
 }
 
 /// Largest per-channel difference (colour in sRGB 8-bit steps, alpha in 1/255) and the share
-/// of pixels differing by more than 2 steps.
+/// of pixels differing by more than 2 steps ([`FrameImage::compare`]).
 pub fn compare(a: &FrameImage, b: &FrameImage) -> (u8, f64) {
-    let (x, y) = (a.rgba8(), b.rgba8());
-    let d: Vec<u8> = x
-        .chunks(4)
-        .zip(y.chunks(4))
-        .map(|(p, q)| (0..4).map(|c| p[c].abs_diff(q[c])).max().unwrap())
-        .collect();
-    let max = d.iter().copied().max().unwrap_or(0);
-    let over = d.iter().filter(|&&v| v > 2).count() as f64 / d.len() as f64;
-    (max, over)
+    a.compare(b)
 }
 
 /// Share of pixels where coverage (alpha) and the exact f64 coverage disagree by more than half

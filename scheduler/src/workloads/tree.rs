@@ -10,6 +10,7 @@ use crate::procedure::{ItemType, Procedure};
 use crate::program::{Program, Seed, UserBindings};
 use crate::stats::RunStats;
 use crate::strategy::Scheduler;
+use rayon::prelude::*;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Fanout {
@@ -30,6 +31,74 @@ pub struct TreeParams {
     /// Payload words per item (item size = 2 + payload words).
     pub payload_words: u32,
     pub seed: u32,
+}
+
+/// The named trees of the benchmark suite (`schedbench --preset NAME`, `schedbench --suite`):
+/// each stresses one thing a scheduler must handle. All start from
+/// [`TreeParams::binary_benchmark`] and change what their name says.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TreePreset {
+    /// 64 roots, binary, depth 14: 2,097,088 items in 15 levels, trivial work (the default).
+    Binary,
+    /// 0..=3 children per node (mean 1.5), depth 20, 64 roots: ragged levels and leaves at
+    /// every depth.
+    Irregular,
+    /// 0..=2 children per node (mean 1, a critical branching process), depth 200, 20,000
+    /// roots: narrow, long-lived work (multi-pass needs up to 200 rounds).
+    Deep,
+    /// The binary tree with 62 payload words (256-byte items): queue bandwidth.
+    LargePayload,
+    /// The binary tree with 64 hash rounds per inner node: compute-bound items.
+    HeavyWork,
+}
+
+impl TreePreset {
+    pub const ALL: [TreePreset; 5] = [
+        TreePreset::Binary,
+        TreePreset::Irregular,
+        TreePreset::Deep,
+        TreePreset::LargePayload,
+        TreePreset::HeavyWork,
+    ];
+
+    /// The command-line name: `binary`, `irregular`, `deep`, `large-payload`, `heavy-work`.
+    pub fn name(self) -> &'static str {
+        match self {
+            TreePreset::Binary => "binary",
+            TreePreset::Irregular => "irregular",
+            TreePreset::Deep => "deep",
+            TreePreset::LargePayload => "large-payload",
+            TreePreset::HeavyWork => "heavy-work",
+        }
+    }
+
+    pub fn parse(s: &str) -> Option<TreePreset> {
+        Self::ALL.into_iter().find(|p| p.name() == s)
+    }
+
+    pub fn params(self) -> TreeParams {
+        let binary = TreeParams::binary_benchmark();
+        match self {
+            TreePreset::Binary => binary,
+            TreePreset::Irregular => TreeParams {
+                fanout: Fanout::Uniform(3),
+                max_depth: 20,
+                roots: 64,
+                ..binary
+            },
+            TreePreset::Deep => TreeParams {
+                fanout: Fanout::Uniform(2),
+                max_depth: 200,
+                roots: 20_000,
+                ..binary
+            },
+            TreePreset::LargePayload => TreeParams {
+                payload_words: 62,
+                ..binary
+            },
+            TreePreset::HeavyWork => TreeParams { work: 64, ..binary },
+        }
+    }
 }
 
 impl TreeParams {
@@ -64,7 +133,7 @@ impl TreeParams {
 }
 
 /// What a run of the tree produced: items per procedure and the leaf checksum.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct TreeResult {
     pub branches: u64,
     pub leaves: u64,
@@ -73,6 +142,36 @@ pub struct TreeResult {
     pub leaf_sum: u32,
     pub leaf_xor: u32,
 }
+
+impl TreeResult {
+    /// Every node of the tree (branches and leaves).
+    pub fn items(&self) -> u64 {
+        self.branches + self.leaves
+    }
+
+    fn add_leaf(&mut self, id: u32, depth: u32, payload: &[u32]) {
+        let h = TreeParams::leaf_hash(id, depth, payload);
+        self.leaves += 1;
+        self.leaves_folded += 1;
+        self.leaf_sum = self.leaf_sum.wrapping_add(h);
+        self.leaf_xor ^= hash(h);
+    }
+
+    /// The result of two disjoint parts of a tree: counts and sums add, xors combine.
+    fn merge(self, o: TreeResult) -> TreeResult {
+        TreeResult {
+            branches: self.branches + o.branches,
+            leaves: self.leaves + o.leaves,
+            leaves_folded: self.leaves_folded + o.leaves_folded,
+            leaf_sum: self.leaf_sum.wrapping_add(o.leaf_sum),
+            leaf_xor: self.leaf_xor ^ o.leaf_xor,
+        }
+    }
+}
+
+/// Subtrees the parallel CPU walk aims to hand out per rayon thread (it expands the top of
+/// the tree breadth-first until it has them, so a few roots still spread over every core).
+const SUBTREES_PER_THREAD: usize = 64;
 
 pub fn hash(x: u32) -> u32 {
     let mut h = x;
@@ -113,14 +212,23 @@ impl TreeParams {
     }
 
     fn child(&self, id: u32, payload: &[u32], work: u32, j: u32) -> (u32, Vec<u32>) {
-        let cid = hash(id.wrapping_mul(0x9e37_79b9).wrapping_add(j + 1));
-        let mut p: Vec<u32> = payload
-            .iter()
-            .enumerate()
-            .map(|(w, &x)| hash(x ^ cid ^ (w as u32).wrapping_mul(0x85eb_ca6b)))
-            .collect();
-        p[0] ^= work;
+        let mut p = Vec::with_capacity(payload.len());
+        let cid = Self::child_into(id, payload, work, j, &mut p);
         (cid, p)
+    }
+
+    /// Child `j` of node `id`: returns its id and appends its payload words to `out`.
+    fn child_into(id: u32, payload: &[u32], work: u32, j: u32, out: &mut Vec<u32>) -> u32 {
+        let cid = hash(id.wrapping_mul(0x9e37_79b9).wrapping_add(j + 1));
+        let at = out.len();
+        out.extend(
+            payload
+                .iter()
+                .enumerate()
+                .map(|(w, &x)| hash(x ^ cid ^ (w as u32).wrapping_mul(0x85eb_ca6b))),
+        );
+        out[at] ^= work;
+        cid
     }
 
     fn work_of(&self, id: u32) -> u32 {
@@ -157,11 +265,7 @@ impl TreeParams {
         while let Some((id, depth, payload)) = stack.pop() {
             let c = self.children(id, depth);
             if c == 0 {
-                let h = Self::leaf_hash(id, depth, &payload);
-                r.leaves += 1;
-                r.leaves_folded += 1;
-                r.leaf_sum = r.leaf_sum.wrapping_add(h);
-                r.leaf_xor ^= hash(h);
+                r.add_leaf(id, depth, &payload);
             } else {
                 r.branches += 1;
                 let work = self.work_of(id);
@@ -172,6 +276,73 @@ impl TreeParams {
             }
         }
         r
+    }
+
+    /// [`TreeParams::reference`] on every core (rayon): the same [`TreeResult`], the CPU floor a
+    /// GPU result must beat. The top of the tree is expanded breadth-first on the calling
+    /// thread until there are [`SUBTREES_PER_THREAD`] subtrees per rayon thread (or the tree
+    /// ends); rayon then walks the subtrees depth-first, each with a flat stack of payload
+    /// words, so no node allocates. Children's order differs from the reference's, which
+    /// cannot change the result: every fold is commutative.
+    pub fn cpu_parallel(&self) -> TreeResult {
+        let p = self.payload_words as usize;
+        let mut done = TreeResult::default();
+        // The frontier: node ids and depths, and their payloads back to back.
+        let (mut nodes, mut words) = (Vec::new(), Vec::new());
+        for i in 0..self.roots {
+            let (id, payload) = self.root(i);
+            nodes.push((id, 0));
+            words.extend(payload);
+        }
+        let want = SUBTREES_PER_THREAD * rayon::current_num_threads();
+        while !nodes.is_empty() && nodes.len() < want {
+            let (mut next, mut next_words) = (Vec::new(), Vec::new());
+            for (i, &(id, depth)) in nodes.iter().enumerate() {
+                let payload = &words[i * p..(i + 1) * p];
+                let c = self.children(id, depth);
+                if c == 0 {
+                    done.add_leaf(id, depth, payload);
+                    continue;
+                }
+                done.branches += 1;
+                let work = self.work_of(id);
+                for j in 0..c {
+                    let cid = Self::child_into(id, payload, work, j, &mut next_words);
+                    next.push((cid, depth + 1));
+                }
+            }
+            (nodes, words) = (next, next_words);
+        }
+        nodes
+            .par_iter()
+            .enumerate()
+            .fold(
+                || (TreeResult::default(), Vec::new(), Vec::new(), vec![0; p]),
+                |(mut r, mut stack, mut stack_words, mut parent), (i, &(id, depth))| {
+                    stack.push((id, depth));
+                    stack_words.extend_from_slice(&words[i * p..(i + 1) * p]);
+                    while let Some((id, depth)) = stack.pop() {
+                        let at = stack_words.len() - p;
+                        parent.copy_from_slice(&stack_words[at..]);
+                        stack_words.truncate(at);
+                        let c = self.children(id, depth);
+                        if c == 0 {
+                            r.add_leaf(id, depth, &parent);
+                            continue;
+                        }
+                        r.branches += 1;
+                        let work = self.work_of(id);
+                        for j in 0..c {
+                            let cid = Self::child_into(id, &parent, work, j, &mut stack_words);
+                            stack.push((cid, depth + 1));
+                        }
+                    }
+                    (r, stack, stack_words, parent)
+                },
+            )
+            .map(|(r, ..)| r)
+            .reduce(TreeResult::default, TreeResult::merge)
+            .merge(done)
     }
 
     pub fn program(&self) -> Result<Program, RunError> {
@@ -380,6 +551,68 @@ mod tests {
         .reference();
         assert_eq!(r.branches + r.leaves, 2_097_088);
         assert_eq!(r.leaves, 64 << 14);
+    }
+
+    #[test]
+    fn presets_have_their_documented_shape() {
+        let names: Vec<_> = TreePreset::ALL.iter().map(|p| p.name()).collect();
+        assert_eq!(
+            names,
+            ["binary", "irregular", "deep", "large-payload", "heavy-work"]
+        );
+        for p in TreePreset::ALL {
+            assert_eq!(TreePreset::parse(p.name()), Some(p));
+        }
+        assert_eq!(TreePreset::parse("binary-tree"), None);
+        assert_eq!(TreePreset::Binary.params(), TreeParams::binary_benchmark());
+        let d = TreePreset::Deep.params();
+        assert_eq!(
+            (d.roots, d.max_depth, d.fanout),
+            (20_000, 200, Fanout::Uniform(2))
+        );
+        let i = TreePreset::Irregular.params();
+        assert_eq!(
+            (i.roots, i.max_depth, i.fanout),
+            (64, 20, Fanout::Uniform(3))
+        );
+        assert_eq!(TreePreset::LargePayload.params().payload_words, 62);
+        assert_eq!(TreePreset::HeavyWork.params().work, 64);
+    }
+
+    #[test]
+    fn parallel_cpu_walk_matches_the_reference() {
+        // Every preset's shape on fewer roots (and the deep one shallower), plus edge cases: no
+        // roots, roots that are leaves, fewer subtrees than the parallel walk wants.
+        let mut cases: Vec<TreeParams> = TreePreset::ALL
+            .iter()
+            .map(|p| TreeParams {
+                roots: 3,
+                max_depth: p.params().max_depth.min(60),
+                ..p.params()
+            })
+            .collect();
+        cases.push(TreeParams {
+            roots: 0,
+            ..TreeParams::binary_benchmark()
+        });
+        cases.push(TreeParams {
+            roots: 5,
+            max_depth: 0,
+            ..TreeParams::binary_benchmark()
+        });
+        cases.push(TreeParams {
+            roots: 1,
+            max_depth: 9,
+            fanout: Fanout::Uniform(4),
+            work: 3,
+            payload_words: 5,
+            seed: 7,
+        });
+        for p in cases {
+            let r = p.reference();
+            assert_eq!(p.cpu_parallel(), r, "{}", p.describe());
+            assert_eq!(r.leaves, r.leaves_folded);
+        }
     }
 
     #[test]

@@ -1,0 +1,254 @@
+//! The command line (clap derive): flags, defaults, ranges. Usage errors exit with status 2 and
+//! name the flag; `--help` exits 0 and shows the defaults.
+
+use crate::catalog::WorkloadName;
+use crate::strategy::{GpuConfig, Policy};
+use crate::suite::Scale;
+use clap::error::ErrorKind;
+use clap::{CommandFactory, Parser, value_parser};
+use scheduler::workloads::tree::{Fanout, TreeParams, TreePreset};
+use std::path::PathBuf;
+
+const EXAMPLES: &str = "Examples:
+  schedbench --workload tree --strategy all --runs 10
+  schedbench --workload tree --preset deep --strategy megakernel --json
+  schedbench --workload reyes --scene killeroo --width 398 --height 258
+  schedbench --suite --size small --out report/";
+
+/// Runs workloads under the scheduler's strategies (and their CPU implementations), checks every
+/// run against the CPU reference, and prints a table of medians (or JSON lines); `--suite`
+/// runs everything and writes a report.
+#[derive(Debug, Parser)]
+#[command(name = "schedbench", after_help = EXAMPLES)]
+pub struct Cli {
+    /// Run the suite: every workload x strategy x problem size. Writes runs.jsonl, summary.md
+    /// and a PNG per workload into --out.
+    #[arg(long, requires = "out")]
+    pub suite: bool,
+
+    /// The suite's output folder (created if missing).
+    #[arg(long, value_name = "DIR", requires = "suite")]
+    pub out: Option<PathBuf>,
+
+    /// The suite's problem sizes: `small` runs in minutes on lavapipe, `full` is for a GPU.
+    #[arg(long, value_enum, default_value_t = Scale::Full, requires = "suite")]
+    pub size: Scale,
+
+    /// The workload to run [default: tree]; with --suite, the only one to run.
+    #[arg(long, value_enum)]
+    pub workload: Option<WorkloadName>,
+
+    /// megakernel, megakernel-fifo, multipass, cpu (the workload's rayon implementation), a
+    /// workload's own baseline, or all (the megakernel under --policy).
+    #[arg(long, default_value = "all", conflicts_with = "suite")]
+    pub strategy: String,
+
+    /// Print one JSON object per run instead of the table.
+    #[arg(long, conflicts_with = "suite")]
+    pub json: bool,
+
+    /// Timed runs per strategy (and size), after one untimed warm-up run
+    /// [default: 5; with --suite: 2 small, 10 full].
+    #[arg(long, value_parser = value_parser!(u32).range(1..))]
+    pub runs: Option<u32>,
+
+    /// The tree the other tree options change: binary (64 roots, depth 14), irregular,
+    /// deep, large-payload or heavy-work.
+    #[arg(long, value_parser = parse_preset, default_value = "binary", help_heading = "Tree")]
+    pub preset: TreePreset,
+
+    /// Root nodes.
+    #[arg(long, help_heading = "Tree")]
+    pub roots: Option<u32>,
+
+    /// Depth of the deepest nodes (roots are at depth 0).
+    #[arg(long, help_heading = "Tree")]
+    pub depth: Option<u32>,
+
+    /// Children per inner node: fixed:K (exactly K) or uniform:K (0..=K from a hash), K in 1..=16.
+    #[arg(long, value_parser = parse_fanout, help_heading = "Tree")]
+    pub fanout: Option<Fanout>,
+
+    /// Hash rounds per inner node (work per item).
+    #[arg(long, help_heading = "Tree")]
+    pub work: Option<u32>,
+
+    /// Payload words per item (item = 2 + payload words).
+    #[arg(long, value_name = "WORDS", value_parser = value_parser!(u32).range(1..=254),
+          help_heading = "Tree")]
+    pub payload: Option<u32>,
+
+    /// Seed of the tree's hashes.
+    #[arg(long, help_heading = "Tree")]
+    pub seed: Option<u32>,
+
+    /// Scene: teapot (built in), killeroo (the shared data's), or a RIB/Newell/BPT file.
+    #[arg(long, default_value = "teapot", help_heading = "Reyes")]
+    pub scene: String,
+
+    /// Image width [default: the scene's].
+    #[arg(long, value_parser = value_parser!(u32).range(1..=16384), help_heading = "Reyes")]
+    pub width: Option<u32>,
+
+    /// Image height [default: the scene's].
+    #[arg(long, value_parser = value_parser!(u32).range(1..=16384), help_heading = "Reyes")]
+    pub height: Option<u32>,
+
+    /// Megakernel workgroups [default: probe how many run at once].
+    #[arg(long, value_parser = value_parser!(u32).range(1..=65535), help_heading = "Scheduler")]
+    pub workgroups: Option<u32>,
+
+    /// The megakernel's queue policy (for --strategy megakernel and all).
+    #[arg(long, value_enum, default_value_t = Policy::Priority, help_heading = "Scheduler")]
+    pub policy: Policy,
+
+    /// Megakernel workgroup steps per claimed batch.
+    #[arg(long, default_value_t = 1, value_parser = value_parser!(u32).range(1..=64),
+          help_heading = "Scheduler")]
+    pub batch_steps: u32,
+
+    /// Queue slots at the start of a run [default: from the problem size].
+    #[arg(long, value_name = "SLOTS", value_parser = value_parser!(u32).range(1..),
+          help_heading = "Scheduler")]
+    pub capacity: Option<u32>,
+}
+
+fn parse_preset(s: &str) -> Result<TreePreset, String> {
+    TreePreset::parse(s).ok_or_else(|| {
+        let names: Vec<_> = TreePreset::ALL.iter().map(|p| p.name()).collect();
+        format!("unknown preset `{s}` (known: {})", names.join(", "))
+    })
+}
+
+/// `fixed:K` or `uniform:K` (also `uniform:0..K`), K in 1..=16.
+pub fn parse_fanout(s: &str) -> Result<Fanout, String> {
+    let (kind, k) = s
+        .split_once(':')
+        .ok_or(format!("`{s}` is not fixed:K or uniform:K"))?;
+    let k: u32 = k
+        .trim_start_matches("0..")
+        .parse()
+        .map_err(|e| format!("`{s}`: {e}"))?;
+    if !(1..=16).contains(&k) {
+        return Err(format!("`{s}`: K must be 1..=16"));
+    }
+    match kind {
+        "fixed" => Ok(Fanout::Fixed(k)),
+        "uniform" => Ok(Fanout::Uniform(k)),
+        _ => Err(format!("`{s}` is not fixed:K or uniform:K")),
+    }
+}
+
+impl Cli {
+    /// Exits with status 2 naming `flag` (clap's usage error).
+    pub fn usage_error(kind: ErrorKind, msg: String) -> ! {
+        Cli::command().error(kind, msg).exit()
+    }
+
+    /// Checks what clap's attributes cannot say: options of one workload with another.
+    pub fn check(&self) {
+        let workload = self.workload.unwrap_or(WorkloadName::Tree);
+        let tree_flags = [
+            ("--roots", self.roots.is_some()),
+            ("--depth", self.depth.is_some()),
+            ("--fanout", self.fanout.is_some()),
+            ("--work", self.work.is_some()),
+            ("--payload", self.payload.is_some()),
+            ("--seed", self.seed.is_some()),
+        ];
+        let reyes_flags = [
+            ("--width", self.width.is_some()),
+            ("--height", self.height.is_some()),
+        ];
+        for (flag, given) in tree_flags {
+            if given && (self.suite || workload != WorkloadName::Tree) {
+                Self::usage_error(
+                    ErrorKind::ArgumentConflict,
+                    format!("{flag} applies to --workload tree without --suite"),
+                );
+            }
+        }
+        for (flag, given) in reyes_flags {
+            if given && (self.suite || workload != WorkloadName::Reyes) {
+                Self::usage_error(
+                    ErrorKind::ArgumentConflict,
+                    format!("{flag} applies to --workload reyes without --suite"),
+                );
+            }
+        }
+    }
+
+    /// The tree: the preset, changed by the tree options.
+    pub fn tree(&self) -> TreeParams {
+        let p = self.preset.params();
+        TreeParams {
+            roots: self.roots.unwrap_or(p.roots),
+            max_depth: self.depth.unwrap_or(p.max_depth),
+            fanout: self.fanout.unwrap_or(p.fanout),
+            work: self.work.unwrap_or(p.work),
+            payload_words: self.payload.unwrap_or(p.payload_words),
+            seed: self.seed.unwrap_or(p.seed),
+        }
+    }
+
+    pub fn gpu_config(&self) -> GpuConfig {
+        GpuConfig {
+            workgroups: self.workgroups,
+            batch_steps: self.batch_steps,
+            capacity: self.capacity,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(args: &[&str]) -> Result<Cli, clap::Error> {
+        Cli::try_parse_from(std::iter::once("schedbench").chain(args.iter().copied()))
+    }
+
+    #[test]
+    fn ranges_and_names_are_checked() {
+        for bad in [
+            &["--workgroups", "0"][..],
+            &["--batch-steps", "0"],
+            &["--runs", "0"],
+            &["--payload", "0"],
+            &["--fanout", "fixed:0"],
+            &["--fanout", "binary:2"],
+            &["--preset", "huge"],
+            &["--workload", "sort"],
+            &["--suite"],
+            &["--out", "x"],
+            &["--suite", "--out", "x", "--json"],
+        ] {
+            let e = parse(bad).expect_err(&format!("{bad:?} accepted"));
+            assert_eq!(e.exit_code(), 2, "{bad:?}");
+        }
+        let e = parse(&["--workgroups", "0"]).unwrap_err().to_string();
+        assert!(e.contains("--workgroups"), "{e}");
+        assert_eq!(parse(&["--help"]).unwrap_err().exit_code(), 0);
+    }
+
+    #[test]
+    fn the_tree_is_the_preset_changed_by_its_options() {
+        let c = parse(&[
+            "--preset",
+            "deep",
+            "--roots",
+            "7",
+            "--fanout",
+            "uniform:0..3",
+        ])
+        .unwrap();
+        let t = c.tree();
+        assert_eq!(
+            (t.roots, t.max_depth, t.fanout),
+            (7, 200, Fanout::Uniform(3))
+        );
+        assert_eq!(parse(&[]).unwrap().tree(), TreeParams::binary_benchmark());
+        let s = parse(&["--suite", "--out", "d", "--size", "small"]).unwrap();
+        assert_eq!((s.size, s.out), (Scale::Small, Some(PathBuf::from("d"))));
+    }
+}

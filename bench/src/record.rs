@@ -1,0 +1,127 @@
+//! One run as a JSON object: a line of `schedbench --json` and of the suite's `runs.jsonl`.
+
+use crate::strategy::Strategy;
+use crate::workload::{Measurement, Prepared};
+use serde::{Deserialize, Serialize};
+
+/// A run, verified or not. Times in milliseconds; scheduler counters are zero where they do not
+/// apply (see `scheduler::RunStats`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunRecord {
+    /// `tree-binary`, `reyes-teapot`, ... (`tree` for a tree given on the command line).
+    pub workload: String,
+    /// `megakernel`, `megakernel-fifo`, `multipass`, ..., `cpu`, or a workload's baseline.
+    pub strategy: String,
+    /// The megakernel's queue policy.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub policy: Option<String>,
+    /// The problem size's label (`roots=4`, `320x240`).
+    pub size: String,
+    /// The workload's parameters in its own words.
+    pub params: String,
+    pub adapter: String,
+    /// Index of the timed run (0-based; the untimed warm-up run is not recorded).
+    pub run: u32,
+    /// Items this run executed.
+    pub items: u64,
+    /// Items of the CPU reference at this size (the plots' x axis).
+    pub problem_items: u64,
+    /// The result equals the CPU reference (within the workload's stated tolerance).
+    pub verified: bool,
+    /// What differed, or the error that stopped the run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+    /// GPU time from timestamp queries; null for CPU runs and adapters without timestamps.
+    pub gpu_ms: Option<f64>,
+    /// Host time of the whole run, result read-back included; null when the run failed.
+    pub wall_ms: Option<f64>,
+    /// Items per second of GPU time (null without it).
+    pub items_per_s: Option<f64>,
+    /// Items per second of wall time.
+    pub items_per_s_wall: Option<f64>,
+    /// Graph workloads: giga traversed edges per second (GPU time where measured, else wall).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gteps: Option<f64>,
+    pub executed: Vec<u64>,
+    pub rounds: u64,
+    pub launches: u64,
+    pub batches: u64,
+    pub idle_polls: u64,
+    pub abandoned: u64,
+    pub queue_growths: u64,
+    pub peak_occupancy: Vec<u64>,
+    pub queue_bytes: u64,
+    pub workgroups: u32,
+}
+
+/// Which run of what: the fields every record of one (workload, size, strategy) shares.
+pub struct RunKey<'a> {
+    pub workload: &'a str,
+    pub strategy: &'a Strategy,
+    pub prepared: &'a Prepared,
+    pub adapter: &'a str,
+    pub run: u32,
+}
+
+impl RunRecord {
+    pub fn new(k: &RunKey, m: &Measurement) -> RunRecord {
+        let s = m.stats.clone().unwrap_or_default();
+        let per_s = |ms: f64| (ms > 0.0).then(|| m.items as f64 / ms * 1e3);
+        let time = m.gpu_ms.unwrap_or(m.wall_ms);
+        RunRecord {
+            error: m.mismatch.clone(),
+            verified: m.verified,
+            items: m.items,
+            gpu_ms: m.gpu_ms,
+            wall_ms: Some(m.wall_ms),
+            items_per_s: m.gpu_ms.and_then(per_s),
+            items_per_s_wall: per_s(m.wall_ms),
+            gteps: m
+                .edges
+                .and_then(|e| (time > 0.0).then(|| e as f64 / time / 1e6)),
+            executed: s.executed,
+            rounds: s.rounds,
+            launches: s.launches,
+            batches: s.batches,
+            idle_polls: s.idle_polls,
+            abandoned: s.abandoned,
+            queue_growths: s.queue_growths,
+            peak_occupancy: s.peak_occupancy,
+            queue_bytes: s.queue_bytes,
+            workgroups: s.workgroups,
+            ..Self::failed(k, String::new())
+        }
+    }
+
+    /// A run that stopped with `error` before it could be measured.
+    pub fn failed(k: &RunKey, error: String) -> RunRecord {
+        RunRecord {
+            workload: k.workload.to_string(),
+            strategy: k.strategy.name(),
+            policy: k.strategy.policy().map(|p| p.name().to_string()),
+            size: k.prepared.size.clone(),
+            params: k.prepared.params.clone(),
+            adapter: k.adapter.to_string(),
+            run: k.run,
+            items: 0,
+            problem_items: k.prepared.problem_items,
+            verified: false,
+            error: Some(error),
+            gpu_ms: None,
+            wall_ms: None,
+            items_per_s: None,
+            items_per_s_wall: None,
+            gteps: None,
+            executed: Vec::new(),
+            rounds: 0,
+            launches: 0,
+            batches: 0,
+            idle_polls: 0,
+            abandoned: 0,
+            queue_growths: 0,
+            peak_occupancy: Vec::new(),
+            queue_bytes: 0,
+            workgroups: 0,
+        }
+    }
+}

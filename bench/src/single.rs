@@ -1,0 +1,168 @@
+//! `schedbench --workload W`: one workload at one size under the chosen strategies; one JSON
+//! object per run (`--json`) or a table of median ± MAD with the ratios between strategies.
+
+use crate::catalog::WorkloadName;
+use crate::cli::Cli;
+use crate::record::RunRecord;
+use crate::reyes_frames::{ReyesWorkload, load_scene};
+use crate::strategy::Strategy;
+use crate::suite::measure;
+use crate::summary::{best_baseline, cells};
+use crate::workload::Workload;
+use clap::error::ErrorKind;
+use reyes::scene;
+use scheduler::{Gpu, StrategyKind};
+use std::path::Path;
+
+/// Timed runs when `--runs` is not given.
+pub const DEFAULT_RUNS: u32 = 5;
+
+/// The workload the command line describes; usage errors exit with status 2.
+fn workload(cli: &Cli) -> Box<dyn Workload> {
+    let config = cli.gpu_config();
+    match cli.workload.unwrap_or(WorkloadName::Tree) {
+        WorkloadName::Tree => Box::new(crate::tree::single_workload(cli.tree(), config)),
+        WorkloadName::Reyes => {
+            let scene = match cli.scene.as_str() {
+                "teapot" => Ok(scene::builtin_teapot()),
+                "killeroo" => load_scene(&reyes::shared_data_dir().join("rib/killeroo.rib")),
+                path => load_scene(Path::new(path)),
+            };
+            let scene = scene.unwrap_or_else(|e| {
+                Cli::usage_error(ErrorKind::InvalidValue, format!("--scene: {e}"))
+            });
+            let size = match (cli.width, cli.height) {
+                (None, None) => None,
+                (w, h) => Some((w.unwrap_or(scene.width), h.unwrap_or(scene.height))),
+            };
+            let name = format!("reyes-{}", cli.scene);
+            Box::new(ReyesWorkload::new(name, scene, vec![size], config))
+        }
+        w @ (WorkloadName::Mandelbrot | WorkloadName::Bfs) => {
+            Cli::usage_error(ErrorKind::InvalidValue, w.not_built())
+        }
+    }
+}
+
+/// The strategies `--strategy` names among the workload's.
+fn strategies(cli: &Cli, w: &dyn Workload) -> Vec<Strategy> {
+    let all = w.strategies();
+    let wanted = |s: &Strategy| s.policy().is_none_or(|p| p == cli.policy);
+    match cli.strategy.as_str() {
+        "all" => all.into_iter().filter(wanted).collect(),
+        s => {
+            let found = if s == StrategyKind::Megakernel.name() {
+                all.into_iter().find(|x| x.is_megakernel() && wanted(x))
+            } else {
+                Strategy::find(&all, s)
+            };
+            match found {
+                Some(x) => vec![x],
+                None => {
+                    let names: Vec<String> = w.strategies().iter().map(|s| s.name()).collect();
+                    Cli::usage_error(
+                        ErrorKind::InvalidValue,
+                        format!(
+                            "--strategy: unknown strategy `{s}` for {} (known: all, {})",
+                            w.name(),
+                            names.join(", ")
+                        ),
+                    )
+                }
+            }
+        }
+    }
+}
+
+/// Runs and prints; Ok(true) when every run was verified.
+pub fn run(cli: &Cli) -> Result<bool, String> {
+    let mut w = workload(cli);
+    let strategies = strategies(cli, w.as_ref());
+    let gpu = if cli.workload == Some(WorkloadName::Reyes) {
+        Gpu::from_env_requiring(reyes::gpu_render::required_features())
+    } else {
+        Gpu::from_env()
+    }
+    .map_err(|e| e.to_string())?;
+    let prepared = w.prepare(&gpu, 0)?;
+    let runs = cli.runs.unwrap_or(DEFAULT_RUNS);
+    let mut records: Vec<RunRecord> = Vec::new();
+    for s in &strategies {
+        for r in measure(&gpu, w.as_mut(), s, &prepared, runs) {
+            if cli.json {
+                println!("{}", serde_json::to_string(&r).expect("records serialise"));
+            }
+            if let Some(e) = r.error.as_ref().filter(|_| !r.verified) {
+                eprintln!("schedbench: {} run {}: {e}", r.strategy, r.run);
+            }
+            records.push(r);
+        }
+    }
+    if !cli.json {
+        print_table(&gpu, &prepared.params, prepared.problem_items, &records);
+    }
+    Ok(records.iter().all(|r| r.verified))
+}
+
+fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord]) {
+    let Some((workload, cs)) = cells(records).into_iter().next() else {
+        return;
+    };
+    println!(
+        "adapter: {}\nworkload: {workload} {params}\nreference: {problem_items} items",
+        gpu.adapter_name()
+    );
+    println!(
+        "{:<16} {:>10} {:>8} {:>20} {:>20} {:>11} {:>8} {:>7}",
+        "strategy",
+        "items",
+        "ok",
+        "gpu ms (med ± MAD)",
+        "wall ms (med ± MAD)",
+        "G items/s",
+        "launch",
+        "rounds"
+    );
+    let fmt = |t: Option<(f64, f64)>| t.map_or("n/a".into(), |(m, d)| format!("{m:.3} ± {d:.3}"));
+    for c in &cs {
+        println!(
+            "{:<16} {:>10} {:>8} {:>20} {:>20} {:>11} {:>8} {:>7}",
+            c.strategy,
+            c.items,
+            c.ok(),
+            fmt(c.gpu),
+            fmt(c.wall),
+            c.gpu.map_or("n/a".into(), |g| format!(
+                "{:.2}",
+                c.items as f64 / g.0 / 1e6
+            )),
+            c.launches,
+            c.rounds
+        );
+    }
+    // GPU time against the first strategy's (the megakernel's when it ran), as before.
+    let gpu_timed: Vec<_> = cs.iter().filter_map(|c| c.gpu.map(|g| (c, g.0))).collect();
+    if let Some(((first, a), rest)) = gpu_timed.split_first() {
+        for (c, b) in rest {
+            println!(
+                "ratio {}/{} GPU time: {:.2}x (same run)",
+                c.strategy,
+                first.strategy,
+                b / a
+            );
+        }
+    }
+    let refs: Vec<_> = cs.iter().collect();
+    if let Some(best) = best_baseline(&refs) {
+        for c in cs.iter().filter(|c| c.megakernel) {
+            if let Some(w) = c.wall {
+                println!(
+                    "{} wall time / best baseline ({}): {:.2}x",
+                    c.strategy,
+                    best.strategy,
+                    w.0 / best.wall.unwrap().0
+                );
+            }
+        }
+    }
+}

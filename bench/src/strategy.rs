@@ -1,0 +1,209 @@
+//! What a benchmark run is timed under: one of the scheduler's strategies (the megakernel once
+//! per queue policy), the workload's CPU implementation (rayon), or a workload's own baseline.
+
+use scheduler::{
+    Gpu, MegakernelConfig, MultipassConfig, Program, QueuePolicy, RunError, Scheduler,
+    StrategyKind, Workgroups,
+};
+
+/// The megakernel's queue policies, as the command line names them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Policy {
+    /// Later procedures first (`QueuePolicy::Priority` with the default order).
+    Priority,
+    /// The queue whose oldest waiting batch was published first (`QueuePolicy::Fifo`).
+    Fifo,
+}
+
+impl Policy {
+    pub const ALL: [Policy; 2] = [Policy::Priority, Policy::Fifo];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Policy::Priority => "priority",
+            Policy::Fifo => "fifo",
+        }
+    }
+
+    pub fn queue_policy(self) -> QueuePolicy {
+        match self {
+            Policy::Priority => QueuePolicy::Priority(Vec::new()),
+            Policy::Fifo => QueuePolicy::Fifo,
+        }
+    }
+}
+
+/// One strategy of a benchmark. Names (records, tables, plots, `--strategy`): `megakernel`
+/// (priority policy, the default), `megakernel-fifo`, every other [`StrategyKind::name`],
+/// `cpu`, and each workload's baselines (e.g. BFS's `frontier`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Strategy {
+    /// The scheduler; `policy` matters only to the megakernel.
+    Scheduler { kind: StrategyKind, policy: Policy },
+    /// The workload's multi-threaded CPU implementation (rayon), timed on the host.
+    Cpu,
+    /// A workload's own implementation outside the scheduler, by name.
+    Baseline(&'static str),
+}
+
+impl Strategy {
+    /// Every scheduler strategy: each [`StrategyKind`] in `StrategyKind::ALL`, the megakernel
+    /// once per [`Policy`]. A new `StrategyKind` joins the suite here with no change.
+    pub fn scheduler_all() -> Vec<Strategy> {
+        let mut v = Vec::new();
+        for kind in StrategyKind::ALL {
+            if kind == StrategyKind::Megakernel {
+                v.extend(Policy::ALL.map(|policy| Strategy::Scheduler { kind, policy }));
+            } else {
+                v.push(Strategy::Scheduler {
+                    kind,
+                    policy: Policy::Priority,
+                });
+            }
+        }
+        v
+    }
+
+    /// Every strategy of a workload with these baselines, scheduler strategies first.
+    pub fn all_for(baselines: &[&'static str]) -> Vec<Strategy> {
+        let mut v = Self::scheduler_all();
+        v.push(Strategy::Cpu);
+        v.extend(baselines.iter().map(|b| Strategy::Baseline(b)));
+        v
+    }
+
+    pub fn name(&self) -> String {
+        match self {
+            Strategy::Scheduler {
+                kind: StrategyKind::Megakernel,
+                policy: Policy::Priority,
+            } => "megakernel".into(),
+            Strategy::Scheduler {
+                kind: StrategyKind::Megakernel,
+                policy,
+            } => format!("megakernel-{}", policy.name()),
+            Strategy::Scheduler { kind, .. } => kind.name().into(),
+            Strategy::Cpu => "cpu".into(),
+            Strategy::Baseline(b) => b.to_string(),
+        }
+    }
+
+    /// The queue policy, for megakernel runs.
+    pub fn policy(&self) -> Option<Policy> {
+        match self {
+            Strategy::Scheduler {
+                kind: StrategyKind::Megakernel,
+                policy,
+            } => Some(*policy),
+            _ => None,
+        }
+    }
+
+    pub fn is_megakernel(&self) -> bool {
+        self.policy().is_some()
+    }
+
+    /// Runs on the GPU (the scheduler or a GPU baseline) rather than on the host's cores.
+    pub fn is_gpu(&self) -> bool {
+        !matches!(self, Strategy::Cpu)
+    }
+
+    /// The strategy named `s` among `all` (`megakernel-priority` is accepted for `megakernel`).
+    pub fn find(all: &[Strategy], s: &str) -> Option<Strategy> {
+        let s = if s == "megakernel-priority" {
+            "megakernel"
+        } else {
+            s
+        };
+        all.iter().find(|x| x.name() == s).cloned()
+    }
+}
+
+/// Scheduler settings the command line can change (defaults: [`GpuConfig::default`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GpuConfig {
+    /// Megakernel workgroups; `None` probes the co-resident count.
+    pub workgroups: Option<u32>,
+    /// Megakernel workgroup steps per claimed batch (at least 1).
+    pub batch_steps: u32,
+    /// Queue slots at the start of a run; `None` lets the workload choose from its size.
+    pub capacity: Option<u32>,
+}
+
+impl Default for GpuConfig {
+    fn default() -> Self {
+        GpuConfig {
+            workgroups: None,
+            batch_steps: 1,
+            capacity: None,
+        }
+    }
+}
+
+/// Compiles `program` for a scheduler strategy, queues starting at `capacity` slots.
+/// Panics if `strategy` is not a scheduler strategy (callers dispatch on that first).
+pub fn compile(
+    gpu: &Gpu,
+    program: &Program,
+    strategy: &Strategy,
+    config: &GpuConfig,
+    capacity: u32,
+) -> Result<Scheduler, RunError> {
+    let Strategy::Scheduler { kind, policy } = strategy else {
+        panic!("compile: `{}` is not a scheduler strategy", strategy.name());
+    };
+    #[allow(unreachable_patterns)] // the wildcard serves strategies added to StrategyKind later
+    match kind {
+        StrategyKind::Megakernel => Scheduler::megakernel(
+            gpu,
+            program,
+            MegakernelConfig {
+                workgroups: config
+                    .workgroups
+                    .map_or(Workgroups::Probe { max: 4096 }, Workgroups::Fixed),
+                policy: policy.queue_policy(),
+                batch_steps: config.batch_steps,
+                initial_capacity: capacity,
+                ..Default::default()
+            },
+        ),
+        StrategyKind::Multipass => Scheduler::multipass(
+            gpu,
+            program,
+            MultipassConfig {
+                initial_capacity: capacity,
+                ..Default::default()
+            },
+        ),
+        // Strategies added to StrategyKind later run with their default configuration.
+        other => Scheduler::new(gpu, program, *other, capacity),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_unique_and_found_again() {
+        let all = Strategy::all_for(&["frontier"]);
+        let names: Vec<String> = all.iter().map(|s| s.name()).collect();
+        assert!(names.contains(&"megakernel".to_string()));
+        assert!(names.contains(&"megakernel-fifo".to_string()));
+        assert!(names.contains(&"multipass".to_string()));
+        assert_eq!(names.iter().filter(|n| *n == "cpu").count(), 1);
+        for (i, n) in names.iter().enumerate() {
+            assert_eq!(names.iter().position(|m| m == n), Some(i), "{n} twice");
+            assert_eq!(Strategy::find(&all, n).as_ref(), Some(&all[i]));
+        }
+        assert_eq!(
+            Strategy::find(&all, "megakernel-priority"),
+            Strategy::find(&all, "megakernel")
+        );
+        assert_eq!(Strategy::find(&all, "gpu"), None);
+        assert_eq!(
+            all.iter().filter(|s| s.is_megakernel()).count(),
+            Policy::ALL.len()
+        );
+    }
+}

@@ -1,0 +1,216 @@
+//! `schedbench --suite`: every workload x strategy x problem size, each strategy warmed up
+//! once and then timed `runs` times, every run verified; writes `runs.jsonl`, `summary.md` and
+//! a plot per workload into the output folder (each file whole or not at all).
+
+use crate::catalog::WorkloadName;
+use crate::files::{PendingFile, write_file};
+use crate::record::{RunKey, RunRecord};
+use crate::strategy::{GpuConfig, Strategy};
+use crate::workload::{Prepared, Workload};
+use crate::{plot, summary};
+use indicatif::{ProgressBar, ProgressStyle};
+use scheduler::Gpu;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+/// Problem sizes of the suite.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Scale {
+    /// Sizes lavapipe on two cores runs in a couple of minutes (what the test runs).
+    Small,
+    /// Sizes for a real GPU: up to and past each workload's benchmark size.
+    Full,
+}
+
+impl Scale {
+    pub fn name(self) -> &'static str {
+        match self {
+            Scale::Small => "small",
+            Scale::Full => "full",
+        }
+    }
+
+    /// Timed runs per strategy and size when `--runs` is not given.
+    pub fn default_runs(self) -> u32 {
+        match self {
+            Scale::Small => 2,
+            Scale::Full => 10,
+        }
+    }
+}
+
+pub struct SuiteOptions {
+    pub out: PathBuf,
+    pub scale: Scale,
+    pub runs: u32,
+    /// Only these workloads (all built ones when empty).
+    pub only: Vec<WorkloadName>,
+    pub config: GpuConfig,
+    /// The command line, for the summary.
+    pub command: String,
+}
+
+/// Full GPU load before each GPU strategy's timed runs (`scheduler::clocks::raise_clocks`;
+/// nothing on CPU adapters).
+pub const WARM_UP: Duration = Duration::from_millis(500);
+
+/// Runs a strategy once untimed (compilation, buffer sizing and the megakernel's probe are not
+/// the strategy's cost), raises the GPU's clocks, then `runs` timed, verified runs. A run that
+/// fails ends the strategy's runs at this size with a failed record; an unverified warm-up
+/// run is recorded as a failure too.
+pub fn measure(
+    gpu: &Gpu,
+    w: &mut dyn Workload,
+    strategy: &Strategy,
+    prepared: &Prepared,
+    runs: u32,
+) -> Vec<RunRecord> {
+    let adapter = gpu.adapter_name();
+    let name = w.name();
+    let key = |run| RunKey {
+        workload: &name,
+        strategy,
+        prepared,
+        adapter: &adapter,
+        run,
+    };
+    let warm = w.run(gpu, strategy).and_then(|m| match m.mismatch {
+        Some(e) if !m.verified => Err(format!("warm-up run: {e}")),
+        _ => Ok(()),
+    });
+    let warm = warm.and_then(|()| {
+        if strategy.is_gpu() {
+            scheduler::clocks::raise_clocks(gpu, WARM_UP).map_err(|e| e.to_string())
+        } else {
+            Ok(())
+        }
+    });
+    if let Err(e) = warm {
+        return vec![RunRecord::failed(&key(0), e)];
+    }
+    let mut out = Vec::new();
+    for run in 0..runs {
+        match w.run(gpu, strategy) {
+            Ok(m) => out.push(RunRecord::new(&key(run), &m)),
+            Err(e) => {
+                out.push(RunRecord::failed(&key(run), e));
+                break;
+            }
+        }
+    }
+    out
+}
+
+fn progress_bar(total: usize) -> ProgressBar {
+    if !std::io::stdout().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(total as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {pos}/{len} {wide_msg}")
+            .expect("a valid template")
+            .progress_chars("=> "),
+    );
+    bar
+}
+
+/// Runs the suite; true when every run was verified. Errors: the output folder or a file
+/// cannot be written, or a workload's input cannot be read.
+pub fn run_suite(gpu: &Gpu, o: &SuiteOptions) -> Result<bool, String> {
+    let start = Instant::now();
+    std::fs::create_dir_all(&o.out).map_err(|e| format!("{}: {e}", o.out.display()))?;
+    let names: Vec<WorkloadName> = if o.only.is_empty() {
+        WorkloadName::ALL
+            .into_iter()
+            .filter(|w| w.built())
+            .collect()
+    } else {
+        o.only.clone()
+    };
+    let mut workloads = Vec::new();
+    for n in &names {
+        workloads.extend(n.suite(o.scale, &o.config)?);
+    }
+    let not_built: Vec<&str> = WorkloadName::ALL
+        .iter()
+        .filter(|w| !w.built())
+        .map(|w| w.name())
+        .collect();
+    let total = workloads
+        .iter()
+        .map(|w| w.sizes().len() * w.strategies().len())
+        .sum();
+    let bar = progress_bar(total);
+    let mut jsonl = PendingFile::new(&o.out, "runs.jsonl")?;
+    let mut records = Vec::new();
+    for w in &mut workloads {
+        let name = w.name();
+        for (i, label) in w.sizes().into_iter().enumerate() {
+            bar.set_message(format!("{name} {label}: input and CPU reference"));
+            let strategies = w.strategies();
+            let prepared = w.prepare(gpu, i);
+            for s in &strategies {
+                bar.set_message(format!("{name} {label}: {}", s.name()));
+                let recs = match &prepared {
+                    Ok(p) => measure(gpu, w.as_mut(), s, p, o.runs),
+                    Err(e) => {
+                        let p = Prepared {
+                            size: label.clone(),
+                            params: String::new(),
+                            problem_items: 0,
+                        };
+                        let key = RunKey {
+                            workload: &name,
+                            strategy: s,
+                            prepared: &p,
+                            adapter: &gpu.adapter_name(),
+                            run: 0,
+                        };
+                        vec![RunRecord::failed(&key, format!("preparing the size: {e}"))]
+                    }
+                };
+                for r in recs {
+                    let mut line = serde_json::to_string(&r).expect("records serialise");
+                    line.push('\n');
+                    jsonl.write(line.as_bytes())?;
+                    if let Some(e) = r.error.as_ref().filter(|_| !r.verified) {
+                        bar.suspend(|| {
+                            eprintln!(
+                                "schedbench: {} {} {} run {}: {e}",
+                                r.workload, r.size, r.strategy, r.run
+                            )
+                        });
+                    }
+                    records.push(r);
+                }
+                bar.inc(1);
+            }
+        }
+    }
+    bar.finish_and_clear();
+    let runs_path = jsonl.finish()?;
+    let header = summary::Header {
+        adapter: gpu.adapter_name(),
+        scale: o.scale,
+        runs: o.runs,
+        command: o.command.clone(),
+        seconds: start.elapsed().as_secs_f64(),
+        cpu_adapter: gpu.info.device_type == wgpu::DeviceType::Cpu,
+        not_built,
+    };
+    let md = summary::markdown(&header, &records);
+    let summary_path = write_file(&o.out, "summary.md", md.as_bytes())?;
+    let plots = plot::write_plots(&o.out, &records)?;
+    let verified = records.iter().filter(|r| r.verified).count();
+    println!(
+        "{} runs ({verified} verified) in {:.0} s: {}, {}, {} plots in {}",
+        records.len(),
+        start.elapsed().as_secs_f64(),
+        runs_path.display(),
+        summary_path.display(),
+        plots.len(),
+        o.out.display()
+    );
+    Ok(verified == records.len())
+}

@@ -1,0 +1,93 @@
+//! The small benchmark suite end to end: the built `schedbench --suite --size small` on the
+//! adapter from the environment (lavapipe in CI; none is a failure, as in every GPU test).
+//! Every run must be verified, every workload x strategy x size present, and the report files
+//! complete. It checks results and files, never speed.
+
+use serde_json::Value;
+use std::collections::BTreeSet;
+use std::process::Command;
+
+/// Strategies every workload runs under (scheduler strategies with the megakernel once per
+/// queue policy, and the CPU implementation); `--strategy` names as in the records.
+const STRATEGIES: [&str; 4] = ["megakernel", "megakernel-fifo", "multipass", "cpu"];
+const WORKLOADS: [&str; 7] = [
+    "tree-binary",
+    "tree-irregular",
+    "tree-deep",
+    "tree-large-payload",
+    "tree-heavy-work",
+    "reyes-teapot",
+    "reyes-killeroo",
+];
+const RUNS: usize = 2;
+
+#[test]
+fn small_suite_verifies_every_run_and_writes_its_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("report");
+    let status = Command::new(env!("CARGO_BIN_EXE_schedbench"))
+        .args(["--suite", "--size", "small", "--runs", &RUNS.to_string()])
+        .arg("--out")
+        .arg(&out)
+        .status()
+        .expect("schedbench runs");
+    assert!(status.success(), "schedbench --suite failed: {status}");
+
+    let text = std::fs::read_to_string(out.join("runs.jsonl")).unwrap();
+    let records: Vec<Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let mut seen = BTreeSet::new();
+    for r in &records {
+        let (w, s, size) = (
+            r["workload"].as_str().unwrap(),
+            r["strategy"].as_str().unwrap(),
+            r["size"].as_str().unwrap(),
+        );
+        assert_eq!(r["verified"], true, "{w} {s} {size}: {}", r["error"]);
+        for field in [
+            "params", "adapter", "items", "gpu_ms", "wall_ms", "rounds", "launches",
+        ] {
+            assert!(r.get(field).is_some(), "{w} {s}: no `{field}`");
+        }
+        assert!(r["wall_ms"].as_f64().unwrap() > 0.0);
+        assert!(r["items"].as_u64().unwrap() > 0, "{w} {s} {size}: no items");
+        if s == "multipass" && w.starts_with("tree") {
+            assert!(r["rounds"].as_u64().unwrap() > 0, "{w} {size}: no rounds");
+        }
+        seen.insert((w.to_string(), s.to_string(), size.to_string()));
+    }
+    for w in WORKLOADS {
+        let sizes: BTreeSet<&str> = seen
+            .iter()
+            .filter(|k| k.0 == w)
+            .map(|k| k.2.as_str())
+            .collect();
+        let want = if w.starts_with("tree") { 2 } else { 1 };
+        assert!(sizes.len() >= want, "{w}: sizes {sizes:?}");
+        for s in STRATEGIES {
+            let of_s: BTreeSet<&str> = seen
+                .iter()
+                .filter(|k| k.0 == w && k.1 == s)
+                .map(|k| k.2.as_str())
+                .collect();
+            assert_eq!(of_s, sizes, "{w} x {s}");
+        }
+    }
+    let per_combination = records.len() / seen.len();
+    assert_eq!((per_combination, records.len() % seen.len()), (RUNS, 0));
+
+    let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    for w in WORKLOADS {
+        assert!(summary.contains(&format!("## {w}")), "summary lacks {w}");
+        let png = std::fs::read(out.join(format!("{w}.png"))).unwrap();
+        assert!(png.starts_with(b"\x89PNG") && png.len() > 10_000, "{w}.png");
+    }
+    assert!(summary.contains("1 (best)"));
+    // Nothing half-written is left behind.
+    for e in std::fs::read_dir(&out).unwrap() {
+        let name = e.unwrap().file_name().into_string().unwrap();
+        assert!(!name.starts_with('.'), "temporary file {name} left");
+    }
+}
