@@ -10,7 +10,7 @@ use std::process::Command;
 /// Strategies every workload runs under (scheduler strategies with the megakernel once per
 /// queue policy, and the CPU implementation); `--strategy` names as in the records.
 const STRATEGIES: [&str; 4] = ["megakernel", "megakernel-fifo", "multipass", "cpu"];
-const WORKLOADS: [&str; 7] = [
+const WORKLOADS: [&str; 9] = [
     "tree-binary",
     "tree-irregular",
     "tree-deep",
@@ -18,6 +18,8 @@ const WORKLOADS: [&str; 7] = [
     "tree-heavy-work",
     "reyes-teapot",
     "reyes-killeroo",
+    "mandelbrot",
+    "bfs",
 ];
 const RUNS: usize = 2;
 
@@ -53,6 +55,10 @@ fn small_suite_verifies_every_run_and_writes_its_report() {
         }
         assert!(r["wall_ms"].as_f64().unwrap() > 0.0);
         assert!(r["items"].as_u64().unwrap() > 0, "{w} {s} {size}: no items");
+        if w == "bfs" {
+            // Graph runs give GTEPS (the Graph500 traversed edges over the run's time).
+            assert!(r["gteps"].as_f64().unwrap() > 0.0, "{s} {size}: no gteps");
+        }
         if s == "multipass" && w.starts_with("tree") {
             assert!(r["rounds"].as_u64().unwrap() > 0, "{w} {size}: no rounds");
         }
@@ -64,7 +70,7 @@ fn small_suite_verifies_every_run_and_writes_its_report() {
             .filter(|k| k.0 == w)
             .map(|k| k.2.as_str())
             .collect();
-        let want = if w.starts_with("tree") { 2 } else { 1 };
+        let want = if w.starts_with("reyes") { 1 } else { 2 };
         assert!(sizes.len() >= want, "{w}: sizes {sizes:?}");
         for s in STRATEGIES {
             let of_s: BTreeSet<&str> = seen
@@ -75,6 +81,12 @@ fn small_suite_verifies_every_run_and_writes_its_report() {
             assert_eq!(of_s, sizes, "{w} x {s}");
         }
     }
+    // BFS also runs its hand-written frontier baseline, at every size.
+    let frontier = seen
+        .iter()
+        .filter(|k| k.0 == "bfs" && k.1 == "frontier")
+        .count();
+    assert_eq!(frontier, 2, "bfs x frontier");
     let per_combination = records.len() / seen.len();
     assert_eq!((per_combination, records.len() % seen.len()), (RUNS, 0));
 

@@ -7,9 +7,11 @@
 //! cargo run --release --bin schedbench -- --workload tree --strategy all --runs 10
 //! cargo run --release --bin schedbench -- --suite --size small --out report/
 
+mod bfs;
 mod catalog;
 mod cli;
 mod files;
+mod mandelbrot;
 mod plot;
 mod record;
 mod reyes_frames;

@@ -16,6 +16,10 @@ use std::path::Path;
 
 /// Timed runs when `--runs` is not given.
 pub const DEFAULT_RUNS: u32 = 5;
+/// Mandelbrot's image side when `--size-px` is not given (an exact view).
+pub const DEFAULT_SIZE_PX: u32 = 1024;
+/// BFS's R-MAT scale when `--scale` is not given.
+pub const DEFAULT_SCALE: u32 = 20;
 
 /// The workload the command line describes; usage errors exit with status 2.
 fn workload(cli: &Cli) -> Box<dyn Workload> {
@@ -38,9 +42,15 @@ fn workload(cli: &Cli) -> Box<dyn Workload> {
             let name = format!("reyes-{}", cli.scene);
             Box::new(ReyesWorkload::new(name, scene, vec![size], config))
         }
-        w @ (WorkloadName::Mandelbrot | WorkloadName::Bfs) => {
-            Cli::usage_error(ErrorKind::InvalidValue, w.not_built())
-        }
+        WorkloadName::Mandelbrot => Box::new(crate::mandelbrot::single_workload(
+            cli.size_px.unwrap_or(DEFAULT_SIZE_PX),
+            config,
+        )),
+        WorkloadName::Bfs => Box::new(
+            crate::bfs::single_workload(cli.scale.unwrap_or(DEFAULT_SCALE), config).unwrap_or_else(
+                |e| Cli::usage_error(ErrorKind::InvalidValue, format!("--scale: {e}")),
+            ),
+        ),
     }
 }
 

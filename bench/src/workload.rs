@@ -66,6 +66,12 @@ pub trait ScheduledProblem: Clone {
     type Output: PartialEq + Debug;
     /// The GPU resources of one problem (its program, buffers and bind group).
     type Run;
+    /// The problem as `gpu` runs it, called before anything else of a size: e.g. Mandelbrot's
+    /// `fma` arithmetic, which decides its CPU reference, or a check that the input fits the
+    /// device's bindings. Errors fail the size (recorded, the suite goes on). Default: unchanged.
+    fn for_device(&self, _gpu: &Gpu) -> Result<Self, RunError> {
+        Ok(self.clone())
+    }
     /// The parameters in words (records' `params`).
     fn describe(&self) -> String;
     /// The CPU reference (may be single-threaded: it is not timed).
@@ -193,6 +199,7 @@ impl<P: ScheduledProblem> Workload for ProblemWorkload<P> {
 
     fn prepare(&mut self, gpu: &Gpu, i: usize) -> Result<Prepared, String> {
         let (label, p) = self.sizes[i].clone();
+        let p = p.for_device(gpu).map_err(|e| e.to_string())?;
         let reference = p.reference();
         let mut slot = self.slot.borrow_mut();
         let reused = slot.run.as_mut().is_some_and(|r| p.retarget(r));
