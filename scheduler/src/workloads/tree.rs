@@ -60,6 +60,7 @@ pub enum TreePreset {
 }
 
 impl TreePreset {
+    /// Every preset, in the order the benchmark lists them.
     pub const ALL: [TreePreset; 5] = [
         TreePreset::Binary,
         TreePreset::Irregular,
@@ -79,10 +80,12 @@ impl TreePreset {
         }
     }
 
+    /// The preset of a command-line name; `None` for an unknown name.
     pub fn parse(s: &str) -> Option<TreePreset> {
         Self::ALL.into_iter().find(|p| p.name() == s)
     }
 
+    /// The tree the preset names (the benchmark sizes of issue 10's table).
     pub fn params(self) -> TreeParams {
         let binary = TreeParams::binary_benchmark();
         match self {
