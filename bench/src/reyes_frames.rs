@@ -2,8 +2,9 @@
 //! `reyes::gpu_render::GpuRenderer` under each scheduler strategy, and by its CPU twin
 //! `reyes::cpu_render` (one thread) as strategy `cpu`.
 //!
-//! Verification, as the Reyes GPU tests do it: items per procedure and micropolygons equal the
-//! CPU twin's exactly, at most [`CPU_TOLERANCE`] of the pixels differ from the twin's image by
+//! Verification, as the Reyes GPU tests do it: items per procedure equal the CPU twin's
+//! exactly, micropolygons within [`MICROPOLYGON_TOLERANCE`] of the twin's, at most
+//! [`CPU_TOLERANCE`] of the pixels differ from the twin's image by
 //! more than 2/255 (GPU rounding of pow/sqrt), and every GPU strategy's image is bit-identical
 //! to the first one's of the same size (samples combine with atomicMax: the order of work
 //! cannot change them).
@@ -25,6 +26,13 @@ use std::time::Instant;
 
 /// Share of pixels that may differ from the CPU twin's by more than 2/255 (tests/common).
 pub const CPU_TOLERANCE: f64 = 0.002;
+
+/// Relative difference of micropolygon counts allowed against the CPU twin. Dice rates are the
+/// ceiling of f32 screen lengths; a GPU's square root and fused multiply-adds may round a length
+/// to the other side of an integer and change one grid's rate by one. Measured on the H200 at
+/// 1592x1030: 11 of Killeroo's 1,389,858 micropolygons (lavapipe matches exactly; the tests
+/// there demand it). The split decisions, and so the items per procedure, matched exactly.
+pub const MICROPOLYGON_TOLERANCE: f64 = 1e-4;
 
 /// The scenes of the suite: the built-in Utah teapot and Killeroo (from the shared data,
 /// found like the tests find it: `reyes::shared_data_dir`).
@@ -215,7 +223,7 @@ impl Workload for ReyesWorkload {
                     frame.counters[C_MICROPOLYGONS],
                     cur.cpu.counters[C_MICROPOLYGONS],
                 );
-                if mps != cpu_mps {
+                if mps.abs_diff(cpu_mps) as f64 > MICROPOLYGON_TOLERANCE * cpu_mps as f64 {
                     problems.push(format!("{mps} micropolygons, the CPU twin's {cpu_mps}"));
                 }
                 let (max, over) = frame.image.compare(&cur.cpu.image);
