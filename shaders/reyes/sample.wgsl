@@ -53,6 +53,24 @@ fn average_color(a: u32, b: u32, c: u32, d: u32) -> u32 {
     return out;
 }
 
+// No colour: what micropolygon_color gives a culled micropolygon (colours use bits 0..29).
+const CULLED: u32 = 0xffffffffu;
+
+// The flat colour of a micropolygon, the average of its corners' packed colours (in .w); CULLED,
+// and counted, when it is one-sided and all four corners face away.
+fn micropolygon_color(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, two_sided: bool)
+    -> u32 {
+    let ca = bitcast<u32>(a.w);
+    let cb = bitcast<u32>(b.w);
+    let cc = bitcast<u32>(c.w);
+    let cd = bitcast<u32>(d.w);
+    if !two_sided && (ca & cb & cc & cd & (1u << 30u)) != 0u {
+        atomicAdd(&counters[C_BACKFACE], 1u);
+        return CULLED;
+    }
+    return average_color(ca, cb, cc, cd);
+}
+
 // Keeps the nearest of the keys written to sub-sample (sx, sy) of pixel (px, py) of the bucket.
 fn write_sample(px: u32, py: u32, sx: u32, sy: u32, z: f32, color: u32) {
     let key = (u64(~bitcast<u32>(z)) << 32u) | u64(color);
@@ -73,16 +91,8 @@ fn micropolygon_dilation(packed: u32, i: u32, j: u32, nu: u32, nv: u32) -> vec4<
 // `grow`: pixels to grow edges ab, bc, cd and da by (micropolygon_dilation); the diagonal ac,
 // inside the micropolygon, by the least of them.
 fn sample_micropolygon(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, grow: vec4<f32>, two_sided: bool) {
-    let ca = bitcast<u32>(a.w);
-    let cb = bitcast<u32>(b.w);
-    let cc = bitcast<u32>(c.w);
-    let cd = bitcast<u32>(d.w);
-    let back = 1u << 30u;
-    if !two_sided && (ca & cb & cc & cd & back) != 0u {
-        atomicAdd(&counters[C_BACKFACE], 1u);
-        return;
-    }
-    let color = average_color(ca, cb, cc, cd);
+    let color = micropolygon_color(a, b, c, d, two_sided);
+    if color == CULLED { return; }
     let g = max(max(grow.x, grow.y), max(grow.z, grow.w));
     let lo = min(min(a.xy, b.xy), min(c.xy, d.xy)) - vec2<f32>(g);
     let hi = max(max(a.xy, b.xy), max(c.xy, d.xy)) + vec2<f32>(g);
@@ -169,15 +179,8 @@ fn sample_near_clipped(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, g
             two_sided);
         return;
     }
-    let ca = bitcast<u32>(a.w);
-    let cb = bitcast<u32>(b.w);
-    let cc = bitcast<u32>(c.w);
-    let cd = bitcast<u32>(d.w);
-    if !two_sided && (ca & cb & cc & cd & (1u << 30u)) != 0u {
-        atomicAdd(&counters[C_BACKFACE], 1u);
-        return;
-    }
-    let color = average_color(ca, cb, cc, cd);
+    let color = micropolygon_color(a, b, c, d, two_sided);
+    if color == CULLED { return; }
     let g = max(max(grow.x, grow.y), max(grow.z, grow.w));
     sample_clipped_triangle(a.xyz, b.xyz, c.xyz, g, color);
     sample_clipped_triangle(a.xyz, c.xyz, d.xyz, g, color);

@@ -93,6 +93,16 @@ pub fn sample_key(z: f32, color: u32) -> u64 {
     ((!z.to_bits() as u64) << 32) | color as u64
 }
 
+/// `micropolygon_color` in sample.wgsl: the average of the corners' packed colours; `None`
+/// when the micropolygon is one-sided and all four corners face away.
+fn micropolygon_color(q: &[[f32; 4]; 4], two_sided: bool) -> Option<u32> {
+    let c = q.map(|v| v[3].to_bits());
+    if !two_sided && (c[0] & c[1] & c[2] & c[3] & (1 << 30)) != 0 {
+        return None;
+    }
+    Some(average_color(c))
+}
+
 /// Keeps the nearest key at sub-sample (sx, sy) of pixel (px, py) of the bucket.
 fn write_sample(f: &Frame, samples: &mut [u64], [px, py, sx, sy]: [u32; 4], z: f32, color: u32) {
     let pixel = (py - f.tile_y0) * f.tile_w + px - f.tile_x0;
@@ -148,11 +158,9 @@ pub fn sample_micropolygon(
     f: &Frame,
     samples: &mut [u64],
 ) -> bool {
-    let c = q.map(|v| v[3].to_bits());
-    if !two_sided && (c[0] & c[1] & c[2] & c[3] & (1 << 30)) != 0 {
+    let Some(color) = micropolygon_color(&q, two_sided) else {
         return false;
-    }
-    let color = average_color(c);
+    };
     let xy = q.map(|v| Vec2::new(v[0], v[1]));
     let g = grow[0].max(grow[1]).max(grow[2].max(grow[3]));
     let lo = xy[0].min(xy[1]).min(xy[2].min(xy[3])) - Vec2::splat(g);
@@ -222,11 +230,9 @@ pub fn sample_near_clipped(
         });
         return sample_micropolygon(projected, grow, two_sided, f, samples);
     }
-    let c = q.map(|v| v[3].to_bits());
-    if !two_sided && (c[0] & c[1] & c[2] & c[3] & (1 << 30)) != 0 {
+    let Some(color) = micropolygon_color(&q, two_sided) else {
         return false;
-    }
-    let color = average_color(c);
+    };
     let p = q.map(|v| Vec3::new(v[0], v[1], v[2]));
     let g = grow[0].max(grow[1]).max(grow[2].max(grow[3]));
     sample_clipped_triangle(&[p[0], p[1], p[2]], g, color, f, samples);
