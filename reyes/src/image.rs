@@ -54,10 +54,7 @@ impl FrameImage {
     pub fn write_png(&self, path: &Path) -> Result<(), String> {
         let img = image::RgbaImage::from_raw(self.width, self.height, self.rgba8())
             .ok_or("image buffer size mismatch")?;
-        atomic_write(path, |tmp| {
-            img.save_with_format(tmp, image::ImageFormat::Png)
-                .map_err(|e| e.to_string())
-        })
+        crate::output::write_atomic(path, &crate::output::png(&img)?)
     }
 
     /// Linear RGB as PFM (bottom row first, little-endian).
@@ -96,24 +93,6 @@ impl FrameImage {
                 }
             }
         }
-        atomic_write(path, |tmp| {
-            std::fs::write(tmp, &bytes).map_err(|e| e.to_string())
-        })
+        crate::output::write_atomic(path, &bytes)
     }
-}
-
-fn atomic_write(
-    path: &Path,
-    write: impl FnOnce(&Path) -> Result<(), String>,
-) -> Result<(), String> {
-    let name = path
-        .file_name()
-        .ok_or_else(|| format!("{}: not a file name", path.display()))?;
-    let tmp = path.with_file_name(format!(".{}.partial", name.to_string_lossy()));
-    write(&tmp)
-        .and_then(|_| std::fs::rename(&tmp, path).map_err(|e| e.to_string()))
-        .map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            format!("{}: {e}", path.display())
-        })
 }

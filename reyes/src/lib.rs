@@ -8,6 +8,7 @@ pub mod cpu_render;
 pub mod frame;
 pub mod gpu_render;
 pub mod image;
+pub mod output;
 pub mod reference;
 pub mod scene;
 pub mod shaders;

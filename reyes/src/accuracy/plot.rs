@@ -68,9 +68,9 @@ pub fn write_png(
     columns: usize,
     legend: &[(Option<Style>, String)],
 ) -> Result<(), String> {
-    draw(title, panels, columns, legend)
-        .save_with_format(path, image::ImageFormat::Png)
-        .map_err(|e| format!("{}: {e}", path.display()))
+    let png = crate::output::png(&draw(title, panels, columns, legend))
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    crate::output::write_atomic(path, &png)
 }
 
 pub fn draw(

@@ -255,7 +255,7 @@ fn render_frame(
     }
     if let Some(p) = &out.stats {
         let text = serde_json::to_string_pretty(&stats).unwrap();
-        std::fs::write(p, text + "\n").map_err(|e| format!("{}: {e}", p.display()))?;
+        reyes::output::write_atomic(p, (text + "\n").as_bytes())?;
     }
     eprintln!(
         "wrote {} ({}x{}, {}{}: {} grids, {} micropolygons, GPU {} ms, wall {:.1} ms)",

@@ -286,7 +286,7 @@ pub fn main(args: impl Iterator<Item = String>) -> Result<(), String> {
 }
 
 fn write(path: &Path, text: &str) -> Result<(), String> {
-    std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
+    reyes::output::write_atomic(path, text.as_bytes())
 }
 
 /// Pareto fronts per scene: cost against geometric error and against FLIP.
