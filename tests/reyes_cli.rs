@@ -1,5 +1,6 @@
 //! The `reyes` command on bad input: a clear error naming the file and line (or patch), a
-//! failing exit status, and no output file left behind. No GPU is needed: these fail first.
+//! failing exit status (2 for usage errors, 1 for the others), and no output file left behind.
+//! No GPU is needed: these fail first. Also its help and version.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -10,19 +11,33 @@ fn scratch(name: &str) -> PathBuf {
     d
 }
 
-/// Runs `reyes render ARGS` in `dir`; returns (success, stderr).
-fn reyes(dir: &Path, args: &[&str]) -> (bool, String) {
+/// Runs `reyes ARGS` in `dir`; returns (exit code, stdout, stderr).
+fn reyes_any(dir: &Path, args: &[&str]) -> (i32, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_reyes"))
-        .arg("render")
         .args(args)
         .current_dir(dir)
         .env("XDG_RUNTIME_DIR", std::env::temp_dir())
         .output()
         .unwrap();
     (
-        out.status.success(),
+        out.status.code().expect("killed by a signal"),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
+}
+
+/// Runs `reyes render ARGS` in `dir`; returns (exit code, stderr).
+fn render_code(dir: &Path, args: &[&str]) -> (i32, String) {
+    let mut all = vec!["render"];
+    all.extend_from_slice(args);
+    let (code, _, err) = reyes_any(dir, &all);
+    (code, err)
+}
+
+/// Runs `reyes render ARGS` in `dir`; returns (success, stderr).
+fn reyes(dir: &Path, args: &[&str]) -> (bool, String) {
+    let (code, err) = render_code(dir, args);
+    (code == 0, err)
 }
 
 fn patch(points: &[&str]) -> String {
@@ -92,45 +107,147 @@ fn bad_scene_files_name_the_file_and_line_and_write_nothing() {
 #[test]
 fn bad_options_are_clear_errors() {
     let dir = scratch("options");
-    for (args, expected) in [
-        (&["--width", "0"][..], "image size 0x"),
+    // (arguments, expected in stderr, exit code): 2 for usage errors (clap names the flag),
+    // 1 for what the renderer refuses.
+    for (args, expected, code) in [
+        (&["--width", "0"][..], "'--width <PX>'", 2),
         (
             &["--width", "wide"][..],
-            "--width: `wide` is not a valid number",
+            "invalid value 'wide' for '--width <PX>'",
+            2,
         ),
-        (&["--memory-budget", "lots"][..], "--memory-budget: `lots`"),
-        (&["--samples", "0"][..], "pixel samples 0x0"),
-        (&["--strategy", "magic"][..], "unknown strategy `magic`"),
-        (&["--frobnicate"][..], "unknown option `--frobnicate`"),
+        (
+            &["--memory-budget", "lots"][..],
+            "--memory-budget: `lots`",
+            2,
+        ),
+        (&["--samples", "0"][..], "'--samples <N|NxM>'", 2),
+        (&["--strategy", "magic"][..], "unknown strategy `magic`", 2),
+        (
+            &["--frobnicate"][..],
+            "unexpected argument '--frobnicate'",
+            2,
+        ),
+        (&["--runs", "0"][..], "'--runs <N>'", 2),
+        (&["--bound-px", "0"][..], "'--bound-px <PX>'", 2),
+        (&["--mp-size", "inf"][..], "'--mp-size <PX>'", 2),
         // Bounds both render paths share (the CPU twin used to run for minutes, or to
         // allocate tens of GiB).
         (
             &["--cpu", "--mp-size", "1e-30"][..],
             "micropolygon size 1e-30 px is not supported",
+            1,
         ),
-        (&["--mp-size", "1e-30"][..], "micropolygon size 1e-30 px"),
+        (&["--mp-size", "1e-30"][..], "micropolygon size 1e-30 px", 1),
         (
             &["--cpu", "--width", "16384", "--height", "16384"][..],
             "needs 4294967296 bytes of RGBA",
+            1,
         ),
-        (&["--cpu", "--bound-px", "0.01"][..], "screen bound 0.01 px"),
+        (
+            &["--cpu", "--bound-px", "0.01"][..],
+            "screen bound 0.01 px",
+            1,
+        ),
         (
             &["--frames", "3-2"][..],
             "--frames: the range `3-2` is empty",
+            2,
         ),
         (
             &["--frames", "2"][..],
             "--frames selects none of the file's frames (1)",
+            1,
         ),
     ] {
-        let (ok, err) = reyes(&dir, args);
-        assert!(!ok, "{args:?} succeeded");
+        let (got, err) = render_code(&dir, args);
+        assert_eq!(got, code, "{args:?}: {err}");
         assert!(
             err.contains(expected),
             "{args:?}: expected `{expected}` in:\n{err}"
         );
     }
     assert!(!dir.join("teapot.png").exists());
+}
+
+/// What the CPU twin would ignore is refused, naming both flags; what it uses is taken.
+#[test]
+fn cpu_refuses_the_gpu_options() {
+    let dir = scratch("cpu");
+    for flag in [
+        &["--runs", "5"][..],
+        &["--strategy", "multipass"],
+        &["--stage-times"],
+        &["--stats", "s.json"],
+        &["--float", "f.pfm"],
+        &["--depth", "d.pfm"],
+    ] {
+        let mut args = vec!["--cpu"];
+        args.extend_from_slice(flag);
+        let (code, err) = render_code(&dir, &args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(
+            err.contains("'--cpu'") && err.contains(flag[0]),
+            "{args:?}: {err}"
+        );
+    }
+    assert!(!dir.join("teapot.png").exists() && !dir.join("s.json").exists());
+    // measure and sweep time the GPU: no --cpu at all.
+    for cmd in ["measure", "sweep"] {
+        let (code, _, err) = reyes_any(&dir, &[cmd, "--cpu"]);
+        assert_eq!(code, 2, "{cmd}: {err}");
+        assert!(err.contains("'--cpu'"), "{cmd}: {err}");
+    }
+}
+
+/// `--help` (top level and each subcommand) and `--version` print to stdout and exit 0; the
+/// help shows defaults and units. Without a subcommand: the help on stderr, exit 2.
+#[test]
+fn help_and_version() {
+    let dir = scratch("help");
+    let (code, out, err) = reyes_any(&dir, &["--help"]);
+    assert_eq!(code, 0, "{err}");
+    for cmd in ["render", "measure", "sweep", "drift"] {
+        assert!(out.contains(cmd), "{out}");
+    }
+    let (code, out, _) = reyes_any(&dir, &["--version"]);
+    assert_eq!(code, 0);
+    assert_eq!(out.trim(), format!("reyes {}", env!("CARGO_PKG_VERSION")));
+    for (cmd, expected) in [
+        ("render", "--memory-budget <BYTES[K|M|G]>"),
+        ("render", "[default: 1]"),
+        ("measure", "--ref-samples <N>"),
+        ("sweep", "[default: 0.5,0.71,1,1.41,2,4]"),
+        ("drift", "[default: 1920]"),
+    ] {
+        let (code, out, err) = reyes_any(&dir, &[cmd, "--help"]);
+        assert_eq!(code, 0, "{cmd}: {err}");
+        assert!(out.contains(expected), "{cmd}: `{expected}` not in:\n{out}");
+    }
+    let (code, out, err) = reyes_any(&dir, &[]);
+    assert_eq!(code, 2);
+    assert!(
+        out.is_empty() && err.contains("Usage: reyes <COMMAND>"),
+        "{err}"
+    );
+}
+
+/// A bad value names its flag and exits 2, in every subcommand.
+#[test]
+fn bad_values_name_their_flag() {
+    let dir = scratch("values");
+    for args in [
+        &["render", "--height", "-3"][..],
+        &["measure", "--ref-samples", "65"],
+        &["sweep", "--mp-sizes", "1,nan"],
+        &["sweep", "--runs", "0"],
+        &["drift", "--paths", "many"],
+    ] {
+        let (code, _, err) = reyes_any(&dir, args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        let flag = args.iter().find(|a| a.starts_with("--")).unwrap();
+        assert!(err.contains(&format!("'{flag} <")), "{args:?}: {err}");
+    }
 }
 
 /// The field input `empty-world.rib` (a world with nothing drawable): every way of rendering it
@@ -213,18 +330,19 @@ fn frame_sequences_write_one_image_per_frame() {
         ok && dir.join("g.02.png").exists() && dir.join("g.03.png").exists(),
         "{err}"
     );
-    // Several frames need a pattern for --stats; a missing folder fails before rendering.
+    // Several frames need a pattern for --stats (which the GPU path writes: both fail before
+    // the GPU is opened); a missing folder fails before rendering.
     for (args, expected) in [
         (
             &["--stats", "s.json"][..],
             "--stats: several frames are rendered",
         ),
         (
-            &["-o", "nowhere/x.png"][..],
+            &["--cpu", "-o", "nowhere/x.png"][..],
             "the folder nowhere does not exist",
         ),
     ] {
-        let mut all = vec![scene.as_str(), "--cpu", "--frames", "1-2"];
+        let mut all = vec![scene.as_str(), "--frames", "1-2"];
         all.extend_from_slice(args);
         let (ok, err) = reyes(&dir, &all);
         assert!(!ok && err.contains(expected), "{args:?}: {err}");
@@ -315,8 +433,9 @@ fn hostile_files_fail_clearly_and_write_nothing() {
             "deep.rib:1025: `AttributeBegin`: blocks nested deeper than 1024",
         ),
     ] {
-        for way in [&["--cpu"][..], &[]] {
-            let mut args = vec![scene.as_str(), "-o", "out.png", "--stats", "s.json"];
+        // --stats is the GPU path's (--cpu refuses it).
+        for way in [&["--cpu"][..], &["--stats", "s.json"]] {
+            let mut args = vec![scene.as_str(), "-o", "out.png"];
             args.extend_from_slice(way);
             let (ok, err) = reyes(&dir, &args);
             assert!(!ok, "{scene}: succeeded");

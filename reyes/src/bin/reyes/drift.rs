@@ -2,39 +2,20 @@
 //! GPU's f32 splits drift from exact f64 subdivision, per split depth, in pixels (see
 //! `reyes::accuracy::drift`), and how deep the scene really splits (CPU pipeline).
 
+use crate::cli::DriftCmd;
 use reyes::accuracy::drift::{self, PathOptions};
 use reyes::cpu_render::render_cpu;
 use reyes::frame::{FrameData, RenderOptions};
 use reyes::scene;
-use std::path::PathBuf;
 
-pub const USAGE: &str = "usage: reyes drift [SCENE.rib|teapot|.bpt] [--width N] [--height N] \
-                         [--paths N] [--seed N] [--json]\n  (default size 1920x1080)";
-
-/// Runs the subcommand on the arguments after `drift`.
-pub fn main(args: impl Iterator<Item = String>) -> Result<(), String> {
-    let mut scene_path: Option<PathBuf> = None;
-    let (mut width, mut height) = (1920u32, 1080u32);
-    let mut o = PathOptions::default();
-    let mut as_json = false;
-    let mut it = args;
-    fn num<T: std::str::FromStr>(v: Option<String>, flag: &str) -> Result<T, String> {
-        let v = v.ok_or_else(|| format!("{flag} needs a value"))?;
-        v.parse()
-            .map_err(|_| format!("{flag}: `{v}` is not a valid number"))
-    }
-    while let Some(a) = it.next() {
-        match a.as_str() {
-            "--width" => width = num(it.next(), "--width")?,
-            "--height" => height = num(it.next(), "--height")?,
-            "--paths" => o.random_paths = num(it.next(), "--paths")?,
-            "--seed" => o.seed = num(it.next(), "--seed")?,
-            "--json" => as_json = true,
-            "-h" | "--help" => return Err(USAGE.into()),
-            s if s.starts_with('-') => return Err(format!("unknown option `{s}`\n{USAGE}")),
-            s => scene_path = Some(PathBuf::from(s)),
-        }
-    }
+/// Runs the subcommand.
+pub fn main(a: DriftCmd) -> Result<(), String> {
+    let (width, height, as_json) = (a.width, a.height, a.json);
+    let o = PathOptions {
+        random_paths: a.paths,
+        seed: a.seed,
+    };
+    let scene_path = a.scene;
     let (scene, name) = match &scene_path {
         None => (scene::builtin_teapot(), "teapot".to_string()),
         Some(p) if p.as_os_str() == "teapot" => (scene::builtin_teapot(), "teapot".to_string()),

@@ -1,10 +1,11 @@
 //! `reyes measure [SCENE] [render options] [--ref-samples N] [--reference-png OUT.png] [--json]`:
-//! renders on the GPU
-//! (a warm-up frame, 0.5 s of full GPU load (clocks), one more frame, then `--runs N` timed ones, median reported) and measures the frame
+//! renders on the GPU (a warm-up frame, 0.5 s of full GPU load (clocks), one more frame, then
+//! `--runs N` timed ones, median reported) and measures the frame
 //! against the exact surfaces (`reyes::accuracy`): geometric error and size of the
 //! micropolygons, PSNR and FLIP against an f64 reference render, pinholes.
 
-use reyes::accuracy::exact_image::{DEFAULT_SAMPLES_PER_AXIS, ReferenceImage, render_reference};
+use crate::cli::MeasureCmd;
+use reyes::accuracy::exact_image::{ReferenceImage, render_reference};
 use reyes::accuracy::geometry::geometry;
 use reyes::accuracy::image_error::image_error;
 use reyes::accuracy::measure::{Measurement, pinhole_count};
@@ -14,9 +15,6 @@ use reyes::scene::{self, Scene};
 use reyes::stats::frame_stats;
 use scheduler::Gpu;
 use std::path::Path;
-
-pub const USAGE: &str = "usage: reyes measure [SCENE.rib|teapot|.bpt] [render options] \
-                         [--ref-samples N] [--reference-png OUT.png] [--json]";
 
 /// The scene named on the command line (none or `teapot`: the built-in teapot) and a short
 /// name for it.
@@ -34,19 +32,6 @@ pub fn load_scene(path: Option<&Path>) -> Result<(Scene, String), String> {
     }
 }
 
-/// Takes `flag VALUE` out of `args` (its last occurrence wins).
-pub fn take_value(args: &mut Vec<String>, flag: &str) -> Result<Option<String>, String> {
-    let mut value = None;
-    while let Some(i) = args.iter().position(|a| a == flag) {
-        if i + 1 >= args.len() {
-            return Err(format!("{flag} needs a value"));
-        }
-        value = Some(args.remove(i + 1));
-        args.remove(i);
-    }
-    Ok(value)
-}
-
 /// [`GpuRenderer::timed_frames`]: the last frame and each timed frame's GPU and wall ms.
 pub fn timed_frames(
     gpu: &Gpu,
@@ -60,31 +45,17 @@ pub fn timed_frames(
     Ok((t.last, t.gpu_ms, t.wall_ms))
 }
 
-pub fn main(args: impl Iterator<Item = String>) -> Result<(), String> {
-    let mut args: Vec<String> = args.collect();
-    let json = args.iter().any(|a| a == "--json");
-    args.retain(|a| a != "--json");
-    let ref_samples = match take_value(&mut args, "--ref-samples")? {
-        Some(v) => v
-            .parse::<u32>()
-            .ok()
-            .filter(|n| (1..=64).contains(n))
-            .ok_or(format!("--ref-samples: `{v}` is not 1..=64"))?,
-        None => DEFAULT_SAMPLES_PER_AXIS,
-    };
-    let reference_png = take_value(&mut args, "--reference-png")?;
-    let a = crate::parse(args.into_iter()).map_err(|e| format!("{e}\n{USAGE}"))?;
-    if a.cpu {
-        return Err("measure times the GPU renderer; --cpu does not apply".into());
-    }
+/// Runs the subcommand.
+pub fn main(a: MeasureCmd) -> Result<(), String> {
+    let (json, ref_samples, reference_png) = (a.json, a.ref_samples, &a.reference_png);
     let (scene, name) = load_scene(a.scene.as_deref())?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
-    let data = FrameData::new(&scene, &a.options)?;
+    let data = FrameData::new(&scene, &a.render.options())?;
     let gpu = Gpu::from_env_requiring(required_features()).map_err(|e| e.to_string())?;
-    let renderer = GpuRenderer::new(&gpu, a.strategy).map_err(|e| e.to_string())?;
-    let (frame, gpu_ms, wall_ms) = timed_frames(&gpu, &renderer, &data, a.runs)?;
+    let renderer = GpuRenderer::new(&gpu, a.render.strategy).map_err(|e| e.to_string())?;
+    let (frame, gpu_ms, wall_ms) = timed_frames(&gpu, &renderer, &data, a.render.runs)?;
     let mut stats = frame_stats(&data, &frame, &gpu.adapter_name(), &scene.warnings);
     let gpu_ms: Vec<f64> = gpu_ms.into_iter().flatten().collect();
     if !gpu_ms.is_empty() {
@@ -97,7 +68,7 @@ pub fn main(args: impl Iterator<Item = String>) -> Result<(), String> {
     let (w, h) = (data.frame.width, data.frame.height);
     let reference: ReferenceImage = render_reference(&scene, w, h, ref_samples);
     if let Some(p) = &reference_png {
-        reference.image.write_png(Path::new(p))?;
+        reference.image.write_png(p)?;
     }
     let t = std::time::Instant::now();
     let geom = geometry(&scene, &data);
@@ -115,7 +86,7 @@ pub fn main(args: impl Iterator<Item = String>) -> Result<(), String> {
         reference: &reference,
     };
     let mut out = m.json();
-    out["runs"] = a.runs.max(1).into();
+    out["runs"] = a.render.runs.max(1).into();
     out["metrics_cpu_ms"] = serde_json::json!({
         "reference": reference.cpu_ms,
         "geometry": geometry_ms,

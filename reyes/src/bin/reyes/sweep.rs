@@ -9,8 +9,9 @@
 //! image metrics per image (the strategies give bit-identical images; if they did not, each
 //! image would be measured on its own).
 
-use crate::measure::{load_scene, take_value, timed_frames};
-use reyes::accuracy::exact_image::{DEFAULT_SAMPLES_PER_AXIS, render_reference};
+use crate::cli::SweepCmd;
+use crate::measure::{load_scene, timed_frames};
+use reyes::accuracy::exact_image::render_reference;
 use reyes::accuracy::geometry::{GeometryStats, geometry};
 use reyes::accuracy::image_error::{ImageError, composite_srgb8, srgb8_errors};
 use reyes::accuracy::measure::pinhole_count;
@@ -24,10 +25,6 @@ use scheduler::stats::median_and_mad;
 use scheduler::{Gpu, StrategyKind};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-
-pub const USAGE: &str = "usage: reyes sweep [--scenes teapot,killeroo|PATH,..] [--out DIR]
-  [--width N] [--height N] [--runs N] [--ref-samples N] [--mp-sizes 0.5,1,..]
-  [--bound-px 8,..|none] [--samples 1,2x2,4,..] [--strategies megakernel,multipass]";
 
 /// How grids are diced: adaptively to a micropolygon size, or split to a fixed screen bound
 /// and diced 16x16.
@@ -58,64 +55,23 @@ struct Config {
     strategies: Vec<StrategyKind>,
 }
 
-fn list<T>(v: &str, flag: &str, f: impl Fn(&str) -> Option<T>) -> Result<Vec<T>, String> {
-    v.split(',')
-        .filter(|s| !s.is_empty())
-        .map(|s| f(s.trim()).ok_or(format!("{flag}: `{s}` is not valid")))
-        .collect()
-}
-
-fn samples(s: &str) -> Option<(u32, u32)> {
-    let (x, y) = s.split_once('x').unwrap_or((s, s));
-    Some((x.parse().ok()?, y.parse().ok()?))
-}
-
-fn parse(args: impl Iterator<Item = String>) -> Result<Config, String> {
-    let mut args: Vec<String> = args.collect();
-    let mut take = |flag: &str| take_value(&mut args, flag);
-    let num = |v: Option<String>, flag: &str, default: u32| -> Result<u32, String> {
-        v.map_or(Ok(default), |v| {
-            v.parse()
-                .ok()
-                .filter(|&n| n > 0)
-                .ok_or(format!("{flag}: `{v}` is not a positive number"))
-        })
-    };
-    let scenes = take("--scenes")?.unwrap_or("teapot,killeroo".into());
-    let out = take("--out")?.unwrap_or("sweep".into());
-    let width = num(take("--width")?, "--width", 1920)?;
-    let height = num(take("--height")?, "--height", 1080)?;
-    let runs = num(take("--runs")?, "--runs", 5)?;
-    let ref_samples = num(
-        take("--ref-samples")?,
-        "--ref-samples",
-        DEFAULT_SAMPLES_PER_AXIS,
-    )?;
-    let mp = take("--mp-sizes")?.unwrap_or("0.5,0.71,1,1.41,2,4".into());
-    let bound = take("--bound-px")?.unwrap_or("8".into());
-    let spp = take("--samples")?.unwrap_or("1,2,4".into());
-    let strategies = take("--strategies")?.unwrap_or("megakernel,multipass".into());
-    if let Some(a) = args.first() {
-        return Err(format!("unknown argument `{a}`\n{USAGE}"));
+impl Config {
+    /// The sweep's settings from its command line.
+    fn new(a: SweepCmd) -> Config {
+        let mut dicings: Vec<Dicing> = a.mp_sizes.into_iter().map(Dicing::MpSize).collect();
+        dicings.extend(a.bound_px.0.into_iter().map(Dicing::BoundPx));
+        Config {
+            scenes: a.scenes.into_iter().filter(|s| !s.is_empty()).collect(),
+            out: a.out,
+            width: a.width,
+            height: a.height,
+            runs: a.runs,
+            ref_samples: a.ref_samples,
+            dicings,
+            samples: a.samples,
+            strategies: a.strategies,
+        }
     }
-    let positive = |s: &str| s.parse::<f32>().ok().filter(|v| *v > 0.0);
-    let mut dicings: Vec<Dicing> = list(&mp, "--mp-sizes", |s| positive(s).map(Dicing::MpSize))?;
-    if bound != "none" {
-        dicings.extend(list(&bound, "--bound-px", |s| {
-            positive(s).map(Dicing::BoundPx)
-        })?);
-    }
-    Ok(Config {
-        scenes: list(&scenes, "--scenes", |s| Some(s.to_string()))?,
-        out: out.into(),
-        width,
-        height,
-        runs,
-        ref_samples,
-        dicings,
-        samples: list(&spp, "--samples", samples)?,
-        strategies: list(&strategies, "--strategies", StrategyKind::parse)?,
-    })
 }
 
 /// `teapot` (built in), `killeroo` (the shared scene) or a path.
@@ -153,8 +109,9 @@ impl Row {
     }
 }
 
-pub fn main(args: impl Iterator<Item = String>) -> Result<(), String> {
-    let c = parse(args)?;
+/// Runs the subcommand.
+pub fn main(a: SweepCmd) -> Result<(), String> {
+    let c = Config::new(a);
     std::fs::create_dir_all(&c.out).map_err(|e| format!("{}: {e}", c.out.display()))?;
     let gpu = Gpu::from_env_requiring(required_features()).map_err(|e| e.to_string())?;
     let adapter = gpu.adapter_name();

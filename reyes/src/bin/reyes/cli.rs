@@ -1,0 +1,425 @@
+//! The command line (clap derive): subcommands, flags, defaults, units and ranges. Usage errors
+//! (an unknown flag, a value out of range, options that conflict) exit with status 2 and name
+//! the flag; `--help` and `--version` print to stdout and exit 0. Errors found later (a bad
+//! scene file, a GPU error, a setting the renderer cannot make) are the subcommands' own and
+//! exit 1.
+
+use clap::{Args, Parser, Subcommand, value_parser};
+use reyes::accuracy::drift::PathOptions;
+use reyes::accuracy::exact_image::DEFAULT_SAMPLES_PER_AXIS;
+use reyes::frame::RenderOptions;
+use reyes::scene::FrameRanges;
+use scheduler::StrategyKind;
+use std::path::PathBuf;
+
+const SEQUENCES: &str = "Frame sequences: a RIB file of several frames writes each frame's \
+Display name into -o's folder, or -o NAME.####.png (#### = the frame number, zero-padded; \
+also for --stats, --float, --depth, which need a #### when several frames are rendered).";
+
+/// Renders RenderMan RIB, Newell and BPT scenes with the Reyes pipeline on the scheduler, and
+/// measures the result against the exact surfaces.
+#[derive(Debug, Parser)]
+#[command(name = "reyes", version, arg_required_else_help = true)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// Each takes negative numbers as values (`--height -3` is a bad height, not a flag `-3`), and a
+/// flag given twice takes its last value (as the hand-written parser did).
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Render a scene to PNG (the built-in teapot without a file).
+    #[command(after_help = SEQUENCES, allow_negative_numbers = true, args_override_self = true)]
+    Render(RenderCmd),
+    /// A frame's geometric and image error against the exact surfaces (GPU render), printed
+    /// as a table or JSON.
+    #[command(allow_negative_numbers = true, args_override_self = true)]
+    Measure(MeasureCmd),
+    /// Speed against error over quality settings: writes sweep.csv, sweep.md and sweep.png.
+    #[command(allow_negative_numbers = true, args_override_self = true)]
+    Sweep(SweepCmd),
+    /// f32 split drift against f64 over 0-24 split levels, in pixels (CPU).
+    #[command(allow_negative_numbers = true, args_override_self = true)]
+    Drift(DriftCmd),
+}
+
+impl Command {
+    /// The subcommand's name, for error messages.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Command::Render(_) => "render",
+            Command::Measure(_) => "measure",
+            Command::Sweep(_) => "sweep",
+            Command::Drift(_) => "drift",
+        }
+    }
+}
+
+/// The options of one rendered frame, shared by `render` and `measure`.
+#[derive(Debug, Clone, Args)]
+pub struct RenderArgs {
+    /// Image width in pixels [default: the scene's Format].
+    #[arg(long, value_name = "PX", value_parser = value_parser!(u32).range(1..))]
+    pub width: Option<u32>,
+
+    /// Image height in pixels [default: the scene's Format].
+    #[arg(long, value_name = "PX", value_parser = value_parser!(u32).range(1..))]
+    pub height: Option<u32>,
+
+    /// Pixel samples per axis: N (NxN) or NxM, each >= 1 [default: the scene's PixelSamples].
+    #[arg(long, value_name = "N|NxM", value_parser = parse_samples)]
+    pub samples: Option<(u32, u32)>,
+
+    /// Target micropolygon edge in pixels (RenderMan's shading rate is its square).
+    #[arg(long, value_name = "PX", default_value_t = RenderOptions::default().mp_size,
+          value_parser = positive_f32)]
+    pub mp_size: f32,
+
+    /// Dice by Patney & Owens' fixed rule instead: split to this screen bound in pixels, then
+    /// dice 16x16 [default: off, adaptive dicing to --mp-size].
+    #[arg(long, value_name = "PX", value_parser = positive_f32)]
+    pub bound_px: Option<f32>,
+
+    /// Most split levels of a patch.
+    #[arg(long, value_name = "N", default_value_t = RenderOptions::default().max_depth)]
+    pub max_depth: u32,
+
+    /// Working memory (sample buffer plus queues) a frame may use, in bytes with an optional
+    /// binary suffix K, M or G (64K, 16M, 1G); beyond it the frame renders in screen buckets
+    /// [default: no limit, one bucket].
+    #[arg(long, value_name = "BYTES[K|M|G]", value_parser = parse_bytes)]
+    pub memory_budget: Option<u64>,
+
+    /// Do not grow micropolygons to close cracks (for comparisons only).
+    #[arg(long)]
+    pub no_crack_dilation: bool,
+
+    /// GPU strategy: megakernel, multipass or multipass-host.
+    #[arg(long, value_name = "NAME", default_value = "megakernel", value_parser = parse_strategy)]
+    pub strategy: StrategyKind,
+
+    /// GPU frames to time (N > 1: after a warm-up; median ± MAD reported).
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = value_parser!(u32).range(1..))]
+    pub runs: u32,
+}
+
+impl RenderArgs {
+    /// The renderer's options (the others at their defaults).
+    pub fn options(&self) -> RenderOptions {
+        RenderOptions {
+            width: self.width,
+            height: self.height,
+            pixel_samples: self.samples,
+            mp_size: self.mp_size,
+            bound_px: self.bound_px,
+            max_depth: self.max_depth,
+            memory_budget: self.memory_budget,
+            crack_dilation: !self.no_crack_dilation,
+            ..RenderOptions::default()
+        }
+    }
+}
+
+/// `reyes render`.
+#[derive(Debug, Args)]
+pub struct RenderCmd {
+    /// A RIB (.rib, .rib.gz), Newell or .bpt scene file, or `teapot` (built in)
+    /// [default: teapot].
+    #[arg(value_name = "SCENE")]
+    pub scene: Option<PathBuf>,
+
+    /// Output PNG [default: SCENE's stem .png; for sequences see below].
+    #[arg(short = 'o', long = "output", value_name = "OUT.png")]
+    pub out: Option<PathBuf>,
+
+    /// Write what the render did (counts, times, warnings) as JSON.
+    #[arg(long, value_name = "OUT.json")]
+    pub stats: Option<PathBuf>,
+
+    /// Write the linear float image as PFM.
+    #[arg(long, value_name = "OUT.pfm")]
+    pub float: Option<PathBuf>,
+
+    /// Write the depth image as PFM.
+    #[arg(long, value_name = "OUT.pfm")]
+    pub depth: Option<PathBuf>,
+
+    /// Multipass: time each procedure's passes on their own.
+    #[arg(long)]
+    pub stage_times: bool,
+
+    /// Render on the CPU reference instead of the GPU: writes the PNG only (not with --strategy,
+    /// --runs, --stage-times, --stats, --float or --depth).
+    #[arg(long, conflicts_with_all = ["strategy", "runs", "stage_times", "stats", "float", "depth"])]
+    pub cpu: bool,
+
+    /// Frames of a sequence to render: N, A-B or a comma list of them (2-3, 2, 1,3)
+    /// [default: all].
+    #[arg(long, value_name = "N|A-B|A,B,..", value_parser = FrameRanges::parse)]
+    pub frames: Option<FrameRanges>,
+
+    #[command(flatten)]
+    pub render: RenderArgs,
+}
+
+/// `reyes measure`: a warm-up frame, 0.5 s of full GPU load (clocks), one more frame, then
+/// `--runs` timed ones (median reported).
+#[derive(Debug, Args)]
+pub struct MeasureCmd {
+    /// A RIB (.rib, .rib.gz), Newell or .bpt scene file, or `teapot` (built in)
+    /// [default: teapot].
+    #[arg(value_name = "SCENE")]
+    pub scene: Option<PathBuf>,
+
+    /// Also write the GPU frame as PNG.
+    #[arg(short = 'o', long = "output", value_name = "OUT.png")]
+    pub out: Option<PathBuf>,
+
+    /// Samples per pixel axis of the f64 reference render on the exact surfaces (1..=64).
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_SAMPLES_PER_AXIS,
+          value_parser = value_parser!(u32).range(1..=64))]
+    pub ref_samples: u32,
+
+    /// Write the reference render as PNG.
+    #[arg(long, value_name = "OUT.png")]
+    pub reference_png: Option<PathBuf>,
+
+    /// Print one JSON object instead of the table.
+    #[arg(long)]
+    pub json: bool,
+
+    #[command(flatten)]
+    pub render: RenderArgs,
+}
+
+/// `reyes sweep`: every scene x dicing setting x sample count x strategy. Its lists differ
+/// from one frame's options (and its sizes default to 1920x1080), so it has its own flags.
+#[derive(Debug, Args)]
+pub struct SweepCmd {
+    /// Scenes: teapot (built in), killeroo (the shared data's) or scene file paths.
+    #[arg(
+        long,
+        value_name = "NAME|PATH,..",
+        value_delimiter = ',',
+        default_value = "teapot,killeroo"
+    )]
+    pub scenes: Vec<String>,
+
+    /// Output folder for sweep.csv, sweep.md and sweep.png (created if missing).
+    #[arg(long, value_name = "DIR", default_value = "sweep")]
+    pub out: PathBuf,
+
+    /// Image width in pixels.
+    #[arg(long, value_name = "PX", default_value_t = 1920, value_parser = value_parser!(u32).range(1..))]
+    pub width: u32,
+
+    /// Image height in pixels.
+    #[arg(long, value_name = "PX", default_value_t = 1080, value_parser = value_parser!(u32).range(1..))]
+    pub height: u32,
+
+    /// Timed GPU frames per setting, after a warm-up (median ± MAD reported).
+    #[arg(long, value_name = "N", default_value_t = 5, value_parser = value_parser!(u32).range(1..))]
+    pub runs: u32,
+
+    /// Samples per pixel axis of the f64 reference render.
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_SAMPLES_PER_AXIS,
+          value_parser = value_parser!(u32).range(1..))]
+    pub ref_samples: u32,
+
+    /// Adaptive dicing: target micropolygon edges in pixels.
+    #[arg(long, value_name = "PX,..", value_delimiter = ',', default_value = "0.5,0.71,1,1.41,2,4",
+          value_parser = positive_f32)]
+    pub mp_sizes: Vec<f32>,
+
+    /// Fixed-bound dicing (split to the bound, dice 16x16): screen bounds in pixels, or none.
+    #[arg(long, value_name = "PX,..|none", default_value = "8", value_parser = parse_bounds)]
+    pub bound_px: Bounds,
+
+    /// Pixel samples per axis: N (NxN) or NxM, each >= 1 (the scene's own count is always
+    /// added).
+    #[arg(long, value_name = "N|NxM,..", value_delimiter = ',', default_value = "1,2,4",
+          value_parser = parse_samples)]
+    pub samples: Vec<(u32, u32)>,
+
+    /// GPU strategies: megakernel, multipass, multipass-host.
+    #[arg(long, value_name = "NAME,..", value_delimiter = ',', default_value = "megakernel,multipass",
+          value_parser = parse_strategy)]
+    pub strategies: Vec<StrategyKind>,
+}
+
+/// `--bound-px` of `sweep`: a list of positive screen bounds (px), empty for `none`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bounds(pub Vec<f32>);
+
+/// `reyes drift`.
+#[derive(Debug, Args)]
+pub struct DriftCmd {
+    /// A RIB (.rib, .rib.gz), Newell or .bpt scene file, or `teapot` (built in)
+    /// [default: teapot].
+    #[arg(value_name = "SCENE")]
+    pub scene: Option<PathBuf>,
+
+    /// Image width in pixels.
+    #[arg(long, value_name = "PX", default_value_t = 1920, value_parser = value_parser!(u32).range(1..))]
+    pub width: u32,
+
+    /// Image height in pixels.
+    #[arg(long, value_name = "PX", default_value_t = 1080, value_parser = value_parser!(u32).range(1..))]
+    pub height: u32,
+
+    /// Random-direction split paths per patch, besides the two alternating ones.
+    #[arg(long, value_name = "N", default_value_t = PathOptions::default().random_paths)]
+    pub paths: usize,
+
+    /// Seed of the random paths.
+    #[arg(long, value_name = "N", default_value_t = PathOptions::default().seed)]
+    pub seed: u64,
+
+    /// Print one JSON object instead of the tables.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `N` (NxN) or `NxM`, each >= 1.
+fn parse_samples(v: &str) -> Result<(u32, u32), String> {
+    let (x, y) = v.split_once('x').unwrap_or((v, v));
+    let p = |s: &str| s.trim().parse::<u32>().ok().filter(|&n| n >= 1);
+    p(x).zip(p(y))
+        .ok_or(format!("`{v}` is not N or NxM with N, M >= 1"))
+}
+
+/// A finite number > 0.
+fn positive_f32(v: &str) -> Result<f32, String> {
+    v.trim()
+        .parse::<f32>()
+        .ok()
+        .filter(|x| x.is_finite() && *x > 0.0)
+        .ok_or(format!("`{v}` is not a finite number > 0"))
+}
+
+/// A byte count with an optional binary suffix: 512K, 64M, 2G.
+fn parse_bytes(v: &str) -> Result<u64, String> {
+    let (digits, shift) = match v.to_ascii_uppercase().chars().last() {
+        Some('K') => (&v[..v.len() - 1], 10),
+        Some('M') => (&v[..v.len() - 1], 20),
+        Some('G') => (&v[..v.len() - 1], 30),
+        _ => (v, 0),
+    };
+    match digits.parse::<u64>() {
+        Ok(n) if n > 0 && n.leading_zeros() >= shift => Ok(n << shift),
+        _ => Err(format!(
+            "--memory-budget: `{v}` is not a positive byte count like 64M"
+        )),
+    }
+}
+
+fn parse_strategy(v: &str) -> Result<StrategyKind, String> {
+    StrategyKind::parse(v).ok_or_else(|| {
+        let names: Vec<&str> = StrategyKind::ALL.iter().map(|k| k.name()).collect();
+        format!("unknown strategy `{v}` (one of {})", names.join(", "))
+    })
+}
+
+fn parse_bounds(v: &str) -> Result<Bounds, String> {
+    if v == "none" {
+        return Ok(Bounds(Vec::new()));
+    }
+    v.split(',')
+        .filter(|s| !s.is_empty())
+        .map(positive_f32)
+        .collect::<Result<_, _>>()
+        .map(Bounds)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    fn parse(args: &[&str]) -> Result<Cli, clap::Error> {
+        Cli::try_parse_from(std::iter::once("reyes").chain(args.iter().copied()))
+    }
+
+    #[test]
+    fn the_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn values_parse_and_ranges_are_checked() {
+        let Command::Render(r) = parse(&[
+            "render",
+            "s.rib",
+            "--samples",
+            "2x3",
+            "--memory-budget",
+            "64K",
+            "--frames",
+            "1,3",
+        ])
+        .unwrap()
+        .command
+        else {
+            panic!("not render")
+        };
+        assert_eq!(r.scene, Some("s.rib".into()));
+        assert_eq!(r.render.samples, Some((2, 3)));
+        assert_eq!(r.render.memory_budget, Some(64 << 10));
+        assert!(r.frames.unwrap().contains(3));
+        assert_eq!(r.render.options().mp_size, 1.0);
+        assert_eq!(parse_samples("4"), Ok((4, 4)));
+        assert_eq!(parse_bytes("1G"), Ok(1 << 30));
+        for bad in [
+            &["render", "--width", "0"][..],
+            &["render", "--runs", "0"],
+            &["render", "--bound-px", "0"],
+            &["render", "--height", "-3"],
+            &["render", "--mp-size", "inf"],
+            &["render", "--mp-size", "NaN"],
+            &["render", "--samples", "0x2"],
+            &["render", "--memory-budget", "0"],
+            &["render", "--memory-budget", "99999999999G"],
+            &["render", "--cpu", "--runs", "5"],
+            &["render", "--cpu", "--strategy", "multipass"],
+            &["render", "--cpu", "--stats", "s.json"],
+            &["measure", "--cpu"],
+            &["measure", "--ref-samples", "65"],
+            &["sweep", "--mp-sizes", "1,-1"],
+            &["sweep", "--strategies", "megakernel,magic"],
+            &["drift", "--height", "0"],
+            &[],
+        ] {
+            let e = parse(bad).map(|_| ()).unwrap_err();
+            assert_eq!(e.exit_code(), 2, "{bad:?}: {e}");
+        }
+        // A flag given twice: the last value.
+        let Command::Drift(d) = parse(&["drift", "--width", "5", "--width", "7"])
+            .unwrap()
+            .command
+        else {
+            panic!("not drift")
+        };
+        assert_eq!(d.width, 7);
+        // --cpu takes what the CPU twin uses.
+        assert!(parse(&["render", "--cpu", "--memory-budget", "64K", "--frames", "2"]).is_ok());
+    }
+
+    #[test]
+    fn sweep_lists() {
+        let Command::Sweep(s) = parse(&["sweep", "--bound-px", "none", "--samples", "1,2x4"])
+            .unwrap()
+            .command
+        else {
+            panic!("not sweep")
+        };
+        assert_eq!(s.bound_px, Bounds(vec![]));
+        assert_eq!(s.samples, [(1, 1), (2, 4)]);
+        assert_eq!(s.mp_sizes, [0.5, 0.71, 1.0, 1.41, 2.0, 4.0]);
+        assert_eq!(
+            s.strategies,
+            [StrategyKind::Megakernel, StrategyKind::Multipass]
+        );
+        assert_eq!(s.scenes, ["teapot", "killeroo"]);
+    }
+}
