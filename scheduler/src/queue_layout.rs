@@ -76,6 +76,42 @@ impl QueueLayout {
             .collect()
     }
 
+    /// What every strategy's run starts from: the seed items per queue, their counts, and each
+    /// queue's most slots ([`QueueLayout::capacity_limits`] under `configured`, then
+    /// [`QueueLayout::within_budget`] with `words_copies`). Errors: a malformed seed, and
+    /// [`RunError::QueueOverflow`] naming the first queue whose seeds alone exceed its limit.
+    pub(crate) fn run_start(
+        program: &Program,
+        seeds: &[Seed],
+        max_binding_bytes: u64,
+        configured: u32,
+        budget: Option<u64>,
+        words_copies: u64,
+    ) -> Result<RunStart, RunError> {
+        let live = Self::seed_items(program, seeds)?;
+        let max_cap = Self::within_budget(
+            program,
+            Self::capacity_limits(program, max_binding_bytes, configured),
+            budget,
+            words_copies,
+        );
+        let seeded: Vec<u32> = (0..program.queue_count())
+            .map(|q| (live[q].len() / program.procs[q].words() as usize) as u32)
+            .collect();
+        if let Some(q) = (0..seeded.len()).find(|&q| seeded[q] > max_cap[q]) {
+            return Err(RunError::QueueOverflow {
+                queue: program.procs[q].proc.name.clone(),
+                capacity: max_cap[q] as u64,
+                needed_more_than: seeded[q] as u64,
+            });
+        }
+        Ok(RunStart {
+            live,
+            seeded,
+            max_cap,
+        })
+    }
+
     /// Per-queue seed items (words back to back), validated against the program.
     pub fn seed_items(program: &Program, seeds: &[Seed]) -> Result<Vec<Vec<u32>>, RunError> {
         let mut per_queue = vec![Vec::new(); program.queue_count()];
@@ -95,4 +131,14 @@ impl QueueLayout {
         }
         Ok(per_queue)
     }
+}
+
+/// See [`QueueLayout::run_start`].
+pub(crate) struct RunStart {
+    /// Seed items per queue, words back to back.
+    pub live: Vec<Vec<u32>>,
+    /// Seed items per queue.
+    pub seeded: Vec<u32>,
+    /// The most slots each queue may grow to in this run.
+    pub max_cap: Vec<u32>,
 }

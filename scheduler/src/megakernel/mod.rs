@@ -18,7 +18,7 @@ use crate::gpu::Gpu;
 use crate::growth::grow;
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
-use crate::queue_layout::QueueLayout;
+use crate::queue_layout::{QueueLayout, RunStart};
 use crate::readback::Readback;
 use crate::stats::RunStats;
 use crate::timing::RunTimer;
@@ -376,31 +376,25 @@ impl Megakernel {
         let workgroups = self.workgroups(gpu, user)?;
         let start_time = Instant::now();
         let nq = self.program.queue_count();
-        let live = QueueLayout::seed_items(&self.program, seeds)?;
-        let max_cap = QueueLayout::within_budget(
+        let RunStart {
+            live,
+            seeded,
+            max_cap,
+        } = QueueLayout::run_start(
             &self.program,
-            QueueLayout::capacity_limits(
-                &self.program,
-                gpu.max_binding_bytes(),
-                self.config.max_capacity,
-            ),
+            seeds,
+            gpu.max_binding_bytes(),
+            self.config.max_capacity,
             max_queue_bytes,
             1,
-        );
+        )?;
         let mut capacity: Vec<u32> = (0..nq)
             .map(|q| {
-                let n = (live[q].len() / self.program.procs[q].words() as usize) as u32;
+                let n = seeded[q];
                 let want = self.config.initial_capacity.max(n.saturating_mul(2)).max(1);
                 want.min(max_cap[q]).max(n)
             })
             .collect();
-        if let Some(q) = (0..nq).find(|&q| capacity[q] > max_cap[q]) {
-            return Err(RunError::QueueOverflow {
-                queue: self.program.procs[q].proc.name.clone(),
-                capacity: max_cap[q] as u64,
-                needed_more_than: capacity[q] as u64,
-            });
-        }
         let mut stats = RunStats {
             strategy: "megakernel".into(),
             executed: vec![0; nq],

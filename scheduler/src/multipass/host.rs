@@ -13,7 +13,7 @@ use crate::gpu::Gpu;
 use crate::growth::grow;
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
-use crate::queue_layout::QueueLayout;
+use crate::queue_layout::{QueueLayout, RunStart};
 use crate::readback::Readback;
 use crate::stats::RunStats;
 use crate::timing::RunTimer;
@@ -192,29 +192,20 @@ impl HostMultipass {
         self.kernels.check_user_group(user)?;
         let start = Instant::now();
         let nq = self.program.queue_count();
-        let live = QueueLayout::seed_items(&self.program, seeds)?;
-        // Two copies of the items per slot; within_budget adds a flag word, which this strategy
+        // Two copies of the items per slot; run_start adds a flag word, which this strategy
         // does not have, so the budget is kept with a little to spare.
-        let max_cap = QueueLayout::within_budget(
+        let RunStart {
+            live,
+            seeded: mut n,
+            max_cap,
+        } = QueueLayout::run_start(
             &self.program,
-            QueueLayout::capacity_limits(
-                &self.program,
-                gpu.max_binding_bytes(),
-                self.config.max_capacity,
-            ),
+            seeds,
+            gpu.max_binding_bytes(),
+            self.config.max_capacity,
             max_queue_bytes,
             2,
-        );
-        let mut n: Vec<u32> = (0..nq)
-            .map(|q| (live[q].len() / self.program.procs[q].words() as usize) as u32)
-            .collect();
-        if let Some(q) = (0..nq).find(|&q| n[q] > max_cap[q]) {
-            return Err(RunError::QueueOverflow {
-                queue: self.program.procs[q].proc.name.clone(),
-                capacity: max_cap[q] as u64,
-                needed_more_than: n[q] as u64,
-            });
-        }
+        )?;
         let mut capacity: Vec<u32> = (0..nq)
             .map(|q| {
                 self.config

@@ -17,7 +17,7 @@ use crate::gpu::Gpu;
 use crate::growth::grow;
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
-use crate::queue_layout::QueueLayout;
+use crate::queue_layout::{QueueLayout, RunStart};
 use crate::stats::RunStats;
 use crate::timing::{PassTimer, StageTimer};
 
@@ -306,31 +306,25 @@ impl Multipass {
         self.kernels.check_user_group(user)?;
         let start = Instant::now();
         let nq = self.program.queue_count();
-        let live = QueueLayout::seed_items(&self.program, seeds)?;
         // Reduce and scatter dispatch one workgroup per SCAN_BLOCK slots, at most 65,535.
-        let max_cap = QueueLayout::within_budget(
+        let RunStart {
+            live,
+            seeded,
+            max_cap,
+        } = QueueLayout::run_start(
             &self.program,
-            QueueLayout::capacity_limits(
-                &self.program,
-                gpu.max_binding_bytes(),
-                self.config.max_capacity.min(65_535 * SCAN_BLOCK),
-            ),
+            seeds,
+            gpu.max_binding_bytes(),
+            self.config.max_capacity.min(65_535 * SCAN_BLOCK),
             max_queue_bytes,
             3,
-        );
+        )?;
         let mut capacity: Vec<u32> = (0..nq)
             .map(|q| {
-                let n = (live[q].len() / self.program.procs[q].words() as usize) as u32;
+                let n = seeded[q];
                 self.config.initial_capacity.min(max_cap[q]).max(n).max(1)
             })
             .collect();
-        if let Some(q) = (0..nq).find(|&q| capacity[q] > max_cap[q]) {
-            return Err(RunError::QueueOverflow {
-                queue: self.program.procs[q].proc.name.clone(),
-                capacity: max_cap[q] as u64,
-                needed_more_than: capacity[q] as u64,
-            });
-        }
         let mut stats = RunStats {
             strategy: "multipass".into(),
             executed: vec![0; nq],
