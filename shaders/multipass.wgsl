@@ -11,7 +11,9 @@ const C_COUNT: u32 = 0u;  // inputs of the current round
 const C_PEAK: u32 = 1u;
 const C_EXEC: u32 = 2u;
 const C_EMITS: u32 = 3u;  // output slots of this round for this target
-const C_NEXT: u32 = 4u;   // compacted outputs = inputs of the next round
+const C_NEXT: u32 = 4u;   // carried inputs + compacted outputs = inputs of the next round
+const C_RUN: u32 = 5u;    // inputs this round runs (all but in a partial round)
+const C_KEEP: u32 = 6u;   // inputs this round carries, unrun, to the front of the next
 fn cw(q: u32, i: u32) -> u32 { return q * CSTRIDE + i; }
 fn gw(i: u32) -> u32 { return NQ * CSTRIDE + i; }
 const G_ROUNDS: u32 = 0u;
@@ -20,6 +22,7 @@ const G_ERR_A: u32 = 2u;
 const G_ERR_B: u32 = 3u;
 const G_HALT: u32 = 4u;
 const G_PLANNED: u32 = 5u; // plans that let their round run, for the host's parity
+const G_PARTIAL: u32 = 6u; // partial rounds (scheduler/src/multipass/partial.rs)
 fn off_w(p: u32, t: u32) -> u32 { return NQ * CSTRIDE + 8u + p * NQ + t; }
 
 const ERR_EMIT: u32 = 1u;
@@ -31,6 +34,9 @@ fn q_in_base(q: u32) -> u32 { return params[9u + q * 8u]; }
 fn q_emit_base(q: u32) -> u32 { return params[10u + q * 8u]; }
 fn q_eflag_base(q: u32) -> u32 { return params[11u + q * 8u]; }
 fn q_sum_base(q: u32) -> u32 { return params[12u + q * 8u]; }
+// 1 when queue q is at its capacity limit: a round it cannot hold runs in part instead of
+// halting for growth.
+fn q_at_limit(q: u32) -> bool { return params[13u + q * 8u] != 0u; }
 
 const SCAN_BLOCK: u32 = 1024u; // flags per scan workgroup: 256 threads x 4
 
@@ -50,6 +56,7 @@ fn mp_emit_load_word(i: u32) -> u32 { return emit[i]; }
 fn mp_emit_store_word(i: u32, w: u32) { emit[i] = w; }
 
 var<workgroup> wg_n: u32;
+var<workgroup> wg_k: u32;
 var<workgroup> wg_item_emits: array<atomic<u32>, 256u * NQ>;
 var<workgroup> wg_sum: array<u32, 256>;
 var<private> sched_proc: u32;
@@ -82,46 +89,103 @@ fn set_args(slot: u32, x: u32) {
     indirect[slot * 3u + 2u] = 1u;
 }
 
-// One thread: takes the previous round's compacted counts as this round's inputs, lays out the
-// output slots, and writes every dispatch size of the round. Refuses (halts, nothing run, inputs
-// intact) when the outputs could exceed a queue's capacity.
+// One thread: takes the previous round's carried and compacted counts as this round's inputs,
+// lays out the output slots, and writes every dispatch size of the round. When a target cannot
+// hold the round's worst case: halts (nothing run, inputs intact) for the host to grow it, or,
+// when it is at its limit, runs only part of the inputs (partial.rs, the host twin) and carries
+// the rest; halts with ERR_OVERFLOW when not one input fits.
 @compute @workgroup_size(1)
 fn mp_plan() {
     var total = 0u;
+    var run: array<u32, NQ>;
     for (var q = 0u; q < NQ; q++) {
         let n = atomicLoad(&mp_ctrl[cw(q, C_NEXT)]);
         atomicStore(&mp_ctrl[cw(q, C_COUNT)], n);
+        run[q] = n;
         total += n;
     }
     var ok = atomicLoad(&mp_ctrl[gw(G_HALT)]) == 0u;
+    var partial = false;
+    var over_t = 0u;
+    var over_m = 0u;
+    for (var t = 0u; t < NQ; t++) {
+        var m = 0u;
+        for (var p = 0u; p < NQ; p++) { m += run[p] * EMITS[p * NQ + t]; }
+        atomicStore(&mp_ctrl[cw(t, C_EMITS)], m);
+        if q_at_limit(t) && m > q_cap(t) / 2u {
+            if !partial || m > over_m { over_t = t; over_m = m; }
+            partial = true;
+        } else if m > q_cap(t) {
+            if ok {
+                ok = false;
+                if atomicExchange(&mp_ctrl[gw(G_ERROR)], ERR_OVERFLOW) == 0u {
+                    atomicStore(&mp_ctrl[gw(G_ERR_A)], t);
+                    atomicStore(&mp_ctrl[gw(G_ERR_B)], m);
+                }
+                atomicStore(&mp_ctrl[gw(G_HALT)], 1u);
+            }
+        }
+    }
+    if ok && partial {
+        // Last procedure first: each runs as many inputs as keep every target within half its
+        // capacity, and at least one when one fits (partial.rs says why).
+        var used: array<u32, NQ>;
+        for (var t = 0u; t < NQ; t++) { used[t] = run[t]; }
+        var any = false;
+        for (var i = 0u; i < NQ; i++) {
+            let p = NQ - 1u - i;
+            var hard = run[p];
+            var soft = run[p];
+            for (var t = 0u; t < NQ; t++) {
+                let grow = EMITS[p * NQ + t];
+                let shrink = select(0u, 1u, t == p);
+                if grow > shrink {
+                    hard = min(hard, (q_cap(t) - used[t]) / (grow - shrink));
+                    let half = q_cap(t) / 2u;
+                    soft = min(soft, select(0u, half - used[t], half > used[t]) / (grow - shrink));
+                }
+            }
+            let r = max(soft, min(hard, 1u));
+            run[p] = r;
+            for (var t = 0u; t < NQ; t++) { used[t] += r * EMITS[p * NQ + t]; }
+            used[p] -= r;
+            any = any || r > 0u;
+        }
+        if any {
+            atomicAdd(&mp_ctrl[gw(G_PARTIAL)], 1u);
+        } else {
+            ok = false;
+            if atomicExchange(&mp_ctrl[gw(G_ERROR)], ERR_OVERFLOW) == 0u {
+                atomicStore(&mp_ctrl[gw(G_ERR_A)], over_t);
+                atomicStore(&mp_ctrl[gw(G_ERR_B)], over_m);
+            }
+            atomicStore(&mp_ctrl[gw(G_HALT)], 1u);
+        }
+    }
     for (var t = 0u; t < NQ; t++) {
         var m = 0u;
         for (var p = 0u; p < NQ; p++) {
             atomicStore(&mp_ctrl[off_w(p, t)], m);
-            m += atomicLoad(&mp_ctrl[cw(p, C_COUNT)]) * EMITS[p * NQ + t];
+            m += run[p] * EMITS[p * NQ + t];
         }
-        atomicStore(&mp_ctrl[cw(t, C_EMITS)], m);
-        if ok && m > q_cap(t) {
-            ok = false;
-            if atomicExchange(&mp_ctrl[gw(G_ERROR)], ERR_OVERFLOW) == 0u {
-                atomicStore(&mp_ctrl[gw(G_ERR_A)], t);
-                atomicStore(&mp_ctrl[gw(G_ERR_B)], m);
-            }
-            atomicStore(&mp_ctrl[gw(G_HALT)], 1u);
-        }
+        // A halted round leaves the whole round's worst case here, for the host's growth.
+        if ok { atomicStore(&mp_ctrl[cw(t, C_EMITS)], m); }
     }
     for (var q = 0u; q < NQ; q++) {
         let n = atomicLoad(&mp_ctrl[cw(q, C_COUNT)]);
         let per_step = 256u / THREADS[q];
         let m = atomicLoad(&mp_ctrl[cw(q, C_EMITS)]);
+        // Every input is visited: run, or copied to the front of the next round's inputs.
         set_args(q, select(0u, min((n + per_step - 1u) / per_step, 65535u), ok));
         set_args(NQ + q, select(0u, (m + SCAN_BLOCK - 1u) / SCAN_BLOCK, ok));
         set_args(2u * NQ + q, select(0u, 1u, ok && m > 0u));
         if ok {
             atomicMax(&mp_ctrl[cw(q, C_PEAK)], n);
-            atomicAdd(&mp_ctrl[cw(q, C_EXEC)], n);
-            // Inputs are consumed by this round; the scan of the round writes C_NEXT.
-            atomicStore(&mp_ctrl[cw(q, C_NEXT)], 0u);
+            atomicAdd(&mp_ctrl[cw(q, C_EXEC)], run[q]);
+            atomicStore(&mp_ctrl[cw(q, C_RUN)], run[q]);
+            atomicStore(&mp_ctrl[cw(q, C_KEEP)], n - run[q]);
+            // The carried inputs lead the next round; the scan of the round adds its outputs.
+            atomicStore(&mp_ctrl[cw(q, C_NEXT)], n - run[q]);
         }
     }
     if ok { atomicAdd(&mp_ctrl[gw(G_PLANNED)], 1u); }
@@ -129,28 +193,38 @@ fn mp_plan() {
 }
 
 // Runs procedure q over this round's inputs, grid-stride, items_per_step items per step.
+// Only the newest C_RUN inputs run (the outputs of the last rounds, so a partial round goes
+// depth first and its live work stays bounded); the older ones are copied, in place, to the
+// front of the next round's inputs.
 fn run_procedure(q: u32, lid: u32, wid: u32, nwg: u32) {
     if lid == 0u { wg_n = atomicLoad(&mp_ctrl[cw(q, C_COUNT)]); }
     let n = workgroupUniformLoad(&wg_n);
+    if lid == 0u { wg_k = atomicLoad(&mp_ctrl[cw(q, C_RUN)]); }
+    let k = workgroupUniformLoad(&wg_k);
     let per_step = 256u / THREADS[q];
     let slot = lid / THREADS[q];
     let thread = lid % THREADS[q];
     for (var first = wid * per_step; first < n; first += nwg * per_step) {
         let idx = first + slot;
-        let live = idx < n;
+        let keep = n - k;
+        let live = idx >= keep && idx < n;
+        if idx < keep {
+            let at = q_in_base(q) + idx * WORDS[q];
+            for (var w = thread; w < WORDS[q]; w += THREADS[q]) { items_out[at + w] = items_in[at + w]; }
+        }
         for (var t = thread; t < NQ; t += THREADS[q]) { atomicStore(&wg_item_emits[slot * NQ + t], 0u); }
         if live {
             // Clear this item's output flags before anything is emitted.
             for (var t = 0u; t < NQ; t++) {
                 let e = EMITS[q * NQ + t];
-                let first_slot = atomicLoad(&mp_ctrl[off_w(q, t)]) + idx * e;
+                let first_slot = atomicLoad(&mp_ctrl[off_w(q, t)]) + (idx - keep) * e;
                 for (var j = thread; j < e; j += THREADS[q]) { emit_flags[q_eflag_base(t) + first_slot + j] = 0u; }
             }
         }
         workgroupBarrier();
         storageBarrier();
         sched_proc = q;
-        sched_item = idx;
+        sched_item = idx - keep;
         sched_slot = slot;
         sched_active = live;
         sched_execute(q, q_in_base(q) + idx * WORDS[q], Invocation(thread, slot, live));
@@ -202,7 +276,7 @@ fn scan_blocks(t: u32, lid: u32) {
         carry += wg_sum[255];
         workgroupBarrier();
     }
-    if lid == 0u { atomicStore(&mp_ctrl[cw(t, C_NEXT)], carry); }
+    if lid == 0u { atomicStore(&mp_ctrl[cw(t, C_NEXT)], atomicLoad(&mp_ctrl[cw(t, C_KEEP)]) + carry); }
 }
 
 fn scan_scatter(t: u32, lid: u32, b: u32) {
@@ -210,7 +284,8 @@ fn scan_scatter(t: u32, lid: u32, b: u32) {
     let i = b * SCAN_BLOCK + lid * 4u;
     let f = flags4(t, i, m);
     let own = f.x + f.y + f.z + f.w;
-    var dst = sums[q_sum_base(t) + b] + workgroup_inclusive_scan(lid, own) - own;
+    let keep = atomicLoad(&mp_ctrl[cw(t, C_KEEP)]);
+    var dst = keep + sums[q_sum_base(t) + b] + workgroup_inclusive_scan(lid, own) - own;
     for (var k = 0u; k < 4u; k++) {
         if f[k] != 0u {
             let src = q_emit_base(t) + (i + k) * WORDS[t];

@@ -9,12 +9,14 @@
 // `sched_execute`, `enqueue_*`, and one entry point per procedure.
 
 // ---- counts buffers; host twin: scheduler/src/multipass/host.rs ----
-// counts_in[q]: inputs of queue q this round (the previous round's appends, or the host's seeds).
-// counts_out[q]: appends to queue q this round (zeroed by the host before the round), then the
-// error words.
+// counts_in[q]: inputs of queue q this round runs (the previous round's appends, or the host's
+// seeds); counts_in[H_SKIP + q]: older inputs before them, carried (multipass/partial.rs).
+// counts_out[q]: appends to queue q this round (zeroed by the host before the round, or set to
+// the inputs it carried there), then the error words, then the next round's skip words (zero).
 const H_ERROR: u32 = 0u;
 const H_ERR_A: u32 = 1u;
 const H_ERR_B: u32 = 2u;
+const H_SKIP: u32 = NQ + 3u;
 const ERR_EMIT: u32 = 1u;
 const ERR_ROOM: u32 = 2u; // an append past a capacity: the host's room check failed (a bug)
 
@@ -68,6 +70,7 @@ fn sched_append_slot(t: u32) -> u32 {
 fn run_procedure(q: u32, lid: u32, wid: u32, nwg: u32) {
     if lid == 0u { wg_n = counts_in[q]; }
     let n = workgroupUniformLoad(&wg_n);
+    let base = q_base(q) + counts_in[H_SKIP + q] * WORDS[q];
     let per_step = 256u / THREADS[q];
     let slot = lid / THREADS[q];
     let thread = lid % THREADS[q];
@@ -79,7 +82,7 @@ fn run_procedure(q: u32, lid: u32, wid: u32, nwg: u32) {
         sched_proc = q;
         sched_slot = slot;
         sched_active = live;
-        sched_execute(q, q_base(q) + idx * WORDS[q], Invocation(thread, slot, live));
+        sched_execute(q, base + idx * WORDS[q], Invocation(thread, slot, live));
         workgroupBarrier();
     }
 }

@@ -246,9 +246,10 @@ fn emitting_more_than_declared_is_an_error_not_a_silent_drop() {
 fn a_queue_that_cannot_hold_live_work_reports_overflow() {
     let gpu = gpu();
     let item = ItemType::new("Word", "struct Word { v: u32 }");
+    // One fan item alone may emit 16 into a sink queue of 8: no plan can run it.
     let fan = Procedure::new("fan", item.clone(), 1)
-        .emits("sink", 8)
-        .body("fn fan_execute(item: Word, inv: Invocation) { for (var i = 0u; i < 8u; i++) { enqueue_sink(item); } }");
+        .emits("sink", 16)
+        .body("fn fan_execute(item: Word, inv: Invocation) { for (var i = 0u; i < 16u; i++) { enqueue_sink(item); } }");
     let sink =
         Procedure::new("sink", item, 1).body("fn sink_execute(item: Word, inv: Invocation) {}");
     let program = Program::new(vec![fan, sink], UserBindings::default()).unwrap();
@@ -289,6 +290,54 @@ fn a_queue_that_cannot_hold_live_work_reports_overflow() {
             Err(RunError::QueueOverflow { queue, .. }) => assert_eq!(queue, "sink"),
             other => panic!("expected an overflow of `sink`, got {other:?}"),
         }
+    }
+}
+
+/// A multi-pass round whose worst case does not fit a queue at its limit runs in part and
+/// carries the rest (`scheduler::multipass::partial`): a tree that needs far more room breadth
+/// first than its queues may have completes exactly, on both multi-pass strategies.
+#[test]
+fn multi_pass_rounds_that_cannot_fit_a_queue_at_its_limit_run_in_part_and_stay_exact() {
+    let gpu = gpu();
+    // Breadth first, the tree's widest level holds several hundred nodes.
+    let params = TreeParams {
+        roots: 2,
+        max_depth: 9,
+        fanout: Fanout::Fixed(2),
+        work: 1,
+        payload_words: 2,
+        seed: 7,
+    };
+    let reference = params.reference();
+    let run = TreeRun::new(&gpu, params).unwrap();
+    let roomy = Scheduler::new(&gpu, &run.program, StrategyKind::MultipassHost, 1 << 16).unwrap();
+    let (wide, _) = run.run(&gpu, &roomy).unwrap();
+    assert!(wide.peak_occupancy[0] > 4 * 32, "{wide:?}");
+    let mp = Scheduler::multipass(
+        &gpu,
+        &run.program,
+        MultipassConfig {
+            initial_capacity: 16,
+            max_capacity: 32,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let mph = Scheduler::multipass_host(
+        &gpu,
+        &run.program,
+        HostMultipassConfig {
+            initial_capacity: 16,
+            max_capacity: 32,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    for s in [mp, mph] {
+        let (stats, result) = run.run(&gpu, &s).unwrap();
+        assert_eq!(result, reference, "{stats:?}");
+        assert!(stats.partial_rounds > 0, "{stats:?}");
+        assert!(stats.peak_occupancy.iter().all(|&p| p <= 32), "{stats:?}");
     }
 }
 
@@ -470,5 +519,100 @@ fn every_thread_that_calls_enqueue_adds_an_item_on_every_strategy() {
             ),
             other => panic!("{kind:?}: expected an emit-limit error, got {other:?}"),
         }
+    }
+}
+
+/// A run recorded without host waits ([`RecordedRun`]): sized from a full run of the same work,
+/// recorded twice into one encoder from seeds in a device buffer, each status says it finished
+/// with the CPU's count; sized to its seeds, its status says it did not (never a silent partial
+/// run); seeds other than those it was made for are refused.
+#[test]
+fn recorded_runs_finish_like_a_run_or_say_they_did_not() {
+    let gpu = gpu();
+    let word = ItemType::new("Word", "struct Word { v: u32 }");
+    let split = Procedure::new("split", word, 1).emits("split", 2).body(
+        "fn split_execute(item: Word, inv: Invocation) { if item.v > 0u { \
+         enqueue_split(Word(item.v - 1u)); enqueue_split(Word(item.v - 1u)); } }",
+    );
+    let program = Program::new(vec![split], UserBindings::none()).unwrap();
+    let roots = [3u32, 5, 6, 0, 11];
+    // A root v is a full binary tree of depth v: 2^(v+1) - 1 items.
+    let expected: u64 = roots.iter().map(|&v| (1u64 << (v + 1)) - 1).sum();
+    let n = roots.len() as u32;
+    let seeds_buf = gpu.upload("seeds", &roots).unwrap();
+    let seeds = [DeviceSeeds {
+        procedure: "split",
+        buffer: &seeds_buf,
+        count: n,
+    }];
+    for kind in [StrategyKind::Megakernel, StrategyKind::Multipass] {
+        // One workgroup: a recorded megakernel's queues get one batch's worst case per
+        // workgroup on top of their size, which on a large GPU (the H200: ~4,000 workgroups)
+        // would make even the tiny run below big enough for the whole tree. (Two were not
+        // co-resident on a loaded lavapipe: slots abandoned after their bounded wait.)
+        let s = match kind {
+            StrategyKind::Megakernel => Scheduler::megakernel(
+                &gpu,
+                &program,
+                MegakernelConfig {
+                    initial_capacity: 64,
+                    workgroups: Workgroups::Fixed(1),
+                    ..Default::default()
+                },
+            )
+            .unwrap(),
+            _ => Scheduler::new(&gpu, &program, kind, 64).unwrap(),
+        };
+        let full = s.run(&gpu, &[Seed::new("split", &roots)], None).unwrap();
+        assert_eq!(full.executed, [expected]);
+        let size = RecordedSize::from_stats(&program, kind, &full, &[n], 1.0);
+        let run = RecordedRun::new(&gpu, &s, &[("split", n)], &size, None, None).unwrap();
+        let words = run.status_words();
+        let status = gpu.storage_buffer("status", 2 * words).unwrap();
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        for k in 0..2 {
+            run.record(&s, &mut enc, &seeds, None, &status, k * words)
+                .unwrap();
+        }
+        gpu.queue.submit([enc.finish()]);
+        let all = gpu.read_words(&status, 0, 2 * words).unwrap();
+        for (k, st) in all.chunks(words as usize).enumerate() {
+            match run.outcome(&program, st).unwrap() {
+                Outcome::Done(stats) => {
+                    assert_eq!(stats.executed, [expected], "{kind:?} record {k}");
+                    assert_eq!(stats.submits, 0);
+                }
+                o => panic!("{kind:?} record {k}: {o:?}"),
+            }
+        }
+        let tiny = RecordedSize {
+            capacity: vec![1],
+            rounds: 1,
+        };
+        let run = RecordedRun::new(&gpu, &s, &[("split", n)], &tiny, None, None).unwrap();
+        assert!(run.size.capacity[0] < expected as u32, "{:?}", run.size);
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        run.record(&s, &mut enc, &seeds, None, &status, 0).unwrap();
+        gpu.queue.submit([enc.finish()]);
+        let st = gpu.read_words(&status, 0, words).unwrap();
+        match run.outcome(&program, &st).unwrap() {
+            Outcome::Incomplete(why) => assert!(!why.is_empty()),
+            o => panic!("{kind:?}: a run too small for its work finished: {o:?}"),
+        }
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        let e = run.record(&s, &mut enc, &[], None, &status, 0).unwrap_err();
+        assert!(matches!(e, RunError::Program(_)), "{e:?}");
+    }
+    let host = Scheduler::new(&gpu, &program, StrategyKind::MultipassHost, 64).unwrap();
+    let e = RecordedRun::new(&gpu, &host, &[("split", n)], &tiny_size(), None, None)
+        .err()
+        .unwrap();
+    assert!(matches!(e, RunError::Program(_)), "{e:?}");
+}
+
+fn tiny_size() -> RecordedSize {
+    RecordedSize {
+        capacity: vec![1],
+        rounds: 1,
     }
 }

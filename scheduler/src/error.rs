@@ -62,7 +62,8 @@ impl fmt::Display for RunError {
             } => write!(
                 f,
                 "queue `{queue}` overflowed: capacity {capacity} items, live work needs more than \
-                 {needed_more_than}; no item was lost, raise the queue capacity limit"
+                 {needed_more_than}; no item was lost (more room: a larger memory budget, or the \
+                 strategy's max_capacity)"
             ),
             RunError::EmitLimit {
                 procedure,

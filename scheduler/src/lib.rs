@@ -9,6 +9,9 @@
 //! - [`HostMultipass`]: the same baseline driven by the host as its authors ran it: exactly
 //!   sized direct dispatches per round, compaction fused into the producing pass.
 //!
+//! [`RecordedRun`] records a run of fixed sizes into the caller's encoder without host waits,
+//! for frames pipelined on the GPU.
+//!
 //! The queue protocol and its correctness argument are in `docs/scheduler.md`.
 #![warn(missing_docs)]
 
@@ -26,6 +29,7 @@ pub mod procedure;
 pub mod program;
 mod queue_layout;
 mod readback;
+pub mod recorded;
 pub mod stats;
 pub mod strategy;
 pub mod timing;
@@ -47,5 +51,6 @@ pub use multipass::host::{HostMultipass, HostMultipassConfig};
 pub use multipass::{Multipass, MultipassConfig};
 pub use procedure::{ItemType, Procedure};
 pub use program::{Program, Seed};
+pub use recorded::{DeviceSeeds, Outcome, RecordedRun, RecordedSize};
 pub use stats::RunStats;
 pub use strategy::{Scheduler, StrategyKind};

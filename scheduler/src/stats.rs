@@ -26,6 +26,9 @@ pub struct RunStats {
     pub abandoned: u64,
     /// Queues grown because live work did not fit.
     pub queue_growths: u64,
+    /// Multi-pass (both): rounds that ran only part of their inputs because a queue at its
+    /// capacity limit could not hold the whole round's worst case (`multipass::partial`).
+    pub partial_rounds: u64,
     /// Most items waiting at once, per queue.
     pub peak_occupancy: Vec<u64>,
     /// Bytes of queue storage allocated at the end of the run.
@@ -66,6 +69,7 @@ impl RunStats {
         self.submits += o.submits;
         self.abandoned += o.abandoned;
         self.queue_growths += o.queue_growths;
+        self.partial_rounds += o.partial_rounds;
         self.queue_bytes = self.queue_bytes.max(o.queue_bytes);
         self.workgroups = self.workgroups.max(o.workgroups);
         self.gpu_ms = self.gpu_ms.zip(o.gpu_ms).map(|(a, b)| a + b);

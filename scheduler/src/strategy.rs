@@ -138,6 +138,15 @@ impl Scheduler {
         }
     }
 
+    /// The program this scheduler runs.
+    pub fn program(&self) -> &Program {
+        match self {
+            Scheduler::Megakernel(m) => m.program(),
+            Scheduler::Multipass(m) => m.program(),
+            Scheduler::MultipassHost(m) => m.program(),
+        }
+    }
+
     /// Which strategy this is.
     pub fn kind(&self) -> StrategyKind {
         match self {

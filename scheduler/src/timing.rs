@@ -182,3 +182,103 @@ impl RunTimer {
         Ok(self.inner.stage_ms().map(|ms| ms[0]))
     }
 }
+
+/// GPU time of a span of passes recorded in one encoder (from the start of its first pass to
+/// the end of its last), read back later with other results instead of by a wait of its own:
+/// for pipelined frames, whose status is read a frame late. `slots` spans may be in flight at
+/// once (one per frame in flight). Without timestamp queries every call records nothing and
+/// [`SpanTimer::ms`] is `None`.
+///
+/// Per span: [`SpanTimer::begin`] for the first pass's `timestamp_writes`, [`SpanTimer::end`]
+/// for the last pass's, then [`SpanTimer::copy`] in the same encoder after the last pass, which
+/// puts [`SpanTimer::WORDS`] words into the caller's buffer; [`SpanTimer::ms`] reads them.
+pub struct SpanTimer {
+    set: Option<wgpu::QuerySet>,
+    resolved: wgpu::Buffer,
+    period_ns: f64,
+    slots: u32,
+}
+
+impl SpanTimer {
+    /// Words [`SpanTimer::copy`] writes: two little-endian u64 timestamps.
+    pub const WORDS: u64 = 4;
+
+    /// A timer of `slots` (at least 1) spans, two timestamps each.
+    pub fn new(gpu: &Gpu, slots: u32) -> SpanTimer {
+        let slots = slots.max(1);
+        let set = gpu.timestamps.then(|| {
+            gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("span timer"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2 * slots,
+            })
+        });
+        // Each slot's resolve lands at its own 256-byte aligned offset (wgpu's rule).
+        let resolved = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("span timestamps"),
+            size: wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT * slots as u64,
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        SpanTimer {
+            set,
+            resolved,
+            period_ns: gpu.queue.get_timestamp_period() as f64,
+            slots,
+        }
+    }
+
+    fn writes(
+        &self,
+        slot: u32,
+        begin: bool,
+        end: bool,
+    ) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        assert!(
+            slot < self.slots,
+            "SpanTimer: slot {slot} of {}",
+            self.slots
+        );
+        self.set
+            .as_ref()
+            .map(|set| wgpu::ComputePassTimestampWrites {
+                query_set: set,
+                beginning_of_pass_write_index: begin.then_some(2 * slot),
+                end_of_pass_write_index: end.then_some(2 * slot + 1),
+            })
+    }
+
+    /// Timestamp writes for the span's first pass.
+    pub fn begin(&self, slot: u32) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        self.writes(slot, true, false)
+    }
+
+    /// Timestamp writes for the span's last pass.
+    pub fn end(&self, slot: u32) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        self.writes(slot, false, true)
+    }
+
+    /// Records the resolve of the span's timestamps and their copy into `dst` (which needs
+    /// `COPY_DST`) at word `dst_word`, after the span's last pass.
+    pub fn copy(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        slot: u32,
+        dst: &wgpu::Buffer,
+        dst_word: u64,
+    ) {
+        if let Some(set) = &self.set {
+            let at = wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT * slot as u64;
+            enc.resolve_query_set(set, 2 * slot..2 * slot + 2, &self.resolved, at);
+            enc.copy_buffer_to_buffer(&self.resolved, at, dst, dst_word * 4, Self::WORDS * 4);
+        }
+    }
+
+    /// The span's GPU milliseconds from the [`SpanTimer::WORDS`] words its copy wrote; `None`
+    /// without timestamp queries.
+    pub fn ms(&self, words: &[u32]) -> Option<f64> {
+        self.set.as_ref()?;
+        let t = |i: usize| words[i] as u64 | (words[i + 1] as u64) << 32;
+        Some(t(2).saturating_sub(t(0)) as f64 * self.period_ns / 1e6)
+    }
+}

@@ -5,6 +5,7 @@
 
 mod compact;
 pub(crate) mod layout;
+pub(crate) mod recorded;
 pub(crate) mod wgsl;
 
 use std::time::Instant;
@@ -217,6 +218,11 @@ impl Megakernel {
         })
     }
 
+    /// The program this megakernel runs.
+    pub fn program(&self) -> &Program {
+        &self.program
+    }
+
     /// Workgroups per launch, probing on first use (the probe launch needs the user's bind
     /// group, as a run does). Errors: those of a run ([`RunError::Timeout`], [`RunError::Device`]).
     pub fn workgroups(&self, gpu: &Gpu, user: Option<&wgpu::BindGroup>) -> Result<u32, RunError> {
@@ -323,7 +329,7 @@ impl Megakernel {
 
     /// Writes ctrl for a launch that starts with `counts[q]` seeds in the first slots of each
     /// queue: reserve, count, budget and peak at the seed count, pending their sum, all else 0.
-    fn write_ctrl(&self, gpu: &Gpu, dq: &DeviceQueues, counts: &[u32]) {
+    fn write_ctrl(&self, gpu: &Gpu, ctrl_buf: &wgpu::Buffer, counts: &[u32]) {
         let nq = self.program.queue_count();
         let mut ctrl = vec![0u32; ctrl_words(nq)];
         for (q, &n) in counts.iter().enumerate() {
@@ -333,7 +339,7 @@ impl Megakernel {
         }
         ctrl[g(nq, G_PENDING)] = counts.iter().sum();
         gpu.queue
-            .write_buffer(&dq.ctrl, 0, bytemuck::cast_slice(&ctrl));
+            .write_buffer(ctrl_buf, 0, bytemuck::cast_slice(&ctrl));
     }
 
     /// Writes live items (per queue, words back to back) as the whole queue state of a launch.
@@ -359,7 +365,7 @@ impl Megakernel {
                 );
             }
         }
-        self.write_ctrl(gpu, dq, &counts);
+        self.write_ctrl(gpu, &dq.ctrl, &counts);
     }
 
     /// Runs the program to completion from `seeds`. `user` is bind group 1, if the program has
@@ -439,7 +445,7 @@ impl Megakernel {
                     reserved,
                     live,
                 } => {
-                    self.write_ctrl(gpu, d, live);
+                    self.write_ctrl(gpu, &d.ctrl, live);
                     Some(self.compaction.prepare(gpu, old, d, reserved)?)
                 }
             };

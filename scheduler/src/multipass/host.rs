@@ -11,6 +11,7 @@ use std::time::Instant;
 use crate::error::RunError;
 use crate::gpu::Gpu;
 use crate::growth::grow;
+use crate::multipass::partial::{at_limit, needs_partial, partial_round};
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
 use crate::queue_layout::{QueueLayout, RunStart};
@@ -26,7 +27,9 @@ const H_ERR_A: usize = 1;
 const H_ERR_B: usize = 2;
 const ERR_EMIT: u32 = 1;
 const ERR_ROOM: u32 = 2;
+/// Error words, then per queue the inputs to skip (carried by a partial round).
 const EXTRA_WORDS: usize = 3;
+const H_SKIP: usize = EXTRA_WORDS;
 
 /// Settings of [`HostMultipass::new`]; [`Default`] gives the documented defaults.
 #[derive(Debug, Clone)]
@@ -48,6 +51,13 @@ impl Default for HostMultipassConfig {
             max_rounds: 100_000,
         }
     }
+}
+
+/// A counts buffer whose round runs all of `n` (no error, nothing skipped).
+fn first_counts(n: &[u32]) -> Vec<u32> {
+    let mut c = vec![0u32; 2 * n.len() + EXTRA_WORDS];
+    c[..n.len()].copy_from_slice(n);
+    c
 }
 
 /// A program compiled for the host-driven multi-pass strategy: one pipeline per procedure,
@@ -102,6 +112,11 @@ pub(crate) fn source(program: &Program) -> String {
 }
 
 impl HostMultipass {
+    /// The program this multi-pass runs.
+    pub fn program(&self) -> &Program {
+        &self.program
+    }
+
     /// Compiles `program` for the host-driven multi-pass on `gpu`. Errors:
     /// [`RunError::Program`] for more than 16 procedures or WGSL that does not compile with the
     /// generated code.
@@ -142,7 +157,7 @@ impl HostMultipass {
 
     fn rounds_buffers(&self, gpu: &Gpu, layout: QueueLayout) -> Result<HostRounds, RunError> {
         let nq = self.program.queue_count();
-        let count_words = (nq + EXTRA_WORDS) as u64;
+        let count_words = (2 * nq + EXTRA_WORDS) as u64;
         let counts = [
             gpu.storage_buffer("round counts a", count_words)?,
             gpu.storage_buffer("round counts b", count_words)?,
@@ -241,7 +256,8 @@ impl HostMultipass {
             }
         }
         gpu.queue
-            .write_buffer(&d.counts[0], 0, bytemuck::cast_slice(&n));
+            .write_buffer(&d.counts[0], 0, bytemuck::cast_slice(&first_counts(&n)));
+        let emits: Vec<Vec<u32>> = self.program.procs.iter().map(|p| p.emits.clone()).collect();
         let mut par = 0;
         while n.iter().any(|&k| k > 0) {
             if stats.rounds >= self.config.max_rounds as u64 {
@@ -251,21 +267,15 @@ impl HostMultipass {
                 )));
             }
             let mut enc = gpu.device.create_command_encoder(&Default::default());
-            // Room for the round's worst case in every target, before it runs.
+            // Room for the round's worst case in every target, before it runs: a target that
+            // lacks it grows; one that cannot (at its limit) makes this a partial round.
+            let worst: Vec<u64> = (0..nq)
+                .map(|t| (0..nq).map(|p| n[p] as u64 * emits[p][t] as u64).sum())
+                .collect();
             let mut grown = capacity.clone();
             for (t, cap) in grown.iter_mut().enumerate() {
-                let m: u64 = (0..nq)
-                    .map(|p| n[p] as u64 * self.program.procs[p].emits[t] as u64)
-                    .sum();
-                if m > *cap as u64 {
-                    if *cap >= max_cap[t] {
-                        return Err(RunError::QueueOverflow {
-                            queue: self.program.procs[t].proc.name.clone(),
-                            capacity: *cap as u64,
-                            needed_more_than: m,
-                        });
-                    }
-                    *cap = grow(*cap, m, max_cap[t]);
+                if worst[t] > *cap as u64 && *cap < max_cap[t] {
+                    *cap = grow(*cap, worst[t], max_cap[t]);
                     stats.queue_growths += 1;
                 }
             }
@@ -287,11 +297,56 @@ impl HostMultipass {
                     }
                 }
                 gpu.queue
-                    .write_buffer(&new.counts[0], 0, bytemuck::cast_slice(&n));
+                    .write_buffer(&new.counts[0], 0, bytemuck::cast_slice(&first_counts(&n)));
                 d = new;
                 par = 0;
             }
-            enc.clear_buffer(&d.counts[1 - par], 0, None);
+            // Inputs this round runs; the rest are carried to the front of the next round's.
+            let at_limit = at_limit(&capacity, &max_cap);
+            let run = if needs_partial(&worst, &capacity, &at_limit) {
+                partial_round(&n, &capacity, &emits).ok_or_else(|| {
+                    let t = (0..nq)
+                        .max_by_key(|&t| worst[t] * at_limit[t] as u64)
+                        .unwrap();
+                    RunError::QueueOverflow {
+                        queue: self.program.procs[t].proc.name.clone(),
+                        capacity: capacity[t] as u64,
+                        needed_more_than: worst[t],
+                    }
+                })?
+            } else {
+                n.clone()
+            };
+            if run == n {
+                enc.clear_buffer(&d.counts[1 - par], 0, None);
+            } else {
+                stats.partial_rounds += 1;
+                // The newest inputs run (depth first, so live work stays bounded); the older
+                // ones stay at the front, copied to the next round's buffer.
+                let mut inputs = vec![0u32; 2 * nq + EXTRA_WORDS];
+                let mut carried = vec![0u32; 2 * nq + EXTRA_WORDS];
+                for q in 0..nq {
+                    let keep = n[q] - run[q];
+                    inputs[q] = run[q];
+                    inputs[nq + H_SKIP + q] = keep;
+                    carried[q] = keep;
+                    let bytes = keep as u64 * d.layout.words[q] as u64 * 4;
+                    let base = d.layout.slot_base[q] as u64 * 4;
+                    if bytes > 0 {
+                        enc.copy_buffer_to_buffer(
+                            &d.items[par],
+                            base,
+                            &d.items[1 - par],
+                            base,
+                            bytes,
+                        );
+                    }
+                }
+                gpu.queue
+                    .write_buffer(&d.counts[par], 0, bytemuck::cast_slice(&inputs));
+                gpu.queue
+                    .write_buffer(&d.counts[1 - par], 0, bytemuck::cast_slice(&carried));
+            }
             {
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("multipass-host round"),
@@ -301,7 +356,7 @@ impl HostMultipass {
                 if let Some(u) = user {
                     pass.set_bind_group(1, u, &[]);
                 }
-                for (q, &k) in n.iter().enumerate() {
+                for (q, &k) in run.iter().enumerate() {
                     if k == 0 {
                         continue;
                     }
@@ -319,7 +374,7 @@ impl HostMultipass {
             stats.submits += 1;
             stats.rounds += 1;
             for q in 0..nq {
-                stats.executed[q] += n[q] as u64;
+                stats.executed[q] += run[q] as u64;
                 stats.peak_occupancy[q] = stats.peak_occupancy[q].max(n[q] as u64);
             }
             let (a, b) = (out[nq + H_ERR_A] as usize, out[nq + H_ERR_B] as usize);

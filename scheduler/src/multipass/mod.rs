@@ -6,6 +6,8 @@
 
 pub mod host;
 pub(crate) mod layout;
+pub mod partial;
+pub(crate) mod recorded;
 pub(crate) mod wgsl;
 
 use std::time::Instant;
@@ -65,6 +67,7 @@ pub struct Multipass {
 
 struct DeviceRounds {
     layout: QueueLayout,
+    at_limit: Vec<bool>,
     ctrl: wgpu::Buffer,
     items: [wgpu::Buffer; 2],
     indirect: wgpu::Buffer,
@@ -109,7 +112,19 @@ impl Multipass {
         })
     }
 
-    fn device_rounds(&self, gpu: &Gpu, layout: QueueLayout) -> Result<DeviceRounds, RunError> {
+    /// The program this multi-pass runs.
+    pub fn program(&self) -> &Program {
+        &self.program
+    }
+
+    /// Buffers of one layout; `at_limit[q]`: queue q cannot grow, so a round it cannot hold
+    /// runs in part ([`partial`]) instead of halting for growth.
+    fn device_rounds(
+        &self,
+        gpu: &Gpu,
+        layout: QueueLayout,
+        at_limit: Vec<bool>,
+    ) -> Result<DeviceRounds, RunError> {
         let nq = self.program.queue_count();
         let ctrl = gpu.storage_buffer("mp_ctrl", ctrl_words(nq) as u64)?;
         let items = [
@@ -127,6 +142,7 @@ impl Multipass {
             p[2] = layout.slot_base[q];
             p[3] = layout.flag_base[q];
             p[4] = sum_words;
+            p[5] = at_limit[q] as u32;
             sum_words += layout.capacity[q].div_ceil(SCAN_BLOCK);
         }
         let sums = gpu.storage_buffer("block sums", sum_words as u64)?;
@@ -163,6 +179,7 @@ impl Multipass {
         });
         Ok(DeviceRounds {
             layout,
+            at_limit,
             ctrl,
             items,
             indirect,
@@ -230,7 +247,7 @@ impl Multipass {
         d: &DeviceRounds,
         rounds: u32,
         first_round: u64,
-        timer: &PassTimer,
+        timer: Option<&PassTimer>,
         stages: Option<&StageTimer>,
         user: Option<&wgpu::BindGroup>,
     ) {
@@ -239,7 +256,7 @@ impl Multipass {
         let begin = |enc: &mut wgpu::CommandEncoder, round: usize, stage: usize| {
             let writes = match stages {
                 Some(st) => st.writes(stage),
-                None => timer.writes(),
+                None => timer.and_then(|t| t.writes()),
             };
             let mut pass = enc
                 .begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -341,9 +358,10 @@ impl Multipass {
         // Rounds encoded since the last upload: round r reads items[r % 2].
         let mut since_upload = 0u64;
         let layout = QueueLayout::new(&self.program, capacity.clone())?;
+        let at_limit = partial::at_limit(&capacity, &max_cap);
         let mut d = match self.cache.lock().unwrap().take() {
-            Some(d) if d.layout == layout => d,
-            _ => self.device_rounds(gpu, layout)?,
+            Some(d) if d.layout == layout && d.at_limit == at_limit => d,
+            _ => self.device_rounds(gpu, layout, at_limit)?,
         };
         self.upload(gpu, &d, &live);
         loop {
@@ -359,7 +377,7 @@ impl Multipass {
                 &d,
                 rounds,
                 since_upload,
-                &timer,
+                Some(&timer),
                 stage_timer.as_ref(),
                 user,
             );
@@ -399,31 +417,30 @@ impl Multipass {
                 // device. A refusal costs a submission, so the growth leaves room for the round
                 // after as well: at least doubling, and at least 2 m.
                 self.accumulate(&mut stats, &ctrl);
+                // A target at its limit runs in part instead of halting: a refusal with nothing
+                // to grow is a real overflow (not one input fits), named by the plan.
                 let mut grown = capacity.clone();
                 for t in 0..nq {
                     let m = ctrl[c(t, C_EMITS)] as u64;
-                    if m <= capacity[t] as u64 {
-                        continue;
+                    if m > capacity[t] as u64 && capacity[t] < max_cap[t] {
+                        grown[t] = grow(capacity[t], 2 * m, max_cap[t]);
+                        stats.queue_growths += 1;
                     }
-                    if capacity[t] >= max_cap[t] {
-                        return Err(RunError::QueueOverflow {
-                            queue: self.program.procs[t].proc.name.clone(),
-                            capacity: capacity[t] as u64,
-                            needed_more_than: m,
-                        });
-                    }
-                    grown[t] = grow(capacity[t], 2 * m, max_cap[t]);
-                    stats.queue_growths += 1;
                 }
                 if grown == capacity {
-                    return Err(RunError::Device(format!(
-                        "multi-pass round refused although every target fits: {ctrl:?}"
-                    )));
+                    return Err(RunError::QueueOverflow {
+                        queue: self.program.procs[a].proc.name.clone(),
+                        capacity: capacity[a] as u64,
+                        needed_more_than: b as u64,
+                    });
                 }
                 capacity = grown;
                 let parity = ctrl[g(nq, G_PLANNED)] as usize % 2;
-                let new =
-                    self.device_rounds(gpu, QueueLayout::new(&self.program, capacity.clone())?)?;
+                let new = self.device_rounds(
+                    gpu,
+                    QueueLayout::new(&self.program, capacity.clone())?,
+                    partial::at_limit(&capacity, &max_cap),
+                )?;
                 self.move_inputs(gpu, &d, parity, &new, &next);
                 d = new;
                 since_upload = 0;
@@ -447,5 +464,6 @@ impl Multipass {
             stats.peak_occupancy[q] = stats.peak_occupancy[q].max(ctrl[c(q, C_PEAK)] as u64);
         }
         stats.rounds += ctrl[g(nq, G_ROUNDS)] as u64;
+        stats.partial_rounds += ctrl[g(nq, G_PARTIAL)] as u64;
     }
 }

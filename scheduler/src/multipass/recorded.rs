@@ -1,0 +1,148 @@
+//! The device-driven multi-pass's [`crate::recorded::RecordedRun`]: a fixed number of rounds
+//! on queues of fixed capacity, seeded on the device, in one pass. A round that would not fit
+//! is refused on the device as in a run (inputs intact, every later round refused too), and an
+//! empty round costs only its plan and empty indirect dispatches.
+
+use super::Multipass;
+use super::layout::*;
+use crate::error::RunError;
+use crate::gpu::Gpu;
+use crate::program::Program;
+use crate::queue_layout::QueueLayout;
+use crate::recorded::{Outcome, RecordedSize};
+use crate::stats::RunStats;
+
+pub(crate) struct Recorded {
+    d: super::DeviceRounds,
+    /// mp_ctrl at the start: the seed counts as the first round's inputs, all else 0.
+    ctrl_start: wgpu::Buffer,
+    rounds: u32,
+}
+
+impl Multipass {
+    /// Queues of `size` (lowered to each queue's limit under the device and `max_queue_bytes`,
+    /// raised to its seeds) and `size.rounds` (at least 1) rounds per record.
+    pub(crate) fn recorded(
+        &self,
+        gpu: &Gpu,
+        seeded: &[u32],
+        size: &RecordedSize,
+        max_queue_bytes: Option<u64>,
+    ) -> Result<(Recorded, RecordedSize), RunError> {
+        let max_cap = QueueLayout::within_budget(
+            &self.program,
+            QueueLayout::capacity_limits(
+                &self.program,
+                gpu.max_binding_bytes(),
+                self.config.max_capacity.min(65_535 * SCAN_BLOCK),
+            ),
+            max_queue_bytes,
+            3,
+        );
+        crate::megakernel::recorded::check_seeds(&self.program, seeded, &max_cap)?;
+        let capacity: Vec<u32> = (0..seeded.len())
+            .map(|q| size.capacity[q].min(max_cap[q]).max(seeded[q]).max(1))
+            .collect();
+        // No partial rounds: a recorded run has a fixed round count, so a round that does not
+        // fit halts and the run reports itself incomplete (the caller re-renders that frame).
+        let d = self.device_rounds(
+            gpu,
+            QueueLayout::new(&self.program, capacity.clone())?,
+            vec![false; seeded.len()],
+        )?;
+        let nq = seeded.len();
+        let mut ctrl = vec![0u32; ctrl_words(nq)];
+        for (q, &n) in seeded.iter().enumerate() {
+            ctrl[c(q, C_NEXT)] = n;
+        }
+        let ctrl_start = gpu.upload("mp_ctrl at start", &ctrl)?;
+        let rounds = size.rounds.max(1);
+        let size = RecordedSize { capacity, rounds };
+        Ok((
+            Recorded {
+                d,
+                ctrl_start,
+                rounds,
+            },
+            size,
+        ))
+    }
+}
+
+impl Recorded {
+    pub fn status_words(&self) -> u64 {
+        self.d.ctrl.size() / 4
+    }
+
+    /// See [`crate::recorded::RecordedRun::record`]; seeds are `(queue, buffer, count)`.
+    pub fn record(
+        &self,
+        m: &Multipass,
+        enc: &mut wgpu::CommandEncoder,
+        seeds: &[(usize, &wgpu::Buffer, u32)],
+        user: Option<&wgpu::BindGroup>,
+        status: &wgpu::Buffer,
+        status_word: u64,
+    ) -> Result<(), RunError> {
+        m.kernels.check_user_group(user)?;
+        let d = &self.d;
+        for &(q, buf, n) in seeds {
+            let bytes = n as u64 * d.layout.words[q] as u64 * 4;
+            if bytes > 0 {
+                enc.copy_buffer_to_buffer(
+                    buf,
+                    0,
+                    &d.items[0],
+                    d.layout.slot_base[q] as u64 * 4,
+                    bytes,
+                );
+            }
+        }
+        enc.copy_buffer_to_buffer(&self.ctrl_start, 0, &d.ctrl, 0, d.ctrl.size());
+        m.encode_rounds(enc, d, self.rounds, 0, None, None, user);
+        enc.copy_buffer_to_buffer(&d.ctrl, 0, status, status_word * 4, d.ctrl.size());
+        Ok(())
+    }
+
+    /// Done when no round was refused and the last left no inputs; an emit beyond a
+    /// declaration is an error.
+    pub fn outcome(
+        &self,
+        program: &Program,
+        size: &RecordedSize,
+        ctrl: &[u32],
+    ) -> Result<Outcome, RunError> {
+        let nq = program.queue_count();
+        let error = ctrl[g(nq, G_ERROR)];
+        let (a, b) = (ctrl[g(nq, G_ERR_A)] as usize, ctrl[g(nq, G_ERR_B)]);
+        if error == ERR_EMIT {
+            return Err(RunError::EmitLimit {
+                procedure: program.procs[a].proc.name.clone(),
+                target: program.procs[b as usize].proc.name.clone(),
+                declared: program.procs[a].emits[b as usize],
+            });
+        }
+        if error == ERR_OVERFLOW {
+            return Ok(Outcome::Incomplete(format!(
+                "a round refused: queue `{}` may receive {b} items, more than its {} slots",
+                program.procs[a].proc.name, size.capacity[a]
+            )));
+        }
+        let left: u64 = (0..nq).map(|q| ctrl[c(q, C_NEXT)] as u64).sum();
+        if left > 0 {
+            return Ok(Outcome::Incomplete(format!(
+                "{left} items left after {} rounds",
+                self.rounds
+            )));
+        }
+        Ok(Outcome::Done(RunStats {
+            strategy: "multipass".into(),
+            executed: (0..nq).map(|q| ctrl[c(q, C_EXEC)] as u64).collect(),
+            peak_occupancy: (0..nq).map(|q| ctrl[c(q, C_PEAK)] as u64).collect(),
+            rounds: ctrl[g(nq, G_ROUNDS)] as u64,
+            launches: self.rounds as u64 * (1 + 4 * nq as u64),
+            queue_bytes: self.d.layout.total_words * 4 * 3 + self.d.layout.total_slots * 4,
+            ..Default::default()
+        }))
+    }
+}
