@@ -662,7 +662,8 @@ fn check_normals(name: &str, s: &Scene, data: &FrameData, max_deg: f64) -> f64 {
     for (i, (p, item)) in s.patches.iter().zip(&data.items).enumerate() {
         for k in 0..17 * 17 {
             let (u, v) = ((k % 17) as f64 / 16.0, (k / 17) as f64 / 16.0);
-            let n = patch_normal(&item.cp, u as f32, v as f32, p.flip_normal);
+            let w = stages::item_weights(item, &data.patch_info[i], &data.primvars);
+            let n = patch_normal(&item.cp, w.as_ref(), u as f32, v as f32, p.flip_normal);
             assert!(
                 n.is_finite() && n.length() > 0.0,
                 "{name} patch {i} at ({u}, {v}): normal {n}"
@@ -723,7 +724,8 @@ fn collapsed_edges_have_finite_outward_normals() {
         for (i, (p, item)) in s.patches.iter().zip(&r.data.items).enumerate() {
             for k in 0..=16 {
                 let u = k as f32 / 16.0;
-                let n = patch_normal(&item.cp, u, 0.0, p.flip_normal)
+                let w = stages::item_weights(item, &r.data.patch_info[i], &r.data.primvars);
+                let n = patch_normal(&item.cp, w.as_ref(), u, 0.0, p.flip_normal)
                     .normalize()
                     .as_dvec3();
                 assert!(
@@ -1009,7 +1011,7 @@ fn reference_normal_of_a_plane() {
     );
     let n = reference_normal(&cp, 0.3, 0.0, false).unwrap();
     assert!(n.distance(DVec3::Z) < 1e-12);
-    let cp32: [f32; 48] = std::array::from_fn(|k| cp[k / 3].to_array()[k % 3] as f32);
-    let m = patch_normal(&cp32, 0.3, 0.0, true);
+    let cp32: [f32; 48] = std::array::from_fn(|k| cp[k / 3][k % 3] as f32);
+    let m = patch_normal(&cp32, None, 0.3, 0.0, true);
     assert!(m.normalize().distance(-Vec3::Z) < 1e-6);
 }

@@ -5,7 +5,7 @@
 //! into four and rendered again; nothing is dropped.
 
 use crate::frame::{Frame, PatchItem, Tile};
-use crate::stages::{bound::CULL_MARGIN_PX, cp_point, project};
+use crate::stages::{Weights, bound::CULL_MARGIN_PX, cp_point, project};
 
 /// Buckets are never cut below this side (pixels); a budget that a bucket this small cannot
 /// meet is an error.
@@ -64,13 +64,19 @@ pub fn quarter(t: Tile) -> Option<Vec<Tile>> {
 }
 
 /// Whether a root patch may reach `tile`: conservative (one pixel wider than Bound's own cull,
-/// which runs again on the GPU), and always true for a patch crossing the near plane, which
-/// has no screen bound yet.
-pub fn may_reach(f: &Frame, item: &PatchItem, t: Tile) -> bool {
+/// which runs again on the GPU; the hull of the Euclidean control points holds a rational
+/// patch too), and always true for a patch crossing the near plane, which
+/// has no screen bound yet. `w`: the item's weights if its patch is rational
+/// (`stages::item_weights`).
+pub fn may_reach(f: &Frame, item: &PatchItem, w: Option<&Weights>, t: Tile) -> bool {
     let mut lo = [f32::INFINITY; 2];
     let mut hi = [f32::NEG_INFINITY; 2];
     for k in 0..16 {
-        let p = cp_point(&item.cp, k);
+        // The Euclidean point.
+        let p = match w {
+            Some(w) => cp_point(&item.cp, k) / w[k],
+            None => cp_point(&item.cp, k),
+        };
         if !(p.z >= f.near) {
             return true;
         }

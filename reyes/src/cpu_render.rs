@@ -46,8 +46,13 @@ pub fn render_cpu(data: &FrameData) -> CpuRender {
                 materials: data.materials.clone(),
                 lights: data.lights.clone(),
                 patch_info: data.patch_info.clone(),
+                primvars: data.primvars.clone(),
                 items: (data.items.iter())
-                    .filter(|i| buckets::may_reach(f, i, tile))
+                    .filter(|i| {
+                        let info = &data.patch_info[i.patch_id as usize];
+                        let w = stages::item_weights(i, info, &data.primvars);
+                        buckets::may_reach(f, i, w.as_ref(), tile)
+                    })
                     .copied()
                     .collect(),
                 memory_budget: data.memory_budget,
@@ -100,7 +105,8 @@ fn walk(
     let mut work: Vec<_> = data.items.clone();
     while let Some(item) = work.pop() {
         executed[0] += 1;
-        match stages::bound::bound(&item, f, &data.patch_info[item.patch_id as usize]) {
+        let info = &data.patch_info[item.patch_id as usize];
+        match stages::bound::bound(&item, f, info, &data.primvars) {
             Decision::Cull(c) => {
                 counters[match c {
                     Cull::Clip => stages::C_CULL_CLIP,

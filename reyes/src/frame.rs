@@ -5,11 +5,15 @@
 use crate::scene::{Light, Patch, Scene, SurfaceKind};
 use bytemuck::{Pod, Zeroable};
 
-/// A queue item of every Reyes stage: a (sub)patch.
+/// A queue item of every Reyes stage: a (sub)patch. 224 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct PatchItem {
-    /// 16 control points, xyz, camera space, `cp[4*v + u]`.
+    /// 16 control points, `x, y, z` each, camera space, point `4*v + u` at `cp[3*(4*v + u)..]`:
+    /// the points themselves for a polynomial patch; for a rational one ([`PATCH_RATIONAL`] in
+    /// its [`PatchInfo::flags`]) the homogeneous `x w, y w, z w`, whose weights are not in the
+    /// item but blossomed from its patch's weight table at [`PatchItem::uv`]
+    /// (`crate::stages::rational_weights`; docs/reyes.md, "Rational patches").
     pub cp: [f32; 48],
     /// Parameter range in the original patch: u0, u1, v0, v1.
     pub uv: [f32; 4],
@@ -100,7 +104,8 @@ pub struct Material {
     pub kd: f32,
     pub ks: f32,
     pub roughness: f32,
-    pub pad: f32,
+    /// `Opacity` (Os) as one fraction: the mean of its channels (docs/reyes.md, Opacity).
+    pub opacity: f32,
 }
 
 #[repr(C)]
@@ -113,13 +118,63 @@ pub struct GpuLight {
     pub pad: f32,
 }
 
+/// What the stages know of an original patch, indexed by `PatchItem::patch_id`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct PatchInfo {
     pub material: u32,
-    /// bit 0: flip the normal; bit 1: two-sided
+    /// bit 0: flip the normal; bit 1: two-sided; bit 2 ([`PATCH_RATIONAL`]): some weight of
+    /// the patch is not 1.
     pub flags: u32,
+    /// The patch's `"Cs"` in [`FrameData::primvars`] ([`field_ref`]), 0 for the material's.
+    pub cs: u32,
+    /// The patch's `"Os"` in [`FrameData::primvars`] ([`field_ref`]), 0 for the material's.
+    pub os: u32,
+    /// A rational patch's weights: the index of 4 entries of [`FrameData::primvars`], entry
+    /// `l` holding the weights of row `v = l` (u = 0..3 in its 4 lanes), as [`root_item`]
+    /// scales them (largest 1). 0 for a polynomial patch, read only under [`PATCH_RATIONAL`].
+    pub weights: u32,
 }
+
+/// Shapes of a colour field in the primitive-variable table (the low 2 bits of
+/// `PatchInfo::cs` / `os`; `FIELD_*` in common.wgsl): one value, 4 bilinear corners, or 16
+/// bicubic Bezier coefficients (`crate::scene::ColorField`).
+pub const FIELD_FLAT: u32 = 1;
+pub const FIELD_BILINEAR: u32 = 2;
+pub const FIELD_BEZIER: u32 = 3;
+
+/// Appends `field` to the primitive-variable table (one `[r, g, b, 0]` entry per value, in
+/// f32) and returns its reference: the entry index shifted left by 2, or-ed with its shape.
+/// Errors when the table would outgrow what a GPU binding holds.
+pub fn field_ref(
+    table: &mut Vec<[f32; 4]>,
+    field: &crate::scene::ColorField,
+) -> Result<u32, String> {
+    use crate::scene::ColorField;
+    let shape = match field {
+        ColorField::Flat(_) => FIELD_FLAT,
+        ColorField::Bilinear(_) => FIELD_BILINEAR,
+        ColorField::Bezier(_) => FIELD_BEZIER,
+    };
+    let at = table.len() as u64;
+    let end = at + field.values().len() as u64;
+    if end * 16 > MAX_FRAME_BUFFER_BYTES || at >= 1 << 30 {
+        return Err(format!(
+            "the patches' primitive variables need more than the {MAX_FRAME_BUFFER_BYTES} bytes a GPU table may hold"
+        ));
+    }
+    table.extend(field.values().iter().map(|c| {
+        let c = f3(*c);
+        [c[0], c[1], c[2], 0.0]
+    }));
+    Ok((at as u32) << 2 | shape)
+}
+
+/// Bit of [`PatchInfo::flags`] (`PATCH_RATIONAL` in common.wgsl): the patch is rational, so
+/// the stages blossom its weights from [`PatchInfo::weights`] and divide by them (homogeneous
+/// arithmetic); without it they take an item's control points as the points, read no table
+/// and skip that work.
+pub const PATCH_RATIONAL: u32 = 4;
 
 /// Quality and size settings of a render; `None` fields come from the scene.
 #[derive(Clone, Debug, PartialEq)]
@@ -170,9 +225,74 @@ pub struct FrameData {
     pub materials: Vec<Material>,
     pub lights: Vec<GpuLight>,
     pub patch_info: Vec<PatchInfo>,
+    /// The colour fields of the patches that have primitive variables, referenced by
+    /// `PatchInfo::cs` / `os` ([`field_ref`]), and the weights of the rational patches
+    /// (`PatchInfo::weights`); empty when no patch has either.
+    pub primvars: Vec<[f32; 4]>,
     pub items: Vec<PatchItem>,
     /// See [`RenderOptions::memory_budget`].
     pub memory_budget: Option<u64>,
+}
+
+impl FrameData {
+    /// What this frame needs compiled into the GPU program ([`SceneFeatures`]).
+    pub fn features(&self) -> SceneFeatures {
+        let os = self.patch_info.iter().any(|i| i.os != 0);
+        SceneFeatures {
+            rational: (self.patch_info.iter()).any(|i| i.flags & PATCH_RATIONAL != 0),
+            primvars: os || self.patch_info.iter().any(|i| i.cs != 0),
+            transparent: os || self.materials.iter().any(|m| m.opacity < 1.0),
+        }
+    }
+}
+
+/// What a frame's scene needs of the stages beyond plain polynomial, opaque patches with their
+/// material's colour. The GPU program is compiled with each as a WGSL constant
+/// (`SCENE_RATIONAL`, `SCENE_PRIMVARS`, `SCENE_TRANSPARENT` in common.wgsl), so that a scene
+/// without them pays nothing for their code paths: not even the registers a GPU compiler keeps
+/// for a branch it cannot rule out (measured on the H200: ~5% of a Killeroo frame).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct SceneFeatures {
+    /// Some patch is rational (`PATCH_RATIONAL`).
+    pub rational: bool,
+    /// Some patch has "Cs" or "Os" primitive variables.
+    pub primvars: bool,
+    /// Some surface is not opaque (a material's `Opacity` or an "Os" below 1).
+    pub transparent: bool,
+}
+
+impl SceneFeatures {
+    /// Every feature: a program that renders any frame.
+    pub const ALL: SceneFeatures = SceneFeatures {
+        rational: true,
+        primvars: true,
+        transparent: true,
+    };
+
+    /// True when a program compiled for `self` renders every frame that needs `need`.
+    pub fn covers(self, need: SceneFeatures) -> bool {
+        (self.rational || !need.rational)
+            && (self.primvars || !need.primvars)
+            && (self.transparent || !need.transparent)
+    }
+
+    /// The features either needs.
+    pub fn union(self, o: SceneFeatures) -> SceneFeatures {
+        SceneFeatures {
+            rational: self.rational || o.rational,
+            primvars: self.primvars || o.primvars,
+            transparent: self.transparent || o.transparent,
+        }
+    }
+
+    /// The WGSL constants that select the stages' code paths (prepended to common.wgsl).
+    pub fn wgsl(self) -> String {
+        format!(
+            "const SCENE_RATIONAL: bool = {};\nconst SCENE_PRIMVARS: bool = {};\n\
+             const SCENE_TRANSPARENT: bool = {};\n",
+            self.rational, self.primvars, self.transparent
+        )
+    }
 }
 
 /// Largest image side accepted (the sample buffer must also fit the adapter; checked there).
@@ -268,6 +388,10 @@ impl FrameData {
         let fov = scene.camera.fov_deg.to_radians();
         let focal = width.min(height) as f64 / 2.0 / (fov / 2.0).tan();
         let lights = gpu_lights(scene);
+        let mut primvars = Vec::new();
+        let patch_info = (scene.patches.iter())
+            .map(|p| patch_info(p, &mut primvars))
+            .collect::<Result<_, _>>()?;
         let frame = Frame {
             width,
             height,
@@ -293,7 +417,8 @@ impl FrameData {
             frame,
             materials: scene.materials.iter().map(gpu_material).collect(),
             lights,
-            patch_info: scene.patches.iter().map(patch_info).collect(),
+            patch_info,
+            primvars,
             items: scene
                 .patches
                 .iter()
@@ -322,7 +447,7 @@ fn gpu_material(m: &crate::scene::Material) -> Material {
         kd: m.kd as f32,
         ks: m.ks as f32,
         roughness: m.roughness as f32,
-        pad: 0.0,
+        opacity: ((m.opacity.x + m.opacity.y + m.opacity.z) / 3.0) as f32,
     }
 }
 
@@ -348,20 +473,62 @@ fn gpu_lights(scene: &Scene) -> Vec<GpuLight> {
         .collect()
 }
 
-fn patch_info(p: &Patch) -> PatchInfo {
-    PatchInfo {
+fn patch_info(p: &Patch, table: &mut Vec<[f32; 4]>) -> Result<PatchInfo, String> {
+    let mut field = |f: Option<&crate::scene::ColorField>| f.map_or(Ok(0), |f| field_ref(table, f));
+    let vars = p.primvars.as_deref();
+    let cs = field(vars.and_then(|v| v.cs.as_ref()))?;
+    let os = field(vars.and_then(|v| v.os.as_ref()))?;
+    let weights = if p.is_rational() {
+        weights_ref(table, &homogeneous_points(p))?
+    } else {
+        0
+    };
+    Ok(PatchInfo {
         material: p.material,
-        flags: p.flip_normal as u32 | (p.two_sided as u32) << 1,
-    }
+        flags: p.flip_normal as u32
+            | (p.two_sided as u32) << 1
+            | if p.is_rational() { PATCH_RATIONAL } else { 0 },
+        cs,
+        os,
+        weights,
+    })
 }
 
-fn root_item(id: u32, p: &Patch) -> PatchItem {
-    let mut cp = [0f32; 48];
-    for (i, c) in p.cp.iter().enumerate() {
-        cp[3 * i..3 * i + 3].copy_from_slice(&f3(*c));
+/// Appends the 16 weights of homogeneous points `h` to the table as 4 entries (row v = l in
+/// entry l) and returns the first entry's index ([`PatchInfo::weights`]). Errors when the
+/// table would outgrow what a GPU binding holds.
+fn weights_ref(table: &mut Vec<[f32; 4]>, h: &[[f32; 4]; 16]) -> Result<u32, String> {
+    let at = table.len() as u64;
+    if (at + 4) * 16 > MAX_FRAME_BUFFER_BYTES {
+        return Err(format!(
+            "the patches' weights and primitive variables need more than the \
+             {MAX_FRAME_BUFFER_BYTES} bytes a GPU table may hold"
+        ));
     }
+    table.extend((0..4).map(|l| std::array::from_fn(|u| h[4 * l + u][3])));
+    Ok(at as u32)
+}
+
+/// The homogeneous control points `(x w, y w, z w, w)` of `p`, `[4*v + u]`, formed in f64 and
+/// rounded once to f32, with the weights scaled so that the largest is 1 (a common factor does
+/// not change a rational surface; this keeps `x w` within f32 wherever `x` is). For a
+/// polynomial patch (all w = 1) these are exactly the f32 coordinates and 1. The object table
+/// of the real-time renderer (roots.wgsl) holds these.
+pub fn homogeneous_points(p: &Patch) -> [[f32; 4]; 16] {
+    let top = p.w.iter().copied().fold(0.0, f64::max);
+    std::array::from_fn(|i| {
+        let w = p.w[i] / top;
+        let c = p.cp[i] * w;
+        [c.x as f32, c.y as f32, c.z as f32, w as f32]
+    })
+}
+
+/// The root item of `p`: the xyz of its [`homogeneous_points`] (for a polynomial patch the f32
+/// points), whose weights [`FrameData::new`] puts in the weight table of a rational patch.
+pub fn root_item(id: u32, p: &Patch) -> PatchItem {
+    let h = homogeneous_points(p);
     PatchItem {
-        cp,
+        cp: std::array::from_fn(|k| h[k / 3][k % 3]),
         uv: [0.0, 1.0, 0.0, 1.0],
         patch_id: id,
         depth: 0,
@@ -392,6 +559,11 @@ mod tests {
             }
         };
         use std::mem::{offset_of, size_of};
+        assert_eq!(
+            size_of::<PatchItem>(),
+            224,
+            "48 floats of control points, uv, 4 words"
+        );
         check(
             "PatchItem",
             size_of::<PatchItem>(),
@@ -425,6 +597,7 @@ mod tests {
                 ("specular", offset_of!(Material, specular)),
                 ("ka", offset_of!(Material, ka)),
                 ("roughness", offset_of!(Material, roughness)),
+                ("opacity", offset_of!(Material, opacity)),
             ],
         );
         check(
@@ -438,8 +611,82 @@ mod tests {
         check(
             "PatchInfo",
             size_of::<PatchInfo>(),
-            &[("flags", offset_of!(PatchInfo, flags))],
+            &[
+                ("flags", offset_of!(PatchInfo, flags)),
+                ("cs", offset_of!(PatchInfo, cs)),
+                ("os", offset_of!(PatchInfo, os)),
+                ("weights", offset_of!(PatchInfo, weights)),
+            ],
         );
+    }
+
+    /// Only patches with primitive variables use table space; each field is referenced by its
+    /// entry index and shape, in f32.
+    #[test]
+    fn primvars_fill_the_table_only_for_patches_that_have_them() {
+        use crate::scene::{ColorField, Primvars};
+        use glam::DVec3;
+        let mut scene = crate::scene::builtin_teapot();
+        let plain = FrameData::new(&scene, &RenderOptions::default()).unwrap();
+        assert!(plain.primvars.is_empty());
+        assert!(plain.patch_info.iter().all(|i| i.cs == 0 && i.os == 0));
+        let corners = [DVec3::X, DVec3::Y, DVec3::Z, DVec3::ONE];
+        scene.patches[3].primvars = Primvars {
+            cs: Some(ColorField::Bilinear(corners)),
+            os: Some(ColorField::Flat(DVec3::splat(0.5))),
+        }
+        .boxed();
+        scene.patches[7].primvars = Primvars {
+            cs: None,
+            os: Some(ColorField::Bezier([DVec3::splat(0.25); 16])),
+        }
+        .boxed();
+        let d = FrameData::new(&scene, &RenderOptions::default()).unwrap();
+        assert_eq!(d.primvars.len(), 4 + 1 + 16);
+        assert_eq!(
+            (d.patch_info[3].cs, d.patch_info[3].os),
+            (FIELD_BILINEAR, 4 << 2 | FIELD_FLAT)
+        );
+        assert_eq!(
+            (d.patch_info[7].cs, d.patch_info[7].os),
+            (0, 5 << 2 | FIELD_BEZIER)
+        );
+        assert_eq!(d.patch_info[0], plain.patch_info[0]);
+        assert_eq!(d.primvars[2], [0.0, 0.0, 1.0, 0.0]);
+        assert_eq!(d.primvars[4], [0.5, 0.5, 0.5, 0.0]);
+        assert_eq!(d.primvars[20], [0.25, 0.25, 0.25, 0.0]);
+    }
+
+    /// A rational patch's item keeps the xyz of its homogeneous points and its weights go to
+    /// the table, 4 entries at `PatchInfo::weights`, as `homogeneous_points` scales them; a
+    /// polynomial patch's item holds its f32 points and it uses no table space.
+    #[test]
+    fn rational_weights_go_to_the_table() {
+        let mut scene = crate::scene::builtin_teapot();
+        scene.patches[5].w[6] = 4.0;
+        scene.patches[5].w[9] = 0.5;
+        let d = FrameData::new(&scene, &RenderOptions::default()).unwrap();
+        assert_eq!(d.primvars.len(), 4);
+        for (i, (p, info)) in scene.patches.iter().zip(&d.patch_info).enumerate() {
+            let h = homogeneous_points(p);
+            let xyz: Vec<f32> = h.iter().flat_map(|q| [q[0], q[1], q[2]]).collect();
+            assert_eq!(d.items[i].cp.to_vec(), xyz);
+            if i == 5 {
+                assert_eq!(info.flags & PATCH_RATIONAL, PATCH_RATIONAL);
+                assert_eq!(info.weights, 0);
+                for k in 0..16 {
+                    assert_eq!(d.primvars[k / 4][k % 4], h[k][3]);
+                }
+                assert_eq!(h[6][3], 1.0, "scaled to a largest of 1");
+                assert_eq!(h[9][3], 0.125);
+            } else {
+                assert_eq!((info.flags & PATCH_RATIONAL, info.weights), (0, 0));
+                let pts =
+                    p.cp.iter()
+                        .flat_map(|c| [c.x as f32, c.y as f32, c.z as f32]);
+                assert_eq!(d.items[i].cp.to_vec(), pts.collect::<Vec<_>>());
+            }
+        }
     }
 
     #[test]

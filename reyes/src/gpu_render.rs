@@ -3,7 +3,7 @@
 //! either strategy, then a resolve pass from sub-samples to pixels.
 
 use crate::buckets;
-use crate::frame::{Frame, FrameData, PatchItem};
+use crate::frame::{Frame, FrameData, PatchItem, SceneFeatures};
 use crate::image::FrameImage;
 use crate::shaders;
 use crate::stages::{C_MAX_DEPTH, COUNTERS};
@@ -23,7 +23,14 @@ pub fn required_features() -> wgpu::Features {
     wgpu::Features::SHADER_INT64 | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX
 }
 
+/// The Reyes program for any frame ([`program_for`] with every feature).
 pub fn program() -> Result<Program, RunError> {
+    program_for(SceneFeatures::ALL)
+}
+
+/// The Reyes program compiled for frames that need at most `features`: the code paths of the
+/// others are constants the GPU compiler removes ([`SceneFeatures`]).
+pub fn program_for(features: SceneFeatures) -> Result<Program, RunError> {
     let item = ItemType::new("PatchItem", shaders::PATCH_ITEM);
     let bound = Procedure::new("bound", item.clone(), 16)
         .shared("vec4<f32>", 16)
@@ -45,8 +52,15 @@ pub fn program() -> Result<Program, RunError> {
     // dicesmall_execute is defined in dice_shade.wgsl and shares diceshade_shared.
     let dicesmall = Procedure::new("dicesmall", item, 64).body("");
     let user = UserBindings {
-        wgsl: [shaders::COMMON, shaders::SHADE, shaders::SAMPLE].concat(),
-        layout: (0..6).map(|b| storage_entry(b, b < 4)).collect(),
+        wgsl: [
+            &features.wgsl(),
+            shaders::COMMON,
+            shaders::SHADE,
+            shaders::SAMPLE,
+        ]
+        .concat(),
+        // 0-3 frame, materials, lights, patch info; 4-5 samples, counters; 6 primvars.
+        layout: (0..7).map(|b| storage_entry(b, b < 4 || b == 6)).collect(),
     };
     Program::new(vec![bound, splitu, splitv, diceshade, dicesmall], user)
 }
@@ -77,9 +91,11 @@ pub const INITIAL_CAPACITY: u32 = 1 << 14;
 
 pub struct GpuRenderer {
     pub program: Program,
+    /// What the program was compiled for; frames needing more are refused.
+    pub features: SceneFeatures,
     pub scheduler: Scheduler,
-    user_layout: wgpu::BindGroupLayout,
-    resolve: wgpu::ComputePipeline,
+    pub(crate) user_layout: wgpu::BindGroupLayout,
+    pub(crate) resolve: wgpu::ComputePipeline,
     /// The last frame's per-frame buffers, reused by the next frame of the same size, so
     /// that a frame allocates nothing large (a 1080p frame's samples are 66 MB).
     frame_buffers: std::sync::Mutex<Option<FrameBuffers>>,
@@ -136,7 +152,19 @@ impl GpuRenderer {
         strategy: StrategyKind,
         stage_timing: bool,
     ) -> Result<GpuRenderer, RunError> {
-        let program = program()?;
+        Self::for_features(gpu, strategy, stage_timing, SceneFeatures::ALL)
+    }
+
+    /// A renderer compiled for frames that need at most `features` (e.g.
+    /// [`FrameData::features`](crate::frame::FrameData::features) of the frames it will
+    /// render): the fastest program for them. Other frames are refused by [`Self::render`].
+    pub fn for_features(
+        gpu: &Gpu,
+        strategy: StrategyKind,
+        stage_timing: bool,
+        features: SceneFeatures,
+    ) -> Result<GpuRenderer, RunError> {
+        let program = program_for(features)?;
         let scheduler = match strategy {
             StrategyKind::Multipass => Scheduler::multipass(
                 gpu,
@@ -149,15 +177,16 @@ impl GpuRenderer {
             )?,
             _ => Scheduler::new(gpu, &program, strategy, INITIAL_CAPACITY)?,
         };
-        Self::from_scheduler(gpu, program, scheduler)
+        Self::from_scheduler(gpu, program, scheduler, features)
     }
 
-    /// A renderer on a scheduler the caller compiled from [`program()`] with its own
-    /// configuration (e.g. another queue policy); [`INITIAL_CAPACITY`] is the usual start.
+    /// A renderer on a scheduler the caller compiled from [`program_for`]`(features)` with its
+    /// own configuration (e.g. another queue policy); [`INITIAL_CAPACITY`] is the usual start.
     pub fn from_scheduler(
         gpu: &Gpu,
         program: Program,
         scheduler: Scheduler,
+        features: SceneFeatures,
     ) -> Result<GpuRenderer, RunError> {
         let user_layout = gpu
             .device
@@ -168,6 +197,7 @@ impl GpuRenderer {
         let resolve = gpu.compute_pipeline("reyes resolve", shaders::RESOLVE, "resolve")?;
         Ok(GpuRenderer {
             program,
+            features,
             scheduler,
             user_layout,
             resolve,
@@ -177,12 +207,20 @@ impl GpuRenderer {
 
     /// Renders a frame; under `data.memory_budget` in screen buckets (see [`crate::buckets`]).
     pub fn render(&self, gpu: &Gpu, data: &FrameData) -> Result<GpuFrame, RunError> {
+        let need = data.features();
+        if !self.features.covers(need) {
+            return Err(RunError::Program(format!(
+                "the frame needs {need:?}; this renderer was compiled for {:?}",
+                self.features
+            )));
+        }
         let start = Instant::now();
         let f = &data.frame;
         // Each table holds at least one element, also for an empty scene (Gpu::upload).
         let materials = gpu.upload("materials", &data.materials)?;
         let lights = gpu.upload("lights", &data.lights)?;
         let infos = gpu.upload("patch info", &data.patch_info)?;
+        let primvars = gpu.upload("primvars", &data.primvars)?;
         let mut todo = buckets::plan(f, data.memory_budget);
         todo.reverse();
         let per_pixel = buckets::sample_bytes_per_pixel(f);
@@ -205,7 +243,9 @@ impl GpuRenderer {
         let bind = gpu.bind_buffers(
             "reyes scene",
             &self.user_layout,
-            &[frame_buf, &materials, &lights, &infos, samples, counters],
+            &[
+                frame_buf, &materials, &lights, &infos, samples, counters, &primvars,
+            ],
         );
         let mut out = GpuFrame {
             image: FrameImage::default(),
@@ -225,7 +265,11 @@ impl GpuRenderer {
             let items: std::borrow::Cow<[PatchItem]> = match data.memory_budget {
                 None => (&data.items[..]).into(),
                 Some(_) => (data.items.iter())
-                    .filter(|i| buckets::may_reach(f, i, tile))
+                    .filter(|i| {
+                        let info = &data.patch_info[i.patch_id as usize];
+                        let w = crate::stages::item_weights(i, info, &data.primvars);
+                        buckets::may_reach(f, i, w.as_ref(), tile)
+                    })
                     .copied()
                     .collect(),
             };
@@ -360,19 +404,7 @@ impl GpuRenderer {
         rgba: &wgpu::Buffer,
         depth: &wgpu::Buffer,
     ) -> Result<Option<f64>, RunError> {
-        let pixels = f.tile_w as u64 * f.tile_h as u64;
-        let groups = pixels.div_ceil(256) as u32;
-        let (gx, gy) = (groups.min(32768), groups.div_ceil(32768));
-        let params = [
-            f.tile_w,
-            f.tile_h,
-            f.spp_x * f.spp_y,
-            gx * 256,
-            f.width,
-            f.tile_x0,
-            f.tile_y0,
-            0,
-        ];
+        let (params, (gx, gy)) = resolve_params(f);
         let params_buf = gpu.storage_buffer("resolve params", params.len() as u64)?;
         gpu.queue
             .write_buffer(&params_buf, 0, bytemuck::cast_slice(&params));
@@ -394,4 +426,32 @@ impl GpuRenderer {
         timer.collect(gpu)?;
         Ok(timer.total_ms())
     }
+}
+
+/// Workgroups of a 1D pass of `threads` threads, `per_group` per workgroup, as a 2D dispatch
+/// (at most 32,768 groups per row, within every adapter's 65,535): `(x, y)` and the threads per
+/// row the shader multiplies its y index by.
+pub(crate) fn dispatch_2d(threads: u64, per_group: u32) -> ((u32, u32), u32) {
+    let groups = threads.div_ceil(per_group as u64);
+    let gx = groups.min(32768) as u32;
+    let gy = groups.div_ceil(32768) as u32;
+    ((gx, gy), gx * per_group)
+}
+
+/// The resolve pass's parameters for the bucket of `f` (`ResolveParams` in resolve.wgsl) and
+/// its dispatch size.
+pub(crate) fn resolve_params(f: &Frame) -> ([u32; 8], (u32, u32)) {
+    let pixels = f.tile_w as u64 * f.tile_h as u64;
+    let ((gx, gy), row) = dispatch_2d(pixels, 256);
+    let params = [
+        f.tile_w,
+        f.tile_h,
+        f.spp_x * f.spp_y,
+        row,
+        f.width,
+        f.tile_x0,
+        f.tile_y0,
+        0,
+    ];
+    (params, (gx, gy))
 }

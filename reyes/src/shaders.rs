@@ -9,3 +9,5 @@ pub const SHADE: &str = include_str!("../../shaders/reyes/shade.wgsl");
 pub const SAMPLE: &str = include_str!("../../shaders/reyes/sample.wgsl");
 pub const DICE_SHADE: &str = include_str!("../../shaders/reyes/dice_shade.wgsl");
 pub const RESOLVE: &str = include_str!("../../shaders/reyes/resolve.wgsl");
+pub const ROOTS: &str = include_str!("../../shaders/reyes/roots.wgsl");
+pub const RGBA8: &str = include_str!("../../shaders/reyes/rgba8.wgsl");

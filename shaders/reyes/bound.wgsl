@@ -1,17 +1,28 @@
 // Bound: 16 threads per patch, one per control point. Projects the control points, reduces them
 // to a screen bound, culls, and decides: split in u, split in v, or dice (with its rates).
 // Rust twin: reyes/src/stages/bound.rs.
+//
+// A rational patch (positive weights) lies in the convex hull of its Euclidean control points
+// xyz / w, as a polynomial one does in that of its points; every bound below uses those, so
+// screen bounds, culling and the near plane mean the same for both. The weights come from the
+// patch's table (rational_weights in common.wgsl): each of the 16 threads blossoms its own,
+// thread 0 all 16 for its reduction. The back-face test runs on the homogeneous xyz and the
+// crack bound has a rational form (their comments say why).
 
 // Workgroup memory per item: 16 control points as (x, y) in pixels, z in camera space,
 // w = 1 (in front of the near plane) + 2 (this thread's back-face terms all hold).
 fn bound_execute(item: PatchItem, inv: Invocation) {
     var cp = item.cp;
     let t = inv.thread;
-    let p = cp_point(&cp, t);
+    let info = patch_info[item.patch_id];
+    let rational = SCENE_RATIONAL && (info.flags & PATCH_RATIONAL) != 0u;
+    // This thread's Euclidean control point (a polynomial patch's cp are the points: no weight,
+    // no division).
+    var p = cp_point(&cp, t);
+    if rational { p = p / rational_weight(info.weights, item.uv, t % 4u, t / 4u); }
     let front = p.z >= frame.near;
     var s = vec2<f32>(0.0);
     if front { s = project(p); }
-    let info = patch_info[item.patch_id];
     let one_sided = (info.flags & 2u) == 0u;
     var back = false;
     if one_sided { back = backfacing_terms(&cp, t, (info.flags & 1u) != 0u); }
@@ -19,6 +30,12 @@ fn bound_execute(item: PatchItem, inv: Invocation) {
     bound_shared[base + t] = vec4<f32>(s, p.z, select(0.0, 1.0, front) + select(0.0, 2.0, back));
     workgroupBarrier();
     if !inv.live || t != 0u { return; }
+    // From here on cp holds the Euclidean points, and w their weights (rational only).
+    var w: array<f32, 16>;
+    if rational {
+        w = rational_weights(info.weights, item.uv);
+        to_euclidean(&cp, &w);
+    }
 
     var pts: array<vec4<f32>, 16>;
     for (var k = 0u; k < 16u; k++) { pts[k] = bound_shared[base + k]; }
@@ -79,7 +96,8 @@ fn bound_execute(item: PatchItem, inv: Invocation) {
         for (var k = 0u; k < 16u; k++) {
             if pts[k].z >= frame.near { zfront = min(zfront, pts[k].z); }
         }
-        g.dilate = select(0u, crack_dilation(&cp, frame.grid_max, frame.grid_max, zfront),
+        g.dilate = select(0u, crack_dilation(&cp, &w, rational, frame.grid_max, frame.grid_max,
+            zfront),
             frame.crack_dilation != 0u);
         if (frame.grid_max + 1u) * (frame.grid_max + 1u) <= SMALL_GRID_POINTS {
             enqueue_dicesmall(g);
@@ -119,7 +137,7 @@ fn bound_execute(item: PatchItem, inv: Invocation) {
     atomicMax(&counters[C_MAX_DEPTH], depth);
     var g = item;
     g.rates = d.y | (d.z << 8u);
-    g.dilate = select(0u, crack_dilation(&cp, d.y, d.z, zmin), frame.crack_dilation != 0u);
+    g.dilate = select(0u, crack_dilation(&cp, &w, rational, d.y, d.z, zmin), frame.crack_dilation != 0u);
     if (d.y + 1u) * (d.z + 1u) <= SMALL_GRID_POINTS {
         enqueue_dicesmall(g);
     } else {
@@ -185,14 +203,17 @@ fn dice_decision(lu: f32, lv: f32, extent: vec2<f32>) -> vec3<u32> {
 }
 
 // Largest gap, in pixels, between each boundary curve of this patch and the chord polyline a
-// neighbour may use for it: |C''| <= 6 max|second difference| of the curve's control points, the
-// chord error of a segment of parameter length h is |C''| h^2 / 8, and a camera-space distance
-// d at depth >= zmin spans at most 2 d f / zmin pixels inside a 90 degree view. Sampling grows
+// neighbour may use for it: the chord error of a segment of parameter length h is
+// max|C''| h^2 / 8, with |C''| <= 6 max|second difference| of the curve's control points
+// (polynomial; curve_c2_rational for a rational curve), and a camera-space distance d at
+// depth >= zmin spans at most 2 d f / zmin pixels inside a 90 degree view. Sampling grows
 // only the micropolygon edges on that boundary by this much (sample.wgsl), so that T-junction
 // gaps between grids diced at different rates close: a gap can exist only there. Packed 8 bits
 // per edge (v = 0, v = 1, u = 0, u = 1), rounded up; each at most MAX_DILATE_PX (a grid that
 // coarse is far above any sane micropolygon size), at least one step (float rounding).
-fn crack_dilation(cp: ptr<function, array<f32, 48>>, nu: u32, nv: u32, zmin: f32) -> u32 {
+// `cp` holds Euclidean points (to_euclidean) and `w` their weights (read only if rational).
+fn crack_dilation(cp: ptr<function, array<f32, 48>>, w: ptr<function, array<f32, 16>>,
+                  rational: bool, nu: u32, nv: u32, zmin: f32) -> u32 {
     let slack = 2.0 * (1.0 + max(f32(frame.width), f32(frame.height)) / frame.focal);
     var packed = 0u;
     for (var e = 0u; e < 4u; e++) {
@@ -201,16 +222,58 @@ fn crack_dilation(cp: ptr<function, array<f32, 48>>, nu: u32, nv: u32, zmin: f32
         let start = select(select(0u, 3u, e == 3u), select(0u, 12u, e == 1u), along_u);
         let step = select(4u, 1u, along_u);
         let n = f32(select(nv, nu, along_u));
-        let b0 = cp_point(cp, start);
-        let b1 = cp_point(cp, start + step);
-        let b2 = cp_point(cp, start + 2u * step);
-        let b3 = cp_point(cp, start + 3u * step);
-        let c2 = 6.0 * max(length(b0 - 2.0 * b1 + b2), length(b1 - 2.0 * b2 + b3));
+        var c2 = 0.0;
+        if rational {
+            let k1 = start + step;
+            let k2 = start + 2u * step;
+            let k3 = start + 3u * step;
+            c2 = curve_c2_rational(vec4<f32>(cp_point(cp, start), (*w)[start]),
+                                   vec4<f32>(cp_point(cp, k1), (*w)[k1]),
+                                   vec4<f32>(cp_point(cp, k2), (*w)[k2]),
+                                   vec4<f32>(cp_point(cp, k3), (*w)[k3]));
+        } else {
+            let b0 = cp_point(cp, start);
+            let b1 = cp_point(cp, start + step);
+            let b2 = cp_point(cp, start + 2u * step);
+            let b3 = cp_point(cp, start + 3u * step);
+            c2 = 6.0 * max(length(b0 - 2.0 * b1 + b2), length(b1 - 2.0 * b2 + b3));
+        }
         let px = c2 / (8.0 * n * n) * frame.focal / zmin * slack;
         let q = clamp(ceil(px * (255.0 / MAX_DILATE_PX)), 1.0, 255.0);
         packed |= u32(q) << (8u * e);
     }
     return packed;
+}
+
+// An upper bound of |C''| on [0, 1] for the rational cubic C with Euclidean control points
+// b_i and weights w_i > 0 (each argument is (b_i, w_i)). Fix t, let c = C(t), and let
+// Y(s) = sum B_i(s) w_i (b_i - c) and w(s) = sum B_i(s) w_i, so Y = w (C - c). Differentiating
+// twice and using Y(t) = 0: w C'' = Y'' - 2 w' Y' / w at t. Bernstein sums are convex
+// combinations, c lies in the hull of the b_i (so |b_i - c| <= r, the net's diameter), and
+//   Y'  = 3 sum B2_i [w_{i+1} (b_{i+1} - b_i) + (w_{i+1} - w_i)(b_i - c)],
+//   Y'' = 6 sum B1_i [w_{i+2} (b_{i+2} - 2 b_{i+1} + b_i) + (w_{i+2} - w_i)(b_{i+1} - b_i)
+//                     + (w_{i+2} - 2 w_{i+1} + w_i)(b_{i+1} - c)],
+//   w'  = 3 sum B2_i (w_{i+1} - w_i),  w >= wmin;
+// so with d1, d2 the largest first and second differences of the b_i and dw1, dw2, ddw those
+// of the w_i (dw2 = max|w_{i+2} - w_i|):
+//   |C''| <= (6 (wmax d2 + dw2 d1 + ddw r) + 18 dw1 / wmin (wmax d1 + dw1 r)) / wmin.
+// With equal weights this is 6 d2, the polynomial bound. Rust twin: stages::bound.
+fn curve_c2_rational(p0: vec4<f32>, p1: vec4<f32>, p2: vec4<f32>, p3: vec4<f32>) -> f32 {
+    let b0 = p0.xyz;
+    let b1 = p1.xyz;
+    let b2 = p2.xyz;
+    let b3 = p3.xyz;
+    let w = vec4<f32>(p0.w, p1.w, p2.w, p3.w);
+    let wmin = min(min(w.x, w.y), min(w.z, w.w));
+    let wmax = max(max(w.x, w.y), max(w.z, w.w));
+    let d1 = max(max(length(b1 - b0), length(b2 - b1)), length(b3 - b2));
+    let d2 = max(length(b0 - 2.0 * b1 + b2), length(b1 - 2.0 * b2 + b3));
+    let r = max(d1, max(max(length(b2 - b0), length(b3 - b1)), length(b3 - b0)));
+    let dw1 = max(max(abs(w.y - w.x), abs(w.z - w.y)), abs(w.w - w.z));
+    let dw2 = max(abs(w.z - w.x), abs(w.w - w.y));
+    let ddw = max(abs(w.x - 2.0 * w.y + w.z), abs(w.y - 2.0 * w.z + w.w));
+    return (6.0 * (wmax * d2 + dw2 * d1 + ddw * r) + 18.0 * dw1 / wmin * (wmax * d1 + dw1 * r))
+        / wmin;
 }
 
 // Safe back-face cull. With the eye at the origin a point is back-facing when
@@ -220,6 +283,10 @@ fn crack_dilation(cp: ptr<function, array<f32, 48>>, nu: u32, nv: u32, zmin: f32
 // det[b_a, dU_b, dV_c] has the back-face sign for every triple, every point of the patch is
 // back-facing. Thread t checks the (dU_b, dV_c) pairs t, t + 16, ... against all 16 b_a,
 // with a relative margin that keeps f32 rounding on the safe side.
+// `cp` is the item's net, the homogeneous xyz of a rational patch: the test runs on the
+// polynomial patch X = w P (X = P for a polynomial patch): Pu = (Xu - wu P) / w and likewise Pv, and
+// det is multilinear and vanishes with X in two places, so det[P, Pu, Pv] = det[X, Xu, Xv] / w^3
+// has the sign of det[X, Xu, Xv] (w > 0), to which the hull argument applies.
 fn backfacing_terms(cp: ptr<function, array<f32, 48>>, t: u32, flip: bool) -> bool {
     let sgn = select(1.0, -1.0, flip);
     for (var k = t; k < 144u; k += 16u) {

@@ -39,7 +39,8 @@ struct Material {
     kd: f32,
     ks: f32,
     roughness: f32,
-    pad: f32,
+    // `Opacity` as one fraction of samples covered: the mean of its channels.
+    opacity: f32,
 }
 
 struct Light {
@@ -50,10 +51,17 @@ struct Light {
     pad: f32,
 }
 
-// Per original patch: material index, and flags bit 0 = flip normal, bit 1 = two-sided.
+// Per original patch: material index, and flags bit 0 = flip normal, bit 1 = two-sided,
+// bit 2 = rational (PATCH_RATIONAL); its "Cs" and "Os" fields in `primvars` (0: the material's
+// Color / Opacity), each the entry index << 2 | its shape (FIELD_*); and for a rational patch
+// the entry index in `primvars` of its 16 weights (4 entries, row v = l in entry l, u in
+// x..w), 0 for a polynomial one (read only under PATCH_RATIONAL).
 struct PatchInfo {
     material: u32,
     flags: u32,
+    cs: u32,
+    os: u32,
+    weights: u32,
 }
 
 @group(1) @binding(0) var<storage, read> frame: Frame;
@@ -64,6 +72,14 @@ struct PatchInfo {
 // atomicMax keeps the nearest, and the result does not depend on the order of writes.
 @group(1) @binding(4) var<storage, read_write> samples: array<atomic<u64>>;
 @group(1) @binding(5) var<storage, read_write> counters: array<atomic<u32>, 16>;
+// Colour fields of the patches with primitive variables (rgb, w unused), over the original
+// patch's (u, v): one value, 4 bilinear corners or 16 bicubic Bezier coefficients; and the
+// weights of the rational patches (PatchInfo.weights).
+@group(1) @binding(6) var<storage, read> primvars: array<vec4<f32>>;
+
+const FIELD_FLAT: u32 = 1u;
+const FIELD_BILINEAR: u32 = 2u;
+const FIELD_BEZIER: u32 = 3u;
 
 const C_CULL_CLIP: u32 = 0u;       // wholly in front of near or behind far
 const C_CULL_OFFSCREEN: u32 = 1u;  // screen bound misses the image
@@ -88,6 +104,9 @@ const NEAR_CLIP_GRID: u32 = 0x10000u;
 // Grids of at most this many points go to DiceSmall (64 threads per grid).
 const SMALL_GRID_POINTS: u32 = 64u;
 const CULL_MARGIN_PX: f32 = 3.0;
+// Bit of PatchInfo.flags: some weight of the patch is not 1. Without it the item's cp are the
+// points themselves: the stages read no weights and divide by nothing.
+const PATCH_RATIONAL: u32 = 4u;
 
 fn cp_point(cp: ptr<function, array<f32, 48>>, i: u32) -> vec3<f32> {
     return vec3<f32>((*cp)[3u * i], (*cp)[3u * i + 1u], (*cp)[3u * i + 2u]);
@@ -97,6 +116,67 @@ fn set_cp_point(cp: ptr<function, array<f32, 48>>, i: u32, p: vec3<f32>) {
     (*cp)[3u * i] = p.x;
     (*cp)[3u * i + 1u] = p.y;
     (*cp)[3u * i + 2u] = p.z;
+}
+
+// Weights of a rational item. Its patch's weight function W(u, v) has the 16 Bernstein
+// coefficients in its table (scaled so that the largest is 1); the item is the sub-patch of
+// the parameter range uv = (u0, u1, v0, v1), and the weight of its control point (i, j) is the
+// blossom (polar form) of W at the u-arguments of i and the v-arguments of j, where the
+// arguments of i = 0..3 are (t0, t0, t0), (t0, t0, t1), (t0, t1, t1), (t1, t1, t1) (Ramshaw,
+// "Blossoms are polar forms", 1989: the Bezier points of a cubic on [t0, t1]). Each weight is
+// a convex combination of the table's, computed from them afresh (no error accumulates over
+// splits), the same bits wherever it is computed: a point on an edge two sub-patches share
+// has all its u- (or v-) arguments equal to the edge's parameter in both.
+
+// (1 - t) a + t b: exactly a at t = 0 and b at t = 1, so a root item (uv = (0, 1, 0, 1))
+// gets the table's weights exactly.
+fn blossom_lerp(a: f32, b: f32, t: f32) -> f32 {
+    return (1.0 - t) * a + t * b;
+}
+
+// The blossom of the cubic with Bernstein coefficients c at the i-th argument triple of
+// [t0, t1]: de Casteljau with one argument per level.
+fn blossom_at(c: vec4<f32>, t0: f32, t1: f32, i: u32) -> f32 {
+    let a = select(t0, t1, i >= 3u);
+    let b = select(t0, t1, i >= 2u);
+    let d = select(t0, t1, i >= 1u);
+    let p0 = blossom_lerp(c.x, c.y, a);
+    let p1 = blossom_lerp(c.y, c.z, a);
+    let p2 = blossom_lerp(c.z, c.w, a);
+    return blossom_lerp(blossom_lerp(p0, p1, b), blossom_lerp(p1, p2, b), d);
+}
+
+// The 4 table rows (v = l) of the weights at `at`, each blossomed at the u-arguments of i.
+fn weight_column(at: u32, uv: vec4<f32>, i: u32) -> vec4<f32> {
+    return vec4<f32>(
+        blossom_at(primvars[at], uv.x, uv.y, i),
+        blossom_at(primvars[at + 1u], uv.x, uv.y, i),
+        blossom_at(primvars[at + 2u], uv.x, uv.y, i),
+        blossom_at(primvars[at + 3u], uv.x, uv.y, i),
+    );
+}
+
+// The weight of control point (i, j) of the rational item with range uv whose patch has its
+// weights at `at` (PatchInfo.weights): 30 lerps.
+fn rational_weight(at: u32, uv: vec4<f32>, i: u32, j: u32) -> f32 {
+    return blossom_at(weight_column(at, uv, i), uv.z, uv.w, j);
+}
+
+// All 16 weights of the item, w[4 j + i], the same bits as rational_weight: 192 lerps.
+fn rational_weights(at: u32, uv: vec4<f32>) -> array<f32, 16> {
+    var w: array<f32, 16>;
+    for (var i = 0u; i < 4u; i++) {
+        let c = weight_column(at, uv, i);
+        for (var j = 0u; j < 4u; j++) { w[4u * j + i] = blossom_at(c, uv.z, uv.w, j); }
+    }
+    return w;
+}
+
+// A rational net made Euclidean: each x w, y w, z w divided by its weight.
+fn to_euclidean(cp: ptr<function, array<f32, 48>>, w: ptr<function, array<f32, 16>>) {
+    for (var k = 0u; k < 16u; k++) {
+        set_cp_point(cp, k, cp_point(cp, k) / (*w)[k]);
+    }
 }
 
 // Camera space to pixels; only meaningful for z > 0.

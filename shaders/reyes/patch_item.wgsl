@@ -1,6 +1,9 @@
 // The queue item of every Reyes stage: a (sub)patch. Host twin: reyes/src/frame.rs.
 struct PatchItem {
-    // 16 control points, xyz each, camera space, row-major cp[4*v + u] (u fastest).
+    // 16 control points, xyz each, camera space, row-major cp[4*v + u] (u fastest): the points
+    // themselves for a polynomial patch; for a rational one (PATCH_RATIONAL in patch_info) their
+    // homogeneous x w, y w, z w, whose weights w are not in the item but follow from uv and the
+    // patch's weight table (rational_weights in common.wgsl; docs/reyes.md).
     cp: array<f32, 48>,
     // The item's parameter range in its original patch: (u0, u1, v0, v1).
     uv: vec4<f32>,

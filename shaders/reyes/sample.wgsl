@@ -4,10 +4,14 @@
 
 fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 { return a.x * b.y - a.y * b.x; }
 
+// Index of sub-sample (sx, sy) of pixel (px, py) in the whole image (not the bucket).
+fn sample_id(px: u32, py: u32, sx: u32, sy: u32) -> u32 {
+    return ((py * frame.width + px) * frame.spp_y + sy) * frame.spp_x + sx;
+}
+
 // Position of sub-sample (sx, sy) of pixel (px, py): stratified, jittered by a hash.
 fn sample_position(px: u32, py: u32, sx: u32, sy: u32) -> vec2<f32> {
-    let id = ((py * frame.width + px) * frame.spp_y + sy) * frame.spp_x + sx;
-    let h = reyes_hash(id ^ frame.seed);
+    let h = reyes_hash(sample_id(px, py, sx, sy) ^ frame.seed);
     let j = vec2<f32>(f32(h & 0xffffu), f32(h >> 16u)) / 65536.0;
     return vec2<f32>(f32(px), f32(py)) + (vec2<f32>(f32(sx), f32(sy)) + j)
         / vec2<f32>(f32(frame.spp_x), f32(frame.spp_y));
@@ -71,6 +75,24 @@ fn micropolygon_color(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, tw
     return average_color(ca, cb, cc, cd);
 }
 
+// Stochastic transparency (Enderton et al. 2010): a micropolygon of opacity `alpha` < 1 covers
+// each sample under it with probability alpha, decided by a hash of the sample (its image index)
+// and the original patch (`salt`), so every strategy, bucket and the CPU twin decide alike, and
+// micropolygons of one patch that overlap (crack dilation) decide alike at a sample.
+struct Cover {
+    alpha: f32,
+    salt: u32,
+}
+
+// Mixed into the patch id before hashing, so the coverage hash differs from the jitter hash.
+const COVER_SALT: u32 = 0x5bd1e995u;
+
+fn covers(c: Cover, id: u32) -> bool {
+    if !SCENE_TRANSPARENT || c.alpha >= 1.0 { return true; }
+    let h = reyes_hash(reyes_hash(id ^ frame.seed) ^ c.salt);
+    return f32(h >> 8u) < c.alpha * 16777216.0;
+}
+
 // Keeps the nearest of the keys written to sub-sample (sx, sy) of pixel (px, py) of the bucket.
 fn write_sample(px: u32, py: u32, sx: u32, sy: u32, z: f32, color: u32) {
     let key = (u64(~bitcast<u32>(z)) << 32u) | u64(color);
@@ -90,9 +112,11 @@ fn micropolygon_dilation(packed: u32, i: u32, j: u32, nu: u32, nv: u32) -> vec4<
 
 // `grow`: pixels to grow edges ab, bc, cd and da by (micropolygon_dilation); the diagonal ac,
 // inside the micropolygon, by the least of them.
-fn sample_micropolygon(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, grow: vec4<f32>, two_sided: bool) {
+// `cover`: the fraction of samples it covers (stochastic transparency, `covers`).
+fn sample_micropolygon(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, grow: vec4<f32>, two_sided: bool,
+                       cover: Cover) {
     let color = micropolygon_color(a, b, c, d, two_sided);
-    if color == CULLED { return; }
+    if color == CULLED || !(cover.alpha > 0.0) { return; }
     let g = max(max(grow.x, grow.y), max(grow.z, grow.w));
     let lo = min(min(a.xy, b.xy), min(c.xy, d.xy)) - vec2<f32>(g);
     let hi = max(max(a.xy, b.xy), max(c.xy, d.xy)) + vec2<f32>(g);
@@ -114,7 +138,7 @@ fn sample_micropolygon(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, g
                     if any(q < lo) || any(q > hi) { continue; }
                     var z = triangle_depth(abc, q);
                     if z < 0.0 { z = triangle_depth(acd, q); }
-                    if z < 0.0 { continue; }
+                    if z < 0.0 || !covers(cover, sample_id(px, py, sx, sy)) { continue; }
                     write_sample(px, py, sx, sy, z, color);
                 }
             }
@@ -173,24 +197,25 @@ fn clip_by_plane(poly: ptr<function, array<vec3<f32>, 8>>, n: u32, plane: vec4<f
 // image's guard band, as hardware rasterizers clip, and what is left is sampled as a fan.
 // Every edge of the clipped polygons grows by the micropolygon's largest `grow` (a rare path).
 fn sample_near_clipped(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, grow: vec4<f32>,
-                       two_sided: bool) {
+                       two_sided: bool, cover: Cover) {
     if min(min(a.z, b.z), min(c.z, d.z)) >= frame.near {
         sample_micropolygon(projected(a), projected(b), projected(c), projected(d), grow,
-            two_sided);
+            two_sided, cover);
         return;
     }
     let color = micropolygon_color(a, b, c, d, two_sided);
-    if color == CULLED { return; }
+    if color == CULLED || !(cover.alpha > 0.0) { return; }
     let g = max(max(grow.x, grow.y), max(grow.z, grow.w));
-    sample_clipped_triangle(a.xyz, b.xyz, c.xyz, g, color);
-    sample_clipped_triangle(a.xyz, c.xyz, d.xyz, g, color);
+    sample_clipped_triangle(a.xyz, b.xyz, c.xyz, g, color, cover);
+    sample_clipped_triangle(a.xyz, c.xyz, d.xyz, g, color, cover);
 }
 
 fn projected(p: vec4<f32>) -> vec4<f32> {
     return vec4<f32>(project(p.xyz), p.z, p.w);
 }
 
-fn sample_clipped_triangle(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, grow: f32, color: u32) {
+fn sample_clipped_triangle(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, grow: f32, color: u32,
+                           cover: Cover) {
     var poly: array<vec3<f32>, 8>;
     poly[0] = a;
     poly[1] = b;
@@ -232,7 +257,7 @@ fn sample_clipped_triangle(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, grow: f32, 
                     if any(q < lo) || any(q > hi) { continue; }
                     var z = -1.0;
                     for (var i = 0u; i + 2u < n && z < 0.0; i++) { z = triangle_depth(fan[i], q); }
-                    if z < 0.0 { continue; }
+                    if z < 0.0 || !covers(cover, sample_id(px, py, sx, sy)) { continue; }
                     write_sample(px, py, sx, sy, z, color);
                 }
             }

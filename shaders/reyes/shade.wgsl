@@ -1,8 +1,10 @@
 // Shading of one grid point with RenderMan's standard surfaces (constant, matte, plastic) and
 // lights (ambient, distant, point). Rust twin: reyes/src/stages/shade.rs.
 
-// `n` is the outside normal (unnormalised). Returns linear RGB.
-fn shade(p: vec3<f32>, n: vec3<f32>, m: Material) -> vec3<f32> {
+// `n` is the outside normal (unnormalised); `cs` the surface colour (the material's Color or the
+// patch's "Cs"), which the standard shaders multiply into ambient and diffuse light. Returns
+// linear RGB.
+fn shade(p: vec3<f32>, n: vec3<f32>, m: Material, cs: vec3<f32>) -> vec3<f32> {
     let i = normalize(p);
     let nn = normalize(n);
     // faceforward(N, I): the side the eye sees.
@@ -26,8 +28,8 @@ fn shade(p: vec3<f32>, n: vec3<f32>, m: Material) -> vec3<f32> {
         let h = normalize(ld + v);
         spec += cl * pow(max(dot(nf, h), 0.0), 1.0 / max(m.roughness, 1.0e-4));
     }
-    if m.kind == 0u { return m.color; }
-    var c = m.color * (m.ka * amb + m.kd * diff);
+    if m.kind == 0u { return cs; }
+    var c = cs * (m.ka * amb + m.kd * diff);
     if m.kind == 2u { c += m.specular * m.ks * spec; }
     return c;
 }

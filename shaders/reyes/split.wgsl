@@ -2,6 +2,10 @@
 // Thread 0 builds the first half and thread 1 the second, each from the parent in registers;
 // exchanging rows through workgroup memory would cost 24 KiB per workgroup in the megakernel
 // (64 items per step), lowering occupancy for every stage. Rust twin: reyes/src/stages/split.rs.
+//
+// A rational item's cp are its homogeneous x w, y w, z w, which split linearly like the points
+// of a polynomial patch: the same code is exact subdivision of both. Its weights need no
+// splitting: they follow from the child's uv (rational_weights in common.wgsl).
 
 // Half `second` of the cubic through p0..p3 at t = 1/2. Every operation is (a + b) * 0.5, which
 // is symmetric, so a curve shared by two patches (in either direction) splits to the same bits.

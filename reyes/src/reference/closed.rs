@@ -6,8 +6,12 @@
 //! renderer's fault.
 //!
 //! [`closed_blob_rib`] generates the file; a test keeps the shipped copy in step.
+//!
+//! Also an exact sphere of eight rational patches ([`rational_sphere`]), the closed surface
+//! with a known silhouette that the rational pipeline is tested on.
 
-use glam::DVec3;
+use crate::scene::{Patch, PatchSource};
+use glam::{DVec3, DVec4};
 
 /// Grid coordinates along each face.
 const GRID: [f64; 4] = [-1.0, -1.0 / 3.0, 1.0 / 3.0, 1.0];
@@ -34,6 +38,67 @@ pub fn blob_patches() -> Vec<[DVec3; 16]> {
                 p[j] = b;
                 g(DVec3::from_array(p))
             }));
+        }
+    }
+    out
+}
+
+/// The sphere of `radius` about `centre` as eight exact rational bicubic patches, one per
+/// octant. Each is the surface of revolution of a quarter circle: the rational quadratic arc
+/// (1, 0), (1, 1), (0, 1) with weights 1, sqrt(1/2), 1 (Piegl & Tiller, *The NURBS Book*,
+/// 7.3) swept about z by the same arc; the 3x3 tensor net (weights multiplied) is raised to
+/// degree 3 in homogeneous coordinates (Q0 = P0, Q1 = (P0 + 2 P1)/3, Q2 = (2 P1 + P2)/3,
+/// Q3 = P2 along each direction). u runs round z from +x to +y, v from the equator to the pole
+/// (the row v = 1 collapses to it); the octant of signs (sx, sy, sz) mirrors that, with
+/// `flip_normal` set where the mirror reverses orientation, so every outside normal points
+/// away from the centre. Octants sharing an edge have bit-identical boundary control points.
+pub fn rational_sphere(centre: DVec3, radius: f64) -> Vec<Patch> {
+    let s = 0.5f64.sqrt();
+    let arc = [(1.0, 0.0, 1.0), (1.0, 1.0, s), (0.0, 1.0, 1.0)];
+    let elevate = |a: [DVec4; 3]| {
+        [
+            a[0],
+            (a[0] + 2.0 * a[1]) / 3.0,
+            (2.0 * a[1] + a[2]) / 3.0,
+            a[2],
+        ]
+    };
+    // Quadratic homogeneous net of the first octant, unit sphere: (x, y) from the circle,
+    // scaled by the meridian's radius, z the meridian's height.
+    let quad: [[DVec4; 3]; 3] = std::array::from_fn(|j| {
+        std::array::from_fn(|i| {
+            let ((cx, cy, wc), (mr, mz, wm)) = (arc[i], arc[j]);
+            let w = wc * wm;
+            (DVec3::new(cx * mr, cy * mr, mz) * w).extend(w)
+        })
+    });
+    let rows = quad.map(elevate);
+    let cols: [[DVec4; 4]; 4] = std::array::from_fn(|i| elevate(rows.map(|r| r[i])));
+    let mut out = Vec::new();
+    for sz in [1.0, -1.0] {
+        for sy in [1.0, -1.0] {
+            for sx in [1.0, -1.0] {
+                let sign = DVec3::new(sx, sy, sz);
+                let (cp, w): (Vec<DVec3>, Vec<f64>) = (0..16)
+                    .map(|k| {
+                        let h = cols[k % 4][k / 4];
+                        (centre + h.truncate() / h.w * sign * radius, h.w)
+                    })
+                    .unzip();
+                out.push(Patch {
+                    cp: cp.try_into().unwrap(),
+                    w: w.try_into().unwrap(),
+                    material: 0,
+                    flip_normal: sx * sy * sz < 0.0,
+                    two_sided: true,
+                    primvars: None,
+                    source: PatchSource {
+                        file: "rational_sphere".into(),
+                        line: 0,
+                        index: out.len() as u32,
+                    },
+                });
+            }
         }
     }
     out

@@ -20,9 +20,17 @@
 //! Cells straddling the near or far plane are split further (their bound is the projection
 //! of the control hull clipped to the z slab) and, once tiny, their corner quad is clipped
 //! to the slab in 3D and filled.
+//!
+//! Rational patches: cells are homogeneous nets halved exactly (`homogeneous::split_u`); every
+//! test above uses the cell's Euclidean control points, whose hull holds a rational patch
+//! with positive weights as it holds a polynomial one, and a curve's projection (a rational
+//! curve with weights w z > 0) stays in the hull of its projected control points. Polynomial
+//! patches (w = 1) give the same numbers as Euclidean nets.
 
+use super::homogeneous::{HomNet, euclidean, homogeneous, split_curve, split_u, split_v};
+use super::polygon::{bounds, clip_z, covers, curve_deviation, cut_at_z};
 use crate::scene::Scene;
-use glam::{DVec2, DVec3};
+use glam::{DVec2, DVec3, DVec4};
 use std::ops::RangeInclusive;
 
 /// A leaf cell's projected control net must fit in a box this big (pixels).
@@ -218,7 +226,7 @@ fn coverage_with(
                             bits[k / 64] |= 1 << (k % 64);
                         });
                     for (i, p) in scene.patches.iter().enumerate().skip(t).step_by(threads) {
-                        r.patch(i, &p.cp);
+                        r.patch(i, &homogeneous(p));
                     }
                     bits
                 })
@@ -263,8 +271,9 @@ pub struct Leaf<'a> {
     pub patch: usize,
     /// Parameter range of the cell in that patch: u0, u1, v0, v1.
     pub uv: [f64; 4],
-    /// The cell's own control net (camera space), from exact de Casteljau halving.
-    pub cp: &'a [DVec3; 16],
+    /// The cell's own control net (camera space, homogeneous `(x w, y w, z w, w)`), from
+    /// exact de Casteljau halving.
+    pub cp: &'a HomNet,
     /// The cell straddled a clipping plane and was filled as its clipped corner quad.
     pub clipped: bool,
 }
@@ -301,7 +310,7 @@ pub fn for_each_covered_sample(
         visit,
     );
     for (i, p) in scene.patches.iter().enumerate() {
-        r.patch(i, &p.cp);
+        r.patch(i, &homogeneous(p));
     }
 }
 
@@ -315,7 +324,7 @@ struct Raster<V> {
     flat_px: f64,
     visit: V,
     patch: usize,
-    leaf_cp: [DVec3; 16],
+    leaf_cp: HomNet,
     leaf_uv: [f64; 4],
     leaf_clipped: bool,
     poly: Vec<DVec2>,
@@ -330,22 +339,23 @@ impl<V: FnMut(&Leaf, [usize; 2], DVec2)> Raster<V> {
             flat_px,
             visit,
             patch: 0,
-            leaf_cp: [DVec3::ZERO; 16],
+            leaf_cp: [DVec4::ZERO; 16],
             leaf_uv: [0.0; 4],
             leaf_clipped: false,
             poly: Vec::new(),
         }
     }
 
-    /// Traverses patch number `index`.
-    fn patch(&mut self, index: usize, cp: &[DVec3; 16]) {
+    /// Traverses patch number `index` (its homogeneous net).
+    fn patch(&mut self, index: usize, cp: &HomNet) {
         self.patch = index;
         self.cell(cp, [0.0, 1.0, 0.0, 1.0], 0);
     }
 
     /// Culls, splits or fills one cell (a sub-patch, as its own Bezier control net, covering
     /// parameters `uv` = u0, u1, v0, v1 of its patch).
-    fn cell(&mut self, cp: &[DVec3; 16], uv: [f64; 4], depth: u32) {
+    fn cell(&mut self, h: &HomNet, uv: [f64; 4], depth: u32) {
+        let cp = &h.map(euclidean);
         let (zmin, zmax) = cp
             .iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
@@ -355,7 +365,7 @@ impl<V: FnMut(&Leaf, [usize; 2], DVec2)> Raster<V> {
             return;
         }
         if !(self.proj.visible_z(zmin) && self.proj.visible_z(zmax)) {
-            return self.straddling(cp, uv, depth);
+            return self.straddling(h, cp, uv, depth);
         }
         let q = cp.map(|p| self.proj.apply(p));
         let bbox = bounds(&q);
@@ -364,13 +374,13 @@ impl<V: FnMut(&Leaf, [usize; 2], DVec2)> Raster<V> {
         }
         let size = (bbox.1 - bbox.0).max_element();
         if depth >= MAX_DEPTH || (size < self.size_px && net_flatness(&q) < self.flat_px) {
-            return self.leaf(cp, uv);
+            return self.leaf(h, uv);
         }
-        self.split(cp, uv, depth, net_extent_u(&q) >= net_extent_v(&q));
+        self.split(h, uv, depth, net_extent_u(&q) >= net_extent_v(&q));
     }
 
     /// Halves a cell along u (else v) and goes on with both halves.
-    fn split(&mut self, cp: &[DVec3; 16], uv: [f64; 4], depth: u32, along_u: bool) {
+    fn split(&mut self, cp: &HomNet, uv: [f64; 4], depth: u32, along_u: bool) {
         let [u0, u1, v0, v1] = uv;
         let (a, b, ua, ub) = if along_u {
             let (a, b) = split_u(cp);
@@ -386,8 +396,8 @@ impl<V: FnMut(&Leaf, [usize; 2], DVec2)> Raster<V> {
     }
 
     /// A cell partly outside the near..far slab: split until its visible bound is tiny,
-    /// then fill its corner quad clipped to the slab.
-    fn straddling(&mut self, cp: &[DVec3; 16], uv: [f64; 4], depth: u32) {
+    /// then fill its corner quad clipped to the slab. `cp` is `h` made Euclidean.
+    fn straddling(&mut self, h: &HomNet, cp: &[DVec3; 16], uv: [f64; 4], depth: u32) {
         let Some(bbox) = self.clipped_bounds(cp) else {
             return;
         };
@@ -400,11 +410,11 @@ impl<V: FnMut(&Leaf, [usize; 2], DVec2)> Raster<V> {
             self.poly.clear();
             self.poly
                 .extend(clipped.iter().map(|&p| self.proj.apply(p)));
-            self.set_leaf(cp, uv, true);
+            self.set_leaf(h, uv, true);
             return self.fill();
         }
         // Alternate directions by depth: the parameter extent is what must shrink here.
-        self.split(cp, uv, depth, depth.is_multiple_of(2));
+        self.split(h, uv, depth, depth.is_multiple_of(2));
     }
 
     /// Screen bound of the control hull clipped to the z slab: the hull's clipped vertices
@@ -429,7 +439,7 @@ impl<V: FnMut(&Leaf, [usize; 2], DVec2)> Raster<V> {
 
     /// Fills a leaf cell: its boundary loop (bottom, right, top, left curves, refined near
     /// samples) is the polygon.
-    fn leaf(&mut self, cp: &[DVec3; 16], uv: [f64; 4]) {
+    fn leaf(&mut self, cp: &HomNet, uv: [f64; 4]) {
         self.set_leaf(cp, uv, false);
         self.poly.clear();
         let c = |i: [usize; 4]| i.map(|k| cp[k]);
@@ -443,8 +453,8 @@ impl<V: FnMut(&Leaf, [usize; 2], DVec2)> Raster<V> {
     /// Appends a boundary curve to the polygon (all its points but the last). A piece is
     /// halved while a sample lies in its projected hull's box and it is not yet straight:
     /// a rule that sees only the piece, so neighbours sharing it build the same polyline.
-    fn edge(&mut self, c: [DVec3; 4], depth: u32) {
-        let q = c.map(|p| self.proj.apply(p));
+    fn edge(&mut self, c: [DVec4; 4], depth: u32) {
+        let q = c.map(|p| self.proj.apply(euclidean(p)));
         let refine = depth < EDGE_MAX_DEPTH
             && self.grid.range(bounds(&q)).is_some()
             && curve_deviation(&q) > EDGE_EPS_PX;
@@ -457,7 +467,7 @@ impl<V: FnMut(&Leaf, [usize; 2], DVec2)> Raster<V> {
         }
     }
 
-    fn set_leaf(&mut self, cp: &[DVec3; 16], uv: [f64; 4], clipped: bool) {
+    fn set_leaf(&mut self, cp: &HomNet, uv: [f64; 4], clipped: bool) {
         self.leaf_cp = *cp;
         self.leaf_uv = uv;
         self.leaf_clipped = clipped;
@@ -486,14 +496,6 @@ impl<V: FnMut(&Leaf, [usize; 2], DVec2)> Raster<V> {
             }
         }
     }
-}
-
-/// Axis-aligned box of a point set.
-fn bounds(q: &[DVec2]) -> (DVec2, DVec2) {
-    q.iter().fold(
-        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-        |(lo, hi), &p| (lo.min(p), hi.max(p)),
-    )
 }
 
 /// Largest distance of a projected control point from the bilinear map of the projected
@@ -536,132 +538,6 @@ fn net_extent_v(q: &[DVec2; 16]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Lexicographic order on points, used to make computations independent of direction.
-fn before(a: DVec2, b: DVec2) -> bool {
-    (a.x, a.y) <= (b.x, b.y)
-}
-
-/// Distance from `p` to segment `ab`, computed identically for `ab` and `ba`.
-fn segment_distance(p: DVec2, a: DVec2, b: DVec2) -> f64 {
-    let (a, b) = if before(a, b) { (a, b) } else { (b, a) };
-    let d = b - a;
-    let l2 = d.length_squared();
-    let t = if l2 > 0.0 {
-        ((p - a).dot(d) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    p.distance(a + d * t)
-}
-
-/// How far a projected cubic's inner control points stray from its chord: the curve lies
-/// within this distance of the chord (hull property). Symmetric under reversal.
-fn curve_deviation(q: &[DVec2; 4]) -> f64 {
-    segment_distance(q[1], q[0], q[3]).max(segment_distance(q[2], q[0], q[3]))
-}
-
-/// De Casteljau halving of a cubic. Every step is (a + b) * 0.5, so halving the reversed
-/// curve gives bit-identical (reversed) halves: shared curves split the same from both
-/// sides.
-fn split_curve(p: [DVec3; 4]) -> ([DVec3; 4], [DVec3; 4]) {
-    let mid = |a: DVec3, b: DVec3| (a + b) * 0.5;
-    let (m01, m12, m23) = (mid(p[0], p[1]), mid(p[1], p[2]), mid(p[2], p[3]));
-    let (n0, n1) = (mid(m01, m12), mid(m12, m23));
-    let c = mid(n0, n1);
-    ([p[0], m01, n0, c], [c, n1, m23, p[3]])
-}
-
-/// Halves a patch in u (each row split as a curve).
-fn split_u(cp: &[DVec3; 16]) -> ([DVec3; 16], [DVec3; 16]) {
-    let (mut a, mut b) = ([DVec3::ZERO; 16], [DVec3::ZERO; 16]);
-    for r in 0..4 {
-        let (l, h) = split_curve([cp[4 * r], cp[4 * r + 1], cp[4 * r + 2], cp[4 * r + 3]]);
-        a[4 * r..4 * r + 4].copy_from_slice(&l);
-        b[4 * r..4 * r + 4].copy_from_slice(&h);
-    }
-    (a, b)
-}
-
-/// Halves a patch in v (each column split as a curve).
-fn split_v(cp: &[DVec3; 16]) -> ([DVec3; 16], [DVec3; 16]) {
-    let (mut a, mut b) = ([DVec3::ZERO; 16], [DVec3::ZERO; 16]);
-    for c in 0..4 {
-        let (l, h) = split_curve([cp[c], cp[c + 4], cp[c + 8], cp[c + 12]]);
-        for k in 0..4 {
-            a[4 * k + c] = l[k];
-            b[4 * k + c] = h[k];
-        }
-    }
-    (a, b)
-}
-
-/// Point where segment ab meets the plane z = `plane`, computed from the endpoint with the
-/// smaller z so that ab and ba give the same point.
-fn cut_at_z(a: DVec3, b: DVec3, plane: f64) -> DVec3 {
-    let (a, b) = if (a.z, a.x, a.y) <= (b.z, b.x, b.y) {
-        (a, b)
-    } else {
-        (b, a)
-    };
-    let t = (plane - a.z) / (b.z - a.z);
-    let p = a + (b - a) * t;
-    DVec3::new(p.x, p.y, plane)
-}
-
-/// Sutherland-Hodgman: the part of a closed 3D loop with z >= plane (`keep_above`) or
-/// z <= plane.
-fn clip_z(poly: &[DVec3], plane: f64, keep_above: bool) -> Vec<DVec3> {
-    let inside = |p: &DVec3| {
-        if keep_above {
-            p.z >= plane
-        } else {
-            p.z <= plane
-        }
-    };
-    let mut out = Vec::with_capacity(poly.len() + 2);
-    for (k, &a) in poly.iter().enumerate() {
-        let b = poly[(k + 1) % poly.len()];
-        if inside(&a) {
-            out.push(a);
-        }
-        if inside(&a) != inside(&b) {
-            out.push(cut_at_z(a, b, plane));
-        }
-    }
-    out
-}
-
-/// Sign of (b - a) x (s - a), computed identically (negated) for the reversed segment.
-fn side(a: DVec2, b: DVec2, s: DVec2) -> f64 {
-    if before(a, b) {
-        (b - a).perp_dot(s - a)
-    } else {
-        -(a - b).perp_dot(s - b)
-    }
-}
-
-/// Non-zero winding test of `s` against a closed polygon, points on the boundary included.
-/// Segment contributions are exact negatives for a segment and its reverse, so polygons that
-/// share edges tile the plane without gaps.
-fn covers(poly: &[DVec2], s: DVec2) -> bool {
-    let mut winding = 0i32;
-    for (k, &a) in poly.iter().enumerate() {
-        let b = poly[(k + 1) % poly.len()];
-        let d = side(a, b, s);
-        if d == 0.0 && s.cmpge(a.min(b)).all() && s.cmple(a.max(b)).all() {
-            return true;
-        }
-        if a.y <= s.y {
-            if b.y > s.y && d > 0.0 {
-                winding += 1;
-            }
-        } else if b.y <= s.y && d < 0.0 {
-            winding -= 1;
-        }
-    }
-    winding != 0
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -677,9 +553,11 @@ mod tests {
                     let (s, t) = ((k % 4) as f64 / 3.0, (k / 4) as f64 / 3.0);
                     (c[0] * (1.0 - s) + c[1] * s) * (1.0 - t) + (c[2] * (1.0 - s) + c[3] * s) * t
                 }),
+                w: Patch::POLYNOMIAL,
                 material: 0,
                 flip_normal: false,
                 two_sided: true,
+                primvars: None,
                 source: PatchSource {
                     file: "test".into(),
                     line: 0,
@@ -816,11 +694,11 @@ mod tests {
             let y = y * (1.0 + 0.6 * bump[i]);
             DVec3::new(0.9 * x + 0.05, 0.9 * y - 0.03, 4.0)
         });
-        let (l, r) = split_u(&cp);
+        let (l, r) = split_u(&cp.map(|p| p.extend(1.0)));
         let (lb, lt) = split_v(&l);
         let (lbl, lbr) = split_u(&lb);
         let (lbl_b, lbl_t) = split_v(&lbl);
-        let pieces = [lbl_b, lbl_t, lbr, lt, r];
+        let pieces = [lbl_b, lbl_t, lbr, lt, r].map(|h| h.map(euclidean));
         let scene = |cps: &[[DVec3; 16]]| Scene {
             patches: cps
                 .iter()

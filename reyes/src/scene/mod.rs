@@ -11,6 +11,9 @@ mod basis;
 mod bpt;
 mod newell;
 mod nurbs;
+mod primvars;
+mod quadric;
+pub(crate) mod rational;
 mod rib;
 mod sequence;
 mod teapot;
@@ -22,6 +25,8 @@ use std::path::Path;
 pub use basis::Basis;
 pub use bpt::parse_bpt;
 pub use newell::parse_newell;
+pub use primvars::{ColorField, Primvars};
+pub use rational::eval_rational_bezier;
 pub use rib::{load_rib, open_rib, parse_rib, parse_rib_frames};
 pub use sequence::{Display, FrameRanges, FrameSequence, SceneFrame};
 pub use teapot::{builtin_teapot, teapot_object_patches};
@@ -93,7 +98,12 @@ impl Default for Scene {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Patch {
     /// 16 control points, row-major: cp[4*v + u], u varies fastest (RenderMan order).
+    /// Euclidean (already divided by their weight when the patch is rational).
     pub cp: [DVec3; 16],
+    /// The weight of each control point, same order: the patch is the rational Bezier surface
+    /// sum(B_i B_j w_ij P_ij) / sum(B_i B_j w_ij). All 1.0 for a polynomial patch (every loader
+    /// but rational `NuPatch` "Pw" and the quadrics); always finite and positive.
+    pub w: [f64; 16],
     pub material: u32,
     /// True when the camera-space geometric normal dPdu x dPdv must be negated to get the
     /// surface's OUTSIDE normal as RenderMan defines it (`Orientation`/`ReverseOrientation`
@@ -101,8 +111,21 @@ pub struct Patch {
     pub flip_normal: bool,
     /// `Sides 2` (the default): both sides visible. `Sides 1`: back-facing parts are culled.
     pub two_sided: bool,
+    /// The patch's own `"Cs"` / `"Os"` over its parameter square; `None` (no cost) when the
+    /// material's `Color` and `Opacity` apply everywhere.
+    pub primvars: Option<Box<Primvars>>,
     /// Where the patch came from, for error messages.
     pub source: PatchSource,
+}
+
+impl Patch {
+    /// Weights of a polynomial (non-rational) patch.
+    pub const POLYNOMIAL: [f64; 16] = [1.0; 16];
+
+    /// True when some weight differs from 1 (the patch needs homogeneous arithmetic).
+    pub fn is_rational(&self) -> bool {
+        self.w != Self::POLYNOMIAL
+    }
 }
 
 /// Origin of a patch: file, line of the request, and index of the patch within that request
@@ -196,7 +219,11 @@ impl SceneError {
 
 impl fmt::Display for SceneError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}:{}: {}", self.file, self.line, self.message)
+        // Line 0: the error is about the whole file (it cannot be read), not a line of it.
+        match self.line {
+            0 => write!(f, "{}: {}", self.file, self.message),
+            line => write!(f, "{}:{line}: {}", self.file, self.message),
+        }
     }
 }
 
@@ -306,20 +333,7 @@ pub(crate) fn rotation(angle_deg: f64, axis: DVec3) -> Option<DMat4> {
 /// Evaluates a bicubic Bezier patch (cp[4*v + u]) and its derivatives at (u, v).
 /// Used by tests and handy for renderer-side checks.
 pub fn eval_bezier(cp: &[DVec3; 16], u: f64, v: f64) -> (DVec3, DVec3, DVec3) {
-    fn bern(t: f64) -> [f64; 4] {
-        let s = 1.0 - t;
-        [s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t]
-    }
-    fn dbern(t: f64) -> [f64; 4] {
-        let s = 1.0 - t;
-        [
-            -3.0 * s * s,
-            3.0 * s * s - 6.0 * t * s,
-            6.0 * t * s - 3.0 * t * t,
-            3.0 * t * t,
-        ]
-    }
-    let (bu, bv, du, dv) = (bern(u), bern(v), dbern(u), dbern(v));
+    let ((bu, du), (bv, dv)) = (rational::bernstein3(u), rational::bernstein3(v));
     let mut p = DVec3::ZERO;
     let mut pu = DVec3::ZERO;
     let mut pv = DVec3::ZERO;
@@ -489,7 +503,7 @@ mod tests {
         assert_eq!(s.materials.len(), 1);
         assert_eq!(s.materials[0].kind, SurfaceKind::Matte);
         assert_eq!((s.materials[0].ka, s.materials[0].kd), (0.0, 1.0));
-        for req in ["Option", "Imager", "Declare", "Displacement", "Attribute"] {
+        for req in ["Option", "Imager", "Displacement", "Attribute"] {
             let hits = s
                 .warnings
                 .iter()
@@ -497,6 +511,8 @@ mod tests {
                 .count();
             assert_eq!(hits, 1, "warnings for {req}: {:?}", s.warnings);
         }
+        // Its `Declare`s are read (and its declared shader parameters then ignored).
+        assert!(!s.warnings.iter().any(|w| w.contains("Declare")));
         assert!(
             s.warnings
                 .iter()
@@ -602,7 +618,7 @@ mod tests {
         let e = load(Path::new("/nonexistent/x.rib")).unwrap_err();
         assert!(
             e.to_string()
-                .starts_with("/nonexistent/x.rib:0: cannot read file")
+                .starts_with("/nonexistent/x.rib: cannot read file")
         );
     }
 

@@ -93,9 +93,11 @@ pub(crate) fn frame(patches: Vec<ObjectPatch>, flip_normal: bool) -> Scene {
         .into_iter()
         .map(|(cp, source)| Patch {
             cp: cp.map(|p| view.transform_point3(p)),
+            w: Patch::POLYNOMIAL,
             material: 0,
             flip_normal,
             two_sided: true,
+            primvars: None,
             source,
         })
         .collect();

@@ -1,8 +1,12 @@
 //! Twin of `shaders/reyes/bound.wgsl`: screen bound, culling, and the split-or-dice decision.
+//! Rational patches are bounded by their Euclidean control points (convex hull; the weights
+//! blossomed from the patch's table, [`super::rational_weights`]), culled as back-facing by
+//! the test on their homogeneous net, and get a rational crack bound; the arguments are
+//! beside the WGSL.
 
-use super::{cp_point, project};
+use super::{ControlNet, Weights, cp_h, cp_point, item_weights, project, to_euclidean};
 use crate::frame::{Frame, PatchInfo, PatchItem};
-use glam::Vec2;
+use glam::{Vec2, Vec4};
 
 /// See `MAX_DILATE_PX` and `CULL_MARGIN_PX` in common.wgsl: bucketed renders stay exact.
 pub const MAX_DILATE_PX: f32 = 2.0;
@@ -35,8 +39,21 @@ pub enum Decision {
     },
 }
 
-pub fn bound(item: &PatchItem, f: &Frame, info: &PatchInfo) -> Decision {
-    let cp = &item.cp;
+/// Bound's decision for `item` (the work of all 16 threads and of thread 0's reduction);
+/// `primvars` is the table of [`crate::frame::FrameData::primvars`], where a rational patch
+/// has its weights.
+pub fn bound(item: &PatchItem, f: &Frame, info: &PatchInfo, primvars: &[[f32; 4]]) -> Decision {
+    // Each thread's weight is the same bits as thread 0's rational_weights (common.wgsl).
+    let weights = item_weights(item, info, primvars);
+    let rational = weights.is_some();
+    let w = weights.unwrap_or([1.0; 16]);
+    // Thread 0's net after to_euclidean: the Euclidean points.
+    let euclidean = if rational {
+        to_euclidean(&item.cp, &w)
+    } else {
+        item.cp
+    };
+    let cp = &euclidean;
     let pts: Vec<(Vec2, f32)> = (0..16)
         .map(|k| {
             let p = cp_point(cp, k);
@@ -53,7 +70,7 @@ pub fn bound(item: &PatchItem, f: &Frame, info: &PatchInfo) -> Decision {
     if zmax < f.near || zmin > f.far {
         return Decision::Cull(Cull::Clip);
     }
-    if info.flags & 2 == 0 && backfacing(cp, info.flags & 1 != 0) {
+    if info.flags & 2 == 0 && backfacing(&item.cp, info.flags & 1 != 0) {
         return Decision::Cull(Cull::Backface);
     }
     let depth = item.splits();
@@ -92,7 +109,8 @@ pub fn bound(item: &PatchItem, f: &Frame, info: &PatchInfo) -> Decision {
         g.dilate = if f.crack_dilation != 0 {
             // At the nearest front control point: see bound.wgsl.
             let zfront = pts.iter().map(|p| p.1).filter(|&z| z >= f.near);
-            crack_dilation(f, cp, f.grid_max, f.grid_max, zfront.fold(zmax, f32::min))
+            let zfront = zfront.fold(zmax, f32::min);
+            crack_dilation(f, cp, &w, rational, f.grid_max, f.grid_max, zfront)
         } else {
             0
         };
@@ -127,7 +145,7 @@ pub fn bound(item: &PatchItem, f: &Frame, info: &PatchInfo) -> Decision {
     let mut g = *item;
     g.rates = nu | nv << 8;
     g.dilate = if f.crack_dilation != 0 {
-        crack_dilation(f, cp, nu, nv, zmin)
+        crack_dilation(f, cp, &w, rational, nu, nv, zmin)
     } else {
         0
     };
@@ -140,7 +158,7 @@ pub fn bound(item: &PatchItem, f: &Frame, info: &PatchInfo) -> Decision {
 /// Screen bound (lo, hi) of the part of the patch in front of the near plane: the projections
 /// of the front control points and of the crossings of the near plane by segments from a front
 /// to a behind control point (`near_visible_bound` in bound.wgsl gives the argument).
-pub fn near_visible_bound(f: &Frame, cp: &[f32; 48]) -> (Vec2, Vec2) {
+pub fn near_visible_bound(f: &Frame, cp: &ControlNet) -> (Vec2, Vec2) {
     let (mut lo, mut hi) = (Vec2::splat(3.0e38), Vec2::splat(-3.0e38));
     for a in 0..16 {
         let p = cp_point(cp, a);
@@ -165,8 +183,9 @@ pub fn near_visible_bound(f: &Frame, cp: &[f32; 48]) -> (Vec2, Vec2) {
 }
 
 /// Whether every point of the patch is back-facing: `backfacing_terms` in bound.wgsl (the
-/// proof is there), all 144 pairs at once.
-pub fn backfacing(cp: &[f32; 48], flip: bool) -> bool {
+/// proof is there, also why the homogeneous net `cp` serves rational patches), all 144 pairs
+/// at once.
+pub fn backfacing(cp: &ControlNet, flip: bool) -> bool {
     let sgn = if flip { -1.0 } else { 1.0 };
     (0..144).all(|k| {
         let (b, c) = (k / 12, k % 12);
@@ -183,7 +202,7 @@ pub fn backfacing(cp: &[f32; 48], flip: bool) -> bool {
 }
 
 /// Camera-space control polygon length along rows (`step` 1, `across` 4) or columns.
-fn polygon_length(cp: &[f32; 48], step: usize, across: usize) -> f32 {
+fn polygon_length(cp: &ControlNet, step: usize, across: usize) -> f32 {
     let mut best = 0f32;
     for r in 0..4 {
         let mut s = 0f32;
@@ -215,8 +234,17 @@ fn dice_decision(f: &Frame, lu: f32, lv: f32, extent: Vec2) -> (u32, u32, u32) {
 
 /// Crack dilation of each boundary edge, packed (v = 0, v = 1, u = 0, u = 1; 8 bits each in
 /// steps of `MAX_DILATE_PX / 255`, rounded up): see `crack_dilation` in bound.wgsl and
-/// docs/reyes.md.
-pub fn crack_dilation(f: &Frame, cp: &[f32; 48], nu: u32, nv: u32, zmin: f32) -> u32 {
+/// docs/reyes.md. `cp` holds Euclidean points ([`to_euclidean`]) and `w` their weights (read
+/// only if `rational`).
+pub fn crack_dilation(
+    f: &Frame,
+    cp: &ControlNet,
+    w: &Weights,
+    rational: bool,
+    nu: u32,
+    nv: u32,
+    zmin: f32,
+) -> u32 {
     let slack = 2.0 * (1.0 + (f.width.max(f.height) as f32) / f.focal);
     let mut packed = 0;
     for e in 0..4 {
@@ -230,11 +258,14 @@ pub fn crack_dilation(f: &Frame, cp: &[f32; 48], nu: u32, nv: u32, zmin: f32) ->
         };
         let step = if along_u { 1 } else { 4 };
         let n = if along_u { nu } else { nv } as f32;
-        let b: Vec<_> = (0..4).map(|k| cp_point(cp, start + k * step)).collect();
-        let c2 = 6.0
-            * (b[0] - 2.0 * b[1] + b[2])
+        let c2 = if rational {
+            curve_c2_rational([0, 1, 2, 3].map(|k| cp_h(cp, w, start + k * step)))
+        } else {
+            let b: Vec<_> = (0..4).map(|k| cp_point(cp, start + k * step)).collect();
+            6.0 * (b[0] - 2.0 * b[1] + b[2])
                 .length()
-                .max((b[1] - 2.0 * b[2] + b[3]).length());
+                .max((b[1] - 2.0 * b[2] + b[3]).length())
+        };
         let px = c2 / (8.0 * n * n) * f.focal / zmin * slack;
         let q = (px * (255.0 / MAX_DILATE_PX)).ceil().clamp(1.0, 255.0);
         packed |= (q as u32) << (8 * e);
@@ -242,51 +273,59 @@ pub fn crack_dilation(f: &Frame, cp: &[f32; 48], nu: u32, nv: u32, zmin: f32) ->
     packed
 }
 
+/// An upper bound of |C''| on [0, 1] for the rational cubic with Euclidean control points and
+/// weights `p[i] = (b_i, w_i)`, w_i > 0: `curve_c2_rational` in bound.wgsl, where the bound is
+/// derived. Equal weights give 6 max|b_{i+2} - 2 b_{i+1} + b_i|, the polynomial bound.
+pub fn curve_c2_rational(p: [Vec4; 4]) -> f32 {
+    let [b0, b1, b2, b3] = p.map(|q| q.truncate());
+    let w = Vec4::new(p[0].w, p[1].w, p[2].w, p[3].w);
+    let wmin = w.x.min(w.y).min(w.z.min(w.w));
+    let wmax = w.x.max(w.y).max(w.z.max(w.w));
+    let d1 = (b1 - b0)
+        .length()
+        .max((b2 - b1).length())
+        .max((b3 - b2).length());
+    let d2 = (b0 - 2.0 * b1 + b2)
+        .length()
+        .max((b1 - 2.0 * b2 + b3).length());
+    let r = d1.max(
+        (b2 - b0)
+            .length()
+            .max((b3 - b1).length())
+            .max((b3 - b0).length()),
+    );
+    let dw1 = (w.y - w.x)
+        .abs()
+        .max((w.z - w.y).abs())
+        .max((w.w - w.z).abs());
+    let dw2 = (w.z - w.x).abs().max((w.w - w.y).abs());
+    let ddw = (w.x - 2.0 * w.y + w.z)
+        .abs()
+        .max((w.y - 2.0 * w.z + w.w).abs());
+    (6.0 * (wmax * d2 + dw2 * d1 + ddw * r) + 18.0 * dw1 / wmin * (wmax * d1 + dw1 * r)) / wmin
+}
+
 #[cfg(test)]
 mod backface_tests {
     use super::*;
-    use glam::DVec3;
 
     /// A patch from a function of the parameters, control points on a 4x4 grid of it.
-    fn patch(mut f: impl FnMut(f32, f32) -> [f32; 3]) -> [f32; 48] {
+    fn patch(mut f: impl FnMut(f32, f32) -> [f32; 3]) -> ControlNet {
         let mut cp = [0f32; 48];
         for j in 0..4 {
             for i in 0..4 {
                 let p = f(i as f32 / 3.0, j as f32 / 3.0);
-                cp[3 * (4 * j + i)..3 * (4 * j + i) + 3].copy_from_slice(&p);
+                super::super::set_cp_point(&mut cp, 4 * j + i, p.into());
             }
         }
         cp
     }
 
-    /// det[P, Pu, Pv] at (u, v) in f64, from the Bernstein form.
-    fn det_at(cp: &[f32; 48], u: f64, v: f64) -> f64 {
-        let b = |t: f64| {
-            [
-                (1. - t).powi(3),
-                3. * t * (1. - t).powi(2),
-                3. * t * t * (1. - t),
-                t.powi(3),
-            ]
-        };
-        let db = |t: f64| {
-            [
-                -3. * (1. - t).powi(2),
-                3. * (1. - t).powi(2) - 6. * t * (1. - t),
-                6. * t * (1. - t) - 3. * t * t,
-                3. * t * t,
-            ]
-        };
-        let (bu, bv, du, dv) = (b(u), b(v), db(u), db(v));
-        let (mut p, mut pu, mut pv) = (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO);
-        for j in 0..4 {
-            for i in 0..4 {
-                let c = cp_point(cp, 4 * j + i).as_dvec3();
-                p += c * bu[i] * bv[j];
-                pu += c * du[i] * bv[j];
-                pv += c * bu[i] * dv[j];
-            }
-        }
+    /// det[P, Pu, Pv] at (u, v) in f64 of the (rational) patch with homogeneous net `cp`
+    /// and weights `w`, from its exact derivatives.
+    fn det_at(cp: &ControlNet, w: &Weights, u: f64, v: f64) -> f64 {
+        let h = std::array::from_fn(|k| cp_h(cp, w, k).as_dvec4());
+        let (p, pu, pv) = crate::reference::homogeneous::eval_rational(&h, u, v);
         p.dot(pu.cross(pv))
     }
 
@@ -314,29 +353,40 @@ mod backface_tests {
 
     #[test]
     fn a_culled_patch_is_back_facing_at_every_point() {
-        // Random bumpy patches near a plane at random attitudes: whenever the test culls, the
-        // exact det has the back sign on a dense parameter grid; and it does cull some.
+        // Random bumpy patches near a plane at random attitudes, every other one rational
+        // (weights in [0.7, 1], the test on its homogeneous net): whenever the test culls,
+        // the exact det of the rational surface has the back sign on a dense parameter grid;
+        // and it does cull some of each kind.
         let mut seed = 0x1234_5678u32;
         let mut rnd = || {
             seed = crate::stages::reyes_hash(seed);
             seed as f32 / u32::MAX as f32 - 0.5
         };
-        let mut culled = 0;
-        for _ in 0..400 {
+        let mut culled = [0; 2];
+        for n in 0..800 {
             let (tilt, bump) = (rnd() * 3.0, rnd() * 0.8);
             let noise: Vec<f32> = (0..16).map(|_| rnd() * bump).collect();
-            let cp = patch(|u, v| {
+            let mut cp = patch(|u, v| {
                 let z = 4.0 + tilt * (u - 0.5);
                 let k = (4.0 * (v * 3.0).round() + (u * 3.0).round()) as usize;
                 [u - 0.5 + rnd() * 0.1, v - 0.5, z + noise[k]]
             });
+            let rational = n % 2 == 1;
+            let mut w = [1f32; 16];
+            if rational {
+                for (k, wk) in w.iter_mut().enumerate() {
+                    *wk = 0.85 + rnd() * 0.3;
+                    let p = cp_point(&cp, k) * *wk;
+                    super::super::set_cp_point(&mut cp, k, p);
+                }
+            }
             for flip in [false, true] {
                 if backfacing(&cp, flip) {
-                    culled += 1;
+                    culled[rational as usize] += 1;
                     let sgn = if flip { -1.0 } else { 1.0 };
                     for j in 0..=32 {
                         for i in 0..=32 {
-                            let d = det_at(&cp, i as f64 / 32.0, j as f64 / 32.0);
+                            let d = det_at(&cp, &w, i as f64 / 32.0, j as f64 / 32.0);
                             assert!(sgn * d > 0.0, "culled but front-facing at ({i}, {j})");
                         }
                     }
@@ -344,8 +394,98 @@ mod backface_tests {
             }
         }
         assert!(
-            culled > 100,
-            "only {culled} of 800 culled: the test proves little"
+            culled.iter().all(|&c| c > 100),
+            "only {culled:?} of 800 each culled: the test proves little"
         );
+    }
+}
+
+#[cfg(test)]
+mod crack_tests {
+    use super::*;
+    use glam::{DVec3, DVec4, Vec3};
+
+    /// |C''(t)| of the rational cubic with homogeneous control points `h`, exactly (f64):
+    /// C = X / w, C' = (X' - w' C) / w, C'' = (X'' - 2 w' C' - w'' C) / w.
+    fn c2_at(h: &[DVec4; 4], t: f64) -> f64 {
+        let s = 1.0 - t;
+        let b = [s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t];
+        let d1 = [
+            -3.0 * s * s,
+            3.0 * s * s - 6.0 * t * s,
+            6.0 * t * s - 3.0 * t * t,
+            3.0 * t * t,
+        ];
+        let d2 = [6.0 * s, 6.0 * t - 12.0 * s, 6.0 * s - 12.0 * t, 6.0 * t];
+        let sum = |w: [f64; 4]| (0..4).map(|i| h[i] * w[i]).sum::<DVec4>();
+        let (x, x1, x2) = (sum(b), sum(d1), sum(d2));
+        let c = x.truncate() / x.w;
+        let c1 = (x1.truncate() - x1.w * c) / x.w;
+        let c2: DVec3 = (x2.truncate() - 2.0 * x1.w * c1 - x2.w * c) / x.w;
+        c2.length()
+    }
+
+    /// The rational crack bound holds: on random rational cubics (weights over two decades)
+    /// it is at least the exact max |C''| on a dense grid, so chord errors max|C''| h^2 / 8 are
+    /// covered; with equal weights it is the polynomial bound exactly.
+    #[test]
+    fn the_rational_second_derivative_bound_holds() {
+        let mut seed = 0xdead_beefu32;
+        let mut rnd = || {
+            seed = crate::stages::reyes_hash(seed);
+            seed as f32 / u32::MAX as f32
+        };
+        let mut worst_ratio = f64::INFINITY;
+        for n in 0..2000 {
+            let spread = [1.0, 4.0, 100.0][n % 3];
+            let p: [Vec4; 4] = std::array::from_fn(|_| {
+                let b = Vec3::new(rnd(), rnd(), rnd()) * 4.0 - 2.0;
+                b.extend(1.0 + rnd() * (spread - 1.0))
+            });
+            let bound = curve_c2_rational(p) as f64;
+            let h = p.map(|q| (q.truncate() * q.w).extend(q.w).as_dvec4());
+            let exact = (0..=400)
+                .map(|k| c2_at(&h, k as f64 / 400.0))
+                .fold(0.0, f64::max);
+            assert!(
+                bound >= exact * (1.0 - 1e-5),
+                "bound {bound} < {exact} for {p:?}"
+            );
+            worst_ratio = worst_ratio.min(bound / exact);
+            // Equal weights: the polynomial bound.
+            let eq = p.map(|q| q.truncate().extend(0.7));
+            let [b0, b1, b2, b3] = eq.map(|q| q.truncate());
+            let poly = 6.0
+                * (b0 - 2.0 * b1 + b2)
+                    .length()
+                    .max((b1 - 2.0 * b2 + b3).length());
+            assert!((curve_c2_rational(eq) - poly).abs() <= 1e-6 * poly);
+        }
+        eprintln!("tightest bound / exact max |C''|: {worst_ratio:.3}");
+    }
+
+    /// On the rational quarter circle (unit radius, degree-raised), the bound is within a
+    /// small factor of the truth: dilation stays close to what the chord error needs.
+    #[test]
+    fn the_bound_is_not_loose_on_a_circular_arc() {
+        let s = 0.5f64.sqrt();
+        let q = [
+            DVec4::new(1.0, 0.0, 0.0, 1.0),
+            DVec4::new(s, s, 0.0, s),
+            DVec4::new(0.0, 1.0, 0.0, 1.0),
+        ];
+        let h = [
+            q[0],
+            (q[0] + 2.0 * q[1]) / 3.0,
+            (2.0 * q[1] + q[2]) / 3.0,
+            q[2],
+        ];
+        let p = h.map(|x| (x.truncate() / x.w).extend(x.w).as_vec4());
+        let bound = curve_c2_rational(p) as f64;
+        let exact = (0..=400)
+            .map(|k| c2_at(&h, k as f64 / 400.0))
+            .fold(0.0, f64::max);
+        eprintln!("quarter circle: bound {bound:.3}, exact max |C''| {exact:.3}");
+        assert!(bound >= exact && bound < 6.0 * exact, "{bound} vs {exact}");
     }
 }

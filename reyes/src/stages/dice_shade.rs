@@ -1,10 +1,10 @@
 //! Twin of `shaders/reyes/dice_shade.wgsl`: the grid of points with normals from the patch's
 //! derivatives, shaded; then every micropolygon sampled.
 
-use super::sample::{micropolygon_dilation, sample_micropolygon, sample_near_clipped};
-use super::{NEAR_CLIP_GRID, cp_point, project, shade};
-use crate::frame::{FrameData, PatchItem};
-use glam::Vec3;
+use super::sample::{Cover, micropolygon_dilation, sample_micropolygon, sample_near_clipped};
+use super::{ControlNet, NEAR_CLIP_GRID, Weights, cp_h, cp_point, item_weights, project, shade};
+use crate::frame::{FIELD_BILINEAR, FIELD_FLAT, FrameData, PatchInfo, PatchItem};
+use glam::{Vec2, Vec3, Vec4};
 
 fn bern3(t: f32) -> [f32; 4] {
     let s = 1.0 - t;
@@ -16,10 +16,10 @@ fn bern2(t: f32) -> [f32; 3] {
     [s * s, 2.0 * t * s, t * t]
 }
 
-/// Position, d/du, d/dv of the patch at (u, v). The tangents come from the hodograph
-/// (differences of neighbouring control points), so they are exactly zero where control
-/// points coincide (see `eval_patch` in dice_shade.wgsl).
-pub fn eval_patch(cp: &[f32; 48], u: f32, v: f32) -> [Vec3; 3] {
+/// Position, d/du, d/dv of a polynomial patch (`cp` the points) at (u, v). The tangents come from the
+/// hodograph (differences of neighbouring control points), so they are exactly zero where
+/// control points coincide (see `eval_patch` in dice_shade.wgsl).
+pub fn eval_patch(cp: &ControlNet, u: f32, v: f32) -> [Vec3; 3] {
     let (bu, bv, hu, hv) = (bern3(u), bern3(v), bern2(u), bern2(v));
     let (mut p, mut pu, mut pv) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
     for j in 0..4 {
@@ -37,9 +37,45 @@ pub fn eval_patch(cp: &[f32; 48], u: f32, v: f32) -> [Vec3; 3] {
     [p, 3.0 * pu, 3.0 * pv]
 }
 
+/// Position, d/du, d/dv of a rational item (homogeneous xyz `cp`, weights `w`) at (u, v): the
+/// 4D sum and its hodograph as in [`eval_patch`], then the quotient rule P = X/w,
+/// Pu = (Xu - wu P)/w (`eval_rational` in dice_shade.wgsl).
+pub fn eval_rational(cp: &ControlNet, w: &Weights, u: f32, v: f32) -> [Vec3; 3] {
+    let (bu, bv, hu, hv) = (bern3(u), bern3(v), bern2(u), bern2(v));
+    let (mut x, mut xu, mut xv) = (Vec4::ZERO, Vec4::ZERO, Vec4::ZERO);
+    for j in 0..4 {
+        for i in 0..4 {
+            let c = cp_h(cp, w, 4 * j + i);
+            x += c * (bu[i] * bv[j]);
+            if i < 3 {
+                xu += (cp_h(cp, w, 4 * j + i + 1) - c) * (hu[i] * bv[j]);
+            }
+            if j < 3 {
+                xv += (cp_h(cp, w, 4 * j + i + 4) - c) * (bu[i] * hv[j]);
+            }
+        }
+    }
+    let p = x.truncate() / x.w;
+    let s = 3.0 / x.w;
+    [
+        p,
+        (xu.truncate() - xu.w * p) * s,
+        (xv.truncate() - xv.w * p) * s,
+    ]
+}
+
+/// [`eval_rational`] for a rational item (`w` its weights, [`item_weights`]), else
+/// [`eval_patch`] (`eval_surface`).
+pub fn eval_surface(cp: &ControlNet, w: Option<&Weights>, u: f32, v: f32) -> [Vec3; 3] {
+    match w {
+        Some(w) => eval_rational(cp, w, u, v),
+        None => eval_patch(cp, u, v),
+    }
+}
+
 /// Squares of the largest control-net steps along u and v (3 times the steps bound |Pu|
-/// and |Pv|).
-pub fn net_steps2(cp: &[f32; 48]) -> [f32; 2] {
+/// and |Pv|) of a polynomial patch.
+pub fn net_steps2(cp: &ControlNet) -> [f32; 2] {
     let mut m = [0f32; 2];
     for j in 0..4 {
         for i in 0..3 {
@@ -51,24 +87,69 @@ pub fn net_steps2(cp: &[f32; 48]) -> [f32; 2] {
     m
 }
 
+/// [`net_steps2`] of a rational item (homogeneous xyz, weights): squares of s_u, s_v with
+/// |Pu| <= 3 s_u, s_u = (wmax du + dwu r) / wmin (`net_steps2_rational` in dice_shade.wgsl
+/// derives it).
+pub fn net_steps2_rational(cp: &ControlNet, w: &Weights) -> [f32; 2] {
+    let (mut lo, mut hi) = (Vec3::splat(3.0e38), Vec3::splat(-3.0e38));
+    let (mut wmin, mut wmax) = (3.0e38f32, 0f32);
+    let mut m = Vec4::ZERO;
+    let e = |h: Vec4| h.truncate() / h.w;
+    for j in 0..4 {
+        for i in 0..4 {
+            let h = cp_h(cp, w, 4 * j + i);
+            lo = lo.min(e(h));
+            hi = hi.max(e(h));
+            wmin = wmin.min(h.w);
+            wmax = wmax.max(h.w);
+        }
+        for i in 0..3 {
+            let (a, b) = (cp_h(cp, w, 4 * j + i), cp_h(cp, w, 4 * j + i + 1));
+            let (c, d) = (cp_h(cp, w, 4 * i + j), cp_h(cp, w, 4 * i + j + 4));
+            let du = e(b) - e(a);
+            let dv = e(d) - e(c);
+            m = m.max(Vec4::new(
+                du.dot(du),
+                dv.dot(dv),
+                (b.w - a.w).abs(),
+                (d.w - c.w).abs(),
+            ));
+        }
+    }
+    let r = (hi - lo).length();
+    let s = (wmax * Vec2::new(m.x.sqrt(), m.y.sqrt()) + Vec2::new(m.z, m.w) * r) / wmin;
+    [s.x * s.x, s.y * s.y]
+}
+
 /// The outside normal. Where it is degenerate (a vanishing tangent at a collapsed edge, or
 /// parallel tangents) it is taken 1e-3, 1e-2, then 1e-1 of the way to the centre until
 /// |Pu x Pv| reaches 1e-3 of its largest possible value on the patch; with no tangent plane
 /// anywhere (all control points equal) it is the direction to the eye. See dice_shade.wgsl.
-pub fn patch_normal(cp: &[f32; 48], u: f32, v: f32, flip: bool) -> Vec3 {
-    patch_normal_at(cp, eval_patch(cp, u, v), u, v, flip)
+/// `cp` is an item's net; `w` its weights if its patch is rational ([`item_weights`]).
+pub fn patch_normal(cp: &ControlNet, w: Option<&Weights>, u: f32, v: f32, flip: bool) -> Vec3 {
+    patch_normal_at(cp, w, eval_surface(cp, w, u, v), u, v, flip)
 }
 
-/// [`patch_normal`] given `e = eval_patch(cp, u, v)`, as DiceShade calls it.
-pub fn patch_normal_at(cp: &[f32; 48], e: [Vec3; 3], u: f32, v: f32, flip: bool) -> Vec3 {
+/// [`patch_normal`] given `e = eval_surface(cp, w, u, v)`, as DiceShade calls it.
+pub fn patch_normal_at(
+    cp: &ControlNet,
+    w: Option<&Weights>,
+    e: [Vec3; 3],
+    u: f32,
+    v: f32,
+    flip: bool,
+) -> Vec3 {
     let mut n = e[1].cross(e[2]);
-    let steps2 = net_steps2(cp);
+    let steps2 = match w {
+        Some(w) => net_steps2_rational(cp, w),
+        None => net_steps2(cp),
+    };
     let least2 = 8.1e-5 * steps2[0] * steps2[1];
     let mut inward = 1.0e-3f32;
     let mut k = 0;
     while k < 3 && !(n.dot(n) > least2) {
         let (qu, qv) = (u + (0.5 - u) * inward, v + (0.5 - v) * inward);
-        let f = eval_patch(cp, qu, qv);
+        let f = eval_surface(cp, w, qu, qv);
         n = f[1].cross(f[2]);
         inward *= 10.0;
         k += 1;
@@ -83,6 +164,56 @@ pub fn patch_normal_at(cp: &[f32; 48], e: [Vec3; 3], u: f32, v: f32, flip: bool)
     if flip { -n } else { n }
 }
 
+/// `color_field` in dice_shade.wgsl: the value at (u, v) of the original patch of the colour
+/// field `field` (`PatchInfo::cs` or `os`, not 0) in the primitive-variable table.
+pub fn color_field(table: &[[f32; 4]], field: u32, u: f32, v: f32) -> Vec3 {
+    let at = (field >> 2) as usize;
+    let c = |k: usize| Vec3::from_slice(&table[at + k][..3]);
+    match field & 3 {
+        FIELD_FLAT => c(0),
+        FIELD_BILINEAR => {
+            let lo = c(0) + (c(1) - c(0)) * u;
+            let hi = c(2) + (c(3) - c(2)) * u;
+            lo + (hi - lo) * v
+        }
+        _ => {
+            let (bu, bv) = (bern3(u), bern3(v));
+            let mut out = Vec3::ZERO;
+            for j in 0..4 {
+                for i in 0..4 {
+                    out += c(4 * j + i) * (bu[i] * bv[j]);
+                }
+            }
+            out
+        }
+    }
+}
+
+/// `original_uv` in dice_shade.wgsl: (u, v) of the item's own square in its original patch.
+pub fn original_uv(item: &PatchItem, u: f32, v: f32) -> (f32, f32) {
+    (
+        item.uv[0] + (item.uv[1] - item.uv[0]) * u,
+        item.uv[2] + (item.uv[3] - item.uv[2]) * v,
+    )
+}
+
+/// `micropolygon_cover` in dice_shade.wgsl: the opacity of micropolygon (i, j) of an nu x nv
+/// grid, the mean of "Os" at its centre (else the material's), as a [`Cover`].
+pub fn micropolygon_cover(item: &PatchItem, data: &FrameData, [i, j, nu, nv]: [u32; 4]) -> Cover {
+    let info: PatchInfo = data.patch_info[item.patch_id as usize];
+    let mut alpha = data.materials[info.material as usize].opacity;
+    if info.os != 0 {
+        let (u, v) = original_uv(
+            item,
+            (i as f32 + 0.5) / nu as f32,
+            (j as f32 + 0.5) / nv as f32,
+        );
+        let o = color_field(&data.primvars, info.os, u, v);
+        alpha = (o.x + o.y + o.z) / 3.0;
+    }
+    Cover::new(alpha, item.patch_id)
+}
+
 /// Grid points (x, y in pixels, z, packed colour bits as f32), row-major, (nu+1) x (nv+1);
 /// for a grid marked [`NEAR_CLIP_GRID`], x, y, z in camera space (projected after clipping).
 pub fn dice(item: &PatchItem, data: &FrameData) -> (u32, u32, Vec<[f32; 4]>) {
@@ -91,12 +222,21 @@ pub fn dice(item: &PatchItem, data: &FrameData) -> (u32, u32, Vec<[f32; 4]>) {
     let info = data.patch_info[item.patch_id as usize];
     let m = &data.materials[info.material as usize];
     let mut grid = Vec::with_capacity(((nu + 1) * (nv + 1)) as usize);
+    // Each GPU thread blossoms the same weights (rational patches only).
+    let weights = item_weights(item, &info, &data.primvars);
+    let w = weights.as_ref();
     for t in 0..(nu + 1) * (nv + 1) {
         let u = (t % (nu + 1)) as f32 / nu as f32;
         let v = (t / (nu + 1)) as f32 / nv as f32;
-        let e = eval_patch(&item.cp, u, v);
-        let n = patch_normal_at(&item.cp, e, u, v, info.flags & 1 != 0);
-        let c = shade::shade(e[0], n, m, &data.lights);
+        let e = eval_surface(&item.cp, w, u, v);
+        let n = patch_normal_at(&item.cp, w, e, u, v, info.flags & 1 != 0);
+        let cs = if info.cs != 0 {
+            let (uo, vo) = original_uv(item, u, v);
+            color_field(&data.primvars, info.cs, uo, vo)
+        } else {
+            Vec3::from(m.color)
+        };
+        let c = shade::shade(e[0], n, m, cs, &data.lights);
         let back = n.dot(e[0]) > 0.0;
         let color = f32::from_bits(shade::pack_color(c, back));
         if item.rates & NEAR_CLIP_GRID != 0 {
@@ -130,7 +270,8 @@ pub fn dice_shade(item: &PatchItem, data: &FrameData, samples: &mut [u64]) -> (u
             sample_micropolygon
         };
         let grow = micropolygon_dilation(item.dilate, i as u32, j as u32, nu, nv);
-        if !sample(q, grow, two_sided, &data.frame, samples) {
+        let cover = micropolygon_cover(item, data, [i as u32, j as u32, nu, nv]);
+        if !sample(q, grow, two_sided, cover, &data.frame, samples) {
             culled += 1;
         }
     }

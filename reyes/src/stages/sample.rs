@@ -8,9 +8,14 @@ fn cross2(a: Vec2, b: Vec2) -> f32 {
     a.x * b.y - a.y * b.x
 }
 
+/// `sample_id` in sample.wgsl: the index of sub-sample (sx, sy) of pixel (px, py) in the whole
+/// image (not the bucket).
+pub fn sample_id(f: &Frame, px: u32, py: u32, sx: u32, sy: u32) -> u32 {
+    ((py * f.width + px) * f.spp_y + sy) * f.spp_x + sx
+}
+
 pub fn sample_position(f: &Frame, px: u32, py: u32, sx: u32, sy: u32) -> Vec2 {
-    let id = ((py * f.width + px) * f.spp_y + sy) * f.spp_x + sx;
-    let h = reyes_hash(id ^ f.seed);
+    let h = reyes_hash(sample_id(f, px, py, sx, sy) ^ f.seed);
     let j = Vec2::new((h & 0xffff) as f32, (h >> 16) as f32) / 65536.0;
     Vec2::new(px as f32, py as f32)
         + (Vec2::new(sx as f32, sy as f32) + j) / Vec2::new(f.spp_x as f32, f.spp_y as f32)
@@ -103,6 +108,39 @@ fn micropolygon_color(q: &[[f32; 4]; 4], two_sided: bool) -> Option<u32> {
     Some(average_color(c))
 }
 
+/// `Cover` in sample.wgsl: the fraction `alpha` of samples a micropolygon covers (its opacity),
+/// and the hash of its original patch that, with each sample's index, decides which
+/// (stochastic transparency, Enderton et al. 2010, "Stochastic Transparency").
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cover {
+    pub alpha: f32,
+    pub salt: u32,
+}
+
+/// `COVER_SALT` in sample.wgsl: mixed into the patch id so that the coverage hash differs
+/// from the jitter hash.
+pub const COVER_SALT: u32 = 0x5bd1e995;
+
+impl Cover {
+    /// The cover of a micropolygon of opacity `alpha` on original patch `patch_id`.
+    pub fn new(alpha: f32, patch_id: u32) -> Cover {
+        Cover {
+            alpha,
+            salt: reyes_hash(patch_id ^ COVER_SALT),
+        }
+    }
+}
+
+/// `covers` in sample.wgsl: whether the micropolygon covers sample `id` (always when
+/// opaque; else when a hash of the sample and the patch, as 24 bits, is below alpha * 2^24).
+pub fn covers(f: &Frame, c: Cover, id: u32) -> bool {
+    if c.alpha >= 1.0 {
+        return true;
+    }
+    let h = reyes_hash(reyes_hash(id ^ f.seed) ^ c.salt);
+    ((h >> 8) as f32) < c.alpha * 16777216.0
+}
+
 /// Keeps the nearest key at sub-sample (sx, sy) of pixel (px, py) of the bucket.
 fn write_sample(f: &Frame, samples: &mut [u64], [px, py, sx, sy]: [u32; 4], z: f32, color: u32) {
     let pixel = (py - f.tile_y0) * f.tile_w + px - f.tile_x0;
@@ -111,14 +149,14 @@ fn write_sample(f: &Frame, samples: &mut [u64], [px, py, sx, sy]: [u32; 4], z: f
 }
 
 /// The sampling loop of `sample_micropolygon` and `sample_clipped_triangle` in sample.wgsl:
-/// every sub-sample of the bucket inside the bound [lo, hi] whose `depth` is not negative keeps
-/// the nearest key.
+/// every sub-sample of the bucket inside the bound [lo, hi] whose `depth` is not negative and
+/// that `cover` covers keeps the nearest key.
 fn sample_under(
     f: &Frame,
     samples: &mut [u64],
-    lo: Vec2,
-    hi: Vec2,
+    (lo, hi): (Vec2, Vec2),
     color: u32,
+    cover: Cover,
     depth: impl Fn(Vec2) -> f32,
 ) {
     let (t0, t1) = (
@@ -140,7 +178,7 @@ fn sample_under(
                         continue;
                     }
                     let z = depth(q);
-                    if z >= 0.0 {
+                    if z >= 0.0 && covers(f, cover, sample_id(f, px, py, sx, sy)) {
                         write_sample(f, samples, [px, py, sx, sy], z, color);
                     }
                 }
@@ -150,17 +188,22 @@ fn sample_under(
 }
 
 /// Samples quad `q` (a, b, c, d around), its edges ab, bc, cd, da grown by `grow` pixels (the
-/// diagonal by the least of them); false when it was culled as back-facing.
+/// diagonal by the least of them), covering the samples `cover` says; false when it was culled
+/// as back-facing.
 pub fn sample_micropolygon(
     q: [[f32; 4]; 4],
     grow: [f32; 4],
     two_sided: bool,
+    cover: Cover,
     f: &Frame,
     samples: &mut [u64],
 ) -> bool {
     let Some(color) = micropolygon_color(&q, two_sided) else {
         return false;
     };
+    if !(cover.alpha > 0.0) {
+        return true;
+    }
     let xy = q.map(|v| Vec2::new(v[0], v[1]));
     let g = grow[0].max(grow[1]).max(grow[2].max(grow[3]));
     let lo = xy[0].min(xy[1]).min(xy[2].min(xy[3])) - Vec2::splat(g);
@@ -168,7 +211,7 @@ pub fn sample_micropolygon(
     let diagonal = grow[0].min(grow[1]).min(grow[2].min(grow[3]));
     let abc = triangle_setup(q[0], q[1], q[2], [grow[1], diagonal, grow[0]]);
     let acd = triangle_setup(q[0], q[2], q[3], [grow[2], grow[3], diagonal]);
-    sample_under(f, samples, lo, hi, color, |s| {
+    sample_under(f, samples, (lo, hi), color, cover, |s| {
         let z = triangle_depth(&abc, s);
         if z < 0.0 { triangle_depth(&acd, s) } else { z }
     });
@@ -220,6 +263,7 @@ pub fn sample_near_clipped(
     q: [[f32; 4]; 4],
     grow: [f32; 4],
     two_sided: bool,
+    cover: Cover,
     f: &Frame,
     samples: &mut [u64],
 ) -> bool {
@@ -228,19 +272,29 @@ pub fn sample_near_clipped(
             let s = super::project(f, Vec3::new(v[0], v[1], v[2]));
             [s[0], s[1], v[2], v[3]]
         });
-        return sample_micropolygon(projected, grow, two_sided, f, samples);
+        return sample_micropolygon(projected, grow, two_sided, cover, f, samples);
     }
     let Some(color) = micropolygon_color(&q, two_sided) else {
         return false;
     };
+    if !(cover.alpha > 0.0) {
+        return true;
+    }
     let p = q.map(|v| Vec3::new(v[0], v[1], v[2]));
     let g = grow[0].max(grow[1]).max(grow[2].max(grow[3]));
-    sample_clipped_triangle(&[p[0], p[1], p[2]], g, color, f, samples);
-    sample_clipped_triangle(&[p[0], p[2], p[3]], g, color, f, samples);
+    let paint = (color, cover);
+    sample_clipped_triangle(&[p[0], p[1], p[2]], g, paint, f, samples);
+    sample_clipped_triangle(&[p[0], p[2], p[3]], g, paint, f, samples);
     true
 }
 
-fn sample_clipped_triangle(tri: &[Vec3; 3], grow: f32, color: u32, f: &Frame, samples: &mut [u64]) {
+fn sample_clipped_triangle(
+    tri: &[Vec3; 3],
+    grow: f32,
+    (color, cover): (u32, Cover),
+    f: &Frame,
+    samples: &mut [u64],
+) {
     let mut poly = tri.to_vec();
     for k in 0..5 {
         if poly.len() < 3 {
@@ -273,7 +327,7 @@ fn sample_clipped_triangle(tri: &[Vec3; 3], grow: f32, color: u32, f: &Frame, sa
     let fan: Vec<Triangle> = (0..s.len() - 2)
         .map(|i| triangle_setup(s[0], s[i + 1], s[i + 2], [grow; 3]))
         .collect();
-    sample_under(f, samples, lo, hi, color, |q| {
+    sample_under(f, samples, (lo, hi), color, cover, |q| {
         let mut z = -1.0;
         for t in &fan {
             if z >= 0.0 {

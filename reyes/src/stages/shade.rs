@@ -3,7 +3,10 @@
 use crate::frame::{GpuLight, Material};
 use glam::Vec3;
 
-pub fn shade(p: Vec3, n: Vec3, m: &Material, lights: &[GpuLight]) -> Vec3 {
+/// `n` is the outside normal (unnormalised); `cs` the surface colour (the material's `Color`
+/// or the patch's `"Cs"`), which the standard shaders multiply into ambient and diffuse light.
+/// Returns linear RGB.
+pub fn shade(p: Vec3, n: Vec3, m: &Material, cs: Vec3, lights: &[GpuLight]) -> Vec3 {
     let i = p.normalize();
     let nn = n.normalize();
     let nf = if nn.dot(i) > 0.0 { -nn } else { nn };
@@ -27,7 +30,6 @@ pub fn shade(p: Vec3, n: Vec3, m: &Material, lights: &[GpuLight]) -> Vec3 {
         let h = (ld + v).normalize();
         spec += cl * nf.dot(h).max(0.0).powf(1.0 / m.roughness.max(1.0e-4));
     }
-    let cs = Vec3::from(m.color);
     if m.kind == 0 {
         return cs;
     }

@@ -1,10 +1,13 @@
-//! Twin of `shaders/reyes/split.wgsl`: de Casteljau halves at the parameter midpoint.
+//! Twin of `shaders/reyes/split.wgsl`: de Casteljau halves at the parameter midpoint, on the
+//! item's xyz (the points, or a rational patch's homogeneous x w, y w, z w, which split
+//! linearly too; its weights follow from the child's uv).
 
 use super::{cp_point, set_cp_point};
 use crate::frame::PatchItem;
 use glam::Vec3;
 
-/// Half `second` of the cubic p0..p3 at t = 1/2 (symmetric: a shared curve splits to the same bits).
+/// Half `second` of the cubic p0..p3 at t = 1/2 (symmetric: a shared curve splits to the same
+/// bits).
 pub fn half_curve(p: [Vec3; 4], second: bool) -> [Vec3; 4] {
     let a = (p[0] + p[1]) * 0.5;
     let b = (p[1] + p[2]) * 0.5;
@@ -19,6 +22,7 @@ pub fn half_curve(p: [Vec3; 4], second: bool) -> [Vec3; 4] {
     }
 }
 
+/// Half `second` of `item` along u (else v), with its parameter range and one more split.
 pub fn split_half(item: &PatchItem, along_u: bool, second: bool) -> PatchItem {
     let mut child = *item;
     let (step, across) = if along_u { (1, 4) } else { (4, 1) };

@@ -27,13 +27,16 @@
 //! the scene file and the archives it reads), [`syntax`] (requests and typed access to their
 //! arguments), [`state`] (options, attributes and the block stack), [`requests`] (the one
 //! dispatch over request names), [`frames`] (frame and world blocks: the sequence of frames),
-//! [`shading`] (surfaces, lights, the material table) and [`patches`] (the patch primitives
-//! and their conversion to Bezier patches).
+//! [`shading`] (surfaces, lights, the material table), [`patches`] (the patch primitives
+//! and their conversion to Bezier patches), [`quadrics`] (the quadric primitives) and
+//! [`primvars`] (`Declare` and the `"Cs"` / `"Os"` primitive variables of patches).
 
 mod frames;
 mod input;
 mod lexer;
 mod patches;
+mod primvars;
+mod quadrics;
 mod requests;
 mod shading;
 mod state;

@@ -1,14 +1,17 @@
 //! The patch primitives (`Patch`, `PatchMesh`, `NuPatch`): their arguments, the conversion
-//! of each piece to a bicubic Bezier patch (through the current `Basis` or the NURBS spans)
-//! and its transformation to camera space.
+//! of each piece to a bicubic Bezier patch (through the current `Basis` or the NURBS spans,
+//! rational for `NuPatch` "Pw") and its transformation to camera space ([`Interp::emit`],
+//! which the quadrics share).
 
 use super::lexer::shown;
+use super::primvars::{ClassCounts, ColorVar, MeshCell};
 use super::state::Interp;
 use super::syntax::{Arg, Args, Param, Request};
 use crate::scene::basis::{Basis, block_to_bezier};
 use crate::scene::nurbs::{self, NuSurface};
-use crate::scene::{Patch, PatchSource, SceneError};
-use glam::{DMat4, DVec3};
+use crate::scene::rational::from_homogeneous;
+use crate::scene::{ColorField, Patch, PatchSource, Primvars, SceneError};
+use glam::{DMat4, DVec3, DVec4};
 
 impl Interp {
     pub(super) fn geometry_ctm(&self, a: &Args) -> Result<DMat4, SceneError> {
@@ -26,13 +29,17 @@ impl Interp {
         Ok(m)
     }
 
-    /// Transforms an object-space Bezier patch to camera space and adds it.
+    /// Transforms an object-space Bezier patch (Euclidean control points `cp`, weights `w`,
+    /// as [`Patch`] holds them) to camera space and adds it. The transform is affine
+    /// ([`Self::geometry_ctm`]), so transforming the Euclidean points with the weights kept
+    /// is transforming the homogeneous points.
     pub(super) fn emit(
         &mut self,
         a: &Args,
         ctm: &DMat4,
         index: usize,
         cp: [DVec3; 16],
+        w: [f64; 16],
     ) -> Result<(), SceneError> {
         let bad = |p: &DVec3| {
             if p.is_nan() { "NaN" } else { "infinite" }
@@ -42,6 +49,17 @@ impl Interp {
                 "patch {index}: control point {k} is {} ({})",
                 bad(p),
                 show_point(*p)
+            )));
+        }
+        // Weights come positive from the conversions, the largest 1; the renderer's f32
+        // must still see them positive.
+        if let Some((k, x)) = w.iter().enumerate().find(|(_, x)| {
+            let f = **x as f32;
+            f.is_nan() || f <= 0.0
+        }) {
+            return Err(a.err(format!(
+                "patch {index}: weight {k} is {x:e} relative to the largest, below the f32 \
+                 range the renderer computes in (the weights span too wide a range)"
             )));
         }
         let cp = cp.map(|p| ctm.project_point3(p));
@@ -65,9 +83,11 @@ impl Interp {
         let material = self.material();
         self.scene.patches.push(Patch {
             cp,
+            w,
             material,
             flip_normal: self.attrs.orientation_rh,
             two_sided: self.attrs.two_sided,
+            primvars: None,
             source: PatchSource {
                 file: a.req.file.to_string(),
                 line: a.req.line,
@@ -77,20 +97,45 @@ impl Interp {
         Ok(())
     }
 
+    /// [`Self::emit`], then gives the new patch its primitive variables.
+    fn emit_with(
+        &mut self,
+        a: &Args,
+        ctm: &DMat4,
+        index: usize,
+        cp: [DVec3; 16],
+        w: [f64; 16],
+        (cs, os): (Option<ColorField>, Option<ColorField>),
+    ) -> Result<(), SceneError> {
+        self.emit(a, ctm, index, cp, w)?;
+        if let Some(p) = self.scene.patches.last_mut() {
+            p.primvars = Primvars { cs, os }.boxed();
+        }
+        Ok(())
+    }
+
     pub(super) fn patch(&mut self, req: &Request, a: &mut Args) -> Result<(), SceneError> {
         let kind = a.string("the patch type")?;
         let n = patch_points(a, kind)?;
         let params = a.params()?;
         let pts = self.positions(req, a, &params, n)?;
+        let counts = ClassCounts {
+            uniform: 1,
+            varying: 4,
+            vertex: n,
+        };
+        let vars = self.color_vars(a, &params, &counts)?;
         let ctm = self.geometry_ctm(a)?;
         check_points(a, 0, &pts, 0..n)?;
+        let (ub, vb) = (&self.attrs.ubasis, &self.attrs.vbasis);
         let cp = if n == 4 {
             bilinear_to_bezier([pts[0], pts[1], pts[2], pts[3]])
         } else {
             let g: [DVec3; 16] = std::array::from_fn(|k| pts[k]);
-            block_to_bezier(&g, &self.attrs.ubasis, &self.attrs.vbasis)
+            block_to_bezier(&g, ub, vb)
         };
-        self.emit(a, &ctm, 0, cp)
+        let fields = vars.map(|v| v.patch_field(n == 16, ub, vb));
+        self.emit_with(a, &ctm, 0, cp, Patch::POLYNOMIAL, fields)
     }
 
     pub(super) fn patch_mesh(&mut self, req: &Request, a: &mut Args) -> Result<(), SceneError> {
@@ -114,6 +159,12 @@ impl Interp {
         let nup = mesh_patches(a, "u", nu, uwrap, ustep, order)?;
         let nvp = mesh_patches(a, "v", nv, vwrap, vstep, order)?;
         let pts = self.positions(req, a, &params, nu * nv)?;
+        let counts = ClassCounts {
+            uniform: nup * nvp,
+            varying: (nup + !uwrap as usize) * (nvp + !vwrap as usize),
+            vertex: nu * nv,
+        };
+        let vars = self.color_vars(a, &params, &counts)?;
         let ctm = self.geometry_ctm(a)?;
         let at = |r: usize, c: usize| pts[(r % nv) * nu + (c % nu)];
         let size = if cubic { 4 } else { 2 };
@@ -134,12 +185,28 @@ impl Interp {
                         at(r0 + 1, c0 + 1),
                     ])
                 };
-                self.emit(a, &ctm, pv * nup + pu, cp)?;
+                let cell = MeshCell {
+                    pu,
+                    pv,
+                    nup,
+                    nvp,
+                    r0,
+                    c0,
+                    nu,
+                    nv,
+                    uwrap,
+                    vwrap,
+                };
+                let (ub, vb) = (&self.attrs.ubasis, &self.attrs.vbasis);
+                let fields = vars.map(|v| v.mesh_field(&cell, cubic, ub, vb));
+                self.emit_with(a, &ctm, pv * nup + pu, cp, Patch::POLYNOMIAL, fields)?;
             }
         }
         Ok(())
     }
 
+    /// `NuPatch`: orders 2 to 4 in each direction, "P" or rational "Pw", the u and v
+    /// subranges; one rational bicubic patch per non-empty knot span pair.
     pub(super) fn nu_patch(&mut self, req: &Request, a: &mut Args) -> Result<(), SceneError> {
         const MAX: usize = 1 << 24;
         let nu = a.int("nu", 1, MAX)?;
@@ -152,60 +219,99 @@ impl Interp {
         let vknot = a.array("vknot")?;
         let vmin = a.num("vmin")?;
         let vmax = a.num("vmax")?;
-        for o in [uorder, vorder] {
-            if o != nurbs::ORDER {
-                return Err(a.err(format!(
-                    "order {o} is not supported (only order 4, bicubic)"
-                )));
-            }
-        }
         let params = a.params()?;
         let mut surf = NuSurface {
             nu,
             nv,
+            uorder,
+            vorder,
             uknot,
             vknot,
             urange: (umin, umax),
             vrange: (vmin, vmax),
             points: &[],
         };
-        // Knots and ranges first: their errors explain count mismatches best.
+        // Orders, knots and ranges first: their errors explain count mismatches best.
         nurbs::span_count(&surf).map_err(|m| a.err(m))?;
-        let pts = self.positions(req, a, &params, nu * nv)?;
+        let (values, dim) = self.position_values(req, a, &params, nu * nv)?;
+        let counts = ClassCounts {
+            uniform: (1 + nu - uorder) * (1 + nv - vorder),
+            varying: (2 + nu - uorder) * (2 + nv - vorder),
+            vertex: nu * nv,
+        };
+        let vars = self.color_vars(a, &params, &counts)?;
         let ctm = self.geometry_ctm(a)?;
+        let pts: Vec<DVec4> = if dim == 4 {
+            let pts: Vec<DVec4> = values.chunks_exact(4).map(DVec4::from_slice).collect();
+            // RenderMan's "Pw" is homogeneous: the point is (x/w, y/w, z/w).
+            if let Some(k) = pts.iter().position(|p| !(p.w > 0.0 && p.w.is_finite())) {
+                let p = pts[k];
+                return Err(a.err(format!(
+                    "point {k} of \"Pw\" [{} {} {} {}] has weight w = {}: weights must be \
+                     positive and finite",
+                    p.x, p.y, p.z, p.w, p.w
+                )));
+            }
+            pts
+        } else {
+            values
+                .chunks_exact(3)
+                .map(|c| DVec3::from_slice(c).extend(1.0))
+                .collect()
+        };
         surf.points = &pts;
         let patches = nurbs::to_bezier(&surf).map_err(|m| a.err(m))?;
         if let Some(k) = pts.iter().position(|p| !p.is_finite()) {
             // Name the first patch the bad point reaches (conversion spreads it to those).
+            let name = if dim == 4 { "Pw" } else { "P" };
+            let p = pts[k].truncate();
             return Err(
                 match patches
                     .iter()
                     .position(|cp| cp.iter().any(|p| !p.is_finite()))
                 {
-                    Some(i) => bad_point(a, i, k, pts[k]),
+                    Some(i) => a.err(format!(
+                        "patch {i}: point {k} of \"{name}\" is {} ({})",
+                        nonfinite(p),
+                        show_point(p)
+                    )),
                     None => a.err(format!(
-                        "point {k} of \"P\" is {} ({})",
-                        nonfinite(pts[k]),
-                        show_point(pts[k])
+                        "point {k} of \"{name}\" is {} ({})",
+                        nonfinite(p),
+                        show_point(p)
                     )),
                 },
             );
         }
-        for (i, cp) in patches.into_iter().enumerate() {
-            self.emit(a, &ctm, i, cp)?;
+        // The colour fields need the points' weights (vertex values are weighted like them).
+        let fields = |v: &Option<ColorVar>| match v {
+            Some(v) => v
+                .nurbs_fields(&surf, (uorder, vorder))
+                .map(|f| f.into_iter().map(Some).collect()),
+            None => Ok(Vec::new()),
+        };
+        let mut cs: Vec<Option<ColorField>> = fields(&vars.cs).map_err(|m| a.err(m))?;
+        let mut os: Vec<Option<ColorField>> = fields(&vars.os).map_err(|m| a.err(m))?;
+        let n = patches.len();
+        cs.resize(n, None);
+        os.resize(n, None);
+        for (i, ((h, cs), os)) in patches.iter().zip(cs).zip(os).enumerate() {
+            let (cp, w) = from_homogeneous(h);
+            self.emit_with(a, &ctm, i, cp, w, (cs, os))?;
         }
         Ok(())
     }
 
-    /// The "P" (or non-rational "Pw") control points of a primitive; other parameters are
-    /// ignored with a warning.
-    pub(super) fn positions(
+    /// The numbers of the position parameter ("P": 3 per point, "Pw": 4) of a primitive of
+    /// `n` points, and that count per point; "Cs" and "Os" are left to `color_vars`, other
+    /// parameters are ignored with a warning.
+    fn position_values<'p>(
         &mut self,
         req: &Request,
         a: &Args,
-        params: &[Param],
+        params: &'p [Param],
         n: usize,
-    ) -> Result<Vec<DVec3>, SceneError> {
+    ) -> Result<(&'p [f64], usize), SceneError> {
         let mut pos = None;
         for p in params {
             match p.name {
@@ -214,6 +320,8 @@ impl Interp {
                 }
                 "P" | "Pw" => pos = Some(p),
                 "Pz" => return Err(a.err("\"Pz\" height fields are not supported")),
+                // Read by `color_vars`.
+                "Cs" | "Os" => {}
                 other => self.ignored_param(req, other),
             }
         }
@@ -228,12 +336,26 @@ impl Interp {
                 v.len()
             )));
         }
+        Ok((v, dim))
+    }
+
+    /// The "P" (or non-rational "Pw") control points of a `Patch` or `PatchMesh`; other
+    /// parameters are ignored with a warning.
+    pub(super) fn positions(
+        &mut self,
+        req: &Request,
+        a: &Args,
+        params: &[Param],
+        n: usize,
+    ) -> Result<Vec<DVec3>, SceneError> {
+        let (v, dim) = self.position_values(req, a, params, n)?;
         let mut out = Vec::with_capacity(n);
         for (k, c) in v.chunks_exact(dim).enumerate() {
             if dim == 4 && c[3] != 1.0 {
                 return Err(a.err(format!(
-                    "point {k} of \"Pw\" has w = {}: rational patches are not supported (w must be 1)",
-                    c[3]
+                    "point {k} of \"Pw\" has w = {}: rational `{}` is not supported (w must be \
+                     1; rational `NuPatch` is)",
+                    c[3], req.name
                 )));
             }
             out.push(DVec3::new(c[0], c[1], c[2]));

@@ -7,6 +7,7 @@
 
 use super::lexer::shown;
 use super::patches::basis_arg;
+use super::quadrics::QUADRICS;
 use super::state::{Block, Interp};
 use super::syntax::{Args, Request};
 use crate::frame::{MAX_IMAGE_SIDE, MAX_PIXEL_SAMPLES};
@@ -39,6 +40,13 @@ pub(super) const KNOWN: &[&str] = &[
     "Patch",
     "PatchMesh",
     "NuPatch",
+    "Sphere",
+    "Cylinder",
+    "Cone",
+    "Disk",
+    "Torus",
+    "Paraboloid",
+    "Hyperboloid",
     "Color",
     "Opacity",
     "Surface",
@@ -52,6 +60,7 @@ pub(super) const KNOWN: &[&str] = &[
     "MotionEnd",
     "ReadArchive",
     "MakeShadow",
+    "Declare",
 ];
 
 impl Interp {
@@ -88,11 +97,13 @@ impl Interp {
             "Basis" | "Color" | "Opacity" | "Sides" | "Orientation" | "ReverseOrientation" => {
                 self.attribute(req, a)
             }
+            "Declare" => self.declare(req, a),
             "Surface" => self.surface(req, a),
             "LightSource" => self.light(req, a),
             "Patch" => self.patch(req, a),
             "PatchMesh" => self.patch_mesh(req, a),
             "NuPatch" => self.nu_patch(req, a),
+            name if QUADRICS.contains(&name) => self.quadric(req, a),
             "ObjectEnd" => Err(a.err("without a matching `ObjectBegin`")),
             "MotionBegin" => {
                 if self.motion.is_some() {

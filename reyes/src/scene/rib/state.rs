@@ -3,6 +3,7 @@
 //! that `AttributeBegin`/`TransformBegin`/`WorldBegin`/`FrameBegin` save them on, and the
 //! interpreter that owns them together with the frames being built.
 
+use super::primvars::Decl;
 use super::syntax::Request;
 use crate::scene::basis::Basis;
 use crate::scene::{Camera, Display, Material, Scene, SceneError, SceneFrame, SurfaceKind};
@@ -142,6 +143,8 @@ pub(super) struct Interp {
     pub(super) current_material: Option<u32>,
     /// Inside `MotionBegin`: whether the first (used) time sample has been seen.
     pub(super) motion: Option<bool>,
+    /// `Declare`d primitive variables by name (global, not saved by blocks).
+    pub(super) declared: HashMap<String, Decl>,
 }
 
 impl Interp {
@@ -160,6 +163,7 @@ impl Interp {
             materials: HashMap::new(),
             current_material: None,
             motion: None,
+            declared: HashMap::new(),
         }
     }
 

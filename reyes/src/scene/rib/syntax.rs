@@ -40,9 +40,11 @@ pub(super) fn is_identifier(w: &str) -> bool {
     w.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_')
 }
 
-/// A parameter of a request's parameter list, name without inline type declaration.
+/// A parameter of a request's parameter list: the name without its inline type declaration,
+/// and that declaration (`"varying color Cs"` gives name `Cs`, decl `varying color`).
 pub(super) struct Param<'r> {
     pub(super) name: &'r str,
+    pub(super) decl: Option<&'r str>,
     pub(super) value: &'r Arg,
 }
 
@@ -182,11 +184,17 @@ impl<'r> Args<'r> {
             };
             self.pos += 1;
             let short = name.split_whitespace().last().unwrap_or("");
+            let decl = name.trim_end().strip_suffix(short).map(str::trim);
+            let decl = decl.filter(|d| !d.is_empty());
             let value = self
                 .peek()
                 .ok_or_else(|| self.err(format!("parameter \"{}\" has no value", shown(short))))?;
             self.pos += 1;
-            out.push(Param { name: short, value });
+            out.push(Param {
+                name: short,
+                decl,
+                value,
+            });
         }
         Ok(out)
     }

@@ -3,7 +3,10 @@
 mod archives;
 mod frames;
 mod hostile;
+mod nupatch;
 mod patches;
+mod primvars;
+mod quadrics;
 mod shading;
 mod state;
 mod syntax;

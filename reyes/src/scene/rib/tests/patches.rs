@@ -206,17 +206,31 @@ fn nu_patch_spans_become_patches() {
 
 #[test]
 fn nu_patch_errors_name_the_line() {
-    let e = err(&nu_patch(true, 0.5));
+    let e = err(&nu_patch(true, 0.0));
+    assert_eq!(
+        e,
+        "t.rib:2: `NuPatch`: point 0 of \"Pw\" [0 0 0 0] has weight w = 0: \
+         weights must be positive and finite"
+    );
+    let e = err(&nu_patch(true, -0.5));
     assert!(
-        e.starts_with("t.rib:2: `NuPatch`: point 0 of \"Pw\" has w = 0.5: rational patches"),
+        e.starts_with("t.rib:2: `NuPatch`: point 0 of \"Pw\""),
         "{e}"
     );
+    assert!(e.contains("has weight w = -0.5"), "{e}");
     let e = err(&world(
-        "\n\nNuPatch 3 3 [0 0 0 1 1 1] 0 1 3 3 [0 0 0 1 1 1] 0 1 \"P\" [0 0 0]",
+        "\n\nNuPatch 5 5 [0 0 0 0 0 1 1 1 1 1] 0 1 3 3 [0 0 0 1 1 1] 0 1 \"P\" [0 0 0]",
     ));
     assert_eq!(
         e,
-        "t.rib:4: `NuPatch`: order 3 is not supported (only order 4, bicubic)"
+        "t.rib:4: `NuPatch`: u order 5 is not supported (orders 2 to 4: linear to cubic)"
+    );
+    let e = err(&world(
+        "NuPatch 3 3 [0 0 0 1 1 1] 0 1 1 1 [0 1] 0 1 \"P\" [0 0 0]",
+    ));
+    assert_eq!(
+        e,
+        "t.rib:2: `NuPatch`: v order 1 is not supported (orders 2 to 4: linear to cubic)"
     );
     let e = err(&nu_patch(false, 1.0).replace("[0 0 0 0 1 2 2 2 2]", "[0 0 0 0 1 2 2 2]"));
     assert!(
