@@ -129,6 +129,19 @@ fn measure_prints_one_json_object_and_the_blob_has_no_pinholes() {
     assert!((0.0..0.1).contains(&num("flip_mean")));
     assert!(num("wall_ms") > 0.0);
     assert!(v["gpu_ms"].is_null() || num("gpu_ms") > 0.0);
+    // The typed report reads it back whole: no key more or less than MeasureReport's.
+    let typed: reyes::accuracy::measure::MeasureReport = serde_json::from_value(v.clone()).unwrap();
+    assert_eq!(serde_json::to_value(&typed).unwrap(), v);
+    assert_eq!(typed.runs, 1);
+    // Every key is documented in docs/reyes.md's table.
+    let docs =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/reyes.md")).unwrap();
+    for key in v.as_object().unwrap().keys() {
+        assert!(
+            docs.contains(&format!("`{key}`")) || docs.contains(&format!("`{key}.")),
+            "`{key}` is not in docs/reyes.md"
+        );
+    }
 }
 
 #[test]
@@ -221,5 +234,7 @@ fn sweep_writes_csv_markdown_and_plot() {
     assert!(md.contains("| strategy | dicing | samples |"));
     let png = image::open(file("sweep.png")).unwrap();
     assert!(png.width() >= 1000 && png.height() >= 800);
+    let svg = std::fs::read_to_string(file("sweep.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.contains("closed_blob: FLIP mean against time"));
     std::fs::remove_dir_all(&dir).unwrap();
 }

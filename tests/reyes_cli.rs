@@ -181,6 +181,7 @@ fn cpu_refuses_the_gpu_options() {
         &["--stats", "s.json"],
         &["--float", "f.pfm"],
         &["--depth", "d.pfm"],
+        &["--exr", "f.exr"],
     ] {
         let mut args = vec!["--cpu"];
         args.extend_from_slice(flag);
@@ -238,6 +239,9 @@ fn bad_values_name_their_flag() {
     let dir = scratch("values");
     for args in [
         &["render", "--height", "-3"][..],
+        &["render", "--width", "100000"],
+        &["render", "--samples", "17"],
+        &["bench", "--samples", "4x17"],
         &["measure", "--ref-samples", "65"],
         &["sweep", "--mp-sizes", "1,nan"],
         &["sweep", "--runs", "0"],
@@ -313,6 +317,24 @@ fn frame_sequences_write_one_image_per_frame() {
     }
     // The teapot turns between frames.
     assert!(imgs[0] != imgs[1] && imgs[1] != imgs[2]);
+    // `-o` naming a folder: the frames go into it, under their Display names (the trial of
+    // 2026-11-30 found them written into its parent, over files there).
+    std::fs::create_dir_all(dir.join("into")).unwrap();
+    for folder in ["into/", "into"] {
+        let (ok, err) = reyes(&dir, &[&scene, "--cpu", "-o", folder]);
+        assert!(ok, "{err}");
+        for (n, img) in imgs.iter().enumerate() {
+            let p = dir.join(format!("into/teapot.000{}.png", n + 1));
+            assert!(png(&p) == *img, "{folder}: {}", p.display());
+            std::fs::remove_file(p).unwrap();
+        }
+        assert!(!dir.join(format!("teapot.0001.png")).exists(), "{folder}");
+    }
+    // One frame selected and a plain `-o` name: that name.
+    let (ok, err) = reyes(&dir, &[&scene, "--cpu", "-o", "one.png", "--frames", "2"]);
+    assert!(ok, "{err}");
+    assert!(png(&dir.join("one.png")) == imgs[1]);
+    assert!(!dir.join("teapot.0002.png").exists());
     // A pattern and a selection.
     let (ok, err) = reyes(
         &dir,
@@ -453,4 +475,225 @@ fn hostile_files_fail_clearly_and_write_nothing() {
     assert!(ok, "{err}");
     assert!(err.len() < 1000, "{} bytes of stderr", err.len());
     assert!(err.contains("… (100001 bytes)`"), "{err}");
+}
+
+/// `reyes bench` on the built-in teapot prints one JSON object with the documented keys
+/// (docs/reyes.md), one row per timed frame; the table names its rows. Needs the GPU (lavapipe).
+#[test]
+fn bench_prints_its_report_as_json() {
+    let dir = scratch("bench");
+    let args = [
+        "bench",
+        "teapot",
+        "--frames",
+        "3",
+        "--json",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--warmup",
+        "1",
+        "--turntable",
+    ];
+    let (code, out, err) = reyes_any(&dir, &args);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap_or_else(|e| panic!("{e}: {out}"));
+    for key in [
+        "scene",
+        "adapter",
+        "strategy",
+        "width",
+        "height",
+        "samples",
+        "frames",
+        "turntable",
+        "degrees_per_frame",
+        "pipelined",
+        "not_pipelined",
+        "wall_ms",
+        "gpu_ms",
+        "wall_minus_gpu_ms",
+        "fps",
+        "micropolygons",
+        "rerendered",
+        "per_frame",
+    ] {
+        assert!(v.get(key).is_some(), "no `{key}` in {out}");
+    }
+    assert_eq!(v["scene"], "teapot");
+    // The default strategy is chosen per adapter: multipass on a CPU adapter (lavapipe).
+    let cpu = v["adapter"].as_str().unwrap().contains("llvmpipe");
+    assert_eq!(v["strategy"], if cpu { "multipass" } else { "megakernel" });
+    if cpu {
+        assert!(err.contains("note: strategy multipass"), "{err}");
+    }
+    assert_eq!(
+        (v["width"].as_u64(), v["height"].as_u64()),
+        (Some(64), Some(48))
+    );
+    assert_eq!(v["frames"], 3);
+    assert_eq!(v["degrees_per_frame"], 120.0);
+    assert_eq!(v["pipelined"], true);
+    for k in ["median", "p95", "min", "max"] {
+        assert!(v["wall_ms"][k].as_f64().unwrap() > 0.0, "wall_ms.{k}");
+    }
+    assert!(v["gpu_ms"].is_null() || v["gpu_ms"]["median"].as_f64().unwrap() > 0.0);
+    assert!(v["fps"].as_f64().unwrap() > 0.0);
+    assert!(v["micropolygons"]["median"].as_f64().unwrap() > 100.0);
+    let rows = v["per_frame"].as_array().unwrap();
+    assert_eq!(rows.len(), 3);
+    assert_eq!(rows[1]["angle_deg"], 120.0);
+    let (code, out, err) = reyes_any(
+        &dir,
+        &[
+            "bench",
+            "--frames",
+            "2",
+            "--warmup",
+            "0",
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--strategy",
+            "multipass",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    for label in ["wall ms", "GPU ms", "fps", "re-rendered"] {
+        assert!(out.contains(label), "no `{label}` in the table: {out}");
+    }
+}
+
+/// Little-endian PFM (`reyes render --float`, `--depth`): width, height, channels and the
+/// samples top row first.
+fn read_pfm(p: &Path) -> (usize, usize, usize, Vec<f32>) {
+    let bytes = std::fs::read(p).unwrap();
+    let mut lines = bytes.splitn(4, |&b| b == b'\n');
+    let kind = lines.next().unwrap();
+    let channels = if kind == b"PF" { 3 } else { 1 };
+    let size = String::from_utf8(lines.next().unwrap().to_vec()).unwrap();
+    let (w, h) = size.split_once(' ').unwrap();
+    let (w, h): (usize, usize) = (w.parse().unwrap(), h.parse().unwrap());
+    assert_eq!(lines.next().unwrap(), b"-1.0", "little-endian scale");
+    let data = lines.next().unwrap();
+    assert_eq!(data.len(), w * h * channels * 4);
+    let f: Vec<f32> = data
+        .chunks(4)
+        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+        .collect();
+    let rows: Vec<&[f32]> = f.chunks(w * channels).rev().collect();
+    (w, h, channels, rows.concat())
+}
+
+/// `--stats` is `FrameStats` whole (every key documented in docs/reyes.md), and `--exr` holds
+/// the rendered frame's colour (premultiplied), alpha and depth exactly: read back with the
+/// `exr` crate against the `--float` and `--depth` PFMs and the PNG of the same render. Needs
+/// the GPU (lavapipe).
+#[test]
+fn stats_and_exr_hold_the_rendered_frame() {
+    let dir = scratch("exr");
+    let (ok, err) = reyes(
+        &dir,
+        &[
+            "teapot",
+            "--width",
+            "40",
+            "--height",
+            "30",
+            "--strategy",
+            "multipass",
+            "--stage-times",
+            "--runs",
+            "2",
+            "-o",
+            "f.png",
+            "--stats",
+            "s.json",
+            "--exr",
+            "f.exr",
+            "--float",
+            "f.pfm",
+            "--depth",
+            "d.pfm",
+        ],
+    );
+    assert!(ok, "{err}");
+    let text = std::fs::read_to_string(dir.join("s.json")).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let typed: reyes::stats::FrameStats = serde_json::from_value(v.clone()).unwrap();
+    assert_eq!(
+        serde_json::to_value(&typed).unwrap(),
+        v,
+        "keys beyond FrameStats"
+    );
+    assert_eq!((typed.width, typed.height), (40, 30));
+    assert_eq!(typed.strategy, "multipass");
+    assert!(typed.micropolygons > 100 && typed.grids_diced > 0);
+    assert_eq!(typed.runs.as_ref().unwrap().count, 2);
+    assert_eq!(v["executed"]["bound"], typed.bounds);
+    let docs =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/reyes.md")).unwrap();
+    for key in v.as_object().unwrap().keys() {
+        assert!(
+            docs.contains(&format!("`{key}`")) || docs.contains(&format!("`{key}.")),
+            "`{key}` is not in docs/reyes.md"
+        );
+    }
+
+    let exr = exr::prelude::read_first_flat_layer_from_file(dir.join("f.exr")).unwrap();
+    let layer = &exr.layer_data;
+    assert_eq!((layer.size.0, layer.size.1), (40, 30));
+    let channel = |name: &str| -> Vec<f32> {
+        let c = (layer.channel_data.list.iter())
+            .find(|c| &c.name == name)
+            .unwrap_or_else(|| panic!("no channel {name}"));
+        match &c.sample_data {
+            exr::prelude::FlatSamples::F32(v) => v.clone(),
+            other => panic!("{name} is not f32: {other:?}"),
+        }
+    };
+    let (w, h, n, rgb) = read_pfm(&dir.join("f.pfm"));
+    assert_eq!((w, h, n), (40, 30, 3));
+    let (_, _, _, depth) = read_pfm(&dir.join("d.pfm"));
+    let a = channel("A");
+    for (c, name) in ["R", "G", "B"].into_iter().enumerate() {
+        let want: Vec<f32> = (0..w * h).map(|p| rgb[p * 3 + c] * a[p]).collect();
+        assert_eq!(channel(name), want, "{name}");
+    }
+    let z = channel("Z");
+    assert_eq!(z.len(), depth.len());
+    assert!(
+        z.iter().zip(&depth).all(|(x, y)| x == y),
+        "Z differs from --depth"
+    );
+    assert!(z.contains(&f32::INFINITY) && z.iter().any(|z| z.is_finite()));
+    let img = png(&dir.join("f.png"));
+    let alpha8: Vec<u8> = a
+        .iter()
+        .map(|a| (a.clamp(0.0, 1.0) * 255.0).round() as u8)
+        .collect();
+    let png_alpha: Vec<u8> = img.pixels().map(|p| p[3]).collect();
+    assert_eq!(alpha8, png_alpha);
+    assert!(covered(&img) > 50);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Without `XDG_RUNTIME_DIR` (no login session: containers, CI) lavapipe used to print
+/// "error: XDG_RUNTIME_DIR is invalid or not set" twice although nothing was wrong; the command
+/// now gives the driver a private folder of its own (`reyes::driver_env`) and prints no error.
+#[test]
+fn no_false_driver_error_without_a_runtime_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_reyes"))
+        .current_dir(dir.path())
+        .env_remove("XDG_RUNTIME_DIR")
+        .args(["render", "--width", "32", "--height", "24", "-o", "t.png"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(!err.contains("XDG_RUNTIME_DIR"), "{err}");
+    assert!(!err.contains("error"), "{err}");
 }

@@ -16,6 +16,7 @@ impl PendingFile {
         let tmp = tempfile::Builder::new()
             .prefix(&format!(".{name}."))
             .suffix(".partial")
+            .permissions(reyes::output::new_file_permissions())
             .tempfile_in(dir)
             .map_err(|e| format!("{}: {e}", dir.display()))?;
         Ok(PendingFile {

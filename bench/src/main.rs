@@ -51,6 +51,8 @@ fn run_suite(cli: &Cli) -> Result<bool, String> {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     cli.check();
+    reyes::driver_env::ensure_xdg_runtime_dir();
+    reyes::logging::init();
     let result = if cli.suite {
         run_suite(&cli)
     } else {
@@ -59,7 +61,7 @@ fn main() -> ExitCode {
     match result {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => {
-            eprintln!("schedbench: some run failed or did not match the CPU reference");
+            log::error!("some run failed or did not match the CPU reference");
             ExitCode::FAILURE
         }
         Err(e) => {

@@ -14,7 +14,7 @@ use crate::suite::Scale;
 use crate::workload::{Measurement, Prepared, Workload, ms_since};
 use reyes::cpu_render::{CpuRender, render_cpu};
 use reyes::frame::{FrameData, RenderOptions};
-use reyes::gpu_render::{GpuRenderer, INITIAL_CAPACITY, program};
+use reyes::gpu_render::{GpuRenderer, INITIAL_CAPACITY, program_for};
 use reyes::image::FrameImage;
 use reyes::scene::{self, Scene};
 use reyes::stages::C_MICROPOLYGONS;
@@ -203,11 +203,13 @@ impl Workload for ReyesWorkload {
             Strategy::Scheduler { .. } => {
                 let mut renderers = self.renderers.borrow_mut();
                 if !renderers.iter().any(|r| r.0 == name) {
-                    let program = program().map_err(|e| e.to_string())?;
+                    // Compiled for what this workload's frame needs, as `reyes render` does.
+                    let features = cur.data.features();
+                    let program = program_for(features).map_err(|e| e.to_string())?;
                     let capacity = self.config.capacity.unwrap_or(INITIAL_CAPACITY);
                     let scheduler = compile(gpu, &program, strategy, &self.config, capacity)
                         .map_err(|e| e.to_string())?;
-                    let r = GpuRenderer::from_scheduler(gpu, program, scheduler)
+                    let r = GpuRenderer::from_scheduler(gpu, program, scheduler, features)
                         .map_err(|e| e.to_string())?;
                     renderers.push((name.clone(), r));
                 }

@@ -103,7 +103,7 @@ pub fn run(cli: &Cli) -> Result<bool, String> {
                 println!("{}", serde_json::to_string(&r).expect("records serialise"));
             }
             if let Some(e) = r.error.as_ref().filter(|_| !r.verified) {
-                eprintln!("schedbench: {} run {}: {e}", r.strategy, r.run);
+                log::error!("{} run {}: {e}", r.strategy, r.run);
             }
             records.push(r);
         }

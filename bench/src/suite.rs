@@ -176,9 +176,12 @@ pub fn run_suite(gpu: &Gpu, o: &SuiteOptions) -> Result<bool, String> {
                     jsonl.write(line.as_bytes())?;
                     if let Some(e) = r.error.as_ref().filter(|_| !r.verified) {
                         bar.suspend(|| {
-                            eprintln!(
-                                "schedbench: {} {} {} run {}: {e}",
-                                r.workload, r.size, r.strategy, r.run
+                            log::error!(
+                                "{} {} {} run {}: {e}",
+                                r.workload,
+                                r.size,
+                                r.strategy,
+                                r.run
                             )
                         });
                     }

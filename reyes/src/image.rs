@@ -1,5 +1,5 @@
-//! A rendered frame and its files: PNG (8-bit sRGB, alpha = coverage), PFM (linear float RGB)
-//! and depth (PFM, one channel). Files are written to a temporary name and renamed, so a failed
+//! A rendered frame and its files: PNG (8-bit sRGB, alpha = coverage), PFM (linear float RGB),
+//! depth (PFM, one channel) and OpenEXR (linear f32 R, G, B, A and Z in one file). Files are written to a temporary name and renamed, so a failed
 //! write never leaves a half-written image under the requested name.
 
 use crate::stages::shade::srgb_encode;
@@ -64,13 +64,58 @@ impl FrameImage {
 
     /// Camera-space depth as a one-channel PFM; background pixels hold +inf.
     pub fn write_depth(&self, path: &Path) -> Result<(), String> {
-        self.pfm(path, 1, |p, _| {
-            if self.depth[p] >= 3.0e38 {
-                f32::INFINITY
-            } else {
-                self.depth[p]
-            }
-        })
+        self.pfm(path, 1, |p, _| self.file_depth(p))
+    }
+
+    /// Background depth in the files: +inf (the renderer's 3e38 "nothing here").
+    fn file_depth(&self, p: usize) -> f32 {
+        if self.depth[p] >= 3.0e38 {
+            f32::INFINITY
+        } else {
+            self.depth[p]
+        }
+    }
+
+    /// The image as OpenEXR: one layer, channels R, G, B, A and Z, all 32-bit float, linear,
+    /// ZIP-compressed (lossless). Colour is premultiplied by alpha (coverage), as OpenEXR
+    /// defines it and compositing tools expect (`R = rgba[0] * rgba[3]`, exactly in f32); Z is
+    /// the camera-space depth of the nearest sample, +inf where the background shows. Rows
+    /// top to bottom. Written with the `exr` crate.
+    pub fn exr(&self) -> Result<Vec<u8>, String> {
+        use exr::prelude::*;
+        let n = self.rgba.len();
+        let premultiplied =
+            |c: usize| FlatSamples::F32(self.rgba.iter().map(|p| p[c] * p[3]).collect());
+        let channels = AnyChannels::sort(SmallVec::from_vec(vec![
+            AnyChannel::new("R", premultiplied(0)),
+            AnyChannel::new("G", premultiplied(1)),
+            AnyChannel::new("B", premultiplied(2)),
+            AnyChannel::new(
+                "A",
+                FlatSamples::F32(self.rgba.iter().map(|p| p[3]).collect()),
+            ),
+            AnyChannel::new(
+                "Z",
+                FlatSamples::F32((0..n).map(|p| self.file_depth(p)).collect()),
+            ),
+        ]));
+        let layer = Layer::new(
+            (self.width as usize, self.height as usize),
+            LayerAttributes::default(),
+            Encoding::SMALL_LOSSLESS,
+            channels,
+        );
+        let mut out = std::io::Cursor::new(Vec::new());
+        Image::from_layer(layer)
+            .write()
+            .to_buffered(&mut out)
+            .map_err(|e| format!("OpenEXR: {e}"))?;
+        Ok(out.into_inner())
+    }
+
+    /// [`FrameImage::exr`] written to `path` (atomically).
+    pub fn write_exr(&self, path: &Path) -> Result<(), String> {
+        crate::output::write_atomic(path, &self.exr()?)
     }
 
     fn pfm(
@@ -94,5 +139,64 @@ impl FrameImage {
             }
         }
         crate::output::write_atomic(path, &bytes)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The OpenEXR file reads back (with the `exr` crate) as the image's channels, exactly:
+    /// premultiplied colour, coverage, depth with the background at +inf.
+    #[test]
+    fn exr_holds_colour_alpha_and_depth_exactly() {
+        let (width, height) = (5u32, 3u32);
+        let n = (width * height) as usize;
+        let img = FrameImage {
+            width,
+            height,
+            rgba: (0..n)
+                .map(|i| {
+                    let t = i as f32 / 7.0;
+                    [t, 1.0 - t / 3.0, 0.1 + t * t, (i % 4) as f32 / 3.0]
+                })
+                .collect(),
+            depth: (0..n)
+                .map(|i| if i % 4 == 0 { 3.0e38 } else { 1.5 + i as f32 })
+                .collect(),
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("f.exr");
+        img.write_exr(&path).unwrap();
+        let read = exr::prelude::read_first_flat_layer_from_file(&path).unwrap();
+        let layer = &read.layer_data;
+        assert_eq!(layer.size.0, width as usize);
+        assert_eq!(layer.size.1, height as usize);
+        let channel = |name: &str| -> Vec<f32> {
+            let c = layer
+                .channel_data
+                .list
+                .iter()
+                .find(|c| &c.name == name)
+                .unwrap_or_else(|| panic!("no channel {name}"));
+            match &c.sample_data {
+                exr::prelude::FlatSamples::F32(v) => v.clone(),
+                other => panic!("{name} is not f32: {other:?}"),
+            }
+        };
+        let names: Vec<String> = (layer.channel_data.list.iter())
+            .map(|c| c.name.to_string())
+            .collect();
+        assert_eq!(names, ["A", "B", "G", "R", "Z"]);
+        for (c, name) in ["R", "G", "B"].into_iter().enumerate() {
+            let want: Vec<f32> = img.rgba.iter().map(|p| p[c] * p[3]).collect();
+            assert_eq!(channel(name), want, "{name}");
+        }
+        let alpha: Vec<f32> = img.rgba.iter().map(|p| p[3]).collect();
+        assert_eq!(channel("A"), alpha);
+        let z = channel("Z");
+        assert_eq!(z[0], f32::INFINITY);
+        assert_eq!(z[1], 2.5);
+        assert_eq!(z, (0..n).map(|p| img.file_depth(p)).collect::<Vec<_>>());
     }
 }

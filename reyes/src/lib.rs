@@ -5,10 +5,14 @@
 pub mod accuracy;
 pub mod buckets;
 pub mod cpu_render;
+pub mod driver_env;
 pub mod frame;
 pub mod gpu_render;
 pub mod image;
+pub mod logging;
+pub mod orbit;
 pub mod output;
+pub mod realtime;
 pub mod reference;
 pub mod scene;
 pub mod shaders;

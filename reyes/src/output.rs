@@ -20,12 +20,30 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
     let mut tmp = tempfile::Builder::new()
         .prefix(&format!(".{}.", name.to_string_lossy()))
         .suffix(".partial")
+        .permissions(new_file_permissions())
         .tempfile_in(dir)
         .map_err(err)?;
     tmp.write_all(bytes).map_err(err)?;
     tmp.as_file().sync_all().map_err(err)?;
     tmp.persist(path).map_err(|e| err(e.error))?;
     Ok(())
+}
+
+/// The permissions an output file is created with: those of any new file (0666 less the
+/// umask, e.g. 0644), not the owner-only 0600 that temporary files get by default.
+pub fn new_file_permissions() -> std::fs::Permissions {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::Permissions::from_mode(0o666)
+    }
+    #[cfg(not(unix))]
+    {
+        // Elsewhere a new file's default: writable, which the metadata of a fresh temp
+        // directory's files gives.
+        let f = tempfile::tempfile().expect("a temporary file");
+        f.metadata().expect("its metadata").permissions()
+    }
 }
 
 /// An image encoded as PNG, for [`write_atomic`].
@@ -57,5 +75,18 @@ mod tests {
         assert!(e.contains("no/such/folder/b.txt"), "{e}");
         let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
         assert_eq!(left.len(), 1, "only a.txt: no temporary file left");
+        // Created as any new file (0666 less the umask), not owner-only as temporary files.
+        #[cfg(target_os = "linux")]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            let status = std::fs::read_to_string("/proc/self/status").unwrap();
+            let umask = status
+                .lines()
+                .find_map(|l| l.strip_prefix("Umask:"))
+                .map(|v| u32::from_str_radix(v.trim(), 8).unwrap())
+                .unwrap();
+            let mode = std::fs::metadata(&p).unwrap().permissions().mode() & 0o777;
+            assert_eq!(mode, 0o666 & !umask, "mode {mode:o}, umask {umask:o}");
+        }
     }
 }

@@ -1,85 +1,338 @@
-//! The `--stats` JSON of a frame: what each stage did and what it cost.
+//! The `--stats` JSON of a frame ([`FrameStats`]): what each stage did and what it cost. Typed
+//! (`serde` derive), so a mistyped or missing key is a compile error rather than a silent
+//! null; the keys, units and meanings are tabled in docs/reyes.md (*Statistics*).
 
 use crate::frame::{FrameData, PatchItem};
-use crate::gpu_render::{GpuFrame, PROCEDURES};
+use crate::gpu_render::GpuFrame;
 use crate::stages as s;
-use serde_json::{Value, json};
+use serde::{Deserialize, Serialize};
 
-pub fn frame_stats(data: &FrameData, g: &GpuFrame, adapter: &str, warnings: &[String]) -> Value {
-    let c = &g.counters;
-    let ex = &g.run.executed;
-    let covered = g.image.covered_pixels();
-    let item_bytes = std::mem::size_of::<PatchItem>() as u64;
-    let peak_queue_bytes: u64 = g.run.peak_occupancy.iter().map(|n| n * item_bytes).sum();
-    let schedule_ms = g.run.gpu_ms;
-    let total_ms = schedule_ms.zip(g.resolve_gpu_ms).map(|(a, b)| a + b);
-    let f = &data.frame;
-    json!({
-        "strategy": g.run.strategy,
-        "adapter": adapter,
-        "width": f.width,
-        "height": f.height,
-        "pixel_samples": [f.spp_x, f.spp_y],
-        "mp_size_px": f.mp_size,
-        "bound_px": if f.bound_px > 0.0 { json!(f.bound_px) } else { Value::Null },
-        "patches_in": data.items.len(),
-        "bounds": ex[0],
-        "splits": ex[1] + ex[2],
-        "splits_u": ex[1],
-        "splits_v": ex[2],
-        "eye_splits": c[s::C_EYE_SPLITS],
-        "culls": {
-            "clip": c[s::C_CULL_CLIP],
-            "offscreen": c[s::C_CULL_OFFSCREEN],
-            "backface_patches": c[s::C_CULL_BACKFACE],
-            "backface_micropolygons": c[s::C_BACKFACE],
-        },
-        "depth_limited": c[s::C_DEPTH_LIMIT],
-        "near_clipped_grids": c[s::C_NEAR_CLIPPED],
-        "grids_diced": ex[3] + ex[4],
-        "grids_small": ex[4],
-        "micropolygons": c[s::C_MICROPOLYGONS],
-        "covered_pixels": covered,
-        "micropolygons_per_covered_pixel": c[s::C_MICROPOLYGONS] as f64 / covered.max(1) as f64,
-        "max_split_depth": c[s::C_MAX_DEPTH],
-        "executed": PROCEDURES.iter().zip(ex).map(|(p, n)| (p.to_string(), json!(n))).collect::<serde_json::Map<_, _>>(),
-        "gpu_ms_per_stage": stage_times(g),
-        "gpu_ms": total_ms,
-        "wall_ms": g.wall_ms,
-        "launches": g.run.launches,
-        "workgroups": g.run.workgroups,
-        "rounds": g.run.rounds,
-        "queue_growths": g.run.queue_growths,
-        "peak_queue_items": g.run.peak_occupancy,
-        "peak_queue_bytes": peak_queue_bytes,
-        "queue_bytes_allocated": g.run.queue_bytes,
-        "sample_bytes": g.sample_bytes,
-        "memory_budget": data.memory_budget,
-        "buckets": g.buckets,
-        "buckets_recut": g.buckets_recut,
-        "scheduler_runs": g.runs,
-        "batches_split": g.batches_split,
-        "peak_working_bytes": g.peak_working_bytes,
-        "warnings": warnings,
-    })
+/// What one GPU frame did and cost. Counts are of the whole frame (every bucket); times in
+/// milliseconds; sizes in bytes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FrameStats {
+    /// The scheduling strategy (`megakernel`, `multipass`, `multipass-host`).
+    pub strategy: String,
+    /// The GPU adapter's name.
+    pub adapter: String,
+    /// Image size in pixels.
+    pub width: u32,
+    pub height: u32,
+    /// Samples per pixel, [x, y].
+    pub pixel_samples: [u32; 2],
+    /// Target micropolygon edge (px).
+    pub mp_size_px: f64,
+    /// Fixed-bound dicing's screen bound (px); null for adaptive dicing.
+    pub bound_px: Option<f64>,
+    /// Root patches of the scene.
+    pub patches_in: usize,
+    /// Bound procedure executions.
+    pub bounds: u64,
+    /// Splits (`splits_u + splits_v`).
+    pub splits: u64,
+    pub splits_u: u64,
+    pub splits_v: u64,
+    /// Splits forced by the near plane.
+    pub eye_splits: u64,
+    pub culls: Culls,
+    /// Grids diced at the split limit (coarser than asked).
+    pub depth_limited: u64,
+    /// Grids crossing the near plane after the allowed eye splits, diced and clipped.
+    pub near_clipped_grids: u64,
+    /// Grids diced (`diceshade` plus `dicesmall` executions).
+    pub grids_diced: u64,
+    /// Grids diced by the small-grid procedure.
+    pub grids_small: u64,
+    /// Micropolygons shaded and sampled.
+    pub micropolygons: u64,
+    /// Pixels with any coverage.
+    pub covered_pixels: usize,
+    pub micropolygons_per_covered_pixel: f64,
+    /// Deepest split level reached.
+    pub max_split_depth: u64,
+    /// Executions per procedure.
+    pub executed: Executed,
+    pub gpu_ms_per_stage: StageTimes,
+    /// GPU time of the scheduler run plus the resolve pass; null without timestamp queries.
+    /// `reyes measure`: the median over its timed frames.
+    pub gpu_ms: Option<f64>,
+    /// Host time of the frame (`reyes measure`: the median over its timed frames).
+    pub wall_ms: f64,
+    /// Compute dispatches.
+    pub launches: u64,
+    /// Workgroups of the megakernel launch or of a multi-pass round's widest dispatch.
+    pub workgroups: u32,
+    /// Multi-pass rounds (0 for the megakernel).
+    pub rounds: u64,
+    /// Times a queue was reallocated larger.
+    pub queue_growths: u64,
+    /// Multi-pass rounds that took only part of a queue (its output would not fit).
+    pub partial_rounds: u64,
+    /// Most items held at once, per queue (in `executed`'s order).
+    pub peak_queue_items: Vec<u64>,
+    /// `peak_queue_items` in bytes (288 per item), summed.
+    pub peak_queue_bytes: u64,
+    /// Bytes of queue storage allocated.
+    pub queue_bytes_allocated: u64,
+    /// Bytes of the sample buffer (one bucket's).
+    pub sample_bytes: u64,
+    /// `--memory-budget` (bytes); null without one.
+    pub memory_budget: Option<u64>,
+    /// Screen buckets rendered (1 without a memory budget).
+    pub buckets: u32,
+    /// Buckets cut again because their queues outgrew the budget.
+    pub buckets_recut: u32,
+    /// Scheduler runs (buckets and batches).
+    pub scheduler_runs: u32,
+    /// Root batches split because their queues would not fit.
+    pub batches_split: u32,
+    /// Largest working memory (sample buffer plus queues) at any point, bytes.
+    pub peak_working_bytes: u64,
+    /// The scene file's, the scene's and the frame's warnings (`reyes::warnings`).
+    pub warnings: Vec<String>,
+    /// `reyes render --runs`: each timed frame's times; absent elsewhere.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub runs: Option<RunSummary>,
+}
+
+/// Patches and micropolygons culled, by reason.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Culls {
+    /// Pieces wholly outside the near/far range.
+    pub clip: u64,
+    /// Pieces wholly off screen.
+    pub offscreen: u64,
+    /// One-sided patches facing away.
+    pub backface_patches: u64,
+    /// Micropolygons of one-sided surfaces facing away.
+    pub backface_micropolygons: u64,
+}
+
+/// Executions of each procedure (the names of `gpu_render::PROCEDURES`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Executed {
+    pub bound: u64,
+    pub splitu: u64,
+    pub splitv: u64,
+    pub diceshade: u64,
+    pub dicesmall: u64,
 }
 
 /// GPU ms per stage: every procedure and the queue work when multi-pass timed them
-/// (`--stage-times`), else the scheduler run as one; the resolve pass always.
-fn stage_times(g: &GpuFrame) -> Value {
-    let mut m = serde_json::Map::new();
-    let per_stage = &g.run.stage_gpu_ms;
-    if per_stage.len() == PROCEDURES.len() + 1 {
-        for (name, ms) in PROCEDURES.iter().chain(&["queue_work"]).zip(per_stage) {
-            m.insert(name.to_string(), json!(ms));
+/// (`--stage-times`), else the scheduler run as one; the resolve pass always. Null times:
+/// the adapter has no timestamp queries.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum StageTimes {
+    PerStage {
+        bound: f64,
+        splitu: f64,
+        splitv: f64,
+        diceshade: f64,
+        dicesmall: f64,
+        /// Multi-pass's queue bookkeeping passes (counts, prefix sums, compaction).
+        queue_work: f64,
+        resolve: Option<f64>,
+    },
+    Whole {
+        schedule: Option<f64>,
+        /// Why the stages are not timed apart.
+        note: String,
+        resolve: Option<f64>,
+    },
+}
+
+/// Median, median absolute deviation and every value of a time over the timed frames (ms).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MedianMad {
+    pub median: f64,
+    pub mad: f64,
+    pub all: Vec<f64>,
+}
+
+impl MedianMad {
+    /// `None` for no values.
+    pub fn of(v: Vec<f64>) -> Option<MedianMad> {
+        if v.is_empty() {
+            return None;
         }
-    } else {
-        m.insert("schedule".into(), json!(g.run.gpu_ms));
-        m.insert(
-            "note".into(),
-            json!("stages interleave inside one megakernel launch; multipass --stage-times times each procedure"),
-        );
+        let (median, mad) = scheduler::stats::median_and_mad(&v);
+        Some(MedianMad {
+            median,
+            mad,
+            all: v,
+        })
     }
-    m.insert("resolve".into(), json!(g.resolve_gpu_ms));
-    Value::Object(m)
+}
+
+/// `reyes render --runs N`: the timed frames' GPU and wall ms.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunSummary {
+    /// Timed frames.
+    pub count: usize,
+    /// Null without timestamp queries.
+    pub gpu_ms: Option<MedianMad>,
+    pub wall_ms: Option<MedianMad>,
+}
+
+impl RunSummary {
+    /// From each run's (GPU ms, wall ms).
+    pub fn of(times: &[(Option<f64>, f64)]) -> RunSummary {
+        RunSummary {
+            count: times.len(),
+            gpu_ms: MedianMad::of(times.iter().filter_map(|t| t.0).collect()),
+            wall_ms: MedianMad::of(times.iter().map(|t| t.1).collect()),
+        }
+    }
+}
+
+/// The statistics of GPU frame `g` of `data`, rendered on `adapter`, with `warnings`.
+pub fn frame_stats(
+    data: &FrameData,
+    g: &GpuFrame,
+    adapter: &str,
+    warnings: &[String],
+) -> FrameStats {
+    let c = &g.counters;
+    let ex = &g.run.executed;
+    let executed = |i: usize| ex.get(i).copied().unwrap_or(0);
+    let covered = g.image.covered_pixels();
+    let item_bytes = std::mem::size_of::<PatchItem>() as u64;
+    let peak_queue_bytes: u64 = g.run.peak_occupancy.iter().map(|n| n * item_bytes).sum();
+    let f = &data.frame;
+    FrameStats {
+        strategy: g.run.strategy.clone(),
+        adapter: adapter.to_string(),
+        width: f.width,
+        height: f.height,
+        pixel_samples: [f.spp_x, f.spp_y],
+        mp_size_px: f.mp_size as f64,
+        bound_px: (f.bound_px > 0.0).then_some(f.bound_px as f64),
+        patches_in: data.items.len(),
+        bounds: executed(0),
+        splits: executed(1) + executed(2),
+        splits_u: executed(1),
+        splits_v: executed(2),
+        eye_splits: c[s::C_EYE_SPLITS],
+        culls: Culls {
+            clip: c[s::C_CULL_CLIP],
+            offscreen: c[s::C_CULL_OFFSCREEN],
+            backface_patches: c[s::C_CULL_BACKFACE],
+            backface_micropolygons: c[s::C_BACKFACE],
+        },
+        depth_limited: c[s::C_DEPTH_LIMIT],
+        near_clipped_grids: c[s::C_NEAR_CLIPPED],
+        grids_diced: executed(3) + executed(4),
+        grids_small: executed(4),
+        micropolygons: c[s::C_MICROPOLYGONS],
+        covered_pixels: covered,
+        micropolygons_per_covered_pixel: c[s::C_MICROPOLYGONS] as f64 / covered.max(1) as f64,
+        max_split_depth: c[s::C_MAX_DEPTH],
+        executed: Executed {
+            bound: executed(0),
+            splitu: executed(1),
+            splitv: executed(2),
+            diceshade: executed(3),
+            dicesmall: executed(4),
+        },
+        gpu_ms_per_stage: stage_times(g),
+        gpu_ms: g.run.gpu_ms.zip(g.resolve_gpu_ms).map(|(a, b)| a + b),
+        wall_ms: g.wall_ms,
+        launches: g.run.launches,
+        workgroups: g.run.workgroups,
+        rounds: g.run.rounds,
+        queue_growths: g.run.queue_growths,
+        partial_rounds: g.run.partial_rounds,
+        peak_queue_items: g.run.peak_occupancy.clone(),
+        peak_queue_bytes,
+        queue_bytes_allocated: g.run.queue_bytes,
+        sample_bytes: g.sample_bytes,
+        memory_budget: data.memory_budget,
+        buckets: g.buckets,
+        buckets_recut: g.buckets_recut,
+        scheduler_runs: g.runs,
+        batches_split: g.batches_split,
+        peak_working_bytes: g.peak_working_bytes,
+        warnings: warnings.to_vec(),
+        runs: None,
+    }
+}
+
+fn stage_times(g: &GpuFrame) -> StageTimes {
+    match g.run.stage_gpu_ms[..] {
+        [bound, splitu, splitv, diceshade, dicesmall, queue_work] => StageTimes::PerStage {
+            bound,
+            splitu,
+            splitv,
+            diceshade,
+            dicesmall,
+            queue_work,
+            resolve: g.resolve_gpu_ms,
+        },
+        _ => StageTimes::Whole {
+            schedule: g.run.gpu_ms,
+            note: "stages interleave inside one megakernel launch; multipass --stage-times \
+                   times each procedure"
+                .into(),
+            resolve: g.resolve_gpu_ms,
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu_render::PROCEDURES;
+
+    /// The typed names follow the procedures' (a renamed procedure must rename its keys).
+    #[test]
+    fn procedure_keys_are_the_procedures_names() {
+        let e = Executed {
+            bound: 0,
+            splitu: 1,
+            splitv: 2,
+            diceshade: 3,
+            dicesmall: 4,
+        };
+        let v = serde_json::to_value(&e).unwrap();
+        let keys: Vec<&String> = v.as_object().unwrap().keys().collect();
+        let mut want: Vec<&str> = PROCEDURES.to_vec();
+        want.sort();
+        assert_eq!(keys, want);
+        for (i, p) in PROCEDURES.iter().enumerate() {
+            assert_eq!(v[p], i as u64);
+        }
+        let t = StageTimes::PerStage {
+            bound: 0.0,
+            splitu: 1.0,
+            splitv: 2.0,
+            diceshade: 3.0,
+            dicesmall: 4.0,
+            queue_work: 5.0,
+            resolve: None,
+        };
+        let v = serde_json::to_value(&t).unwrap();
+        for (i, p) in PROCEDURES.iter().chain(&["queue_work"]).enumerate() {
+            assert_eq!(v[p], i as f64);
+        }
+        // Untagged: each shape reads back as itself.
+        let back: StageTimes = serde_json::from_value(v).unwrap();
+        assert_eq!(back, t);
+        let w = StageTimes::Whole {
+            schedule: Some(1.5),
+            note: "n".into(),
+            resolve: Some(0.5),
+        };
+        let back: StageTimes = serde_json::from_str(&serde_json::to_string(&w).unwrap()).unwrap();
+        assert_eq!(back, w);
+    }
+
+    #[test]
+    fn run_summary_of_times() {
+        let r = RunSummary::of(&[(Some(2.0), 5.0), (None, 3.0), (Some(4.0), 4.0)]);
+        assert_eq!(r.count, 3);
+        assert_eq!(r.gpu_ms.as_ref().unwrap().all, [2.0, 4.0]);
+        assert_eq!(r.wall_ms.as_ref().unwrap().median, 4.0);
+        assert!(RunSummary::of(&[(None, 1.0)]).gpu_ms.is_none());
+    }
 }

@@ -1,6 +1,8 @@
 //! Split drift: how far the GPU's f32 de Casteljau halving (`stages::split`, the twin of
 //! `split.wgsl`) wanders from exact subdivision of the original f64 patch, in pixels at the
-//! frame's camera.
+//! frame's camera. Both halve homogeneous nets (the GPU item's xyz with the weights the stages
+//! blossom from its patch's table), so rational patches are measured the same way (distances
+//! between Euclidean points).
 //!
 //! Two measurements:
 //! - [`path_drift`]: every patch followed down seeded split paths (u and v alternating from
@@ -18,12 +20,13 @@
 //!   same grid, against the exact one: split drift plus the dicer's own rounding.
 
 use crate::frame::{Frame, FrameData, PatchItem};
-use crate::scene::{Scene, eval_bezier};
+use crate::reference::homogeneous::{HomNet, euclidean_net, eval_net, homogeneous};
+use crate::scene::Scene;
 use crate::stages::bound::{Decision, bound};
-use crate::stages::dice_shade::eval_patch;
+use crate::stages::dice_shade::eval_surface;
 use crate::stages::split::split_half;
-use crate::stages::{self, cp_point};
-use glam::{DVec2, DVec3};
+use crate::stages::{self, Weights, cp_h, item_weights};
+use glam::{DVec2, DVec3, DVec4};
 use serde_json::{Value, json};
 
 /// Deepest split level measured: the renderer's default `max_depth`.
@@ -87,13 +90,14 @@ pub struct Step {
 #[derive(Clone, Copy, Debug)]
 struct Pair {
     gpu: PatchItem,
-    exact: [DVec3; 16],
+    /// Homogeneous, like the item's.
+    exact: HomNet,
     /// u0, u1, v0, v1 in f64 (dyadic, so these equal the item's f32 range exactly).
     uv: [f64; 4],
 }
 
 impl Pair {
-    fn root(item: PatchItem, cp: &[DVec3; 16]) -> Pair {
+    fn root(item: PatchItem, cp: &HomNet) -> Pair {
         Pair {
             gpu: item,
             exact: *cp,
@@ -119,8 +123,8 @@ impl Pair {
     }
 }
 
-/// f64 de Casteljau half of a cubic at t = 1/2.
-fn half_curve_f64(p: [DVec3; 4], second: bool) -> [DVec3; 4] {
+/// f64 de Casteljau half of a (homogeneous) cubic at t = 1/2.
+fn half_curve_f64(p: [DVec4; 4], second: bool) -> [DVec4; 4] {
     let a = (p[0] + p[1]) * 0.5;
     let b = (p[1] + p[2]) * 0.5;
     let c = (p[2] + p[3]) * 0.5;
@@ -134,8 +138,8 @@ fn half_curve_f64(p: [DVec3; 4], second: bool) -> [DVec3; 4] {
     }
 }
 
-/// f64 reference of `stages::split::split_half` on a control net `cp[4*v + u]`.
-pub fn split_half_f64(cp: &[DVec3; 16], along_u: bool, second: bool) -> [DVec3; 16] {
+/// f64 reference of `stages::split::split_half` on a homogeneous control net `cp[4*v + u]`.
+pub fn split_half_f64(cp: &HomNet, along_u: bool, second: bool) -> HomNet {
     let mut out = *cp;
     let (step, across) = if along_u { (1, 4) } else { (4, 1) };
     for r in 0..4 {
@@ -159,23 +163,36 @@ struct PatchDrift {
 /// Parameters of the 3x3 grid the surface and grid distances are taken on.
 const GRID_T: [f64; 3] = [0.0, 0.5, 1.0];
 
-fn measure(pair: &Pair, original: &[DVec3; 16], cam: &Projector, frame: &Frame) -> PatchDrift {
+/// `original` is the root patch's homogeneous net; `w` the GPU item's weights if its patch is
+/// rational (`stages::item_weights`).
+fn measure(
+    pair: &Pair,
+    original: &HomNet,
+    w: Option<&Weights>,
+    cam: &Projector,
+    frame: &Frame,
+) -> PatchDrift {
+    let rational = w.is_some();
     let dist = |a: Option<DVec2>, b: Option<DVec2>| match (a, b) {
         (Some(a), Some(b)) => a.distance(b),
         _ => f64::NAN,
     };
-    let cp32: [DVec3; 16] = std::array::from_fn(|k| cp_point(&pair.gpu.cp, k).as_dvec3());
+    let h32: HomNet =
+        std::array::from_fn(|k| cp_h(&pair.gpu.cp, w.unwrap_or(&[1.0; 16]), k).as_dvec4());
+    let (cp32, exact) = (euclidean_net(&h32), euclidean_net(&pair.exact));
     let cp = (0..16)
-        .map(|k| dist(cam.pixel(cp32[k]), cam.pixel(pair.exact[k])))
+        .map(|k| dist(cam.pixel(cp32[k]), cam.pixel(exact[k])))
         .fold(f64::NAN, f64::max);
     let (mut surface, mut grid) = (f64::NAN, f64::NAN);
     let [u0, u1, v0, v1] = pair.uv;
     for t in GRID_T {
         for s in GRID_T {
-            let exact = eval_bezier(original, u0 + s * (u1 - u0), v0 + t * (v1 - v0)).0;
+            let at = (u0 + s * (u1 - u0), v0 + t * (v1 - v0));
+            let exact = eval_net(original, rational, at.0, at.1).0;
             let exact_px = cam.pixel(exact);
-            surface = surface.max(dist(cam.pixel(eval_bezier(&cp32, s, t).0), exact_px));
-            let diced = eval_patch(&pair.gpu.cp, s as f32, t as f32)[0];
+            let sub = eval_net(&h32, rational, s, t).0;
+            surface = surface.max(dist(cam.pixel(sub), exact_px));
+            let diced = eval_surface(&pair.gpu.cp, w, s as f32, t as f32)[0];
             let diced_px = (diced.z >= frame.near)
                 .then(|| DVec2::from(stages::project(frame, diced).map(|x| x as f64)));
             grid = grid.max(dist(diced_px, exact_px));
@@ -308,11 +325,13 @@ pub fn path_drift(scene: &Scene, data: &FrameData, o: &PathOptions) -> Vec<Depth
     let cam = Projector::new(scene, &data.frame);
     let mut per_depth: Vec<Vec<PatchDrift>> = vec![Vec::new(); MAX_LEVELS as usize + 1];
     for (i, (patch, item)) in scene.patches.iter().zip(&data.items).enumerate() {
+        let root = homogeneous(patch);
         for path in paths(i, o) {
-            let mut pair = Pair::root(*item, &patch.cp);
+            let mut pair = Pair::root(*item, &root);
             for (depth, samples) in per_depth.iter_mut().enumerate() {
-                if cam.overlaps_image(&pair.exact, &data.frame) {
-                    samples.push(measure(&pair, &patch.cp, &cam, &data.frame));
+                if cam.overlaps_image(&euclidean_net(&pair.exact), &data.frame) {
+                    let w = item_weights(&pair.gpu, &data.patch_info[i], &data.primvars);
+                    samples.push(measure(&pair, &root, w.as_ref(), &cam, &data.frame));
                 }
                 if let Some(&s) = path.get(depth) {
                     pair = pair.split(&pair.gpu, s);
@@ -372,10 +391,10 @@ pub fn tree_drift(scene: &Scene, data: &FrameData) -> TreeDrift {
         .iter()
         .zip(&data.items)
         .enumerate()
-        .map(|(i, (p, item))| (i, Pair::root(*item, &p.cp)))
+        .map(|(i, (p, item))| (i, Pair::root(*item, &homogeneous(p))))
         .collect();
     while let Some((i, pair)) = work.pop() {
-        match bound(&pair.gpu, f, &data.patch_info[i]) {
+        match bound(&pair.gpu, f, &data.patch_info[i], &data.primvars) {
             Decision::Cull(_) => {}
             Decision::Split { along_u, item, .. } => {
                 for second in [false, true] {
@@ -393,7 +412,10 @@ pub fn tree_drift(scene: &Scene, data: &FrameData) -> TreeDrift {
                 if per_depth.len() <= d as usize {
                     per_depth.resize(d as usize + 1, Vec::new());
                 }
-                per_depth[d as usize].push(measure(&pair, &scene.patches[i].cp, &cam, f));
+                let p = &scene.patches[i];
+                let w = item_weights(&pair.gpu, &data.patch_info[i], &data.primvars);
+                let m = measure(&pair, &homogeneous(p), w.as_ref(), &cam, f);
+                per_depth[d as usize].push(m);
             }
         }
     }
@@ -473,7 +495,7 @@ mod tests {
         let o = PathOptions::default();
         for (i, p) in s.patches.iter().enumerate() {
             for path in paths(i, &o) {
-                let mut cp = p.cp;
+                let mut cp = homogeneous(p);
                 let mut uv = [0.0, 1.0, 0.0, 1.0];
                 for st in &path {
                     cp = split_half_f64(&cp, st.along_u, st.second);
@@ -482,8 +504,8 @@ mod tests {
                     if st.second { uv[lo] = m } else { uv[hi] = m }
                 }
                 for (a, b) in [(0.0, 0.0), (0.3, 0.7), (1.0, 0.5)] {
-                    let sub = eval_bezier(&cp, a, b).0;
-                    let orig = eval_bezier(
+                    let sub = eval_net(&cp, false, a, b).0;
+                    let orig = crate::scene::eval_bezier(
                         &p.cp,
                         uv[0] + a * (uv[1] - uv[0]),
                         uv[2] + b * (uv[3] - uv[2]),
@@ -507,7 +529,7 @@ mod tests {
         for (item, p) in data.items.iter_mut().zip(&s.patches) {
             for k in 0..16 {
                 // One pixel in x at this point's depth.
-                item.cp[3 * k] += (p.cp[k].z / data.frame.focal as f64) as f32;
+                item.cp[3 * k] += (p.cp[k].z / data.frame.focal as f64 * p.w[k]) as f32;
             }
         }
         let rows = path_drift(&s, &data, &PathOptions::default());

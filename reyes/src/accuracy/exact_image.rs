@@ -7,8 +7,9 @@
 //! point under the sample is solved for by Newton's method on the original patch (projection
 //! of the exact surface equal to the sample position), evaluated exactly (`surface::eval`),
 //! depth-tested by camera-space z against the other surfaces there, culled when seen from its
-//! back on a `Sides 1` patch, and shaded in f64 (`surface::shade`), clamped to [0, 1] as the
-//! renderer's colour encoding does. A pixel is the box-filtered mean of its covered samples
+//! back on a `Sides 1` patch, and shaded in f64 (`surface::shade`, with the patch's `"Cs"`
+//! where it has one), clamped to [0, 1] as the renderer's colour encoding does. Opacity is not
+//! modelled: every surface is opaque here. A pixel is the box-filtered mean of its covered samples
 //! (straight colour, alpha = covered fraction), as the renderer's resolve pass does.
 //!
 //! Its own accuracy: coverage is exact at the sample points; the sample's surface point is
@@ -151,8 +152,12 @@ fn band(
                     }
                     let patch = &scene.patches[hit.patch as usize];
                     let e = eval(patch, hit.u, hit.v);
-                    let m = &scene.materials[patch.material as usize];
-                    sum += shade(e.p, e.n, m, lights).clamp(DVec3::ZERO, DVec3::ONE);
+                    let mut m =
+                        std::borrow::Cow::Borrowed(&scene.materials[patch.material as usize]);
+                    if let Some(cs) = patch.primvars.as_ref().and_then(|p| p.cs.as_ref()) {
+                        m.to_mut().color = cs.eval(hit.u, hit.v);
+                    }
+                    sum += shade(e.p, e.n, &m, lights).clamp(DVec3::ZERO, DVec3::ONE);
                     count += 1;
                     zmin = zmin.min(hit.z);
                     unconverged += !hit.converged as u64;

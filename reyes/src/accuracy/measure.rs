@@ -1,12 +1,13 @@
-//! One frame's cost and accuracy as the JSON object `reyes measure` prints: the settings and
-//! times from `stats::frame_stats`, and the metrics of this module's siblings.
+//! One frame's cost and accuracy as the JSON object `reyes measure` prints ([`MeasureReport`]):
+//! the settings and times from `stats::frame_stats`, and the metrics of this module's siblings.
 
 use super::exact_image::ReferenceImage;
 use super::geometry::GeometryStats;
 use super::image_error::ImageError;
 use crate::image::FrameImage;
 use crate::reference::pinholes;
-use serde_json::{Value, json};
+use crate::stats::FrameStats;
+use serde::{Deserialize, Serialize};
 
 /// Pixels that the exact surfaces cover completely, together with their eight neighbours
 /// (`Coverage::interior` of the reference), but the render leaves partly empty. Computed for
@@ -22,56 +23,138 @@ pub fn pinhole_count(image: &FrameImage, reference: &ReferenceImage) -> usize {
 pub struct Measurement<'a> {
     pub scene: &'a str,
     /// `stats::frame_stats` of the render (settings, counts, times).
-    pub stats: &'a Value,
+    pub stats: &'a FrameStats,
     pub geometry: &'a GeometryStats,
     pub image: &'a ImageError,
     pub pinholes: usize,
     /// Covered area of the render: the sum of its alpha, in square pixels.
     pub coverage_px: f64,
     pub reference: &'a ReferenceImage,
+    /// Timed GPU frames behind `gpu_ms` and `wall_ms`.
+    pub runs: u32,
+    /// Host time of the metrics themselves.
+    pub metrics_cpu_ms: MetricsCpuMs,
+}
+
+/// What `reyes measure --json` prints: one frame's settings, cost and accuracy. Keys, units and
+/// meanings are tabled in docs/reyes.md (*Statistics*).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MeasureReport {
+    /// The scene's short name (file stem, or `teapot`).
+    pub scene: String,
+    pub settings: Settings,
+    /// Median GPU ms (scheduler run plus resolve) over the timed frames; null without
+    /// timestamp queries.
+    pub gpu_ms: Option<f64>,
+    /// Median host ms over the timed frames.
+    pub wall_ms: f64,
+    /// Largest screen distance (px) between a drawn point and the exact surface.
+    pub geom_err_max_px: f64,
+    /// 99th percentile over micropolygons of each one's largest distance (px).
+    pub geom_err_p99_px: f64,
+    /// Longest micropolygon side on screen (px).
+    pub mp_edge_max_px: f64,
+    /// Mean micropolygon area on screen (px²).
+    pub mp_area_mean_px: f64,
+    /// Micropolygons the GPU drew.
+    pub micropolygons: u64,
+    /// Micropolygons the geometric metrics measured (the CPU twin's drawn ones).
+    pub micropolygons_measured: u64,
+    pub micropolygons_per_covered_pixel: f64,
+    /// PSNR (dB) of the 8-bit sRGB image over black against the reference; null when equal
+    /// byte for byte (infinite).
+    pub psnr_db: Option<f64>,
+    /// Mean FLIP against the reference (0: identical, 1: most different).
+    pub flip_mean: f64,
+    /// Pixels the exact surfaces cover with their neighbours that the render leaves partly
+    /// empty ([`pinhole_count`]).
+    pub pinholes: usize,
+    /// Covered area of the render: the sum of its alpha (px²).
+    pub coverage_px: f64,
+    /// Covered area of the exact surfaces (px²).
+    pub reference_coverage_px: f64,
+    pub reference: ReferenceInfo,
+    /// Timed GPU frames.
+    pub runs: u32,
+    pub metrics_cpu_ms: MetricsCpuMs,
+}
+
+/// The render's settings (as in `FrameStats`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Settings {
+    pub strategy: String,
+    pub adapter: String,
+    pub width: u32,
+    pub height: u32,
+    /// Samples per pixel, [x, y].
+    pub pixel_samples: [u32; 2],
+    /// Target micropolygon edge (px).
+    pub mp_size_px: f64,
+    /// Fixed-bound dicing's bound (px); null for adaptive dicing.
+    pub bound_px: Option<f64>,
+}
+
+/// The f64 reference render on the exact surfaces.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ReferenceInfo {
+    /// Samples per pixel, [x, y].
+    pub samples_per_pixel: [u32; 2],
+    /// Samples that hit a surface.
+    pub covered_samples: u64,
+    /// Samples whose ray-patch intersection did not converge.
+    pub unconverged_samples: u64,
+    /// Host ms of the reference render.
+    pub cpu_ms: f64,
+}
+
+/// Host ms of each metric.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MetricsCpuMs {
+    pub reference: f64,
+    pub geometry: f64,
+    pub image_error: f64,
 }
 
 impl Measurement<'_> {
-    /// The JSON object. `psnr_db` is null when the render equals the reference byte for byte
-    /// (infinite PSNR).
-    pub fn json(&self) -> Value {
+    /// The report.
+    pub fn report(&self) -> MeasureReport {
         let s = self.stats;
         let g = self.geometry;
         let r = self.reference;
         let n = r.samples_per_axis;
-        json!({
-            "scene": self.scene,
-            "settings": {
-                "strategy": s["strategy"],
-                "adapter": s["adapter"],
-                "width": s["width"],
-                "height": s["height"],
-                "pixel_samples": s["pixel_samples"],
-                "mp_size_px": s["mp_size_px"],
-                "bound_px": s["bound_px"],
+        MeasureReport {
+            scene: self.scene.to_string(),
+            settings: Settings {
+                strategy: s.strategy.clone(),
+                adapter: s.adapter.clone(),
+                width: s.width,
+                height: s.height,
+                pixel_samples: s.pixel_samples,
+                mp_size_px: s.mp_size_px,
+                bound_px: s.bound_px,
             },
-            "gpu_ms": s["gpu_ms"],
-            "wall_ms": s["wall_ms"],
-            "geom_err_max_px": g.err_max_px,
-            "geom_err_p99_px": g.err_p99_px,
-            "mp_edge_max_px": g.edge_max_px,
-            "mp_area_mean_px": g.area_mean_px,
-            "micropolygons": s["micropolygons"],
-            "micropolygons_measured": g.micropolygons,
-            "micropolygons_per_covered_pixel": s["micropolygons_per_covered_pixel"],
-            "psnr_db": if self.image.psnr_db.is_finite() { json!(self.image.psnr_db) } else { Value::Null },
-            "flip_mean": self.image.flip_mean,
-            "pinholes": self.pinholes,
-            // Grown or shrunk silhouettes show here: the render's covered area against the
-            // exact surfaces' (both in square pixels).
-            "coverage_px": self.coverage_px,
-            "reference_coverage_px": r.coverage.area(),
-            "reference": {
-                "samples_per_pixel": [n, n],
-                "covered_samples": r.covered_samples,
-                "unconverged_samples": r.unconverged_samples,
-                "cpu_ms": r.cpu_ms,
+            gpu_ms: s.gpu_ms,
+            wall_ms: s.wall_ms,
+            geom_err_max_px: g.err_max_px,
+            geom_err_p99_px: g.err_p99_px,
+            mp_edge_max_px: g.edge_max_px,
+            mp_area_mean_px: g.area_mean_px,
+            micropolygons: s.micropolygons,
+            micropolygons_measured: g.micropolygons,
+            micropolygons_per_covered_pixel: s.micropolygons_per_covered_pixel,
+            psnr_db: self.image.psnr_db.is_finite().then_some(self.image.psnr_db),
+            flip_mean: self.image.flip_mean,
+            pinholes: self.pinholes,
+            coverage_px: self.coverage_px,
+            reference_coverage_px: r.coverage.area(),
+            reference: ReferenceInfo {
+                samples_per_pixel: [n, n],
+                covered_samples: r.covered_samples,
+                unconverged_samples: r.unconverged_samples,
+                cpu_ms: r.cpu_ms,
             },
-        })
+            runs: self.runs,
+            metrics_cpu_ms: self.metrics_cpu_ms,
+        }
     }
 }

@@ -1,10 +1,18 @@
-//! Scatter plots of cost against error as a PNG: panels with log-log axes, points styled by
-//! series, the Pareto front joined as a staircase and ringed, one point highlighted. Drawn
-//! with the `image` crate and the public-domain 8x8 bitmap font of `font8x8`, so it needs no
-//! system fonts (nothing to install on a GPU box or in CI).
+//! Scatter plots of cost against error (`reyes sweep`), drawn with `plotters` as PNG or SVG:
+//! panels with log-log axes, points styled by series, the Pareto front joined as a staircase
+//! and ringed, one point highlighted with a red ring and a label, an optional dashed
+//! reference line. Text is laid out with `ab_glyph` from a font compiled into the binary
+//! (Ubuntu Light, from `epaint_default_fonts`, as the benchmark suite's plots), so no system
+//! font or fontconfig is needed; the SVG names the font family and leaves drawing the text to
+//! the viewer.
 
-use image::{Rgb, RgbImage};
+use plotters::coord::Shift;
+use plotters::coord::ranged1d::{KeyPointHint, NoDefaultFormatting, Ranged, ValueFormatter};
+use plotters::prelude::*;
+use plotters::style::{FontStyle, register_font};
+use std::ops::Range;
 use std::path::Path;
+use std::sync::Once;
 
 /// Marker shapes (one per pixel-sample setting in the sweep).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -17,6 +25,7 @@ pub enum Shape {
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Style {
+    /// sRGB.
     pub colour: [u8; 3],
     pub shape: Shape,
     /// Outline only.
@@ -34,6 +43,7 @@ pub struct Point {
     pub highlight: Option<String>,
 }
 
+/// One chart. Points with a non-positive or non-finite coordinate are left out (log axes).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Panel {
     pub title: String,
@@ -44,116 +54,201 @@ pub struct Panel {
     pub hline: Option<(f64, String)>,
 }
 
-const PANEL_W: u32 = 640;
-const PANEL_H: u32 = 440;
-const LEFT: i32 = 74;
-const RIGHT: i32 = 18;
-const TOP: i32 = 30;
-const BOTTOM: i32 = 46;
-const HEADER: u32 = 28;
-const LEGEND_LINE: u32 = 14;
-
-const WHITE: [u8; 3] = [255, 255, 255];
-const BLACK: [u8; 3] = [0, 0, 0];
-const GREY: [u8; 3] = [200, 200, 200];
-const DARK: [u8; 3] = [70, 70, 70];
-const RED: [u8; 3] = [220, 20, 20];
-
-/// Draws `panels` in rows of `columns` under `title`, with `legend` (a style, or None for a
-/// plain line of text, and its text) at the bottom, and writes a PNG.
-pub fn write_png(
-    path: &Path,
-    title: &str,
-    panels: &[Panel],
-    columns: usize,
-    legend: &[(Option<Style>, String)],
-) -> Result<(), String> {
-    let png = crate::output::png(&draw(title, panels, columns, legend))
-        .map_err(|e| format!("{}: {e}", path.display()))?;
-    crate::output::write_atomic(path, &png)
+/// A figure: `panels` in rows of `columns` under `title`, with `legend` at the bottom (a
+/// marker style, or None for a plain line of text, and its text).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Figure<'a> {
+    pub title: &'a str,
+    pub panels: &'a [Panel],
+    pub columns: usize,
+    pub legend: &'a [(Option<Style>, String)],
 }
 
-pub fn draw(
-    title: &str,
-    panels: &[Panel],
-    columns: usize,
-    legend: &[(Option<Style>, String)],
-) -> RgbImage {
-    let columns = columns.max(1);
-    let rows = panels.len().div_ceil(columns).max(1) as u32;
-    let legend_h = legend.len() as u32 * LEGEND_LINE + 10;
-    let mut c = Canvas(RgbImage::from_pixel(
-        PANEL_W * columns as u32,
-        HEADER + rows * PANEL_H + legend_h,
-        Rgb(WHITE),
-    ));
-    c.text(10, 8, title, BLACK, 2);
-    for (k, p) in panels.iter().enumerate() {
-        let x0 = (k % columns) as i32 * PANEL_W as i32;
-        let y0 = HEADER as i32 + (k / columns) as i32 * PANEL_H as i32;
-        c.panel(x0, y0, p);
+/// Pixels of one panel.
+pub const PANEL_W: u32 = 640;
+pub const PANEL_H: u32 = 440;
+const HEADER: u32 = 36;
+const LEGEND_LINE: u32 = 18;
+
+const FONT: &str = "sans-serif";
+const DARK: RGBColor = RGBColor(70, 70, 70);
+pub const RED: [u8; 3] = [220, 20, 20];
+
+fn rgb(c: [u8; 3]) -> RGBColor {
+    RGBColor(c[0], c[1], c[2])
+}
+
+fn err(e: impl std::fmt::Display) -> String {
+    format!("plot: {e}")
+}
+
+fn register_fonts() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        if register_font(FONT, FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT).is_err() {
+            panic!("the embedded font does not parse");
+        }
+    });
+}
+
+impl Figure<'_> {
+    fn columns(&self) -> usize {
+        self.columns.max(1)
     }
-    let mut y = (HEADER + rows * PANEL_H + 4) as i32;
-    for (style, text) in legend {
-        let tx = match style {
-            Some(s) => {
-                c.marker(16, y + 4, s);
-                28
-            }
-            None => 10,
+
+    fn rows(&self) -> u32 {
+        self.panels.len().div_ceil(self.columns()).max(1) as u32
+    }
+
+    /// Width and height in pixels.
+    pub fn size(&self) -> (u32, u32) {
+        let legend_h = self.legend.len() as u32 * LEGEND_LINE + 12;
+        (
+            PANEL_W * self.columns() as u32,
+            HEADER + self.rows() * PANEL_H + legend_h,
+        )
+    }
+
+    /// The figure as PNG bytes, and each panel's drawn points' pixel positions (in the order
+    /// of their points, `None` for points left out).
+    pub fn png(&self) -> Result<(Vec<u8>, Vec<Vec<Option<(i32, i32)>>>), String> {
+        let (w, h) = self.size();
+        let mut buf = vec![0u8; (w * h * 3) as usize];
+        let positions = {
+            let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+            self.draw(&root)?
         };
-        c.text(tx, y, text, BLACK, 1);
-        y += LEGEND_LINE as i32;
-    }
-    c.0
-}
-
-/// A log10 axis from `lo` to `hi` (in log10 units) mapped to pixels `a..b`.
-#[derive(Clone, Copy)]
-struct Axis {
-    lo: f64,
-    hi: f64,
-    a: f64,
-    b: f64,
-}
-
-impl Axis {
-    /// Covers the positive finite `values` with a margin; at least 0.3 decades.
-    fn fit(values: impl Iterator<Item = f64>, a: f64, b: f64) -> Axis {
-        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        for v in values.filter(|v| v.is_finite() && *v > 0.0) {
-            lo = lo.min(v.log10());
-            hi = hi.max(v.log10());
-        }
-        if !lo.is_finite() {
-            (lo, hi) = (0.0, 1.0);
-        }
-        let mid = (lo + hi) / 2.0;
-        let half = ((hi - lo) / 2.0).max(0.15) * 1.08;
-        Axis {
-            lo: mid - half,
-            hi: mid + half,
-            a,
-            b,
-        }
+        let img = image::RgbImage::from_raw(w, h, buf).ok_or("plot buffer size")?;
+        Ok((crate::output::png(&img)?, positions))
     }
 
-    fn px(&self, v: f64) -> f64 {
-        self.a + (v.log10() - self.lo) / (self.hi - self.lo) * (self.b - self.a)
+    /// The figure as SVG.
+    pub fn svg(&self) -> Result<String, String> {
+        let mut text = String::new();
+        {
+            let root = SVGBackend::with_string(&mut text, self.size()).into_drawing_area();
+            self.draw(&root)?;
+        }
+        Ok(text)
     }
 
-    /// Tick values 1, 2, 5 x 10^k inside the axis.
-    fn ticks(&self) -> Vec<f64> {
-        let mut t = Vec::new();
-        for k in self.lo.floor() as i32..=self.hi.ceil() as i32 {
-            for m in [1.0, 2.0, 5.0] {
-                let v = m * 10f64.powi(k);
-                if (self.lo..=self.hi).contains(&v.log10()) {
-                    t.push(v);
+    /// Writes the PNG to `path` (atomically).
+    pub fn write_png(&self, path: &Path) -> Result<(), String> {
+        let (png, _) = self.png().map_err(|e| format!("{}: {e}", path.display()))?;
+        crate::output::write_atomic(path, &png)
+    }
+
+    /// Writes the SVG to `path` (atomically).
+    pub fn write_svg(&self, path: &Path) -> Result<(), String> {
+        let svg = self.svg().map_err(|e| format!("{}: {e}", path.display()))?;
+        crate::output::write_atomic(path, svg.as_bytes())
+    }
+
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+    ) -> Result<Vec<Vec<Option<(i32, i32)>>>, String> {
+        register_fonts();
+        root.fill(&WHITE).map_err(err)?;
+        let (header, rest) = root.split_vertically(HEADER);
+        header
+            .draw(&Text::new(
+                self.title.to_string(),
+                (10, 8),
+                (FONT, 22).into_font().color(&BLACK),
+            ))
+            .map_err(err)?;
+        let (grid, legend) = rest.split_vertically(self.rows() * PANEL_H);
+        let cells = grid.split_evenly((self.rows() as usize, self.columns()));
+        let mut positions = Vec::new();
+        for (p, area) in self.panels.iter().zip(&cells) {
+            positions.push(panel(area, p)?);
+        }
+        let mut y = 6;
+        for (style, text) in self.legend {
+            let x = match style {
+                Some(s) => {
+                    marker(&legend, (16, y + 8), s)?;
+                    30
                 }
-            }
+                None => 10,
+            };
+            legend
+                .draw(&Text::new(
+                    text.clone(),
+                    (x, y),
+                    (FONT, 14).into_font().color(&BLACK),
+                ))
+                .map_err(err)?;
+            y += LEGEND_LINE as i32;
         }
-        t
+        root.present().map_err(err)?;
+        Ok(positions)
+    }
+}
+
+/// A log axis covering the positive finite `values` with a margin (at least 0.3 decades), in
+/// log10 units, with its ticks (log10 of 1, 2, 5 x 10^k inside it; every 1..9 x 10^k where
+/// those are fewer than three). Drawn on a linear coordinate of log10 values, so the ticks are
+/// these round numbers.
+fn log_axis(values: impl Iterator<Item = f64>) -> LogAxis {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in values.filter(|v| v.is_finite() && *v > 0.0) {
+        lo = lo.min(v.log10());
+        hi = hi.max(v.log10());
+    }
+    if !lo.is_finite() {
+        (lo, hi) = (0.0, 1.0);
+    }
+    let mid = (lo + hi) / 2.0;
+    let half = ((hi - lo) / 2.0).max(0.15) * 1.08;
+    let range = mid - half..mid + half;
+    let ticks = |mantissas: &[f64]| -> Vec<f64> {
+        (range.start.floor() as i32..=range.end.ceil() as i32)
+            .flat_map(|k| mantissas.iter().map(move |m| (m * 10f64.powi(k)).log10()))
+            .filter(|t| range.contains(t))
+            .collect()
+    };
+    let mut t = ticks(&[1.0, 2.0, 5.0]);
+    if t.len() < 3 {
+        t = ticks(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]);
+    }
+    LogAxis { range, ticks: t }
+}
+
+/// A `plotters` coordinate of log10 values, linear in them, whose grid lines and labels are
+/// [`log_axis`]'s round ticks, labelled with the values themselves.
+#[derive(Clone, Debug)]
+struct LogAxis {
+    range: Range<f64>,
+    ticks: Vec<f64>,
+}
+
+impl Ranged for LogAxis {
+    type FormatOption = NoDefaultFormatting;
+    type ValueType = f64;
+
+    fn map(&self, v: &f64, limit: (i32, i32)) -> i32 {
+        let t = (v - self.range.start) / (self.range.end - self.range.start);
+        limit.0 + ((limit.1 - limit.0) as f64 * t).round() as i32
+    }
+
+    fn key_points<H: KeyPointHint>(&self, hint: H) -> Vec<f64> {
+        // Grid lines and labels at the ticks; no light lines between them.
+        if hint.weight().allow_light_points() {
+            return Vec::new();
+        }
+        self.ticks.clone()
+    }
+
+    fn range(&self) -> Range<f64> {
+        self.range.clone()
+    }
+}
+
+impl ValueFormatter<f64> for LogAxis {
+    fn format(v: &f64) -> String {
+        label(10f64.powf(*v))
     }
 }
 
@@ -163,251 +258,266 @@ fn label(v: f64) -> String {
     format!("{v:.decimals$}")
 }
 
-struct Canvas(RgbImage);
-
-impl Canvas {
-    fn put(&mut self, x: i32, y: i32, c: [u8; 3]) {
-        if x >= 0 && y >= 0 && (x as u32) < self.0.width() && (y as u32) < self.0.height() {
-            self.0.put_pixel(x as u32, y as u32, Rgb(c));
-        }
-    }
-
-    fn rect(&mut self, x0: i32, y0: i32, x1: i32, y1: i32, c: [u8; 3]) {
-        for y in y0..=y1 {
-            for x in x0..=x1 {
-                self.put(x, y, c);
-            }
-        }
-    }
-
-    /// A line `width` px thick; `dash` > 0 draws dash-long pieces with equal gaps.
-    fn line(
-        &mut self,
-        (x0, y0): (f64, f64),
-        (x1, y1): (f64, f64),
-        c: [u8; 3],
-        width: i32,
-        dash: f64,
-    ) {
-        let len = (x1 - x0).hypot(y1 - y0);
-        let steps = len.ceil().max(1.0) as usize;
-        for k in 0..=steps {
-            let t = k as f64 / steps as f64;
-            if dash > 0.0 && (t * len / dash) as u64 % 2 == 1 {
-                continue;
-            }
-            let (x, y) = (
-                (x0 + (x1 - x0) * t).round() as i32,
-                (y0 + (y1 - y0) * t).round() as i32,
-            );
-            let lo = -(width - 1) / 2;
-            self.rect(x + lo, y + lo, x + lo + width - 1, y + lo + width - 1, c);
-        }
-    }
-
-    fn ring(&mut self, cx: i32, cy: i32, r: f64, c: [u8; 3], width: f64) {
-        let ri = r.ceil() as i32 + 1;
-        for dy in -ri..=ri {
-            for dx in -ri..=ri {
-                let d = ((dx * dx + dy * dy) as f64).sqrt();
-                if (d - r).abs() <= width / 2.0 {
-                    self.put(cx + dx, cy + dy, c);
-                }
-            }
-        }
-    }
-
-    fn marker(&mut self, cx: i32, cy: i32, s: &Style) {
-        let r = 4i32;
-        let inside = |dx: i32, dy: i32, r: i32| match s.shape {
-            Shape::Circle => dx * dx + dy * dy <= r * r,
-            Shape::Square => dx.abs() <= r - 1 && dy.abs() <= r - 1,
-            Shape::Diamond => dx.abs() + dy.abs() <= r,
-            // Apex up, base at dy = r - 1.
-            Shape::Triangle => dy <= r - 1 && 2 * dx.abs() <= dy + r + 1,
-        };
-        for dy in -r - 1..=r + 1 {
-            for dx in -r - 1..=r + 1 {
-                if !inside(dx, dy, r + 1) {
-                    continue;
-                }
-                let edge = !inside(dx, dy, r - 1);
-                match (s.hollow, edge) {
-                    (true, true) => self.put(cx + dx, cy + dy, s.colour),
-                    (true, false) => {}
-                    (false, true) => self.put(cx + dx, cy + dy, DARK),
-                    (false, false) => self.put(cx + dx, cy + dy, s.colour),
-                }
-            }
-        }
-    }
-
-    /// 8x8 glyphs scaled by `scale`; bit k of a glyph row is column k.
-    fn text(&mut self, x: i32, y: i32, s: &str, c: [u8; 3], scale: i32) {
-        for (i, ch) in s.chars().enumerate() {
-            let glyph = glyph(ch);
-            for (row, bits) in glyph.iter().enumerate() {
-                for col in 0..8 {
-                    if bits >> col & 1 == 1 {
-                        let (px, py) = (x + (i as i32 * 8 + col) * scale, y + row as i32 * scale);
-                        self.rect(px, py, px + scale - 1, py + scale - 1, c);
-                    }
-                }
-            }
-        }
-    }
-
-    /// Text rotated a quarter turn anticlockwise (reads bottom to top), ending at y.
-    fn text_up(&mut self, x: i32, y: i32, s: &str, c: [u8; 3]) {
-        for (i, ch) in s.chars().enumerate() {
-            let glyph = glyph(ch);
-            for (row, bits) in glyph.iter().enumerate() {
-                for col in 0..8 {
-                    if bits >> col & 1 == 1 {
-                        self.put(x + row as i32, y - (i as i32 * 8 + col), c);
-                    }
-                }
-            }
-        }
-    }
-
-    fn panel(&mut self, x0: i32, y0: i32, p: &Panel) {
-        let (l, r) = (x0 + LEFT, x0 + PANEL_W as i32 - RIGHT);
-        let (t, b) = (y0 + TOP, y0 + PANEL_H as i32 - BOTTOM);
-        let xs = Axis::fit(p.points.iter().map(|q| q.x), l as f64, r as f64);
-        let ys = Axis::fit(
-            p.points
-                .iter()
-                .map(|q| q.y)
-                .chain(p.hline.as_ref().map(|h| h.0)),
-            b as f64,
-            t as f64,
-        );
-        self.text(x0 + 8, y0 + 10, &p.title, BLACK, 1);
-        for v in xs.ticks() {
-            let x = xs.px(v).round() as i32;
-            self.line((x as f64, t as f64), (x as f64, b as f64), GREY, 1, 0.0);
-            let s = label(v);
-            self.text(x - 4 * s.len() as i32, b + 6, &s, BLACK, 1);
-        }
-        for v in ys.ticks() {
-            let y = ys.px(v).round() as i32;
-            self.line((l as f64, y as f64), (r as f64, y as f64), GREY, 1, 0.0);
-            let s = label(v);
-            self.text(l - 6 - 8 * s.len() as i32, y - 4, &s, BLACK, 1);
-        }
-        self.line((l as f64, b as f64), (r as f64, b as f64), BLACK, 1, 0.0);
-        self.line((l as f64, t as f64), (l as f64, b as f64), BLACK, 1, 0.0);
-        let xl = &p.x_label;
-        self.text((l + r) / 2 - 4 * xl.len() as i32, b + 22, xl, BLACK, 1);
-        let yl = &p.y_label;
-        self.text_up(x0 + 6, (t + b) / 2 + 4 * yl.len() as i32, yl, BLACK);
-        if let Some((v, text)) = &p.hline {
-            let y = ys.px(*v);
-            self.line((l as f64, y), (r as f64, y), RED, 1, 6.0);
-            self.text(r - 8 * text.len() as i32 - 2, y as i32 - 11, text, RED, 1);
-        }
-        let drawable = |q: &&Point| q.x.is_finite() && q.x > 0.0 && q.y.is_finite() && q.y > 0.0;
-        let pos = |q: &Point| (xs.px(q.x), ys.px(q.y));
-        // The front as a staircase: from each point right to the next one's cost, then down.
-        let mut front: Vec<&Point> = p
-            .points
-            .iter()
-            .filter(drawable)
-            .filter(|q| q.front)
-            .collect();
-        front.sort_by(|a, b| a.x.total_cmp(&b.x));
-        for w in front.windows(2) {
-            let (a, c) = (pos(w[0]), pos(w[1]));
-            self.line(a, (c.0, a.1), DARK, 2, 0.0);
-            self.line((c.0, a.1), c, DARK, 2, 0.0);
-        }
-        for q in p.points.iter().filter(drawable) {
-            let (x, y) = pos(q);
-            self.marker(x.round() as i32, y.round() as i32, &q.style);
-        }
-        for q in p.points.iter().filter(drawable) {
-            let (x, y) = pos(q);
-            let (x, y) = (x.round() as i32, y.round() as i32);
-            if q.front {
-                self.ring(x, y, 7.5, BLACK, 1.5);
-            }
-            if let Some(text) = &q.highlight {
-                self.ring(x, y, 11.0, RED, 2.5);
-                self.text(x + 14, y - 14, text, RED, 1);
-            }
-        }
+/// The corners of a polygon marker of radius `r` px about (0, 0) (y down).
+fn corners(shape: Shape, r: i32) -> Vec<(i32, i32)> {
+    match shape {
+        Shape::Square => vec![(-r, -r), (r, -r), (r, r), (-r, r)],
+        Shape::Triangle => vec![(0, -r - 1), (r + 1, r), (-r - 1, r)],
+        Shape::Diamond => vec![(0, -r - 1), (r + 1, 0), (0, r + 1), (-r - 1, 0)],
+        Shape::Circle => Vec::new(),
     }
 }
 
-/// The 8x8 bitmap of `ch` (`?` outside ASCII).
-fn glyph(ch: char) -> [u8; 8] {
-    font8x8::legacy::BASIC_LEGACY
-        .get(ch as usize)
-        .copied()
-        .unwrap_or(font8x8::legacy::BASIC_LEGACY[b'?' as usize])
+/// Draws a marker centred on `at`: filled in its colour with a dark edge, or (hollow) an
+/// outline in its colour.
+fn marker<DB: DrawingBackend, CT: CoordTranslate>(
+    area: &DrawingArea<DB, CT>,
+    at: CT::From,
+    s: &Style,
+) -> Result<(), String> {
+    let r = 5;
+    let colour = rgb(s.colour);
+    let result = match (s.shape, s.hollow) {
+        (Shape::Circle, true) => {
+            area.draw(&(EmptyElement::at(at) + Circle::new((0, 0), r, colour.stroke_width(2))))
+        }
+        (Shape::Circle, false) => area.draw(
+            &(EmptyElement::at(at)
+                + Circle::new((0, 0), r, colour.filled())
+                + Circle::new((0, 0), r, DARK.stroke_width(1))),
+        ),
+        (shape, hollow) => {
+            let c = corners(shape, r);
+            let mut closed = c.clone();
+            closed.push(c[0]);
+            if hollow {
+                area.draw(
+                    &(EmptyElement::at(at) + PathElement::new(closed, colour.stroke_width(2))),
+                )
+            } else {
+                area.draw(
+                    &(EmptyElement::at(at)
+                        + Polygon::new(c, colour.filled())
+                        + PathElement::new(closed, DARK.stroke_width(1))),
+                )
+            }
+        }
+    };
+    result.map_err(err)
+}
+
+fn drawable(q: &Point) -> bool {
+    q.x.is_finite() && q.x > 0.0 && q.y.is_finite() && q.y > 0.0
+}
+
+/// Draws one panel; its points' pixel positions.
+fn panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    p: &Panel,
+) -> Result<Vec<Option<(i32, i32)>>, String> {
+    let x_axis = log_axis(p.points.iter().map(|q| q.x));
+    let xs = x_axis.range.clone();
+    let y_axis = log_axis(
+        p.points
+            .iter()
+            .map(|q| q.y)
+            .chain(p.hline.as_ref().map(|h| h.0)),
+    );
+    let at = |x: f64, y: f64| (x.log10(), y.log10());
+    let mut chart = ChartBuilder::on(area)
+        .caption(&p.title, (FONT, 16))
+        .margin(10)
+        .x_label_area_size(42)
+        .y_label_area_size(66)
+        .build_cartesian_2d(x_axis, y_axis)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc(&p.x_label)
+        .y_desc(&p.y_label)
+        .light_line_style(WHITE)
+        .label_style((FONT, 12))
+        .axis_desc_style((FONT, 14))
+        .draw()
+        .map_err(err)?;
+    if let Some((v, text)) = &p.hline {
+        let red = rgb(RED);
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(xs.start, v.log10()), (xs.end, v.log10())],
+                6,
+                6,
+                red.stroke_width(1),
+            ))
+            .map_err(err)?;
+        let dx = -8 * text.len() as i32 - 4;
+        chart
+            .draw_series(std::iter::once(
+                EmptyElement::at((xs.end, v.log10()))
+                    + Text::new(text.clone(), (dx, -16), (FONT, 13).into_font().color(&red)),
+            ))
+            .map_err(err)?;
+    }
+    // The front as a staircase: from each point right to the next one's cost, then down.
+    let mut front: Vec<&Point> = (p.points.iter())
+        .filter(|q| drawable(q) && q.front)
+        .collect();
+    front.sort_by(|a, b| a.x.total_cmp(&b.x));
+    let mut stairs = Vec::new();
+    for (i, q) in front.iter().enumerate() {
+        if i > 0 {
+            stairs.push(at(q.x, front[i - 1].y));
+        }
+        stairs.push(at(q.x, q.y));
+    }
+    if stairs.len() > 1 {
+        chart
+            .draw_series(LineSeries::new(stairs, DARK.stroke_width(2)))
+            .map_err(err)?;
+    }
+    let plot = chart.plotting_area();
+    for q in p.points.iter().filter(|q| drawable(q)) {
+        marker(plot, at(q.x, q.y), &q.style)?;
+    }
+    for q in p.points.iter().filter(|q| drawable(q)) {
+        if q.front {
+            plot.draw(
+                &(EmptyElement::at(at(q.x, q.y)) + Circle::new((0, 0), 8, BLACK.stroke_width(1))),
+            )
+            .map_err(err)?;
+        }
+        if let Some(text) = &q.highlight {
+            let red = rgb(RED);
+            plot.draw(
+                &(EmptyElement::at(at(q.x, q.y))
+                    + Circle::new((0, 0), 11, red.stroke_width(2))
+                    + Text::new(text.clone(), (14, -22), (FONT, 13).into_font().color(&red))),
+            )
+            .map_err(err)?;
+        }
+    }
+    Ok(p.points
+        .iter()
+        .map(|q| drawable(q).then(|| chart.backend_coord(&at(q.x, q.y))))
+        .collect())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn style(colour: [u8; 3]) -> Style {
+    fn style(colour: [u8; 3], shape: Shape) -> Style {
         Style {
             colour,
-            shape: Shape::Square,
+            shape,
             hollow: false,
         }
     }
 
-    /// Points land where the log axes say, in their colour, with the highlight ring in red.
-    #[test]
-    fn points_are_drawn_where_the_axes_put_them() {
-        let blue = [10, 20, 200];
-        let pts = vec![
-            Point {
-                x: 1.0,
-                y: 0.1,
-                style: style(blue),
-                front: true,
-                highlight: None,
-            },
-            Point {
-                x: 10.0,
-                y: 0.01,
-                style: style(blue),
-                front: true,
-                highlight: Some("default".into()),
-            },
-        ];
-        let panel = Panel {
-            title: "t".into(),
-            x_label: "GPU ms".into(),
-            y_label: "error".into(),
-            points: pts,
-            hline: None,
+    const BLUE: [u8; 3] = [10, 20, 200];
+    const ORANGE: [u8; 3] = [230, 120, 10];
+
+    fn panels() -> Vec<Panel> {
+        let pt = |x, y, shape, front, highlight: Option<&str>| Point {
+            x,
+            y,
+            style: style(if front { BLUE } else { ORANGE }, shape),
+            front,
+            highlight: highlight.map(String::from),
         };
-        let img = draw("title", &[panel], 1, &[(None, "legend".into())]);
-        assert_eq!(img.width(), PANEL_W);
-        let xs = Axis::fit(
-            [1.0, 10.0].into_iter(),
-            LEFT as f64,
-            (PANEL_W as i32 - RIGHT) as f64,
-        );
-        let top = HEADER as i32;
-        let ys = Axis::fit(
-            [0.1, 0.01].into_iter(),
-            (top + PANEL_H as i32 - BOTTOM) as f64,
-            (top + TOP) as f64,
-        );
-        for (x, y) in [(1.0, 0.1), (10.0, 0.01)] {
-            let (px, py) = (xs.px(x).round() as u32, ys.px(y).round() as u32);
-            assert_eq!(img.get_pixel(px, py).0, blue, "point ({x}, {y})");
+        let a = Panel {
+            title: "teapot: error against time".into(),
+            x_label: "GPU ms".into(),
+            y_label: "geom_err_max_px".into(),
+            points: vec![
+                pt(1.0, 0.1, Shape::Square, true, None),
+                pt(10.0, 0.01, Shape::Diamond, true, Some("default")),
+                pt(20.0, 0.2, Shape::Triangle, false, None),
+                pt(-1.0, 0.2, Shape::Circle, false, None),
+            ],
+            hline: Some((0.5, "0.5 px".into())),
+        };
+        let mut b = a.clone();
+        b.title = "second".into();
+        b.hline = None;
+        vec![a, b]
+    }
+
+    fn figure<'a>(panels: &'a [Panel], legend: &'a [(Option<Style>, String)]) -> Figure<'a> {
+        Figure {
+            title: "reyes sweep test",
+            panels,
+            columns: 2,
+            legend,
         }
-        // The red ring around the highlighted point.
-        let (px, py) = (xs.px(10.0).round() as u32, ys.px(0.01).round() as u32);
-        assert_eq!(img.get_pixel(px + 11, py).0, RED);
-        assert_ne!(img.get_pixel(px + 11, py + 30).0, RED);
+    }
+
+    /// The PNG decodes at the figure's size; points are drawn in their colour where the log
+    /// axes put them, the front's staircase joins the front, the default is ringed in red.
+    #[test]
+    fn png_points_front_and_highlight_are_drawn() {
+        let panels = panels();
+        let legend = vec![
+            (Some(style(BLUE, Shape::Circle)), "megakernel".to_string()),
+            (None, "plain text".to_string()),
+        ];
+        let f = figure(&panels, &legend);
+        let (png, positions) = f.png().unwrap();
+        let img = image::load_from_memory(&png).unwrap().to_rgb8();
+        assert_eq!((img.width(), img.height()), f.size());
+        assert_eq!(f.size().0, 2 * PANEL_W);
+        let px = |(x, y): (i32, i32)| img.get_pixel(x as u32, y as u32).0;
+        for (k, pos) in positions.iter().enumerate() {
+            assert_eq!(pos.len(), 4);
+            assert!(pos[3].is_none(), "x = -1 cannot be drawn on a log axis");
+            let (a, b, c) = (pos[0].unwrap(), pos[1].unwrap(), pos[2].unwrap());
+            // The second panel sits right of the first.
+            assert!(a.0 >= k as i32 * PANEL_W as i32 && a.0 < (k as i32 + 1) * PANEL_W as i32);
+            assert!(a.0 < b.0 && b.0 < c.0, "{a:?} {b:?} {c:?}");
+            assert!(b.1 > a.1, "smaller error lower");
+            assert_eq!(px(a), BLUE, "panel {k}: front point");
+            assert_eq!(px(b), BLUE);
+            assert_eq!(px(c), ORANGE);
+            // The staircase: right from a at a's height, then down to b.
+            let dark = |p: [u8; 3]| p.iter().all(|&v| v < 140);
+            let mid = ((a.0 + b.0) / 2, a.1);
+            assert!(
+                (-1..=1).any(|d| dark(px((mid.0, mid.1 + d)))),
+                "panel {k}: no staircase at {mid:?}"
+            );
+            let down = (b.0, (a.1 + b.1) / 2);
+            assert!((-1..=1).any(|d| dark(px((down.0 + d, down.1)))));
+            // The red ring about the default point, and none about the others.
+            let reddish = |p: [u8; 3]| p[0] > 150 && p[1] < 90 && p[2] < 90;
+            let ring = |q: (i32, i32)| {
+                (-12..=12)
+                    .flat_map(|dy| (-12..=12).map(move |dx| (dx, dy)))
+                    .filter(|(dx, dy)| {
+                        let d = ((dx * dx + dy * dy) as f64).sqrt().round() as i32;
+                        (9..=13).contains(&d)
+                    })
+                    .filter(|&(dx, dy)| reddish(px((q.0 + dx, q.1 + dy))))
+                    .count()
+            };
+            assert!(ring(b) > 20, "panel {k}: red ring {}", ring(b));
+            assert_eq!(ring(c), 0);
+        }
+        // Dark text in the title band.
+        assert!(
+            (0..HEADER).any(|y| (0..200).any(|x| img.get_pixel(x, y).0.iter().all(|&v| v < 100)))
+        );
+    }
+
+    #[test]
+    fn svg_has_the_text_and_every_marker() {
+        let panels = panels();
+        let svg = figure(&panels, &[]).svg().unwrap();
+        assert!(svg.starts_with("<svg"), "{}", &svg[..40]);
+        assert!(svg.contains("reyes sweep test") && svg.contains("geom_err_max_px"));
+        assert!(svg.contains("0.5 px") && svg.contains("default"));
+        // Per panel: one square and one diamond and one triangle (polygons), rings as circles.
+        assert!(svg.matches("<polygon").count() >= 6, "{svg}");
+        assert!(svg.matches("<circle").count() >= 2 * 3, "{svg}");
     }
 
     #[test]
@@ -416,8 +526,18 @@ mod tests {
         assert_eq!(label(0.5), "0.5");
         assert_eq!(label(200.0), "200");
         assert_eq!(label(1.0), "1");
-        let a = Axis::fit([0.3, 30.0].into_iter(), 0.0, 100.0);
-        assert!(a.px(0.3) > 0.0 && a.px(30.0) < 100.0);
-        assert_eq!(a.ticks(), vec![0.5, 1.0, 2.0, 5.0, 10.0, 20.0]);
+        let LogAxis { range: r, ticks: t } = log_axis([0.3, 30.0, f64::NAN, -1.0].into_iter());
+        let (lo, hi) = (10f64.powf(r.start), 10f64.powf(r.end));
+        assert!(lo < 0.3 && lo > 0.2 && hi > 30.0 && hi < 45.0, "{lo} {hi}");
+        let t: Vec<String> = t.iter().map(|t| label(10f64.powf(*t))).collect();
+        assert_eq!(t, ["0.5", "1", "2", "5", "10", "20"]);
+        let LogAxis {
+            range: one,
+            ticks: t,
+        } = log_axis([2.0, 3.5].into_iter());
+        assert!(one.start < 2f64.log10() && one.end > 2f64.log10());
+        assert!(one.end - one.start > 0.3);
+        let t: Vec<String> = t.iter().map(|t| label(10f64.powf(*t))).collect();
+        assert_eq!(t, ["2", "3"], "1..9 where 1, 2, 5 give fewer than three");
     }
 }

@@ -1,10 +1,12 @@
-//! The ground-truth surface: a scene's bicubic Bezier patches evaluated in f64 straight from
-//! its control points (points, derivatives, outside normals), shaded with the same surface and
+//! The ground-truth surface: a scene's bicubic Bezier patches, polynomial or rational, evaluated
+//! in f64 straight from their control points and weights (points, exact derivatives, outside
+//! normals; `reference::homogeneous::eval_patch`), shaded with the same surface and
 //! light models as `stages/shade.rs` but in f64. Nothing here reads a `PatchItem` or
 //! `FrameData`, so it shares no arithmetic with the GPU path or its f32 twins: the metrics in
 //! this module's siblings compare the renderer against it.
 
-use crate::scene::{Light, Material, Patch, Scene, SurfaceKind, eval_bezier};
+use crate::reference::homogeneous::eval_patch;
+use crate::scene::{Light, Material, Patch, Scene, SurfaceKind};
 use glam::DVec3;
 
 /// An exact surface point of a patch.
@@ -24,14 +26,26 @@ const DEGENERATE_STEP: f64 = 1.0e-7;
 
 /// Evaluates patch `patch` at parameters (u, v) of its own [0, 1]^2.
 pub fn eval(patch: &Patch, u: f64, v: f64) -> SurfacePoint {
-    let (p, dpdu, dpdv) = eval_bezier(&patch.cp, u, v);
+    let (p, dpdu, dpdv) = eval_patch(patch, u, v);
     let mut n = dpdu.cross(dpdv);
-    if !(n.length_squared() > 1.0e-24 * dpdu.length_squared() * dpdv.length_squared()) {
+    // A rational patch's tangent along a collapsed edge is not exactly zero but rounding noise
+    // of about 1e-16 |P| (quotient rule), at any angle: call it degenerate below 1e-12 of the
+    // control points' distance from the eye. (Polynomial: tiny = 0, the test as before.)
+    let tiny = if patch.is_rational() {
+        1.0e-12 * patch.cp.iter().map(|c| c.length()).fold(0.0, f64::max)
+    } else {
+        0.0
+    };
+    let degenerate = !(n.length_squared()
+        > 1.0e-24 * dpdu.length_squared() * dpdv.length_squared())
+        || dpdu.length() <= tiny
+        || dpdv.length() <= tiny;
+    if degenerate {
         let (iu, iv) = (
             u + (0.5 - u) * DEGENERATE_STEP,
             v + (0.5 - v) * DEGENERATE_STEP,
         );
-        let (_, a, b) = eval_bezier(&patch.cp, iu, iv);
+        let (_, a, b) = eval_patch(patch, iu, iv);
         n = a.cross(b);
     }
     if patch.flip_normal {
@@ -106,9 +120,11 @@ mod tests {
     fn patch(cp: [DVec3; 16]) -> Patch {
         Patch {
             cp,
+            w: Patch::POLYNOMIAL,
             material: 0,
             flip_normal: false,
             two_sided: true,
+            primvars: None,
             source: PatchSource {
                 file: "test".into(),
                 line: 0,
@@ -195,8 +211,13 @@ mod tests {
             for (u, v) in [(0.25, 0.25), (0.5, 0.75), (0.8, 0.4)] {
                 let e = eval(p, u, v);
                 let c = shade(e.p, e.n, m, &lights);
-                let c32 =
-                    crate::stages::shade::shade(e.p.as_vec3(), e.n.as_vec3(), m32, &data.lights);
+                let c32 = crate::stages::shade::shade(
+                    e.p.as_vec3(),
+                    e.n.as_vec3(),
+                    m32,
+                    m32.color.into(),
+                    &data.lights,
+                );
                 worst = worst.max((c - c32.as_dvec3()).abs().max_element());
             }
         }

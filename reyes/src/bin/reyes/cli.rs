@@ -14,7 +14,7 @@ use std::path::PathBuf;
 
 const SEQUENCES: &str = "Frame sequences: a RIB file of several frames writes each frame's \
 Display name into -o's folder, or -o NAME.####.png (#### = the frame number, zero-padded; \
-also for --stats, --float, --depth, which need a #### when several frames are rendered).";
+also for --stats, --float, --depth, --exr, which need a #### when several frames are rendered).";
 
 /// Renders RenderMan RIB, Newell and BPT scenes with the Reyes pipeline on the scheduler, and
 /// measures the result against the exact surfaces.
@@ -36,12 +36,16 @@ pub enum Command {
     /// as a table or JSON.
     #[command(allow_negative_numbers = true, args_override_self = true)]
     Measure(MeasureCmd),
-    /// Speed against error over quality settings: writes sweep.csv, sweep.md and sweep.png.
+    /// Speed against error over quality settings: writes sweep.csv, sweep.md, sweep.png and sweep.svg.
     #[command(allow_negative_numbers = true, args_override_self = true)]
     Sweep(SweepCmd),
     /// f32 split drift against f64 over 0-24 split levels, in pixels (CPU).
     #[command(allow_negative_numbers = true, args_override_self = true)]
     Drift(DriftCmd),
+    /// Time frames of a turning scene, pipelined on the GPU: per-frame wall and GPU ms (median,
+    /// p95) and frames per second, as a table or JSON.
+    #[command(allow_negative_numbers = true, args_override_self = true)]
+    Bench(BenchCmd),
 }
 
 impl Command {
@@ -52,6 +56,7 @@ impl Command {
             Command::Measure(_) => "measure",
             Command::Sweep(_) => "sweep",
             Command::Drift(_) => "drift",
+            Command::Bench(_) => "bench",
         }
     }
 }
@@ -60,14 +65,14 @@ impl Command {
 #[derive(Debug, Clone, Args)]
 pub struct RenderArgs {
     /// Image width in pixels [default: the scene's Format].
-    #[arg(long, value_name = "PX", value_parser = value_parser!(u32).range(1..))]
+    #[arg(long, value_name = "PX", value_parser = value_parser!(u32).range(1..=MAX_SIDE))]
     pub width: Option<u32>,
 
     /// Image height in pixels [default: the scene's Format].
-    #[arg(long, value_name = "PX", value_parser = value_parser!(u32).range(1..))]
+    #[arg(long, value_name = "PX", value_parser = value_parser!(u32).range(1..=MAX_SIDE))]
     pub height: Option<u32>,
 
-    /// Pixel samples per axis: N (NxN) or NxM, each >= 1 [default: the scene's PixelSamples].
+    /// Pixel samples per axis: N (NxN) or NxM, each 1..=16 [default: the scene's PixelSamples].
     #[arg(long, value_name = "N|NxM", value_parser = parse_samples)]
     pub samples: Option<(u32, u32)>,
 
@@ -95,16 +100,33 @@ pub struct RenderArgs {
     #[arg(long)]
     pub no_crack_dilation: bool,
 
-    /// GPU strategy: megakernel, multipass or multipass-host.
-    #[arg(long, value_name = "NAME", default_value = "megakernel", value_parser = parse_strategy)]
-    pub strategy: StrategyKind,
-
-    /// GPU frames to time (N > 1: after a warm-up; median ± MAD reported).
-    #[arg(long, value_name = "N", default_value_t = 1, value_parser = value_parser!(u32).range(1..))]
-    pub runs: u32,
+    /// GPU strategy: megakernel, multipass or multipass-host [default: megakernel; multipass
+    /// on a CPU adapter such as lavapipe, where it is several times faster].
+    #[arg(long, value_name = "NAME", value_parser = parse_strategy)]
+    pub strategy: Option<StrategyKind>,
 }
 
 impl RenderArgs {
+    /// The strategy to run on `gpu`: the one asked for; else the megakernel, except on a CPU
+    /// adapter (lavapipe), where its persistent workgroups run one at a time and the
+    /// device-driven multi-pass renders the teapot several times faster (README, "Without a
+    /// GPU"). A default chosen for the adapter is said on stderr, with how to override it.
+    pub fn strategy_for(&self, gpu: &scheduler::Gpu) -> StrategyKind {
+        if let Some(s) = self.strategy {
+            return s;
+        }
+        if gpu.info.device_type == scheduler::wgpu::DeviceType::Cpu {
+            eprintln!(
+                "note: strategy multipass, the default on a CPU adapter ({}): the megakernel's \
+                 persistent workgroups do not run side by side there (--strategy megakernel to \
+                 use it anyway)",
+                gpu.adapter_name()
+            );
+            return StrategyKind::Multipass;
+        }
+        StrategyKind::Megakernel
+    }
+
     /// The renderer's options (the others at their defaults).
     pub fn options(&self) -> RenderOptions {
         RenderOptions {
@@ -145,19 +167,29 @@ pub struct RenderCmd {
     #[arg(long, value_name = "OUT.pfm")]
     pub depth: Option<PathBuf>,
 
+    /// Write colour, alpha and depth as one OpenEXR file: channels R, G, B (premultiplied by
+    /// A), A (coverage) and Z (camera-space depth, +inf on the background), 32-bit float,
+    /// linear.
+    #[arg(long, value_name = "OUT.exr")]
+    pub exr: Option<PathBuf>,
+
     /// Multipass: time each procedure's passes on their own.
     #[arg(long)]
     pub stage_times: bool,
 
     /// Render on the CPU reference instead of the GPU: writes the PNG only (not with --strategy,
-    /// --runs, --stage-times, --stats, --float or --depth).
-    #[arg(long, conflicts_with_all = ["strategy", "runs", "stage_times", "stats", "float", "depth"])]
+    /// --runs, --stage-times, --stats, --float, --depth or --exr).
+    #[arg(long, conflicts_with_all = ["strategy", "runs", "stage_times", "stats", "float", "depth", "exr"])]
     pub cpu: bool,
 
     /// Frames of a sequence to render: N, A-B or a comma list of them (2-3, 2, 1,3)
     /// [default: all].
     #[arg(long, value_name = "N|A-B|A,B,..", value_parser = FrameRanges::parse)]
     pub frames: Option<FrameRanges>,
+
+    /// GPU frames to time (N > 1: after a warm-up; median ± MAD reported).
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = value_parser!(u32).range(1..))]
+    pub runs: u32,
 
     #[command(flatten)]
     pub render: RenderArgs,
@@ -189,6 +221,48 @@ pub struct MeasureCmd {
     #[arg(long)]
     pub json: bool,
 
+    /// GPU frames to time (N > 1: after a warm-up; median ± MAD reported).
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = value_parser!(u32).range(1..))]
+    pub runs: u32,
+
+    #[command(flatten)]
+    pub render: RenderArgs,
+}
+
+/// `reyes bench`: frames of a turning scene rendered by the persistent pipelined renderer
+/// (`reyes::realtime`), after 0.5 s of full GPU load (clocks) and `--warmup` untimed frames.
+#[derive(Debug, Args)]
+pub struct BenchCmd {
+    /// A RIB (.rib, .rib.gz), Newell or .bpt scene file, or `teapot` (built in)
+    /// [default: teapot].
+    #[arg(value_name = "SCENE")]
+    pub scene: Option<PathBuf>,
+
+    /// Frames to time.
+    #[arg(long, value_name = "N", default_value_t = 100, value_parser = value_parser!(u32).range(1..))]
+    pub frames: u32,
+
+    /// Turn the scene one full turn over the timed frames (360/N degrees per frame) about the
+    /// camera's up axis through its centre [default: every frame at --angle].
+    #[arg(long)]
+    pub turntable: bool,
+
+    /// Turntable angle of the first frame, degrees.
+    #[arg(long, value_name = "DEG", default_value_t = 0.0, value_parser = finite_f64)]
+    pub angle: f64,
+
+    /// Untimed frames before the timed ones (after the clock warm-up).
+    #[arg(long, value_name = "N", default_value_t = 10)]
+    pub warmup: u32,
+
+    /// Print one JSON object instead of the table.
+    #[arg(long)]
+    pub json: bool,
+
+    /// Write the last timed frame's angle once more as PNG (8-bit, converted on the GPU).
+    #[arg(short = 'o', long = "output", value_name = "OUT.png")]
+    pub out: Option<PathBuf>,
+
     #[command(flatten)]
     pub render: RenderArgs,
 }
@@ -206,16 +280,16 @@ pub struct SweepCmd {
     )]
     pub scenes: Vec<String>,
 
-    /// Output folder for sweep.csv, sweep.md and sweep.png (created if missing).
+    /// Output folder for sweep.csv, sweep.md, sweep.png and sweep.svg (created if missing).
     #[arg(long, value_name = "DIR", default_value = "sweep")]
     pub out: PathBuf,
 
     /// Image width in pixels.
-    #[arg(long, value_name = "PX", default_value_t = 1920, value_parser = value_parser!(u32).range(1..))]
+    #[arg(long, value_name = "PX", default_value_t = 1920, value_parser = value_parser!(u32).range(1..=MAX_SIDE))]
     pub width: u32,
 
     /// Image height in pixels.
-    #[arg(long, value_name = "PX", default_value_t = 1080, value_parser = value_parser!(u32).range(1..))]
+    #[arg(long, value_name = "PX", default_value_t = 1080, value_parser = value_parser!(u32).range(1..=MAX_SIDE))]
     pub height: u32,
 
     /// Timed GPU frames per setting, after a warm-up (median ± MAD reported).
@@ -261,11 +335,11 @@ pub struct DriftCmd {
     pub scene: Option<PathBuf>,
 
     /// Image width in pixels.
-    #[arg(long, value_name = "PX", default_value_t = 1920, value_parser = value_parser!(u32).range(1..))]
+    #[arg(long, value_name = "PX", default_value_t = 1920, value_parser = value_parser!(u32).range(1..=MAX_SIDE))]
     pub width: u32,
 
     /// Image height in pixels.
-    #[arg(long, value_name = "PX", default_value_t = 1080, value_parser = value_parser!(u32).range(1..))]
+    #[arg(long, value_name = "PX", default_value_t = 1080, value_parser = value_parser!(u32).range(1..=MAX_SIDE))]
     pub height: u32,
 
     /// Random-direction split paths per patch, besides the two alternating ones.
@@ -282,11 +356,29 @@ pub struct DriftCmd {
 }
 
 /// `N` (NxN) or `NxM`, each >= 1.
+/// Largest image side (`reyes::frame::MAX_IMAGE_SIDE`), as a clap range bound.
+const MAX_SIDE: i64 = reyes::frame::MAX_IMAGE_SIDE as i64;
+
 fn parse_samples(v: &str) -> Result<(u32, u32), String> {
     let (x, y) = v.split_once('x').unwrap_or((v, v));
-    let p = |s: &str| s.trim().parse::<u32>().ok().filter(|&n| n >= 1);
+    let max = reyes::frame::MAX_PIXEL_SAMPLES;
+    let p = |s: &str| {
+        s.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|&n| (1..=max).contains(&n))
+    };
     p(x).zip(p(y))
-        .ok_or(format!("`{v}` is not N or NxM with N, M >= 1"))
+        .ok_or(format!("`{v}` is not N or NxM with N, M in 1..={max}"))
+}
+
+/// A finite number.
+fn finite_f64(v: &str) -> Result<f64, String> {
+    v.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|x| x.is_finite())
+        .ok_or(format!("`{v}` is not a finite number"))
 }
 
 /// A finite number > 0.
@@ -383,11 +475,15 @@ mod tests {
             &["render", "--cpu", "--runs", "5"],
             &["render", "--cpu", "--strategy", "multipass"],
             &["render", "--cpu", "--stats", "s.json"],
+            &["render", "--cpu", "--exr", "x.exr"],
             &["measure", "--cpu"],
             &["measure", "--ref-samples", "65"],
             &["sweep", "--mp-sizes", "1,-1"],
             &["sweep", "--strategies", "megakernel,magic"],
             &["drift", "--height", "0"],
+            &["bench", "--frames", "0"],
+            &["bench", "--angle", "inf"],
+            &["bench", "--runs", "3"],
             &[],
         ] {
             let e = parse(bad).map(|_| ()).unwrap_err();

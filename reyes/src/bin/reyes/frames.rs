@@ -3,7 +3,7 @@
 //! tested without rendering.
 //!
 //! Output names, per frame:
-//! - a name with a run of `#` (`-o out.####.png`, also `--stats`, `--float`, `--depth`): the
+//! - a name with a run of `#` (`-o out.####.png`, also `--stats`, `--float`, `--depth`, `--exr`): the
 //!   run becomes the frame number, zero-padded to its length;
 //! - a file of one frame: `-o` as given, else `SCENE.png` (as before sequences existed);
 //! - a sequence: the frame's `Display` name in `-o`'s folder (its file name only: a scene
@@ -22,6 +22,7 @@ pub struct Outputs {
     pub stats: Option<PathBuf>,
     pub float: Option<PathBuf>,
     pub depth: Option<PathBuf>,
+    pub exr: Option<PathBuf>,
 }
 
 /// Where the command line says outputs go.
@@ -30,6 +31,7 @@ pub struct Requested<'a> {
     pub stats: Option<&'a Path>,
     pub float: Option<&'a Path>,
     pub depth: Option<&'a Path>,
+    pub exr: Option<&'a Path>,
     /// The scene's stem ("teapot" for teapot.rib), for default names.
     pub stem: &'a str,
 }
@@ -78,10 +80,11 @@ pub fn plan(
         let frame = &seq.frames[i];
         let n = frame.number;
         let outputs = Outputs {
-            image: image_path(frame, req, sequence),
+            image: image_path(frame, req, sequence, several),
             stats: side(req.stats, "--stats", n)?,
             float: side(req.float, "--float", n)?,
             depth: side(req.depth, "--depth", n)?,
+            exr: side(req.exr, "--exr", n)?,
         };
         if let Some((j, _)) = out
             .iter()
@@ -107,6 +110,7 @@ fn check_folders(o: &Outputs) -> Result<(), String> {
         o.stats.as_ref(),
         o.float.as_ref(),
         o.depth.as_ref(),
+        o.exr.as_ref(),
     ];
     for p in paths.into_iter().flatten() {
         let dir = p.parent().filter(|d| !d.as_os_str().is_empty());
@@ -146,33 +150,46 @@ pub fn numbered(p: &Path, n: u32) -> PathBuf {
     p.with_file_name(name)
 }
 
-fn image_path(frame: &SceneFrame, req: &Requested, sequence: bool) -> PathBuf {
+/// True when `-o` names a folder: it ends with a separator or is an existing folder.
+fn is_folder(p: &Path) -> bool {
+    p.as_os_str()
+        .to_string_lossy()
+        .ends_with(std::path::MAIN_SEPARATOR)
+        || p.is_dir()
+}
+
+/// The image of `frame`: `-o`'s #### pattern numbered; `-o`'s name when one frame is rendered;
+/// else, in `-o`'s folder (`-o` itself when it names one), the frame's `Display` name or
+/// `<stem>.<frame>.png`.
+fn image_path(frame: &SceneFrame, req: &Requested, sequence: bool, several: bool) -> PathBuf {
     if let Some(out) = req.out.filter(|p| has_pattern(p)) {
         return numbered(out, frame.number);
     }
-    if !sequence {
-        return req
-            .out
-            .map(Path::to_path_buf)
-            .unwrap_or_else(|| PathBuf::from(format!("{}.png", req.stem)));
+    let folder = req.out.filter(|p| is_folder(p));
+    let file = req.out.filter(|_| folder.is_none());
+    if let Some(out) = file.filter(|_| !several) {
+        return out.to_path_buf();
     }
-    let dir = req
-        .out
-        .and_then(Path::parent)
-        .map(Path::to_path_buf)
-        .unwrap_or_default();
-    let from_display = frame
-        .display
-        .as_ref()
+    if !sequence && folder.is_none() {
+        return PathBuf::from(format!("{}.png", req.stem));
+    }
+    let dir = match (folder, file) {
+        (Some(f), _) => f.to_path_buf(),
+        (None, Some(out)) => out.parent().map(Path::to_path_buf).unwrap_or_default(),
+        (None, None) => PathBuf::new(),
+    };
+    let from_display = (frame.display.as_ref())
+        .filter(|_| sequence)
         .and_then(|d| Path::new(&d.name).file_name())
         .map(|n| as_png(Path::new(n)));
-    let name = from_display.unwrap_or_else(|| {
-        let stem = req
-            .out
-            .and_then(Path::file_stem)
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| req.stem.to_string());
-        PathBuf::from(format!("{stem}.{:04}.png", frame.number))
+    let name = from_display.unwrap_or_else(|| match (file, sequence) {
+        (Some(out), _) => {
+            let stem = out.file_stem().map(|s| s.to_string_lossy().into_owned());
+            let stem = stem.unwrap_or_else(|| req.stem.to_string());
+            PathBuf::from(format!("{stem}.{:04}.png", frame.number))
+        }
+        (None, true) => PathBuf::from(format!("{}.{:04}.png", req.stem, frame.number)),
+        (None, false) => PathBuf::from(format!("{}.png", req.stem)),
     });
     dir.join(name)
 }
@@ -218,6 +235,7 @@ mod tests {
             stats: stats.map(Path::new),
             float: None,
             depth: None,
+            exr: None,
             stem: "scene",
         }
     }

@@ -2,6 +2,7 @@
 //! [options]` renders a RIB / Newell / BPT scene (default: the built-in Utah teapot) through
 //! the scheduler and writes a PNG; `--stats` writes what it did as JSON.
 
+mod bench;
 mod cli;
 mod drift;
 mod frames;
@@ -10,10 +11,10 @@ mod sweep;
 
 use clap::Parser;
 use cli::{Cli, Command, RenderCmd};
-use reyes::frame::FrameData;
+use reyes::frame::{FrameData, SceneFeatures};
 use reyes::gpu_render::{GpuRenderer, required_features};
 use reyes::scene::{self, FrameSequence, Scene};
-use reyes::stats::frame_stats;
+use reyes::stats::{RunSummary, frame_stats};
 use scheduler::{Gpu, StrategyKind};
 use std::process::ExitCode;
 
@@ -42,18 +43,19 @@ fn load_sequence(a: &RenderCmd) -> Result<(FrameSequence, String), String> {
 fn run(a: RenderCmd) -> Result<(), String> {
     let (seq, stem) = load_sequence(&a)?;
     for w in &seq.warnings {
-        eprintln!("warning: {w}");
+        log::warn!("{w}");
     }
     let requested = frames::Requested {
         out: a.out.as_deref(),
         stats: a.stats.as_deref(),
         float: a.float.as_deref(),
         depth: a.depth.as_deref(),
+        exr: a.exr.as_deref(),
         stem: &stem,
     };
     let (jobs, skipped) = frames::plan(&seq, a.frames.as_ref(), &requested)?;
     for w in &skipped {
-        eprintln!("warning: {w}");
+        log::warn!("{w}");
     }
     // Each frame's options are checked before any renders.
     let options = a.render.options();
@@ -62,7 +64,11 @@ fn run(a: RenderCmd) -> Result<(), String> {
         .map(|(i, _)| FrameData::new(&seq.frames[*i].scene, &options))
         .collect::<Result<Vec<_>, _>>()?;
     let gpu = match (a.cpu, jobs.is_empty()) {
-        (false, false) => Some(gpu_renderer(&a)?),
+        (false, false) => {
+            // One program for every frame: compiled for what they need together.
+            let need = (data.iter()).fold(SceneFeatures::default(), |f, d| f.union(d.features()));
+            Some(gpu_renderer(&a, need)?)
+        }
         _ => None,
     };
     for ((i, outputs), data) in jobs.iter().zip(&data) {
@@ -82,14 +88,15 @@ fn run(a: RenderCmd) -> Result<(), String> {
 }
 
 /// The GPU and its renderer, made once for all frames.
-fn gpu_renderer(a: &RenderCmd) -> Result<(Gpu, GpuRenderer), String> {
+fn gpu_renderer(a: &RenderCmd, features: SceneFeatures) -> Result<(Gpu, GpuRenderer), String> {
     let gpu = Gpu::from_env_requiring(required_features()).map_err(|e| e.to_string())?;
-    if a.stage_times && a.render.strategy == StrategyKind::Megakernel {
-        eprintln!(
-            "warning: --stage-times: the megakernel's stages share one launch; only multipass times them apart"
+    let strategy = a.render.strategy_for(&gpu);
+    if a.stage_times && strategy == StrategyKind::Megakernel {
+        log::warn!(
+            "--stage-times: the megakernel's stages share one launch; only multipass times them apart"
         );
     }
-    let renderer = GpuRenderer::with_stage_timing(&gpu, a.render.strategy, a.stage_times)
+    let renderer = GpuRenderer::for_features(&gpu, strategy, a.stage_times, features)
         .map_err(|e| e.to_string())?;
     Ok((gpu, renderer))
 }
@@ -107,7 +114,7 @@ fn render_frame(
         let r = reyes::cpu_render::render_cpu(data);
         // The CPU twin keeps the GPU's counters: the same frame warnings.
         for w in reyes::warnings::frame_warnings(data, &r.counters) {
-            eprintln!("warning: {w}");
+            log::warn!("{w}");
         }
         r.image.write_png(&out.image)?;
         eprintln!("wrote {} (CPU reference)", out.image.display());
@@ -115,12 +122,13 @@ fn render_frame(
     };
     // One frame makes the image; with --runs N > 1, N frames are timed after a warm-up
     // (GpuRenderer::timed_frames).
-    let (frame, times) = if a.render.runs > 1 {
+    let (frame, times) = if a.runs > 1 {
         let t = renderer
-            .timed_frames(gpu, data, a.render.runs)
+            .timed_frames(gpu, data, a.runs)
             .map_err(|e| e.to_string())?;
         for (i, (g, w)) in t.gpu_ms.iter().zip(&t.wall_ms).enumerate() {
-            eprintln!("run {i}: GPU {g:?} ms, wall {w:.2} ms");
+            let g = g.map_or("n/a".into(), |g| format!("{g:.3}"));
+            eprintln!("run {i}: GPU {g} ms, wall {w:.2} ms");
         }
         let times = t
             .gpu_ms
@@ -138,7 +146,7 @@ fn render_frame(
     // Where the renderer gave up on something (near-plane culls, split limit, nothing drawn).
     let frame_warnings = reyes::warnings::frame_warnings(data, &frame.counters);
     for w in &frame_warnings {
-        eprintln!("warning: {w}");
+        log::warn!("{w}");
     }
     let all_warnings: Vec<String> = file_warnings
         .iter()
@@ -147,13 +155,16 @@ fn render_frame(
         .cloned()
         .collect();
     let mut stats = frame_stats(data, &frame, &gpu.adapter_name(), &all_warnings);
-    stats["runs"] = run_summary(&times);
+    stats.runs = Some(RunSummary::of(&times));
     frame.image.write_png(&out.image)?;
     if let Some(p) = &out.float {
         frame.image.write_pfm(p)?;
     }
     if let Some(p) = &out.depth {
         frame.image.write_depth(p)?;
+    }
+    if let Some(p) = &out.exr {
+        frame.image.write_exr(p)?;
     }
     if let Some(p) = &out.stats {
         let text = serde_json::to_string_pretty(&stats).unwrap();
@@ -164,7 +175,7 @@ fn render_frame(
         out.image.display(),
         data.frame.width,
         data.frame.height,
-        a.render.strategy.name(),
+        frame.run.strategy,
         match frame.buckets {
             1 => String::new(),
             n => format!(
@@ -172,14 +183,15 @@ fn render_frame(
                 frame.peak_working_bytes as f64 / (1 << 20) as f64
             ),
         },
-        stats["grids_diced"],
-        stats["micropolygons"],
-        match (&stats["runs"]["gpu_ms"], stats["gpu_ms"].as_f64()) {
-            (serde_json::Value::Object(m), _) if a.render.runs > 1 => format!(
+        stats.grids_diced,
+        stats.micropolygons,
+        match (
+            stats.runs.as_ref().and_then(|r| r.gpu_ms.as_ref()),
+            stats.gpu_ms
+        ) {
+            (Some(m), _) if a.runs > 1 => format!(
                 "{:.3} ± {:.3} (median ± MAD of {})",
-                m["median"].as_f64().unwrap_or(f64::NAN),
-                m["mad"].as_f64().unwrap_or(f64::NAN),
-                a.render.runs
+                m.median, m.mad, a.runs
             ),
             (_, Some(v)) => format!("{v:.3}"),
             _ => "n/a".into(),
@@ -189,31 +201,18 @@ fn render_frame(
     Ok(())
 }
 
-/// Median and median absolute deviation of each run's GPU and wall time.
-fn run_summary(times: &[(Option<f64>, f64)]) -> serde_json::Value {
-    fn med_mad(v: Vec<f64>) -> serde_json::Value {
-        if v.is_empty() {
-            return serde_json::Value::Null;
-        }
-        let (median, mad) = scheduler::stats::median_and_mad(&v);
-        serde_json::json!({ "median": median, "mad": mad, "all": v })
-    }
-    serde_json::json!({
-        "count": times.len(),
-        "gpu_ms": med_mad(times.iter().filter_map(|t| t.0).collect()),
-        "wall_ms": med_mad(times.iter().map(|t| t.1).collect()),
-    })
-}
-
 fn main() -> ExitCode {
     // Usage errors exit 2 naming the flag; --help and --version print to stdout and exit 0.
     let cli = Cli::parse();
+    reyes::driver_env::ensure_xdg_runtime_dir();
+    reyes::logging::init();
     let name = cli.command.name();
     let result = match cli.command {
         Command::Render(a) => run(a),
         Command::Measure(a) => measure::main(a),
         Command::Sweep(a) => sweep::main(a),
         Command::Drift(a) => drift::main(a),
+        Command::Bench(a) => bench::main(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -8,7 +8,7 @@ use crate::cli::MeasureCmd;
 use reyes::accuracy::exact_image::{ReferenceImage, render_reference};
 use reyes::accuracy::geometry::geometry;
 use reyes::accuracy::image_error::image_error;
-use reyes::accuracy::measure::{Measurement, pinhole_count};
+use reyes::accuracy::measure::{Measurement, MetricsCpuMs, pinhole_count};
 use reyes::frame::FrameData;
 use reyes::gpu_render::{GpuFrame, GpuRenderer, required_features};
 use reyes::scene::{self, Scene};
@@ -50,18 +50,20 @@ pub fn main(a: MeasureCmd) -> Result<(), String> {
     let (json, ref_samples, reference_png) = (a.json, a.ref_samples, &a.reference_png);
     let (scene, name) = load_scene(a.scene.as_deref())?;
     for w in &scene.warnings {
-        eprintln!("warning: {w}");
+        log::warn!("{w}");
     }
     let data = FrameData::new(&scene, &a.render.options())?;
     let gpu = Gpu::from_env_requiring(required_features()).map_err(|e| e.to_string())?;
-    let renderer = GpuRenderer::new(&gpu, a.render.strategy).map_err(|e| e.to_string())?;
-    let (frame, gpu_ms, wall_ms) = timed_frames(&gpu, &renderer, &data, a.render.runs)?;
+    let renderer =
+        GpuRenderer::for_features(&gpu, a.render.strategy_for(&gpu), false, data.features())
+            .map_err(|e| e.to_string())?;
+    let (frame, gpu_ms, wall_ms) = timed_frames(&gpu, &renderer, &data, a.runs)?;
     let mut stats = frame_stats(&data, &frame, &gpu.adapter_name(), &scene.warnings);
     let gpu_ms: Vec<f64> = gpu_ms.into_iter().flatten().collect();
     if !gpu_ms.is_empty() {
-        stats["gpu_ms"] = scheduler::stats::median_and_mad(&gpu_ms).0.into();
+        stats.gpu_ms = Some(scheduler::stats::median_and_mad(&gpu_ms).0);
     }
-    stats["wall_ms"] = scheduler::stats::median_and_mad(&wall_ms).0.into();
+    stats.wall_ms = scheduler::stats::median_and_mad(&wall_ms).0;
     if let Some(p) = &a.out {
         frame.image.write_png(p)?;
     }
@@ -84,18 +86,18 @@ pub fn main(a: MeasureCmd) -> Result<(), String> {
         pinholes: pinhole_count(&frame.image, &reference),
         coverage_px: frame.image.rgba.iter().map(|p| p[3] as f64).sum(),
         reference: &reference,
+        runs: a.runs.max(1),
+        metrics_cpu_ms: MetricsCpuMs {
+            reference: reference.cpu_ms,
+            geometry: geometry_ms,
+            image_error: image_ms,
+        },
     };
-    let mut out = m.json();
-    out["runs"] = a.render.runs.max(1).into();
-    out["metrics_cpu_ms"] = serde_json::json!({
-        "reference": reference.cpu_ms,
-        "geometry": geometry_ms,
-        "image_error": image_ms,
-    });
+    let out = serde_json::to_value(m.report()).map_err(|e| e.to_string())?;
     if json {
         println!("{out}");
     } else {
-        for (k, v) in out.as_object().unwrap() {
+        for (k, v) in out.as_object().into_iter().flatten() {
             println!("{k:>32}: {v}");
         }
     }

@@ -1,7 +1,7 @@
 //! `reyes sweep`: speed against error over the quality settings. For each scene, each dicing
 //! setting (target micropolygon size, or Patney & Owens' fixed bound), each pixel-sample count
 //! and each strategy: GPU time (warm-up, then `--runs` timed frames, median ± MAD) and the
-//! metrics of `reyes measure`. Writes `sweep.csv`, `sweep.md` and `sweep.png` (GPU ms against
+//! metrics of `reyes measure`. Writes `sweep.csv`, `sweep.md`, `sweep.png` and `sweep.svg` (GPU ms against
 //! the geometric error and against FLIP, Pareto fronts and the default settings marked).
 //!
 //! Work that does not depend on a setting is done once: the reference render per scene, the
@@ -16,7 +16,7 @@ use reyes::accuracy::geometry::{GeometryStats, geometry};
 use reyes::accuracy::image_error::{ImageError, composite_srgb8, srgb8_errors};
 use reyes::accuracy::measure::pinhole_count;
 use reyes::accuracy::pareto::pareto_front;
-use reyes::accuracy::plot::{self, Panel, Point, Shape, Style};
+use reyes::accuracy::plot::{Figure, Panel, Point, Shape, Style};
 use reyes::frame::{FrameData, RenderOptions};
 use reyes::gpu_render::{GpuRenderer, required_features};
 use reyes::image::FrameImage;
@@ -233,9 +233,9 @@ pub fn main(a: SweepCmd) -> Result<(), String> {
         &c.out.join("sweep.md"),
         &markdown(&rows, &c, &adapter, &command, elapsed),
     )?;
-    plot_png(&c.out.join("sweep.png"), &rows, &c, &adapter)?;
+    plots(&c.out, &rows, &c, &adapter)?;
     eprintln!(
-        "wrote {}/sweep.{{csv,md,png}} ({} settings, {elapsed:.0} s)",
+        "wrote {}/sweep.{{csv,md,png,svg}} ({} settings, {elapsed:.0} s)",
         c.out.display(),
         rows.len()
     );
@@ -401,7 +401,8 @@ fn style(r: &Row) -> Style {
     }
 }
 
-fn plot_png(path: &Path, rows: &[Row], c: &Config, adapter: &str) -> Result<(), String> {
+/// Writes `sweep.png` and `sweep.svg` into `dir`.
+fn plots(dir: &Path, rows: &[Row], c: &Config, adapter: &str) -> Result<(), String> {
     let timed = if rows.iter().all(|r| r.gpu_ms.is_some()) {
         "GPU ms (median)"
     } else {
@@ -464,11 +465,13 @@ fn plot_png(path: &Path, rows: &[Row], c: &Config, adapter: &str) -> Result<(), 
             "black rings and staircase: Pareto front; red ring: default settings".to_string(),
         ),
     ];
-    plot::write_png(
-        path,
-        &format!("reyes sweep, {}x{}, {adapter}", c.width, c.height),
-        &panels,
-        2,
-        &legend,
-    )
+    let title = format!("reyes sweep, {}x{}, {adapter}", c.width, c.height);
+    let figure = Figure {
+        title: &title,
+        panels: &panels,
+        columns: 2,
+        legend: &legend,
+    };
+    figure.write_png(&dir.join("sweep.png"))?;
+    figure.write_svg(&dir.join("sweep.svg"))
 }

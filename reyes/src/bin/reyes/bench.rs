@@ -1,0 +1,239 @@
+//! `reyes bench [SCENE] [--width W --height H] [--frames N] [--turntable] [--json]
+//! [--strategy NAME] [render options]`: frames of a (turning) scene by the persistent pipelined
+//! renderer (`reyes::realtime`): per-frame wall and GPU ms (median, p95) and frames per second,
+//! as a table or one JSON object ([`BenchReport`], keys in docs/reyes.md).
+
+use crate::cli::BenchCmd;
+use reyes::gpu_render::{WARM_UP, required_features};
+use reyes::realtime::{Pixels, RealtimeFrame, RealtimeRenderer};
+use reyes::stages::C_MICROPOLYGONS;
+use scheduler::Gpu;
+use scheduler::StrategyKind;
+use serde::Serialize;
+
+/// Median and 95th percentile (nearest rank) of per-frame values, with the extremes.
+#[derive(Debug, Serialize)]
+pub struct Summary {
+    pub median: f64,
+    pub p95: f64,
+    pub min: f64,
+    pub max: f64,
+}
+
+impl Summary {
+    /// `None` for no values.
+    pub fn of(values: &[f64]) -> Option<Summary> {
+        if values.is_empty() {
+            return None;
+        }
+        let mut v = values.to_vec();
+        v.sort_by(f64::total_cmp);
+        let rank = |q: f64| v[((q * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1];
+        let n = v.len();
+        Some(Summary {
+            median: if n % 2 == 1 {
+                v[n / 2]
+            } else {
+                (v[n / 2 - 1] + v[n / 2]) / 2.0
+            },
+            p95: rank(0.95),
+            min: v[0],
+            max: v[n - 1],
+        })
+    }
+}
+
+/// One timed frame.
+#[derive(Debug, Serialize)]
+pub struct FrameRow {
+    pub angle_deg: f64,
+    pub wall_ms: f64,
+    pub gpu_ms: Option<f64>,
+    pub micropolygons: u64,
+    /// Why the pipelined attempt did not finish, when the frame was rendered again.
+    pub rerendered: Option<String>,
+}
+
+/// What `reyes bench --json` prints.
+#[derive(Debug, Serialize)]
+pub struct BenchReport {
+    pub scene: String,
+    pub adapter: String,
+    pub strategy: String,
+    pub width: u32,
+    pub height: u32,
+    /// Pixel samples per axis.
+    pub samples: [u32; 2],
+    /// Timed frames.
+    pub frames: u32,
+    pub turntable: bool,
+    pub degrees_per_frame: f64,
+    /// Frames pipelined on the GPU; `false` with the reason in `not_pipelined`.
+    pub pipelined: bool,
+    pub not_pipelined: Option<String>,
+    /// Per-frame host time between frame completions.
+    pub wall_ms: Summary,
+    /// Per-frame GPU time (first pass start to last pass end); null without timestamps.
+    pub gpu_ms: Option<Summary>,
+    /// Per-frame wall minus GPU time: what the host adds.
+    pub wall_minus_gpu_ms: Option<Summary>,
+    /// Timed frames over the sum of their wall times.
+    pub fps: f64,
+    pub micropolygons: Summary,
+    /// Frames rendered again because their fixed sizes did not suffice.
+    pub rerendered: u32,
+    pub per_frame: Vec<FrameRow>,
+}
+
+pub fn main(a: BenchCmd) -> Result<(), String> {
+    let (scene, name) = crate::measure::load_scene(a.scene.as_deref())?;
+    for w in &scene.warnings {
+        log::warn!("{w}");
+    }
+    let options = a.render.options();
+    let gpu = Gpu::from_env_requiring(required_features()).map_err(|e| e.to_string())?;
+    let strategy = a.render.strategy_for(&gpu);
+    let mut r = RealtimeRenderer::new(&gpu, &scene, &options, strategy, Pixels::None)
+        .map_err(|e| e.to_string())?;
+    let step = if a.turntable {
+        360.0 / a.frames as f64
+    } else {
+        0.0
+    };
+    let angle = |i: u32| (a.angle + step * i as f64).to_radians();
+    scheduler::clocks::raise_clocks(&gpu, WARM_UP).map_err(|e| e.to_string())?;
+    // Warm-up and timed frames in one pipelined stream, so that the first timed frame finds the
+    // pipeline full as every later one does.
+    let timed: Vec<f64> = (0..a.frames).map(angle).collect();
+    let warm = (0..a.warmup).map(|i| angle(i % a.frames));
+    let all: Vec<f64> = warm.chain(timed.iter().copied()).collect();
+    let mut frames = r.render(&gpu, &all).map_err(|e| e.to_string())?;
+    frames.drain(..a.warmup as usize);
+    if let Some(out) = &a.out {
+        r.set_pixels(&gpu, Pixels::Rgba8)
+            .map_err(|e| e.to_string())?;
+        let last = r
+            .render(&gpu, &timed[timed.len() - 1..])
+            .map_err(|e| e.to_string())?;
+        let (w, h, _) = r.frame_size();
+        let img = image::RgbaImage::from_raw(w, h, last[0].rgba8.clone().unwrap_or_default())
+            .ok_or("image buffer size mismatch")?;
+        reyes::output::write_atomic(out, &reyes::output::png(&img)?)?;
+        eprintln!("wrote {}", out.display());
+    }
+    let report = report(&a, &name, &gpu, strategy, &r, step, &frames);
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&report).unwrap());
+    } else {
+        print_table(&report);
+    }
+    Ok(())
+}
+
+fn report(
+    a: &BenchCmd,
+    name: &str,
+    gpu: &Gpu,
+    strategy: StrategyKind,
+    r: &RealtimeRenderer,
+    step: f64,
+    frames: &[RealtimeFrame],
+) -> BenchReport {
+    let (width, height, samples) = r.frame_size();
+    let wall: Vec<f64> = frames.iter().map(|f| f.wall_ms).collect();
+    let gpu_ms: Option<Vec<f64>> = frames.iter().map(|f| f.gpu_ms).collect();
+    let diff = gpu_ms
+        .as_ref()
+        .map(|g| wall.iter().zip(g).map(|(w, g)| w - g).collect::<Vec<_>>());
+    let mp: Vec<f64> = (frames.iter())
+        .map(|f| f.counters[C_MICROPOLYGONS] as f64)
+        .collect();
+    BenchReport {
+        scene: name.into(),
+        adapter: gpu.adapter_name(),
+        strategy: strategy.name().into(),
+        width,
+        height,
+        samples,
+        frames: frames.len() as u32,
+        turntable: a.turntable,
+        degrees_per_frame: step,
+        pipelined: r.not_pipelined().is_none(),
+        not_pipelined: r.not_pipelined().map(String::from),
+        wall_ms: Summary::of(&wall).expect("at least one frame"),
+        gpu_ms: gpu_ms.as_deref().and_then(Summary::of),
+        wall_minus_gpu_ms: diff.as_deref().and_then(Summary::of),
+        fps: frames.len() as f64 / (wall.iter().sum::<f64>() / 1e3),
+        micropolygons: Summary::of(&mp).expect("at least one frame"),
+        rerendered: frames.iter().filter(|f| f.rerendered.is_some()).count() as u32,
+        per_frame: frames
+            .iter()
+            .map(|f| FrameRow {
+                angle_deg: f.angle.to_degrees(),
+                wall_ms: f.wall_ms,
+                gpu_ms: f.gpu_ms,
+                micropolygons: f.counters[C_MICROPOLYGONS],
+                rerendered: f.rerendered.clone(),
+            })
+            .collect(),
+    }
+}
+
+fn print_table(r: &BenchReport) {
+    println!(
+        "reyes bench: {} {}x{} ({}x{} samples), {}, {} frames{}, {}",
+        r.scene,
+        r.width,
+        r.height,
+        r.samples[0],
+        r.samples[1],
+        r.strategy,
+        r.frames,
+        if r.turntable {
+            format!(" (turntable, {:.2} deg/frame)", r.degrees_per_frame)
+        } else {
+            String::new()
+        },
+        r.adapter
+    );
+    if let Some(why) = &r.not_pipelined {
+        println!("not pipelined: {why}");
+    }
+    println!("{:<14} {:>10} {:>10}", "", "median", "p95");
+    let row = |label: &str, s: Option<&Summary>| match s {
+        Some(s) => println!("{label:<14} {:>10.3} {:>10.3}", s.median, s.p95),
+        None => println!("{label:<14} {:>10} {:>10}", "n/a", "n/a"),
+    };
+    row("wall ms", Some(&r.wall_ms));
+    row("GPU ms", r.gpu_ms.as_ref());
+    row("wall - GPU ms", r.wall_minus_gpu_ms.as_ref());
+    println!("{:<14} {:>10.0}", "micropolygons", r.micropolygons.median);
+    println!("{:<14} {:>10.1}", "fps", r.fps);
+    println!(
+        "{:<14} {:>10}",
+        "re-rendered",
+        format!("{} of {}", r.rerendered, r.frames)
+    );
+    let mut reasons: Vec<&str> = (r.per_frame.iter())
+        .filter_map(|f| f.rerendered.as_deref())
+        .collect();
+    reasons.dedup();
+    for why in reasons.iter().take(3) {
+        println!("  re-rendered: {why}");
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median_and_p95_by_nearest_rank() {
+        let v: Vec<f64> = (1..=20).map(|i| i as f64).collect();
+        let s = Summary::of(&v).unwrap();
+        assert_eq!((s.median, s.p95, s.min, s.max), (10.5, 19.0, 1.0, 20.0));
+        let s = Summary::of(&[3.0]).unwrap();
+        assert_eq!((s.median, s.p95), (3.0, 3.0));
+        assert!(Summary::of(&[]).is_none());
+    }
+}

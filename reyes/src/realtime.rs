@@ -1,0 +1,677 @@
+//! Frames whose wall time is their GPU time: a persistent renderer for many frames of one scene
+//! under a moving camera (`reyes bench`; the turntable of [`crate::orbit`]).
+//!
+//! [`GpuRenderer::render`] makes everything per frame: uploads, a run that reads counters back
+//! between launches, and a read-back of the f32 image. Here, instead:
+//! - the scene is uploaded once: each patch's homogeneous control points (`x w, y w, z w, w`) in
+//!   a table, the materials, lights and patch flags; a frame writes only an 80-byte [`Orbit`]
+//!   (its camera transform);
+//! - the root items are made on the GPU (`roots.wgsl`: the transform, then the same root item
+//!   as [`crate::frame::FrameData::new`] makes on the host), every frame rebuilt from the
+//!   patches; nothing is cached between frames but buffers and pipelines;
+//! - every buffer is allocated once ([`RealtimeRenderer::new`]) and reused: samples, counters,
+//!   image, the queues of a [`RecordedRun`] (the scheduler's run of fixed sizes, recorded
+//!   without host waits);
+//! - frames are pipelined: frame i+1 is recorded and submitted while the GPU runs frame i (at
+//!   most [`IN_FLIGHT`] submitted and unfinished); each frame's status (the scheduler's control
+//!   block, the Reyes counters, two GPU timestamps: about 100 words) is copied into a mapped
+//!   staging ring and read a frame late; nothing else is read back unless an image is wanted
+//!   ([`Pixels`]), which is converted to 8-bit on the GPU (`rgba8.wgsl`).
+//!
+//! A frame whose fixed sizes did not suffice (a queue out of room, a megakernel launch at its
+//! loop bound, multi-pass out of rounds) is found a frame late from its status and rendered again
+//! by [`GpuRenderer::render`] from the same root items (read back from the GPU), which grows its
+//! queues, splits batches and cuts buckets as needed: the frame comes out right and says that it
+//! was rendered again ([`RealtimeFrame::rerendered`]); the fixed sizes then grow to what that
+//! render needed. A wrong frame is never returned.
+//!
+//! Not pipelined (every frame by [`GpuRenderer::render`] from GPU-made roots, each reported as
+//! rendered again with the reason): the host-driven multi-pass (it plans rounds on the host),
+//! and a memory budget too small for the whole frame's samples (those frames need buckets).
+
+use crate::buckets;
+use crate::frame::{FrameData, PatchItem, RenderOptions};
+use crate::gpu_render::{GpuRenderer, dispatch_2d, resolve_params};
+use crate::image::FrameImage;
+use crate::orbit;
+use crate::scene::Scene;
+use crate::shaders;
+use crate::stages::COUNTERS;
+use bytemuck::{Pod, Zeroable};
+use scheduler::timing::SpanTimer;
+use scheduler::{
+    DeviceSeeds, Gpu, Outcome, RecordedRun, RecordedSize, RunError, RunStats, StrategyKind,
+};
+use std::collections::VecDeque;
+use std::rc::Rc;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
+
+/// Frames submitted and not yet finished, at most: the GPU runs one while the host records the
+/// next.
+pub const IN_FLIGHT: usize = 2;
+
+/// Fixed sizes are this much above what a full render of the first frame needed (a turning
+/// scene needs more in some frames than in others).
+pub const HEADROOM: f64 = 1.5;
+
+/// The per-frame uniform: the camera transform of the frame's root items (`Orbit` in roots.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct Orbit {
+    /// Column-major affine transform of camera-space points ([`orbit::orbit_matrix`]).
+    pub m: [[f32; 4]; 4],
+    pub patches: u32,
+    /// Threads per row of the 2D dispatch.
+    pub row: u32,
+    pub pad: [u32; 2],
+}
+
+/// What a frame brings back to the host besides its status.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pixels {
+    /// Nothing (timing).
+    None,
+    /// The 8-bit sRGB image, converted on the GPU: 4 bytes per pixel.
+    Rgba8,
+    /// The f32 linear image and depth ([`FrameImage`]), as `reyes render` gives them (tests).
+    Float,
+}
+
+/// One finished frame.
+#[derive(Clone, Debug)]
+pub struct RealtimeFrame {
+    /// Turntable angle, radians.
+    pub angle: f64,
+    /// GPU time: from the start of the frame's first pass to the end of its last, plus, for a
+    /// frame rendered again, that render's timed passes. `None` without timestamp queries.
+    pub gpu_ms: Option<f64>,
+    /// Host time between this frame's completion and the previous one's (the first: since its
+    /// recording began): what a viewer waits per frame.
+    pub wall_ms: f64,
+    /// The Reyes counters ([`crate::stages`]).
+    pub counters: [u64; COUNTERS],
+    /// The scheduler's statistics of the frame's run.
+    pub run: RunStats,
+    /// Why the pipelined attempt did not finish, when the frame was rendered again by
+    /// [`GpuRenderer::render`].
+    pub rerendered: Option<String>,
+    /// With [`Pixels::Rgba8`]: the 8-bit image, row-major RGBA.
+    pub rgba8: Option<Vec<u8>>,
+    /// With [`Pixels::Float`]: the f32 image and depth.
+    pub image: Option<FrameImage>,
+}
+
+/// Buffers of one frame in flight.
+struct Slot {
+    orbit: wgpu::Buffer,
+    roots: wgpu::Buffer,
+    roots_bind: wgpu::BindGroup,
+    /// MAP_READ: the frame's status.
+    status: wgpu::Buffer,
+    /// MAP_READ, per [`Pixels`]: rgba8, or rgba f32 and depth.
+    pixels: Vec<wgpu::Buffer>,
+}
+
+struct InFlight {
+    angle: f64,
+    slot: usize,
+    submission: wgpu::SubmissionIndex,
+    /// The run recorded (the sizes may grow while this frame is in flight).
+    recorded: Option<Rc<RecordedRun>>,
+    /// Buffers mapped for reading (status, then pixels), and maps completed by their callbacks.
+    maps: Vec<wgpu::Buffer>,
+    mapped: Arc<AtomicUsize>,
+    pixels: Pixels,
+}
+
+/// A renderer of many frames of one scene; see the module documentation.
+pub struct RealtimeRenderer {
+    renderer: GpuRenderer,
+    kind: StrategyKind,
+    /// The frame's settings and scene tables; `items` are the host's unturned roots.
+    base: FrameData,
+    centre: glam::DVec3,
+    patches: u32,
+    pixels: Pixels,
+    roots_pipeline: wgpu::ComputePipeline,
+    rgba8_pipeline: wgpu::ComputePipeline,
+    scene_bind: wgpu::BindGroup,
+    resolve_bind: wgpu::BindGroup,
+    rgba8_bind: wgpu::BindGroup,
+    samples: wgpu::Buffer,
+    counters: wgpu::Buffer,
+    rgba: wgpu::Buffer,
+    depth: wgpu::Buffer,
+    rgba8: wgpu::Buffer,
+    /// Kept alive for the bind groups.
+    _tables: Vec<wgpu::Buffer>,
+    slots: Vec<Slot>,
+    timer: SpanTimer,
+    /// The pipelined run; `None` when frames are not pipelined (`not_pipelined` says why).
+    recorded: Option<Rc<RecordedRun>>,
+    /// The sizes asked for (before the device's and the budget's limits).
+    wanted: RecordedSize,
+    not_pipelined: Option<String>,
+    roots_groups: (u32, u32),
+    resolve_groups: (u32, u32),
+    rgba8_groups: (u32, u32),
+}
+
+const STATUS_COUNTERS: u64 = COUNTERS as u64;
+
+impl RealtimeRenderer {
+    /// Uploads `scene` for frames of `options` under `strategy`, compiles the pipelines, and
+    /// renders the unturned frame once with [`GpuRenderer::render`] to size the pipelined run
+    /// ([`HEADROOM`] above its needs). Errors: the options' ([`FrameData::new`], as
+    /// [`RunError::Program`]), and those of a render.
+    pub fn new(
+        gpu: &Gpu,
+        scene: &Scene,
+        options: &RenderOptions,
+        strategy: StrategyKind,
+        pixels: Pixels,
+    ) -> Result<RealtimeRenderer, RunError> {
+        let base = FrameData::new(scene, options).map_err(RunError::Program)?;
+        let renderer = GpuRenderer::for_features(gpu, strategy, false, base.features())?;
+        let f = base.frame;
+        let n = scene.patches.len() as u32;
+        // The object table: homogeneous control points (x w, y w, z w, w), cp[4*v + u], whose
+        // xyz are the host's root item and whose w its patch's weight table
+        // (frame::homogeneous_points: weights scaled to a largest of 1).
+        let objects: Vec<[f32; 4]> = (scene.patches.iter())
+            .flat_map(crate::frame::homogeneous_points)
+            .collect();
+        let objects = gpu.upload("patch table", &objects)?;
+        let frame_buf = gpu.upload("frame", &[f])?;
+        let materials = gpu.upload("materials", &base.materials)?;
+        let lights = gpu.upload("lights", &base.lights)?;
+        let infos = gpu.upload("patch info", &base.patch_info)?;
+        let primvars = gpu.upload("primvars", &base.primvars)?;
+        let pixels_n = f.width as u64 * f.height as u64;
+        let spp = (f.spp_x * f.spp_y) as u64;
+        let samples = gpu.storage_buffer("samples", pixels_n * spp * 2)?;
+        let counters = gpu.storage_buffer("counters", STATUS_COUNTERS)?;
+        let rgba = gpu.storage_buffer("rgba", pixels_n * 4)?;
+        let depth = gpu.storage_buffer("depth", pixels_n)?;
+        let rgba8 = gpu.storage_buffer("rgba8", pixels_n)?;
+        let scene_bind = gpu.bind_buffers(
+            "reyes scene",
+            &renderer.user_layout,
+            &[
+                &frame_buf, &materials, &lights, &infos, &samples, &counters, &primvars,
+            ],
+        );
+        let (resolve, resolve_groups) = resolve_params(&f);
+        let resolve_buf = gpu.upload("resolve params", &resolve)?;
+        let resolve_bind = gpu.bind_buffers(
+            "resolve",
+            &renderer.resolve.get_bind_group_layout(0),
+            &[&resolve_buf, &samples, &rgba, &depth],
+        );
+        let (rgba8_groups, row) = dispatch_2d(pixels_n, 256);
+        let rgba8_buf = gpu.upload("rgba8 params", &[pixels_n as u32, row, 0, 0])?;
+        let src = [shaders::COMMON, shaders::SHADE, shaders::RGBA8].concat();
+        let rgba8_pipeline = gpu.compute_pipeline("reyes rgba8", &src, "to_rgba8")?;
+        let rgba8_bind = gpu.bind_buffers(
+            "rgba8",
+            &rgba8_pipeline.get_bind_group_layout(0),
+            &[&rgba8_buf, &rgba, &rgba8],
+        );
+        let src = [shaders::PATCH_ITEM, shaders::ROOTS].concat();
+        let roots_pipeline = gpu.compute_pipeline("reyes roots", &src, "make_roots")?;
+        let (roots_groups, _) = dispatch_2d(n as u64, 64);
+        let mut slots = Vec::new();
+        for _ in 0..IN_FLIGHT {
+            let orbit = gpu.storage_buffer("orbit", (size_of::<Orbit>() / 4) as u64)?;
+            let roots = gpu.upload("roots", &vec![PatchItem::zeroed(); n as usize])?;
+            let roots_bind = gpu.bind_buffers(
+                "roots",
+                &roots_pipeline.get_bind_group_layout(0),
+                &[&orbit, &objects, &roots],
+            );
+            slots.push(Slot {
+                orbit,
+                roots,
+                roots_bind,
+                status: map_buffer(gpu, "frame status", 4)?,
+                pixels: Vec::new(),
+            });
+        }
+        let mut r = RealtimeRenderer {
+            renderer,
+            kind: strategy,
+            centre: orbit::scene_centre(scene),
+            patches: n,
+            pixels: Pixels::None,
+            roots_pipeline,
+            rgba8_pipeline,
+            scene_bind,
+            resolve_bind,
+            rgba8_bind,
+            samples,
+            counters,
+            rgba,
+            depth,
+            rgba8,
+            _tables: vec![
+                objects,
+                frame_buf,
+                materials,
+                lights,
+                infos,
+                resolve_buf,
+                rgba8_buf,
+            ],
+            slots,
+            timer: SpanTimer::new(gpu, IN_FLIGHT as u32),
+            recorded: None,
+            wanted: RecordedSize {
+                capacity: Vec::new(),
+                rounds: 0,
+            },
+            not_pipelined: None,
+            roots_groups,
+            resolve_groups,
+            rgba8_groups,
+            base,
+        };
+        r.set_pixels(gpu, pixels)?;
+        if strategy == StrategyKind::MultipassHost {
+            r.not_pipelined =
+                Some("the host-driven multi-pass plans each round on the host".into());
+        } else if buckets::plan(&f, r.base.memory_budget).len() > 1 {
+            r.not_pipelined = Some(format!(
+                "the memory budget of {} bytes does not hold the whole frame's samples: frames \
+                 render in buckets",
+                r.base.memory_budget.unwrap_or(0)
+            ));
+        } else {
+            let first = r.renderer.render(gpu, &r.base)?;
+            let size = r.size_from(&first.run);
+            r.resize(gpu, size)?;
+        }
+        Ok(r)
+    }
+
+    /// Why frames are not pipelined, when they are not.
+    pub fn not_pipelined(&self) -> Option<&str> {
+        self.not_pipelined.as_deref()
+    }
+
+    /// The fixed sizes of the pipelined run, after the device's and the budget's limits.
+    pub fn size(&self) -> Option<&RecordedSize> {
+        self.recorded.as_ref().map(|r| &r.size)
+    }
+
+    /// Image width and height in pixels, and pixel samples per axis.
+    pub fn frame_size(&self) -> (u32, u32, [u32; 2]) {
+        let f = &self.base.frame;
+        (f.width, f.height, [f.spp_x, f.spp_y])
+    }
+
+    /// The strategy's scheduler and the renderer that renders a frame again.
+    pub fn renderer(&self) -> &GpuRenderer {
+        &self.renderer
+    }
+
+    /// What each frame brings back ([`Pixels`]); allocates the staging buffers it needs (not
+    /// between frames: call it before [`RealtimeRenderer::render`]).
+    pub fn set_pixels(&mut self, gpu: &Gpu, pixels: Pixels) -> Result<(), RunError> {
+        let n = self.base.frame.width as u64 * self.base.frame.height as u64;
+        let words: &[u64] = match pixels {
+            Pixels::None => &[],
+            Pixels::Rgba8 => &[n],
+            Pixels::Float => &[4 * n, n],
+        };
+        for s in &mut self.slots {
+            s.pixels = (words.iter())
+                .map(|&w| map_buffer(gpu, "frame pixels", w))
+                .collect::<Result<_, _>>()?;
+        }
+        self.pixels = pixels;
+        Ok(())
+    }
+
+    /// Sets the fixed sizes of the pipelined run (allocating its queues; tests use it to force
+    /// a frame that does not fit). Does nothing when frames are not pipelined.
+    pub fn resize(&mut self, gpu: &Gpu, size: RecordedSize) -> Result<(), RunError> {
+        if self.not_pipelined.is_some() {
+            return Ok(());
+        }
+        let run = RecordedRun::new(
+            gpu,
+            &self.renderer.scheduler,
+            &[("bound", self.patches)],
+            &size,
+            Some(&self.scene_bind),
+            self.base.memory_budget.map(|b| {
+                b.saturating_sub(
+                    buckets::sample_bytes_per_pixel(&self.base.frame) * self.pixels_n(),
+                )
+            }),
+        )?;
+        let words = run.status_words() + STATUS_COUNTERS + SpanTimer::WORDS;
+        for s in &mut self.slots {
+            if s.status.size() < words * 4 {
+                s.status = map_buffer(gpu, "frame status", words)?;
+            }
+        }
+        self.recorded = Some(Rc::new(run));
+        self.wanted = size;
+        Ok(())
+    }
+
+    /// The GPU buffers [`Pixels`] copies back: rgba8, or rgba and depth.
+    fn pixel_sources(&self) -> Vec<&wgpu::Buffer> {
+        match self.pixels {
+            Pixels::None => vec![],
+            Pixels::Rgba8 => vec![&self.rgba8],
+            Pixels::Float => vec![&self.rgba, &self.depth],
+        }
+    }
+
+    fn pixels_n(&self) -> u64 {
+        self.base.frame.width as u64 * self.base.frame.height as u64
+    }
+
+    fn size_from(&self, run: &RunStats) -> RecordedSize {
+        let program = self.renderer.scheduler.program();
+        let mut seeds = vec![0; program.queue_count()];
+        seeds[program.index_of("bound").unwrap()] = self.patches;
+        RecordedSize::from_stats(program, self.kind, run, &seeds, HEADROOM)
+    }
+
+    /// Renders one frame per turntable angle (radians), pipelined, and returns them in order.
+    /// Errors: a device error or timeout, an emit beyond a procedure's declaration, and those
+    /// of a frame rendered again (e.g. a queue overflow of one patch in the smallest bucket).
+    pub fn render(&mut self, gpu: &Gpu, angles: &[f64]) -> Result<Vec<RealtimeFrame>, RunError> {
+        let mut out = Vec::with_capacity(angles.len());
+        let mut flight: VecDeque<InFlight> = VecDeque::new();
+        let mut last = Instant::now();
+        for (i, &angle) in angles.iter().enumerate() {
+            flight.push_back(self.submit(gpu, i % IN_FLIGHT, angle)?);
+            // Frame i runs on the GPU (after i - 1) while frame i - 1 is finished here; then
+            // frame i + 1 is recorded while i runs.
+            if flight.len() == IN_FLIGHT {
+                let f = flight.pop_front().unwrap();
+                out.push(self.finish(gpu, f, &mut last)?);
+            }
+        }
+        while let Some(f) = flight.pop_front() {
+            out.push(self.finish(gpu, f, &mut last)?);
+        }
+        Ok(out)
+    }
+
+    /// Records and submits one frame in ring slot `slot`.
+    fn submit(&self, gpu: &Gpu, slot: usize, angle: f64) -> Result<InFlight, RunError> {
+        let s = &self.slots[slot];
+        let (_, row) = dispatch_2d(self.patches as u64, 64);
+        let orbit = Orbit {
+            m: orbit::orbit_matrix(self.centre, angle),
+            patches: self.patches,
+            row,
+            pad: [0; 2],
+        };
+        gpu.queue
+            .write_buffer(&s.orbit, 0, bytemuck::bytes_of(&orbit));
+        let recorded = self.recorded.clone();
+        let timer_slot = slot as u32;
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        let groups = |pass: &mut wgpu::ComputePass, (x, y): (u32, u32)| {
+            if x > 0 {
+                pass.dispatch_workgroups(x, y, 1);
+            }
+        };
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("roots"),
+                timestamp_writes: recorded.as_ref().and_then(|_| self.timer.begin(timer_slot)),
+            });
+            pass.set_pipeline(&self.roots_pipeline);
+            pass.set_bind_group(0, &s.roots_bind, &[]);
+            groups(&mut pass, self.roots_groups);
+        }
+        let mut maps = Vec::new();
+        if let Some(rec) = &recorded {
+            enc.clear_buffer(&self.samples, 0, None);
+            enc.clear_buffer(&self.counters, 0, None);
+            let seeds = [DeviceSeeds {
+                procedure: "bound",
+                buffer: &s.roots,
+                count: self.patches,
+            }];
+            rec.record(
+                &self.renderer.scheduler,
+                &mut enc,
+                &seeds,
+                Some(&self.scene_bind),
+                &s.status,
+                0,
+            )?;
+            let at = rec.status_words();
+            enc.copy_buffer_to_buffer(&self.counters, 0, &s.status, at * 4, STATUS_COUNTERS * 4);
+            {
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("resolve"),
+                    timestamp_writes: self.timer.end(timer_slot),
+                });
+                pass.set_pipeline(&self.renderer.resolve);
+                pass.set_bind_group(0, &self.resolve_bind, &[]);
+                groups(&mut pass, self.resolve_groups);
+                pass.set_pipeline(&self.rgba8_pipeline);
+                pass.set_bind_group(0, &self.rgba8_bind, &[]);
+                groups(&mut pass, self.rgba8_groups);
+            }
+            self.timer
+                .copy(&mut enc, timer_slot, &s.status, at + STATUS_COUNTERS);
+            maps.push(s.status.clone());
+            for (src, dst) in self.pixel_sources().into_iter().zip(&s.pixels) {
+                enc.copy_buffer_to_buffer(src, 0, dst, 0, src.size());
+                maps.push(dst.clone());
+            }
+        }
+        let submission = gpu.queue.submit([enc.finish()]);
+        let mapped = Arc::new(AtomicUsize::new(0));
+        for b in &maps {
+            let done = mapped.clone();
+            b.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+                if r.is_ok() {
+                    done.fetch_add(1, Ordering::Release);
+                }
+            });
+        }
+        Ok(InFlight {
+            angle,
+            slot,
+            submission,
+            recorded,
+            mapped,
+            maps,
+            pixels: self.pixels,
+        })
+    }
+
+    /// Waits for a frame (bounded), reads its status and pixels, and renders it again when its
+    /// run did not finish.
+    fn finish(
+        &mut self,
+        gpu: &Gpu,
+        f: InFlight,
+        last: &mut Instant,
+    ) -> Result<RealtimeFrame, RunError> {
+        let polled = gpu.device.poll(wgpu::PollType::Wait {
+            submission_index: Some(f.submission.clone()),
+            timeout: Some(gpu.timeout),
+        });
+        if let Some(e) = gpu.take_error() {
+            return Err(RunError::Device(format!("a pipelined frame: {e}")));
+        }
+        match polled {
+            Ok(_) => {}
+            Err(wgpu::PollError::Timeout) => {
+                return Err(RunError::Timeout {
+                    what: "a pipelined frame".into(),
+                    seconds: gpu.timeout.as_secs_f64(),
+                });
+            }
+            Err(e) => return Err(RunError::Device(format!("a pipelined frame: {e}"))),
+        }
+        if f.mapped.load(Ordering::Acquire) != f.maps.len() {
+            return Err(RunError::Device(
+                "a frame finished but its status was not mapped".into(),
+            ));
+        }
+        let Some(rec) = f.recorded else {
+            let why = self.not_pipelined.clone().unwrap_or_default();
+            return self.render_again(gpu, f.slot, f.angle, why, None, last);
+        };
+        let words = rec.status_words();
+        let status = read_mapped(&f.maps[0], words + STATUS_COUNTERS + SpanTimer::WORDS)?;
+        let (sched, rest) = status.split_at(words as usize);
+        let gpu_ms = self.timer.ms(&rest[COUNTERS..]);
+        let mut pixels: Vec<Vec<u32>> = Vec::new();
+        for (b, src) in f.maps[1..].iter().zip(self.pixel_sources()) {
+            pixels.push(read_mapped(b, src.size() / 4)?);
+        }
+        let program = self.renderer.scheduler.program();
+        match rec.outcome(program, sched)? {
+            Outcome::Done(run) => {
+                let mut counters = [0u64; COUNTERS];
+                for (c, v) in counters.iter_mut().zip(&rest[..COUNTERS]) {
+                    *c = *v as u64;
+                }
+                let now = Instant::now();
+                let wall_ms = now.duration_since(*last).as_secs_f64() * 1e3;
+                *last = now;
+                let (w, h) = (self.base.frame.width, self.base.frame.height);
+                let (rgba8, image) = match f.pixels {
+                    Pixels::None => (None, None),
+                    Pixels::Rgba8 => (Some(bytemuck::cast_slice(&pixels[0]).to_vec()), None),
+                    Pixels::Float => {
+                        let fl: &[f32] = bytemuck::cast_slice(&pixels[0]);
+                        let image = FrameImage {
+                            width: w,
+                            height: h,
+                            rgba: fl.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect(),
+                            depth: pixels[1].iter().map(|&z| f32::from_bits(z)).collect(),
+                        };
+                        (None, Some(image))
+                    }
+                };
+                Ok(RealtimeFrame {
+                    angle: f.angle,
+                    gpu_ms,
+                    wall_ms,
+                    counters,
+                    run,
+                    rerendered: None,
+                    rgba8,
+                    image,
+                })
+            }
+            Outcome::Incomplete(why) => self.render_again(gpu, f.slot, f.angle, why, gpu_ms, last),
+        }
+    }
+
+    /// Renders the frame whose roots are in `slot` with [`GpuRenderer::render`] and grows the
+    /// fixed sizes to what it needed. `attempt_ms`: GPU time of the pipelined attempt.
+    fn render_again(
+        &mut self,
+        gpu: &Gpu,
+        slot: usize,
+        angle: f64,
+        why: String,
+        attempt_ms: Option<f64>,
+        last: &mut Instant,
+    ) -> Result<RealtimeFrame, RunError> {
+        let bytes = self.patches as u64 * size_of::<PatchItem>() as u64;
+        let roots = gpu.read_buffer(&self.slots[slot].roots, 0, bytes)?;
+        let data = FrameData {
+            items: bytemuck::pod_collect_to_vec(&roots),
+            ..self.base.clone()
+        };
+        let g = self.renderer.render(gpu, &data)?;
+        if self.recorded.is_some() {
+            let size = self.size_from(&g.run).max(&self.wanted);
+            if size != self.wanted {
+                self.resize(gpu, size)?;
+            }
+        }
+        let now = Instant::now();
+        let wall_ms = now.duration_since(*last).as_secs_f64() * 1e3;
+        *last = now;
+        let rerun_ms = g.run.gpu_ms.zip(g.resolve_gpu_ms).map(|(a, b)| a + b);
+        let gpu_ms = match attempt_ms {
+            Some(a) => rerun_ms.map(|r| a + r),
+            None => rerun_ms,
+        };
+        Ok(RealtimeFrame {
+            angle,
+            gpu_ms,
+            wall_ms,
+            counters: g.counters,
+            rerendered: Some(why),
+            rgba8: (self.pixels == Pixels::Rgba8).then(|| g.image.rgba8()),
+            image: (self.pixels == Pixels::Float).then(|| g.image.clone()),
+            run: g.run,
+        })
+    }
+}
+
+/// A `MAP_READ | COPY_DST` buffer of `words` u32 words (at least 2, an even count: maps are
+/// 8-byte granular).
+fn map_buffer(gpu: &Gpu, label: &str, words: u64) -> Result<wgpu::Buffer, RunError> {
+    let bytes = words.max(2).next_multiple_of(2) * 4;
+    if bytes > gpu.device.limits().max_buffer_size {
+        return Err(RunError::Device(format!(
+            "buffer `{label}` needs {bytes} bytes, more than this device allows"
+        )));
+    }
+    Ok(gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    }))
+}
+
+/// The first `words` words of a mapped buffer; unmaps it.
+fn read_mapped(b: &wgpu::Buffer, words: u64) -> Result<Vec<u32>, RunError> {
+    let out = {
+        let view = b
+            .slice(..)
+            .get_mapped_range()
+            .map_err(|e| RunError::Device(format!("mapped range: {e}")))?;
+        bytemuck::cast_slice::<u8, u32>(&view)[..words as usize].to_vec()
+    };
+    b.unmap();
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn orbit_matches_its_wgsl_layout() {
+        let src = [shaders::PATCH_ITEM, shaders::ROOTS].concat();
+        let l = scheduler::wgsl::struct_layout(&src, "Orbit").unwrap();
+        // WGSL rounds the struct up to its 16-byte alignment (the mat4x4's).
+        assert_eq!(l.size as usize, size_of::<Orbit>());
+        for (field, off) in [
+            ("m", std::mem::offset_of!(Orbit, m)),
+            ("patches", std::mem::offset_of!(Orbit, patches)),
+            ("row", std::mem::offset_of!(Orbit, row)),
+        ] {
+            let got = l
+                .members
+                .iter()
+                .find(|(n, _)| n == field)
+                .map(|m| m.1 as usize);
+            assert_eq!(got, Some(off), "Orbit.{field}");
+        }
+    }
+}
