@@ -14,9 +14,92 @@ pub fn grow(capacity: u32, need: u64, limit: u32) -> u32 {
         .max(capacity as u64) as u32
 }
 
+/// Growth of a multi-pass run's refused rounds, whose cost is a submission: the host waits for
+/// it, makes new buffers, and the rounds encoded after the refused one run empty (about as
+/// long as a small full round: their dispatches and barriers remain). Each refusal therefore
+/// grows the queues for the rounds after it too, by the work's own growth per round measured
+/// so far, over a horizon that doubles with every refusal (1, 2, 4, … rounds): work growing
+/// geometrically from far too small a start is refused `O(log rounds)` times instead of once
+/// every round or two, and the next submission encodes only the rounds the new capacity is
+/// expected to hold ([`Anticipation::rounds_until_refusal`]).
+#[derive(Debug, Clone)]
+pub struct Anticipation {
+    /// Worst-case items emitted (all targets) by the last round seen, and the round it was.
+    last: (u64, u64),
+    refusals: u32,
+    /// Growth per round of the worst-case output, `>= 1`.
+    per_round: f64,
+}
+
+impl Anticipation {
+    /// Largest growth per round believed: a larger measured jump (one round of a huge fan-out)
+    /// would otherwise grow the queues to their limit at once.
+    pub const MAX_PER_ROUND: f64 = 16.0;
+
+    /// Starts from the first round's worst-case output `m0` (from the seeds and the declared
+    /// emits, known on the host).
+    pub fn new(m0: u64) -> Anticipation {
+        Anticipation {
+            last: (m0.max(1), 0),
+            refusals: 0,
+            per_round: 1.0,
+        }
+    }
+
+    /// Records a refusal of `round` (rounds run before it in the whole run) whose worst-case
+    /// output was `m` items (all targets), and returns the factor by which that output should
+    /// be multiplied to size the queues: `2 × g^(2^h)` for the `h`-th refusal (from 0) and the
+    /// measured growth per round `g`, at most [`Self::MAX_PER_ROUND`]`^4`.
+    pub fn refused(&mut self, round: u64, m: u64) -> f64 {
+        let (m_prev, r_prev) = self.last;
+        let rounds = round.saturating_sub(r_prev).max(1) as f64;
+        let measured = (m.max(1) as f64 / m_prev as f64).powf(1.0 / rounds);
+        self.per_round = measured.clamp(1.0, Self::MAX_PER_ROUND);
+        self.last = (m.max(1), round);
+        let horizon = 2f64.powi(self.refusals.min(8) as i32);
+        self.refusals += 1;
+        2.0 * self
+            .per_round
+            .powf(horizon)
+            .min(Self::MAX_PER_ROUND.powi(4))
+    }
+
+    /// Rounds a submission should encode after a refused round of worst-case output `m` was
+    /// given `capacity` slots (the smallest over its targets, relative to their share of `m`):
+    /// the round the growth is expected to be refused next, at most `max`, at least 2; `max`
+    /// when the work is not growing.
+    pub fn rounds_until_refusal(&self, capacity_over_m: f64, max: u32) -> u32 {
+        if self.per_round <= 1.0 + 1e-9 || !capacity_over_m.is_finite() {
+            return max;
+        }
+        let held = (capacity_over_m.max(1.0).ln() / self.per_round.ln()).floor();
+        (held + 2.0).clamp(2.0, max as f64) as u32
+    }
+}
+
 #[cfg(test)]
 mod tests {
-    use super::grow;
+    use super::{Anticipation, grow};
+
+    #[test]
+    fn refusals_anticipate_geometric_growth_over_a_doubling_horizon() {
+        // Output doubling per round, first round 160 items.
+        let mut a = Anticipation::new(160);
+        // Refused at round 2 with 640: growth 2 per round measured; 2 × 2^1.
+        assert_eq!(a.refused(2, 640), 4.0);
+        // The capacity 4 m holds two more doublings: refusal expected at the 4th round.
+        assert_eq!(a.rounds_until_refusal(4.0, 16), 4);
+        // Next refusal: horizon 2 rounds, 2 × 2^2.
+        assert_eq!(a.refused(5, 5120), 8.0);
+        assert_eq!(a.refused(8, 40960), 32.0);
+        // Not growing: full submissions.
+        let mut flat = Anticipation::new(100);
+        assert_eq!(flat.refused(3, 100), 2.0);
+        assert_eq!(flat.rounds_until_refusal(2.0, 16), 16);
+        // A huge jump is believed only up to MAX_PER_ROUND per round.
+        let mut jump = Anticipation::new(1);
+        assert_eq!(jump.refused(1, 1 << 30), 2.0 * Anticipation::MAX_PER_ROUND);
+    }
 
     #[test]
     fn growth_doubles_jumps_to_the_need_and_stops_at_the_limit() {

@@ -16,7 +16,7 @@ use layout::*;
 
 use crate::error::RunError;
 use crate::gpu::Gpu;
-use crate::growth::grow;
+use crate::growth::{Anticipation, grow};
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
 use crate::queue_layout::{QueueLayout, RunStart};
@@ -336,12 +336,31 @@ impl Multipass {
             max_queue_bytes,
             3,
         )?;
-        let mut capacity: Vec<u32> = (0..nq)
+        // The first round's worst-case output is known here: queues too small for it grow
+        // before the first submission rather than after a refused one.
+        let first_emits: Vec<u64> = (0..nq)
+            .map(|t| {
+                (0..nq)
+                    .map(|p| seeded[p] as u64 * self.program.procs[p].emits[t] as u64)
+                    .sum()
+            })
+            .collect();
+        let capacity: Vec<u32> = (0..nq)
             .map(|q| {
                 let n = seeded[q];
                 self.config.initial_capacity.min(max_cap[q]).max(n).max(1)
             })
             .collect();
+        let mut capacity: Vec<u32> = (0..nq)
+            .map(|t| match first_emits[t] > capacity[t] as u64 {
+                true => grow(capacity[t], 2 * first_emits[t], max_cap[t]),
+                false => capacity[t],
+            })
+            .collect();
+        let mut anticipation = Anticipation::new(first_emits.iter().sum());
+        let rounds_per_submit = self.config.rounds_per_submit.max(1);
+        // Rounds of the next submission: all of them, but fewer while queues grow.
+        let mut rounds = rounds_per_submit;
         let mut stats = RunStats {
             strategy: "multipass".into(),
             executed: vec![0; nq],
@@ -349,7 +368,6 @@ impl Multipass {
             ..Default::default()
         };
         let mut timer = PassTimer::new(gpu);
-        let rounds_per_submit = self.config.rounds_per_submit.max(1);
         let mut stage_timer = self
             .config
             .stage_timing
@@ -370,7 +388,6 @@ impl Multipass {
                     "work left after {encoded} multi-pass rounds"
                 )));
             }
-            let rounds = self.config.rounds_per_submit.max(1);
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             self.encode_rounds(
                 &mut enc,
@@ -411,23 +428,39 @@ impl Multipass {
                 self.accumulate(&mut stats, &ctrl);
                 break;
             }
-            if halted {
+            if !halted {
+                rounds = (rounds * 2).min(rounds_per_submit);
+            } else {
                 // The refused round's inputs are intact in items[planned % 2]. Every target whose
                 // worst case m did not fit grows and the inputs move to the new buffers on the
-                // device. A refusal costs a submission, so the growth leaves room for the round
-                // after as well: at least doubling, and at least 2 m.
+                // device. A refusal costs a submission, so the growth leaves room for the rounds
+                // after as well ([`Anticipation`]): at least doubling, at least 2 m, and m times
+                // the work's measured growth over a horizon that doubles with each refusal.
                 self.accumulate(&mut stats, &ctrl);
+                let m: Vec<u64> = (0..nq).map(|t| ctrl[c(t, C_EMITS)] as u64).collect();
+                let factor = anticipation.refused(stats.rounds, m.iter().sum());
                 // A target at its limit runs in part instead of halting: a refusal with nothing
                 // to grow is a real overflow (not one input fits), named by the plan.
                 let mut grown = capacity.clone();
                 for t in 0..nq {
-                    let m = ctrl[c(t, C_EMITS)] as u64;
-                    if m > capacity[t] as u64 && capacity[t] < max_cap[t] {
-                        grown[t] = grow(capacity[t], 2 * m, max_cap[t]);
-                        stats.queue_growths += 1;
+                    if m[t] > capacity[t] as u64 && capacity[t] < max_cap[t] {
+                        grown[t] = grow(capacity[t], 2 * m[t], max_cap[t]);
                     }
                 }
-                if grown == capacity {
+                let refused_grew = grown != capacity;
+                for t in 0..nq {
+                    let need = (m[t] as f64 * factor).min(u32::MAX as f64) as u64;
+                    if need > grown[t] as u64 {
+                        grown[t] = grow(grown[t], need, max_cap[t]);
+                    }
+                }
+                stats.queue_growths += (0..nq).filter(|&t| grown[t] != capacity[t]).count() as u64;
+                let held = (0..nq)
+                    .filter(|&t| m[t] > 0)
+                    .map(|t| grown[t] as f64 / m[t] as f64)
+                    .fold(f64::INFINITY, f64::min);
+                rounds = anticipation.rounds_until_refusal(held, rounds_per_submit);
+                if !refused_grew {
                     return Err(RunError::QueueOverflow {
                         queue: self.program.procs[a].proc.name.clone(),
                         capacity: capacity[a] as u64,
