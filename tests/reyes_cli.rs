@@ -697,3 +697,162 @@ fn no_false_driver_error_without_a_runtime_folder() {
     assert!(!err.contains("XDG_RUNTIME_DIR"), "{err}");
     assert!(!err.contains("error"), "{err}");
 }
+
+/// What a progress bar writes: carriage returns, escape codes, the bar and its estimate.
+fn progress_marks(text: &str) -> Vec<&'static str> {
+    [("\r", "\\r"), ("\x1b", "ESC"), ("ETA", "ETA"), ("[=", "[=")]
+        .into_iter()
+        .filter(|(mark, _)| text.contains(mark))
+        .map(|(_, name)| name)
+        .collect()
+}
+
+/// With stdout and stderr piped (not terminals) the long commands show no progress bar: a
+/// GPU frame sequence with `--runs 2` and a small sweep print their usual lines and nothing of
+/// a bar. `--runs` prints the median GPU time of the runs beside the last run's wall time.
+/// Needs the GPU (lavapipe).
+#[test]
+fn progress_is_silent_when_output_is_piped() {
+    let scene = field("three-frames.rib");
+    let dir = scratch("quiet");
+    let args = [
+        "render",
+        scene.as_str(),
+        "--width",
+        "48",
+        "--height",
+        "30",
+        "--strategy",
+        "multipass",
+        "--runs",
+        "2",
+    ];
+    let (code, out, err) = reyes_any(&dir, &args);
+    assert_eq!(code, 0, "{err}");
+    for n in 1..=3 {
+        assert!(dir.join(format!("teapot.000{n}.png")).is_file(), "{err}");
+        assert!(err.contains(&format!("frame {n}:\n")), "{err}");
+    }
+    // One summary per frame: 2 runs, the median GPU ms (lavapipe has timestamps; n/a
+    // elsewhere), the last run's wall ms.
+    let summaries: Vec<&str> = err
+        .lines()
+        .filter(|l| l.contains("2 runs: GPU ") && l.contains("last run wall "))
+        .collect();
+    assert_eq!(summaries.len(), 3, "{err}");
+    assert!(
+        summaries
+            .iter()
+            .all(|l| l.contains("(median ± MAD)") || l.contains("GPU n/a")),
+        "{err}"
+    );
+    assert_eq!(progress_marks(&out), Vec::<&str>::new(), "{out:?}");
+    assert_eq!(progress_marks(&err), Vec::<&str>::new(), "{err:?}");
+
+    let sweep_out = dir.join("sweep");
+    let (code, out, err) = reyes_any(
+        &dir,
+        &[
+            "sweep",
+            "--scenes",
+            "teapot",
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--runs",
+            "1",
+            "--ref-samples",
+            "2",
+            "--mp-sizes",
+            "2",
+            "--bound-px",
+            "none",
+            "--samples",
+            "1",
+            "--strategies",
+            "multipass",
+            "--out",
+            sweep_out.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    assert!(sweep_out.join("sweep.csv").is_file());
+    assert!(
+        err.contains("teapot: reference 32x24") && err.contains("(2 settings, "),
+        "{err}"
+    );
+    assert_eq!(progress_marks(&out), Vec::<&str>::new(), "{out:?}");
+    assert_eq!(progress_marks(&err), Vec::<&str>::new(), "{err:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Under a pseudo-terminal (util-linux `script`) the same kind of command draws its bar, with
+/// the count and the estimate, and its usual lines still come through whole. The CPU twin of
+/// a three-frame sequence: no GPU needed.
+#[cfg(target_os = "linux")]
+#[test]
+fn progress_bar_is_drawn_on_a_terminal() {
+    let scene = field("three-frames.rib");
+    let dir = scratch("tty");
+    let command = format!(
+        "'{}' render '{scene}' --cpu --width 64 --height 40",
+        env!("CARGO_BIN_EXE_reyes")
+    );
+    let out = Command::new("script")
+        .args(["-qec", &command, "/dev/null"])
+        .current_dir(&dir)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .expect("util-linux `script` runs the command under a pseudo-terminal");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    assert!(
+        text.contains("3/3 ETA ") && text.contains("\r") && text.contains("[===="),
+        "no bar in {text:?}"
+    );
+    // The notes are written above the bar: each starts on a line of its own or one the bar
+    // was just cleared from (ESC [2K), never after the bar's text.
+    for n in 1..=3 {
+        let line = format!("wrote teapot.000{n}.png (CPU reference)");
+        let at = text
+            .find(&line)
+            .unwrap_or_else(|| panic!("no `{line}` in {text:?}"));
+        let before = &text[..at];
+        assert!(
+            before.ends_with('\n') || before.ends_with("\x1b[2K"),
+            "{text:?}"
+        );
+        assert!(dir.join(format!("teapot.000{n}.png")).is_file());
+    }
+    // Warnings (log records) go above the bar too: two empty frames each warn.
+    std::fs::write(
+        dir.join("empty.rib"),
+        "Format 16 12 1\nFrameBegin 1\nWorldBegin\nWorldEnd\nFrameEnd\n\
+         FrameBegin 2\nWorldBegin\nWorldEnd\nFrameEnd\n",
+    )
+    .unwrap();
+    let out = Command::new("script")
+        .args([
+            "-qec",
+            &format!("'{}' render empty.rib --cpu", env!("CARGO_BIN_EXE_reyes")),
+            "/dev/null",
+        ])
+        .current_dir(&dir)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    let warning = "warning: nothing was drawn";
+    let parts: Vec<&str> = text.split(warning).collect();
+    assert_eq!(parts.len(), 3, "two warnings in {text:?}");
+    for before in &parts[..2] {
+        assert!(
+            before.ends_with('\n') || before.ends_with("\x1b[2K"),
+            "{text:?}"
+        );
+    }
+    assert!(text.contains("2/2 ETA "), "no bar in {text:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

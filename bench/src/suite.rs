@@ -8,9 +8,7 @@ use crate::record::{RunKey, RunRecord};
 use crate::strategy::{GpuConfig, Strategy};
 use crate::workload::{Prepared, Workload};
 use crate::{plot, summary};
-use indicatif::{ProgressBar, ProgressStyle};
 use scheduler::Gpu;
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -102,19 +100,6 @@ pub fn measure(
     out
 }
 
-fn progress_bar(total: usize) -> ProgressBar {
-    if !std::io::stdout().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(total as u64);
-    bar.set_style(
-        ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {pos}/{len} {wide_msg}")
-            .expect("a valid template")
-            .progress_chars("=> "),
-    );
-    bar
-}
-
 /// Runs the suite; true when every run was verified. Errors: the output folder or a file
 /// cannot be written, or a workload's input cannot be read.
 pub fn run_suite(gpu: &Gpu, o: &SuiteOptions) -> Result<bool, String> {
@@ -140,8 +125,9 @@ pub fn run_suite(gpu: &Gpu, o: &SuiteOptions) -> Result<bool, String> {
     let total = workloads
         .iter()
         .map(|w| w.sizes().len() * w.strategies().len())
-        .sum();
-    let bar = progress_bar(total);
+        .sum::<usize>();
+    // On a terminal: a bar over (workload, size, strategy) steps (`reyes::progress`).
+    let bar = reyes::progress::bar(total as u64, "");
     let mut jsonl = PendingFile::new(&o.out, "runs.jsonl")?;
     let mut records = Vec::new();
     for w in &mut workloads {
@@ -174,16 +160,15 @@ pub fn run_suite(gpu: &Gpu, o: &SuiteOptions) -> Result<bool, String> {
                     let mut line = serde_json::to_string(&r).expect("records serialise");
                     line.push('\n');
                     jsonl.write(line.as_bytes())?;
+                    // The logger writes above the bar (`reyes::logging`).
                     if let Some(e) = r.error.as_ref().filter(|_| !r.verified) {
-                        bar.suspend(|| {
-                            log::error!(
-                                "{} {} {} run {}: {e}",
-                                r.workload,
-                                r.size,
-                                r.strategy,
-                                r.run
-                            )
-                        });
+                        log::error!(
+                            "{} {} {} run {}: {e}",
+                            r.workload,
+                            r.size,
+                            r.strategy,
+                            r.run
+                        );
                     }
                     records.push(r);
                 }

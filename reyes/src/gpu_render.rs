@@ -379,6 +379,17 @@ impl GpuRenderer {
         data: &FrameData,
         runs: u32,
     ) -> Result<TimedFrames, RunError> {
+        self.timed_frames_with(gpu, data, runs, &indicatif::ProgressBar::hidden())
+    }
+
+    /// [`GpuRenderer::timed_frames`], advancing `progress` by one after each timed frame.
+    pub fn timed_frames_with(
+        &self,
+        gpu: &Gpu,
+        data: &FrameData,
+        runs: u32,
+        progress: &indicatif::ProgressBar,
+    ) -> Result<TimedFrames, RunError> {
         self.render(gpu, data)?;
         scheduler::clocks::raise_clocks(gpu, WARM_UP)?;
         let mut last = self.render(gpu, data)?;
@@ -387,6 +398,7 @@ impl GpuRenderer {
             last = self.render(gpu, data)?;
             gpu_ms.push(last.run.gpu_ms.zip(last.resolve_gpu_ms).map(|(a, b)| a + b));
             wall_ms.push(last.wall_ms);
+            progress.inc(1);
         }
         Ok(TimedFrames {
             last,

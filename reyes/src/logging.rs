@@ -3,6 +3,8 @@
 //! `RUST_LOG=wgpu_hal=debug,naga=info`); without it, warnings and errors of every crate
 //! (ours, and wgpu's and naga's own), which a clean run does not print. Records of our
 //! crates read `warning: ...` as before; others name their source (`warning [wgpu_hal::...]:`).
+//! Each record is written with the progress bars taken off the terminal (`progress::suspend`),
+//! so a warning printed while a bar is shown goes above it instead of through it.
 
 use std::io::Write;
 
@@ -35,12 +37,35 @@ pub fn format_line(level: log::Level, target: &str, message: &std::fmt::Argument
     }
 }
 
+/// env_logger's logger, writing each record with the progress bars suspended.
+struct AboveBars(env_logger::Logger);
+
+impl log::Log for AboveBars {
+    fn enabled(&self, metadata: &log::Metadata) -> bool {
+        self.0.enabled(metadata)
+    }
+
+    fn log(&self, record: &log::Record) {
+        if self.0.matches(record) {
+            crate::progress::suspend(|| self.0.log(record));
+        }
+    }
+
+    fn flush(&self) {
+        self.0.flush();
+    }
+}
+
 /// Starts the logger (once; later calls do nothing).
 pub fn init() {
-    let _ =
+    let logger =
         env_logger::Builder::from_env(env_logger::Env::default().default_filter_or(DEFAULT_FILTER))
             .format(|buf, r| writeln!(buf, "{}", format_line(r.level(), r.target(), r.args())))
-            .try_init();
+            .build();
+    let max = logger.filter();
+    if log::set_boxed_logger(Box::new(AboveBars(logger))).is_ok() {
+        log::set_max_level(max);
+    }
 }
 
 #[cfg(test)]

@@ -387,6 +387,16 @@ impl RealtimeRenderer {
     /// Errors: a device error or timeout, an emit beyond a procedure's declaration, and those
     /// of a frame rendered again (e.g. a queue overflow of one patch in the smallest bucket).
     pub fn render(&mut self, gpu: &Gpu, angles: &[f64]) -> Result<Vec<RealtimeFrame>, RunError> {
+        self.render_with(gpu, angles, &indicatif::ProgressBar::hidden())
+    }
+
+    /// [`RealtimeRenderer::render`], advancing `progress` by one as each frame is finished.
+    pub fn render_with(
+        &mut self,
+        gpu: &Gpu,
+        angles: &[f64],
+        progress: &indicatif::ProgressBar,
+    ) -> Result<Vec<RealtimeFrame>, RunError> {
         let mut out = Vec::with_capacity(angles.len());
         let mut flight: VecDeque<InFlight> = VecDeque::new();
         let mut last = Instant::now();
@@ -397,10 +407,12 @@ impl RealtimeRenderer {
             if flight.len() == IN_FLIGHT {
                 let f = flight.pop_front().unwrap();
                 out.push(self.finish(gpu, f, &mut last)?);
+                progress.inc(1);
             }
         }
         while let Some(f) = flight.pop_front() {
             out.push(self.finish(gpu, f, &mut last)?);
+            progress.inc(1);
         }
         Ok(out)
     }

@@ -25,6 +25,7 @@ use crate::image::FrameImage;
 use crate::reference::exact::{Coverage, Leaf, for_each_covered_sample};
 use crate::scene::Scene;
 use glam::{DVec2, DVec3};
+use indicatif::ProgressBar;
 
 /// Samples per pixel axis of the reference unless told otherwise (64 per pixel).
 pub const DEFAULT_SAMPLES_PER_AXIS: u32 = 8;
@@ -73,11 +74,31 @@ pub fn render_reference(
     height: u32,
     samples_per_axis: u32,
 ) -> ReferenceImage {
+    render_reference_with(
+        scene,
+        width,
+        height,
+        samples_per_axis,
+        &ProgressBar::hidden(),
+    )
+}
+
+/// [`render_reference`], advancing `progress` by each band's pixel rows as it is done (the
+/// caller sets its length: `height` rows).
+pub fn render_reference_with(
+    scene: &Scene,
+    width: u32,
+    height: u32,
+    samples_per_axis: u32,
+    progress: &ProgressBar,
+) -> ReferenceImage {
     let start = std::time::Instant::now();
     let (w, h, n) = (width as usize, height as usize, samples_per_axis as usize);
     let lights = scene_lights(scene);
     let bands = in_chunks(h, BAND_ROWS, |rows| {
-        band(scene, &lights, width, height, n, rows.start, rows.end)
+        let b = band(scene, &lights, width, height, n, rows.start, rows.end);
+        progress.inc(rows.len() as u64);
+        b
     });
     let mut rgba = vec![[0f32; 4]; w * h];
     let mut depth = vec![3.0e38f32; w * h];
@@ -280,11 +301,14 @@ mod tests {
         .unwrap()
     }
 
-    /// Rendering in bands gives exactly the coverage the whole-image traversal gives.
+    /// Rendering in bands gives exactly the coverage the whole-image traversal gives; the
+    /// progress counts every row once.
     #[test]
     fn coverage_matches_the_exact_reference() {
         for s in [builtin_teapot(), blob()] {
-            let r = render_reference(&s, 48, 36, 4);
+            let rows = ProgressBar::hidden();
+            let r = render_reference_with(&s, 48, 36, 4, &rows);
+            assert_eq!(rows.position(), 36);
             let c = coverage(&s, 48, 36, 4);
             assert_eq!(r.coverage, c);
             assert!(r.covered_samples > 1000);

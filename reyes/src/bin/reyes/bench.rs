@@ -1,7 +1,8 @@
 //! `reyes bench [SCENE] [--width W --height H] [--frames N] [--turntable] [--json]
 //! [--strategy NAME] [render options]`: frames of a (turning) scene by the persistent pipelined
 //! renderer (`reyes::realtime`): per-frame wall and GPU ms (median, p95) and frames per second,
-//! as a table or one JSON object ([`BenchReport`], keys in docs/reyes.md).
+//! as a table or one JSON object ([`BenchReport`], keys in docs/reyes.md). On a terminal a
+//! progress bar counts the frames (`reyes::progress`).
 
 use crate::cli::BenchCmd;
 use reyes::gpu_render::{WARM_UP, required_features};
@@ -107,7 +108,9 @@ pub fn main(a: BenchCmd) -> Result<(), String> {
     let timed: Vec<f64> = (0..a.frames).map(angle).collect();
     let warm = (0..a.warmup).map(|i| angle(i % a.frames));
     let all: Vec<f64> = warm.chain(timed.iter().copied()).collect();
-    let mut frames = r.render(&gpu, &all).map_err(|e| e.to_string())?;
+    let bar = reyes::progress::bar(all.len() as u64, "frames (warm-up and timed)");
+    let mut frames = r.render_with(&gpu, &all, &bar).map_err(|e| e.to_string())?;
+    bar.finish_and_clear();
     frames.drain(..a.warmup as usize);
     if let Some(out) = &a.out {
         r.set_pixels(&gpu, Pixels::Rgba8)

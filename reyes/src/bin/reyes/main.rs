@@ -71,9 +71,22 @@ fn run(a: RenderCmd) -> Result<(), String> {
         }
         _ => None,
     };
+    // A bar over every frame rendered (with --runs N > 1: every timed frame) when there are
+    // several; nothing for one frame.
+    let per_frame = if gpu.is_some() { a.runs.max(1) } else { 1 };
+    let steps = jobs.len() as u64 * per_frame as u64;
+    let bar = if steps > 1 {
+        reyes::progress::bar(steps, "")
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
     for ((i, outputs), data) in jobs.iter().zip(&data) {
+        let number = seq.frames[*i].number;
         if seq.frames.len() > 1 {
-            eprintln!("frame {}:", seq.frames[*i].number);
+            reyes::progress::note(format!("frame {number}:"));
+            bar.set_message(format!("frame {number}"));
+        } else {
+            bar.set_message("timed frames");
         }
         render_frame(
             &a,
@@ -82,8 +95,10 @@ fn run(a: RenderCmd) -> Result<(), String> {
             data,
             outputs,
             gpu.as_ref(),
+            &bar,
         )?;
     }
+    bar.finish_and_clear();
     Ok(())
 }
 
@@ -109,26 +124,28 @@ fn render_frame(
     data: &FrameData,
     out: &frames::Outputs,
     gpu: Option<&(Gpu, GpuRenderer)>,
+    progress: &indicatif::ProgressBar,
 ) -> Result<(), String> {
     let Some((gpu, renderer)) = gpu else {
         let r = reyes::cpu_render::render_cpu(data);
+        progress.inc(1);
         // The CPU twin keeps the GPU's counters: the same frame warnings.
         for w in reyes::warnings::frame_warnings(data, &r.counters) {
             log::warn!("{w}");
         }
         r.image.write_png(&out.image)?;
-        eprintln!("wrote {} (CPU reference)", out.image.display());
+        reyes::progress::note(format!("wrote {} (CPU reference)", out.image.display()));
         return Ok(());
     };
     // One frame makes the image; with --runs N > 1, N frames are timed after a warm-up
     // (GpuRenderer::timed_frames).
     let (frame, times) = if a.runs > 1 {
         let t = renderer
-            .timed_frames(gpu, data, a.runs)
+            .timed_frames_with(gpu, data, a.runs, progress)
             .map_err(|e| e.to_string())?;
         for (i, (g, w)) in t.gpu_ms.iter().zip(&t.wall_ms).enumerate() {
             let g = g.map_or("n/a".into(), |g| format!("{g:.3}"));
-            eprintln!("run {i}: GPU {g} ms, wall {w:.2} ms");
+            reyes::progress::note(format!("run {i}: GPU {g} ms, wall {w:.2} ms"));
         }
         let times = t
             .gpu_ms
@@ -139,6 +156,7 @@ fn render_frame(
         (t.last, times)
     } else {
         let f = renderer.render(gpu, data).map_err(|e| e.to_string())?;
+        progress.inc(1);
         let gpu_ms = f.run.gpu_ms.zip(f.resolve_gpu_ms).map(|(x, y)| x + y);
         let wall_ms = f.wall_ms;
         (f, vec![(gpu_ms, wall_ms)])
@@ -170,8 +188,8 @@ fn render_frame(
         let text = serde_json::to_string_pretty(&stats).unwrap();
         reyes::output::write_atomic(p, (text + "\n").as_bytes())?;
     }
-    eprintln!(
-        "wrote {} ({}x{}, {}{}: {} grids, {} micropolygons, GPU {} ms, wall {:.1} ms)",
+    reyes::progress::note(format!(
+        "wrote {} ({}x{}, {}{}: {} grids, {} micropolygons, {})",
         out.image.display(),
         data.frame.width,
         data.frame.height,
@@ -185,20 +203,30 @@ fn render_frame(
         },
         stats.grids_diced,
         stats.micropolygons,
-        match (
-            stats.runs.as_ref().and_then(|r| r.gpu_ms.as_ref()),
-            stats.gpu_ms
-        ) {
-            (Some(m), _) if a.runs > 1 => format!(
-                "{:.3} ± {:.3} (median ± MAD of {})",
-                m.median, m.mad, a.runs
-            ),
-            (_, Some(v)) => format!("{v:.3}"),
-            _ => "n/a".into(),
-        },
-        frame.wall_ms
-    );
+        times_text(stats.runs.as_ref(), stats.gpu_ms, frame.wall_ms)
+    ));
     Ok(())
+}
+
+/// The frame's times as `reyes render` prints them: one run's GPU and wall ms; of several
+/// (`--runs N`), the median GPU ms (± MAD) of the N timed frames beside the last one's wall ms.
+/// `gpu_ms` is the last frame's; "n/a" without timestamps.
+fn times_text(runs: Option<&RunSummary>, gpu_ms: Option<f64>, last_wall_ms: f64) -> String {
+    match runs.filter(|r| r.count > 1) {
+        Some(r) => {
+            let gpu = r.gpu_ms.as_ref().map_or("GPU n/a".into(), |m| {
+                format!("GPU {:.3} ± {:.3} ms (median ± MAD)", m.median, m.mad)
+            });
+            format!(
+                "{} runs: {gpu}, last run wall {last_wall_ms:.1} ms",
+                r.count
+            )
+        }
+        None => {
+            let gpu = gpu_ms.map_or("GPU n/a".into(), |v| format!("GPU {v:.3} ms"));
+            format!("{gpu}, wall {last_wall_ms:.1} ms")
+        }
+    }
 }
 
 fn main() -> ExitCode {
@@ -220,5 +248,31 @@ fn main() -> ExitCode {
             eprintln!("reyes {name}: {e}");
             ExitCode::FAILURE
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn several_runs_print_the_median_gpu_time_beside_the_last_wall_time() {
+        let times = [(Some(2.0), 10.0), (Some(1.0), 30.0), (Some(4.0), 20.0)];
+        let s = RunSummary::of(&times);
+        assert_eq!(
+            times_text(Some(&s), Some(4.0), 20.0),
+            "3 runs: GPU 2.000 ± 1.000 ms (median ± MAD), last run wall 20.0 ms"
+        );
+        let no_timestamps = RunSummary::of(&[(None, 10.0), (None, 12.0)]);
+        assert_eq!(
+            times_text(Some(&no_timestamps), None, 12.0),
+            "2 runs: GPU n/a, last run wall 12.0 ms"
+        );
+        let one = RunSummary::of(&[(Some(1.5), 9.0)]);
+        assert_eq!(
+            times_text(Some(&one), Some(1.5), 9.0),
+            "GPU 1.500 ms, wall 9.0 ms"
+        );
+        assert_eq!(times_text(None, None, 9.0), "GPU n/a, wall 9.0 ms");
     }
 }

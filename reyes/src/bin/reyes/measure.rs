@@ -2,10 +2,11 @@
 //! renders on the GPU (a warm-up frame, 0.5 s of full GPU load (clocks), one more frame, then
 //! `--runs N` timed ones, median reported) and measures the frame
 //! against the exact surfaces (`reyes::accuracy`): geometric error and size of the
-//! micropolygons, PSNR and FLIP against an f64 reference render, pinholes.
+//! micropolygons, PSNR and FLIP against an f64 reference render, pinholes. The reference
+//! render shows a progress bar on a terminal (`reyes::progress`).
 
 use crate::cli::MeasureCmd;
-use reyes::accuracy::exact_image::{ReferenceImage, render_reference};
+use reyes::accuracy::exact_image::{ReferenceImage, render_reference_with};
 use reyes::accuracy::geometry::geometry;
 use reyes::accuracy::image_error::image_error;
 use reyes::accuracy::measure::{Measurement, MetricsCpuMs, pinhole_count};
@@ -68,7 +69,9 @@ pub fn main(a: MeasureCmd) -> Result<(), String> {
         frame.image.write_png(p)?;
     }
     let (w, h) = (data.frame.width, data.frame.height);
-    let reference: ReferenceImage = render_reference(&scene, w, h, ref_samples);
+    let rows = reyes::progress::bar(h as u64, "reference render: pixel rows");
+    let reference: ReferenceImage = render_reference_with(&scene, w, h, ref_samples, &rows);
+    rows.finish_and_clear();
     if let Some(p) = &reference_png {
         reference.image.write_png(p)?;
     }

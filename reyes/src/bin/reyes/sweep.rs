@@ -8,10 +8,13 @@
 //! geometry metrics per dicing setting (they do not depend on samples or strategy), and the
 //! image metrics per image (the strategies give bit-identical images; if they did not, each
 //! image would be measured on its own).
+//!
+//! On a terminal a progress bar counts the settings (one step per scene, dicing, samples and
+//! strategy) and another the rows of each scene's reference render (`reyes::progress`).
 
 use crate::cli::SweepCmd;
 use crate::measure::{load_scene, timed_frames};
-use reyes::accuracy::exact_image::render_reference;
+use reyes::accuracy::exact_image::render_reference_with;
 use reyes::accuracy::geometry::{GeometryStats, geometry};
 use reyes::accuracy::image_error::{ImageError, composite_srgb8, srgb8_errors};
 use reyes::accuracy::measure::pinhole_count;
@@ -123,6 +126,12 @@ pub fn main(a: SweepCmd) -> Result<(), String> {
     let start = std::time::Instant::now();
     let mut rows = Vec::new();
     let defaults = RenderOptions::default();
+    // Settings per scene; a scene whose own sample count is not in --samples adds its own.
+    let per_samples = (c.dicings.len() * c.strategies.len()) as u64;
+    let settings = reyes::progress::bar(
+        c.scenes.len() as u64 * c.samples.len() as u64 * per_samples,
+        "settings",
+    );
     for name in &c.scenes {
         let (scene, short) = load_scene(scene_path(name).as_deref())?;
         let short = if name == "killeroo" {
@@ -131,18 +140,22 @@ pub fn main(a: SweepCmd) -> Result<(), String> {
             short
         };
         let (w, h) = (c.width, c.height);
-        let reference = render_reference(&scene, w, h, c.ref_samples);
+        settings.set_message(format!("settings ({short})"));
+        let ref_rows = reyes::progress::bar(h as u64, &format!("{short}: reference pixel rows"));
+        let reference = render_reference_with(&scene, w, h, c.ref_samples, &ref_rows);
+        ref_rows.finish_and_clear();
         let mut images: Vec<Vec<u8>> = Vec::new();
         let first_row = rows.len();
-        eprintln!(
+        reyes::progress::note(format!(
             "{short}: reference {w}x{h}, {n}x{n} samples/pixel, {:.1} s",
             reference.cpu_ms / 1e3,
             n = c.ref_samples
-        );
+        ));
         // The scene's own sample count is the default: sweep it even if not asked.
         let mut sample_set = c.samples.clone();
         if !sample_set.contains(&scene.pixel_samples) {
             sample_set.push(scene.pixel_samples);
+            settings.inc_length(per_samples);
         }
         for &dicing in &c.dicings {
             let options = |spp| RenderOptions {
@@ -199,7 +212,7 @@ pub fn main(a: SweepCmd) -> Result<(), String> {
                         front_geom: false,
                         front_flip: false,
                     };
-                    eprintln!(
+                    reyes::progress::note(format!(
                         "{short} {} {} {}x{}: {:.3} ms, geom max {:.3} px, pinholes {}, {} workgroups",
                         row.strategy,
                         dicing.label(),
@@ -209,8 +222,9 @@ pub fn main(a: SweepCmd) -> Result<(), String> {
                         row.geom.err_max_px,
                         row.pinholes,
                         frame.run.workgroups
-                    );
+                    ));
                     rows.push((row, image));
+                    settings.inc(1);
                 }
             }
         }
@@ -219,11 +233,12 @@ pub fn main(a: SweepCmd) -> Result<(), String> {
         for (row, image) in &mut rows[first_row..] {
             row.img = errors[*image];
         }
-        eprintln!(
+        reyes::progress::note(format!(
             "{short}: image metrics of {} distinct images done",
             images.len()
-        );
+        ));
     }
+    settings.finish_and_clear();
     let mut rows: Vec<Row> = rows.into_iter().map(|r| r.0).collect();
     mark_fronts(&mut rows);
     let elapsed = start.elapsed().as_secs_f64();
