@@ -4,6 +4,7 @@
 
 pub mod accuracy;
 pub mod buckets;
+pub mod camera;
 pub mod cpu_render;
 pub mod driver_env;
 pub mod frame;
@@ -12,6 +13,7 @@ pub mod image;
 pub mod logging;
 pub mod orbit;
 pub mod output;
+pub mod present;
 pub mod progress;
 pub mod realtime;
 pub mod reference;

@@ -1,5 +1,6 @@
 //! Frames whose wall time is their GPU time: a persistent renderer for many frames of one scene
-//! under a moving camera (`reyes bench`; the turntable of [`crate::orbit`]).
+//! under a moving camera: the turntable of [`crate::orbit`] (`reyes bench`), or any camera-space
+//! transform per frame, as the viewer's orbit, pan and dolly ([`crate::camera`], `reyes view`).
 //!
 //! [`GpuRenderer::render`] makes everything per frame: uploads, a run that reads counters back
 //! between launches, and a read-back of the f32 image. Here, instead:
@@ -16,7 +17,9 @@
 //!   most [`IN_FLIGHT`] submitted and unfinished); each frame's status (the scheduler's control
 //!   block, the Reyes counters, two GPU timestamps: about 100 words) is copied into a mapped
 //!   staging ring and read a frame late; nothing else is read back unless an image is wanted
-//!   ([`Pixels`]), which is converted to 8-bit on the GPU (`rgba8.wgsl`).
+//!   ([`Pixels`]), which is converted to 8-bit on the GPU (`rgba8.wgsl`); the 8-bit image
+//!   also stays on the GPU ([`RealtimeRenderer::image_buffer`]) for a window to draw without a
+//!   read-back.
 //!
 //! A frame whose fixed sizes did not suffice (a queue out of room, a megakernel launch at its
 //! loop bound, multi-pass out of rounds) is found a frame late from its status and rendered again
@@ -38,6 +41,7 @@ use crate::scene::Scene;
 use crate::shaders;
 use crate::stages::COUNTERS;
 use bytemuck::{Pod, Zeroable};
+use glam::DMat4;
 use scheduler::timing::SpanTimer;
 use scheduler::{
     DeviceSeeds, Gpu, Outcome, RecordedRun, RecordedSize, RunError, RunStats, StrategyKind,
@@ -60,7 +64,8 @@ pub const HEADROOM: f64 = 1.5;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct Orbit {
-    /// Column-major affine transform of camera-space points ([`orbit::orbit_matrix`]).
+    /// Column-major affine transform of camera-space points ([`orbit::orbit_matrix`],
+    /// [`crate::camera::ViewCamera::transform`]).
     pub m: [[f32; 4]; 4],
     pub patches: u32,
     /// Threads per row of the 2D dispatch.
@@ -82,8 +87,9 @@ pub enum Pixels {
 /// One finished frame.
 #[derive(Clone, Debug)]
 pub struct RealtimeFrame {
-    /// Turntable angle, radians.
-    pub angle: f64,
+    /// The camera-space transform of the scene the frame was rendered under (f64; the GPU
+    /// applies it in f32).
+    pub transform: DMat4,
     /// GPU time: from the start of the frame's first pass to the end of its last, plus, for a
     /// frame rendered again, that render's timed passes. `None` without timestamp queries.
     pub gpu_ms: Option<f64>,
@@ -115,7 +121,7 @@ struct Slot {
 }
 
 struct InFlight {
-    angle: f64,
+    transform: DMat4,
     slot: usize,
     submission: wgpu::SubmissionIndex,
     /// The run recorded (the sizes may grow while this frame is in flight).
@@ -311,6 +317,31 @@ impl RealtimeRenderer {
         (f.width, f.height, [f.spp_x, f.spp_y])
     }
 
+    /// The frame's settings (size, samples, focal length, micropolygon size).
+    pub fn frame(&self) -> &crate::frame::Frame {
+        &self.base.frame
+    }
+
+    /// The strategy frames are rendered with.
+    pub fn strategy(&self) -> StrategyKind {
+        self.kind
+    }
+
+    /// Centre of the scene's control points' bounding box, camera space: the point the
+    /// turntable and the viewer's camera turn about ([`orbit::scene_centre`]).
+    pub fn centre(&self) -> glam::DVec3 {
+        self.centre
+    }
+
+    /// The 8-bit sRGB image on the GPU: `width * height` u32 words, row-major from the top row,
+    /// each the bytes r, g, b, a in memory order (`rgba8.wgsl`); `STORAGE | COPY_SRC`. When
+    /// [`RealtimeRenderer::render`] or [`RealtimeRenderer::render_transforms`] returns, it holds
+    /// the last returned frame (a frame rendered again is written here too), until the next
+    /// call's frames overwrite it: work submitted in between (a draw to a window) reads it.
+    pub fn image_buffer(&self) -> &wgpu::Buffer {
+        &self.rgba8
+    }
+
     /// The strategy's scheduler and the renderer that renders a frame again.
     pub fn renderer(&self) -> &GpuRenderer {
         &self.renderer
@@ -383,9 +414,9 @@ impl RealtimeRenderer {
         RecordedSize::from_stats(program, self.kind, run, &seeds, HEADROOM)
     }
 
-    /// Renders one frame per turntable angle (radians), pipelined, and returns them in order.
-    /// Errors: a device error or timeout, an emit beyond a procedure's declaration, and those
-    /// of a frame rendered again (e.g. a queue overflow of one patch in the smallest bucket).
+    /// Renders one frame per turntable angle (radians; [`orbit::orbit_transform`] about the
+    /// scene's centre), pipelined, and returns them in order. Errors: as
+    /// [`RealtimeRenderer::render_transforms`].
     pub fn render(&mut self, gpu: &Gpu, angles: &[f64]) -> Result<Vec<RealtimeFrame>, RunError> {
         self.render_with(gpu, angles, &indicatif::ProgressBar::hidden())
     }
@@ -397,11 +428,37 @@ impl RealtimeRenderer {
         angles: &[f64],
         progress: &indicatif::ProgressBar,
     ) -> Result<Vec<RealtimeFrame>, RunError> {
-        let mut out = Vec::with_capacity(angles.len());
+        let transforms: Vec<DMat4> = (angles.iter())
+            .map(|&a| orbit::orbit_transform(self.centre, a))
+            .collect();
+        self.render_transforms_with(gpu, &transforms, progress)
+    }
+
+    /// Renders one frame per camera-space transform of the scene's control points (an affine
+    /// f64 matrix, applied on the GPU in f32; e.g. [`crate::camera::ViewCamera::transform`]),
+    /// pipelined, and returns them in order. Errors: a device error or timeout, an emit beyond
+    /// a procedure's declaration, and those of a frame rendered again (e.g. a queue overflow of
+    /// one patch in the smallest bucket).
+    pub fn render_transforms(
+        &mut self,
+        gpu: &Gpu,
+        transforms: &[DMat4],
+    ) -> Result<Vec<RealtimeFrame>, RunError> {
+        self.render_transforms_with(gpu, transforms, &indicatif::ProgressBar::hidden())
+    }
+
+    /// [`RealtimeRenderer::render_transforms`], advancing `progress` by one per finished frame.
+    pub fn render_transforms_with(
+        &mut self,
+        gpu: &Gpu,
+        transforms: &[DMat4],
+        progress: &indicatif::ProgressBar,
+    ) -> Result<Vec<RealtimeFrame>, RunError> {
+        let mut out = Vec::with_capacity(transforms.len());
         let mut flight: VecDeque<InFlight> = VecDeque::new();
         let mut last = Instant::now();
-        for (i, &angle) in angles.iter().enumerate() {
-            flight.push_back(self.submit(gpu, i % IN_FLIGHT, angle)?);
+        for (i, &transform) in transforms.iter().enumerate() {
+            flight.push_back(self.submit(gpu, i % IN_FLIGHT, transform)?);
             // Frame i runs on the GPU (after i - 1) while frame i - 1 is finished here; then
             // frame i + 1 is recorded while i runs.
             if flight.len() == IN_FLIGHT {
@@ -418,11 +475,13 @@ impl RealtimeRenderer {
     }
 
     /// Records and submits one frame in ring slot `slot`.
-    fn submit(&self, gpu: &Gpu, slot: usize, angle: f64) -> Result<InFlight, RunError> {
+    fn submit(&self, gpu: &Gpu, slot: usize, transform: DMat4) -> Result<InFlight, RunError> {
         let s = &self.slots[slot];
         let (_, row) = dispatch_2d(self.patches as u64, 64);
         let orbit = Orbit {
-            m: orbit::orbit_matrix(self.centre, angle),
+            m: transform
+                .to_cols_array_2d()
+                .map(|col| col.map(|v| v as f32)),
             patches: self.patches,
             row,
             pad: [0; 2],
@@ -496,7 +555,7 @@ impl RealtimeRenderer {
             });
         }
         Ok(InFlight {
-            angle,
+            transform,
             slot,
             submission,
             recorded,
@@ -538,7 +597,7 @@ impl RealtimeRenderer {
         }
         let Some(rec) = f.recorded else {
             let why = self.not_pipelined.clone().unwrap_or_default();
-            return self.render_again(gpu, f.slot, f.angle, why, None, last);
+            return self.render_again(gpu, f.slot, f.transform, why, None, last);
         };
         let words = rec.status_words();
         let status = read_mapped(&f.maps[0], words + STATUS_COUNTERS + SpanTimer::WORDS)?;
@@ -574,7 +633,7 @@ impl RealtimeRenderer {
                     }
                 };
                 Ok(RealtimeFrame {
-                    angle: f.angle,
+                    transform: f.transform,
                     gpu_ms,
                     wall_ms,
                     counters,
@@ -584,7 +643,9 @@ impl RealtimeRenderer {
                     image,
                 })
             }
-            Outcome::Incomplete(why) => self.render_again(gpu, f.slot, f.angle, why, gpu_ms, last),
+            Outcome::Incomplete(why) => {
+                self.render_again(gpu, f.slot, f.transform, why, gpu_ms, last)
+            }
         }
     }
 
@@ -594,7 +655,7 @@ impl RealtimeRenderer {
         &mut self,
         gpu: &Gpu,
         slot: usize,
-        angle: f64,
+        transform: DMat4,
         why: String,
         attempt_ms: Option<f64>,
         last: &mut Instant,
@@ -606,6 +667,10 @@ impl RealtimeRenderer {
             ..self.base.clone()
         };
         let g = self.renderer.render(gpu, &data)?;
+        // The GPU image holds the incomplete attempt: the right frame replaces it (converted
+        // on the host: FrameImage::rgba8, within one step of rgba8.wgsl).
+        let rgba8 = g.image.rgba8();
+        gpu.queue.write_buffer(&self.rgba8, 0, &rgba8);
         if self.recorded.is_some() {
             let size = self.size_from(&g.run).max(&self.wanted);
             if size != self.wanted {
@@ -621,12 +686,12 @@ impl RealtimeRenderer {
             None => rerun_ms,
         };
         Ok(RealtimeFrame {
-            angle,
+            transform,
             gpu_ms,
             wall_ms,
             counters: g.counters,
             rerendered: Some(why),
-            rgba8: (self.pixels == Pixels::Rgba8).then(|| g.image.rgba8()),
+            rgba8: (self.pixels == Pixels::Rgba8).then_some(rgba8),
             image: (self.pixels == Pixels::Float).then(|| g.image.clone()),
             run: g.run,
         })

@@ -11,3 +11,5 @@ pub const DICE_SHADE: &str = include_str!("../../shaders/reyes/dice_shade.wgsl")
 pub const RESOLVE: &str = include_str!("../../shaders/reyes/resolve.wgsl");
 pub const ROOTS: &str = include_str!("../../shaders/reyes/roots.wgsl");
 pub const RGBA8: &str = include_str!("../../shaders/reyes/rgba8.wgsl");
+/// The viewer's draw of a frame to a window (`reyes view`; twin: [`crate::present`]).
+pub const PRESENT: &str = include_str!("../../shaders/reyes/present.wgsl");

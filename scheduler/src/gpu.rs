@@ -47,17 +47,47 @@ impl Gpu {
     /// Like [`Gpu::from_env`], for programs whose user code needs more `features` (e.g. 64-bit
     /// atomics); an adapter without them is an error that names them.
     pub fn from_env_requiring(features: wgpu::Features) -> Result<Gpu, RunError> {
-        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
+        Self::open(&Self::instance_from_env(), None, features)
+    }
+
+    /// The wgpu instance [`Gpu::from_env`] opens its adapter from: the backends of
+    /// `WGPU_BACKEND`, else the primary ones. A window's surface is made from it before
+    /// [`Gpu::from_env_for_surface`].
+    pub fn instance_from_env() -> wgpu::Instance {
+        wgpu::Instance::new(wgpu::InstanceDescriptor {
             backends: wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY),
             ..wgpu::InstanceDescriptor::new_without_display_handle()
-        });
+        })
+    }
+
+    /// Like [`Gpu::from_env_requiring`], on an adapter of `instance` that can present to
+    /// `surface` (made from the same instance). Errors: [`RunError::NoAdapter`] when no
+    /// adapter both presents to the surface and has `features`.
+    pub fn from_env_for_surface(
+        instance: &wgpu::Instance,
+        surface: &wgpu::Surface<'_>,
+        features: wgpu::Features,
+    ) -> Result<Gpu, RunError> {
+        Self::open(instance, Some(surface), features)
+    }
+
+    fn open(
+        instance: &wgpu::Instance,
+        surface: Option<&wgpu::Surface<'_>>,
+        features: wgpu::Features,
+    ) -> Result<Gpu, RunError> {
         let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(
-            &instance, None,
+            instance, surface,
         ))
         .map_err(|e| {
             RunError::NoAdapter(format!(
-                "{e}. Install a Vulkan driver (on Debian: `apt-get install -y mesa-vulkan-drivers` \
-                 for lavapipe) or set WGPU_ADAPTER_NAME / WGPU_BACKEND"
+                "{e}{}. Install a Vulkan driver (on Debian: `apt-get install -y \
+                 mesa-vulkan-drivers` for lavapipe) or set WGPU_ADAPTER_NAME / WGPU_BACKEND",
+                if surface.is_some() {
+                    " (an adapter that can present to the window)"
+                } else {
+                    ""
+                }
             ))
         })?;
         Self::from_adapter(adapter, features)

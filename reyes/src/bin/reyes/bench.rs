@@ -124,7 +124,7 @@ pub fn main(a: BenchCmd) -> Result<(), String> {
         reyes::output::write_atomic(out, &reyes::output::png(&img)?)?;
         eprintln!("wrote {}", out.display());
     }
-    let report = report(&a, &name, &gpu, strategy, &r, step, &frames);
+    let report = report(&a, &name, &gpu, strategy, &r, step, &frames, &timed);
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report).unwrap());
     } else {
@@ -133,6 +133,7 @@ pub fn main(a: BenchCmd) -> Result<(), String> {
     Ok(())
 }
 
+#[allow(clippy::too_many_arguments)]
 fn report(
     a: &BenchCmd,
     name: &str,
@@ -141,6 +142,7 @@ fn report(
     r: &RealtimeRenderer,
     step: f64,
     frames: &[RealtimeFrame],
+    angles: &[f64],
 ) -> BenchReport {
     let (width, height, samples) = r.frame_size();
     let wall: Vec<f64> = frames.iter().map(|f| f.wall_ms).collect();
@@ -169,10 +171,9 @@ fn report(
         fps: frames.len() as f64 / (wall.iter().sum::<f64>() / 1e3),
         micropolygons: Summary::of(&mp).expect("at least one frame"),
         rerendered: frames.iter().filter(|f| f.rerendered.is_some()).count() as u32,
-        per_frame: frames
-            .iter()
-            .map(|f| FrameRow {
-                angle_deg: f.angle.to_degrees(),
+        per_frame: (frames.iter().zip(angles))
+            .map(|(f, angle)| FrameRow {
+                angle_deg: angle.to_degrees(),
                 wall_ms: f.wall_ms,
                 gpu_ms: f.gpu_ms,
                 micropolygons: f.counters[C_MICROPOLYGONS],

@@ -46,7 +46,18 @@ pub enum Command {
     /// p95) and frames per second, as a table or JSON.
     #[command(allow_negative_numbers = true, args_override_self = true)]
     Bench(BenchCmd),
+    /// Open a window on a scene: orbit, pan and zoom with the mouse, keys for strategy and
+    /// quality, frame times in the title, S saves a screenshot (controls below).
+    #[command(after_help = VIEW_CONTROLS, allow_negative_numbers = true, args_override_self = true)]
+    View(ViewCmd),
 }
+
+const VIEW_CONTROLS: &str = "Controls: left drag orbits about the scene's centre; right or \
+middle drag pans; the wheel zooms (dollies towards the centre); M cycles the strategy \
+(megakernel, multipass, multipass-host); [ and ] halve and double the micropolygon size (by \
+sqrt 2); 1-4 set NxN pixel samples, + and - add or remove one per axis; R resets the camera; \
+S saves a screenshot PNG; Esc or Q quits. The title shows frames per second, wall and GPU \
+milliseconds, micropolygons, the strategy, micropolygon size and samples.";
 
 impl Command {
     /// The subcommand's name, for error messages.
@@ -57,6 +68,7 @@ impl Command {
             Command::Sweep(_) => "sweep",
             Command::Drift(_) => "drift",
             Command::Bench(_) => "bench",
+            Command::View(_) => "view",
         }
     }
 }
@@ -262,6 +274,30 @@ pub struct BenchCmd {
     /// Write the last timed frame's angle once more as PNG (8-bit, converted on the GPU).
     #[arg(short = 'o', long = "output", value_name = "OUT.png")]
     pub out: Option<PathBuf>,
+
+    #[command(flatten)]
+    pub render: RenderArgs,
+}
+
+/// `reyes view`: a window on a scene, rendered by the persistent renderer (`reyes::realtime`)
+/// and drawn without a read-back; see `VIEW_CONTROLS`. `--width`/`--height` set the window's
+/// first size; frames then render at the window's size.
+#[derive(Debug, Args)]
+pub struct ViewCmd {
+    /// A RIB (.rib, .rib.gz), Newell or .bpt scene file, or `teapot` (built in)
+    /// [default: teapot].
+    #[arg(value_name = "SCENE")]
+    pub scene: Option<PathBuf>,
+
+    /// Render this many frames, then exit (with --screenshot: save the last first); for
+    /// scripts and tests [default: run until closed].
+    #[arg(long, value_name = "N", value_parser = value_parser!(u32).range(1..))]
+    pub frames: Option<u32>,
+
+    /// Where S saves the frame (PNG, 8-bit sRGB, the rendered image without the window's
+    /// background) [default: reyes-view-NNNN.png in the current folder, the first free NNNN].
+    #[arg(long, value_name = "OUT.png")]
+    pub screenshot: Option<PathBuf>,
 
     #[command(flatten)]
     pub render: RenderArgs,
@@ -484,6 +520,8 @@ mod tests {
             &["bench", "--frames", "0"],
             &["bench", "--angle", "inf"],
             &["bench", "--runs", "3"],
+            &["view", "--frames", "0"],
+            &["view", "--mp-size", "0"],
             &[],
         ] {
             let e = parse(bad).map(|_| ()).unwrap_err();

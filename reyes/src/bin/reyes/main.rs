@@ -8,6 +8,7 @@ mod drift;
 mod frames;
 mod measure;
 mod sweep;
+mod view;
 
 use clap::Parser;
 use cli::{Cli, Command, RenderCmd};
@@ -241,6 +242,7 @@ fn main() -> ExitCode {
         Command::Sweep(a) => sweep::main(a),
         Command::Drift(a) => drift::main(a),
         Command::Bench(a) => bench::main(a),
+        Command::View(a) => view::main(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
