@@ -12,6 +12,7 @@ pub mod image;
 pub mod logging;
 pub mod orbit;
 pub mod output;
+pub mod raster_peer;
 pub mod realtime;
 pub mod reference;
 pub mod scene;
