@@ -195,65 +195,130 @@ pub fn msaa_samples(gpu: &Gpu, wanted: u32) -> u32 {
         .unwrap_or(1)
 }
 
-/// Segments per side `[nu, nv]` of the patch whose Euclidean camera-space control points are
-/// `e` (`e[4*v + u]`), `[0, 0]` when culled; twin of `grid_rate` in tessellate.wgsl (see
-/// there). The GPU's `distance` may round differently, so a side's rate can differ by one.
-pub fn grid_rate(f: &Frame, e: &[Vec3; 16], max_rate: u32) -> [u32; 2] {
+/// A patch's grid (`GridRate` in tessellate.wgsl): `n` = `[nu, nv]` segments (`[0, 0]` when
+/// culled) and `edges` the segments of its boundary curves v = 0, v = 1 (along u) and u = 0,
+/// u = 1 (along v), each from that curve's own control polygon, so that the two patches
+/// sharing a boundary place the same points on it (no T-junction cracks; [`edge_param`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GridRate {
+    pub n: [u32; 2],
+    pub edges: [u32; 4],
+}
+
+/// The grid of the patch whose Euclidean camera-space control points are `e` (`e[4*v + u]`);
+/// twin of `grid_rate` in tessellate.wgsl (see there). The GPU's `distance` may round
+/// differently, so a rate can differ by one.
+pub fn grid_rate(f: &Frame, e: &[Vec3; 16], max_rate: u32) -> GridRate {
+    let culled = GridRate {
+        n: [0; 2],
+        edges: [0; 4],
+    };
     let zmin = e.iter().map(|p| p.z).fold(3.0e38f32, f32::min);
     let zmax = e.iter().map(|p| p.z).fold(-3.0e38f32, f32::max);
     if zmax < f.near || zmin > f.far {
-        return [0, 0];
+        return culled;
     }
     if zmin < f.near {
-        return [max_rate, max_rate];
+        return GridRate {
+            n: [max_rate; 2],
+            edges: [max_rate; 4],
+        };
     }
     let s: [Vec2; 16] = std::array::from_fn(|k| Vec2::from(stages::project(f, e[k])));
     let lo = s.iter().fold(Vec2::splat(3.0e38), |a, p| a.min(*p));
     let hi = s.iter().fold(Vec2::splat(-3.0e38), |a, p| a.max(*p));
     if hi.x < 0.0 || hi.y < 0.0 || lo.x > f.width as f32 || lo.y > f.height as f32 {
-        return [0, 0];
+        return culled;
     }
-    let mut len = Vec2::ZERO;
-    for a in 0..4 {
-        let mut l = Vec2::ZERO;
+    let mut len = [Vec2::ZERO; 4];
+    for (a, l) in len.iter_mut().enumerate() {
         for b in 0..3 {
             l.x += s[4 * a + b + 1].distance(s[4 * a + b]);
             l.y += s[4 * (b + 1) + a].distance(s[4 * b + a]);
         }
-        len = len.max(l);
     }
-    let n = (len / f.mp_size).ceil().min(Vec2::splat(max_rate as f32));
-    let n = n.max(Vec2::ONE);
-    [n.x as u32, n.y as u32]
+    let segments = |l: Vec2| {
+        let n = (l / f.mp_size).ceil().min(Vec2::splat(max_rate as f32));
+        let n = n.max(Vec2::ONE);
+        [n.x as u32, n.y as u32]
+    };
+    let n = segments(len[0].max(len[1]).max(len[2].max(len[3])));
+    let [e0, e1] = segments(Vec2::new(len[0].x, len[3].x));
+    let [e2, e3] = segments(Vec2::new(len[0].y, len[3].y));
+    GridRate {
+        n,
+        edges: [e0, e1, e2, e3],
+    }
 }
 
-/// The vertices `tessellate` makes for patch `id` (`patch` in camera space) on an `nu` x `nv`
-/// grid, row-major: the CPU twin, through the same evaluation and shading as DiceShade's twin
-/// ([`stages::dice_shade::dice`] of the patch's root item, kept in camera space), mapped to
-/// the clip position of [`RasterVertex`].
+/// `edge_param` in tessellate.wgsl: the parameter of point `i` of `n` along a boundary of
+/// `e <= n` segments, round(i e / n) / e in integers.
+pub fn edge_param(i: u32, n: u32, e: u32) -> f32 {
+    ((2 * i * e + n) / (2 * n)) as f32 / e as f32
+}
+
+/// The vertices `tessellate` makes for patch `id` (`patch` in camera space) with grid `rate`,
+/// row-major: the CPU twin, evaluated and shaded as DiceShade's twin does
+/// ([`stages::dice_shade::dice`]) for the patch's root item at the same (u, v), mapped to the
+/// clip position of [`RasterVertex`].
 pub fn tessellate_cpu(
     data: &FrameData,
     id: u32,
     patch: &Patch,
-    nu: u32,
-    nv: u32,
+    rate: &GridRate,
 ) -> Vec<RasterVertex> {
-    let mut item = root_item(id, patch);
-    item.rates = nu | nv << 8 | stages::NEAR_CLIP_GRID;
+    let item = root_item(id, patch);
     let f = &data.frame;
+    let [nu, nv] = rate.n;
+    let edges = rate.edges;
+    let info = data.patch_info[id as usize];
+    let m = &data.materials[info.material as usize];
+    let weights = stages::item_weights(&item, &info, &data.primvars);
     let scale = Vec2::new(
         2.0 * f.focal / (f.width as f32 * f.near),
         2.0 * f.focal / (f.height as f32 * f.near),
     );
-    let (_, _, grid) = stages::dice_shade::dice(&item, data);
-    grid.iter()
-        .map(|g| RasterVertex {
-            x: g[0] * scale.x,
-            y: g[1] * scale.y,
-            w: g[2] / f.near,
-            color: g[3].to_bits(),
-        })
-        .collect()
+    let mut out = Vec::with_capacity(((nu + 1) * (nv + 1)) as usize);
+    for k in 0..(nu + 1) * (nv + 1) {
+        let (i, j) = (k % (nu + 1), k / (nu + 1));
+        let mut u = i as f32 / nu as f32;
+        let mut v = j as f32 / nv as f32;
+        if j == 0 {
+            u = edge_param(i, nu, edges[0]);
+        }
+        if j == nv {
+            u = edge_param(i, nu, edges[1]);
+        }
+        if i == 0 {
+            v = edge_param(j, nv, edges[2]);
+        }
+        if i == nu {
+            v = edge_param(j, nv, edges[3]);
+        }
+        let e = stages::dice_shade::eval_surface(&item.cp, weights.as_ref(), u, v);
+        let n = stages::dice_shade::patch_normal_at(
+            &item.cp,
+            weights.as_ref(),
+            e,
+            u,
+            v,
+            info.flags & 1 != 0,
+        );
+        let cs = if info.cs != 0 {
+            stages::dice_shade::color_field(&data.primvars, info.cs, u, v)
+        } else {
+            Vec3::from(m.color)
+        };
+        let c = stages::shade::shade(e[0], n, m, cs, &data.lights);
+        let back = n.dot(e[0]) > 0.0;
+        out.push(RasterVertex {
+            x: e[0].x * scale.x,
+            y: e[0].y * scale.y,
+            w: e[0].z / f.near,
+            color: stages::shade::pack_color(c, back),
+        });
+    }
+    out
 }
 
 /// The peer's tessellation of the last frame drawn, read back ([`RasterPeer::geometry`]).
@@ -261,6 +326,8 @@ pub fn tessellate_cpu(
 pub struct Tessellation {
     /// Per patch: `[nu, nv, first vertex, first quad]`, `nu = 0` when culled.
     pub grids: Vec<[u32; 4]>,
+    /// Per patch: its boundaries' segments ([`GridRate::edges`]).
+    pub edges: Vec<[u32; 4]>,
     pub vertices: Vec<RasterVertex>,
     /// 6 per quad: triangles (a, b, c) and (a, c, d) of quad corners a b c d.
     pub indices: Vec<u32>,
@@ -702,7 +769,7 @@ impl RasterPeer {
                 COUNT_WORDS * 4,
                 wgpu::BufferUsages::COPY_DST,
             )?,
-            grids: buffer(gpu, "raster grids", patches.max(1) as u64 * 16, u)?,
+            grids: buffer(gpu, "raster grids", patches.max(1) as u64 * 32, u)?,
             draw_args: buffer(gpu, "raster draw", 20, wgpu::BufferUsages::INDIRECT)?,
             params: gpu.upload("raster tessellate params", &[params])?,
             vertex_capacity: params.vertex_capacity,
@@ -816,7 +883,8 @@ impl RasterPeer {
     pub fn geometry(&self, gpu: &Gpu) -> Result<Tessellation, RunError> {
         let g = &self.geometry;
         let counts = TessCounts::from_words(&gpu.read_words(&g.counts, 0, COUNT_WORDS)?);
-        let grids = gpu.read_words(&g.grids, 0, 4 * self.patches as u64)?;
+        let grids = gpu.read_words(&g.grids, 0, 8 * self.patches as u64)?;
+        let entries: Vec<[u32; 4]> = grids.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
         let vertices = gpu.read_buffer(
             &g.vertices,
             0,
@@ -825,7 +893,8 @@ impl RasterPeer {
         let indices =
             gpu.read_words(&g.indices, 0, 6 * counts.quads.min(g.quad_capacity) as u64)?;
         Ok(Tessellation {
-            grids: grids.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect(),
+            grids: entries.iter().step_by(2).copied().collect(),
+            edges: entries.iter().skip(1).step_by(2).copied().collect(),
             vertices: bytemuck::pod_collect_to_vec(&vertices),
             indices,
             counts,
@@ -1144,15 +1213,32 @@ mod tests {
         };
         // 10 pixels a side, give or take the rounding of three thirds.
         let r = grid_rate(&f, &at(0.0, 10.0), 64);
-        assert!(r.iter().all(|n| (10..=11).contains(n)), "{r:?}");
-        assert_eq!(grid_rate(&f, &at(0.0, 1.0), 64), [64, 64]);
-        assert_eq!(grid_rate(&f, &at(0.0, -1.0), 64), [0, 0]);
-        assert_eq!(grid_rate(&f, &at(0.0, 200.0), 64), [0, 0]);
-        assert_eq!(grid_rate(&f, &at(100.0, 10.0), 64), [0, 0]);
+        assert!(r.n.iter().all(|n| (10..=11).contains(n)), "{r:?}");
+        assert!(r.edges.iter().all(|n| (10..=11).contains(n)), "{r:?}");
+        assert_eq!(grid_rate(&f, &at(0.0, 1.0), 64).n, [64, 64]);
+        assert_eq!(grid_rate(&f, &at(0.0, -1.0), 64).n, [0, 0]);
+        assert_eq!(grid_rate(&f, &at(0.0, 200.0), 64).n, [0, 0]);
+        assert_eq!(grid_rate(&f, &at(100.0, 10.0), 64).n, [0, 0]);
         let mut crossing = at(0.0, 10.0);
         crossing[0].z = -1.0;
-        assert_eq!(grid_rate(&f, &crossing, 64), [64, 64]);
+        assert_eq!(grid_rate(&f, &crossing, 64).n, [64, 64]);
         let coarse = Frame { mp_size: 4.0, ..f };
-        assert_eq!(grid_rate(&coarse, &at(0.0, 10.0), 64), [3, 3]);
+        assert_eq!(grid_rate(&coarse, &at(0.0, 10.0), 64).n, [3, 3]);
+        // A patch whose row v = 1 is half as long: that boundary gets fewer segments.
+        let mut taper = at(0.0, 10.0);
+        for p in &mut taper[12..] {
+            p.x *= 0.5;
+        }
+        let r = grid_rate(&coarse, &taper, 64);
+        assert_eq!((r.n[0], r.edges[0], r.edges[1]), (3, 3, 2), "{r:?}");
+        // Boundary points land on the boundary's own k / e, and the ends stay.
+        assert_eq!(
+            (0..=3).map(|i| edge_param(i, 3, 2)).collect::<Vec<_>>(),
+            [0.0, 0.5, 0.5, 1.0]
+        );
+        assert_eq!(
+            (0..=4).map(|i| edge_param(i, 4, 4)).collect::<Vec<_>>(),
+            [0.0, 0.25, 0.5, 0.75, 1.0]
+        );
     }
 }

@@ -39,7 +39,8 @@ struct RasterVertex {
 @group(0) @binding(5) var<storage, read_write> indices: array<u32>;
 // T_* below.
 @group(0) @binding(6) var<storage, read_write> tess_counts: array<atomic<u32>, 8>;
-// Per patch: (nu, nv, first vertex, first quad); nu = 0 when culled or out of room.
+// Per patch, two entries: (nu, nv, first vertex, first quad), nu = 0 when culled or out of
+// room; and its edge rates (GridRate.edges).
 @group(0) @binding(7) var<storage, read_write> grids: array<vec4<u32>>;
 // DrawIndexedIndirectArgs: index count, instance count, first index, base vertex, first instance.
 @group(0) @binding(8) var<storage, read_write> draw_args: array<u32, 5>;
@@ -59,24 +60,35 @@ const TESS_BACK_WORDS: u32 = 133u;
 
 var<workgroup> tess_cp: array<vec4<f32>, 16>;
 var<workgroup> tess_grid: vec4<u32>;
+var<workgroup> tess_edges: vec4<u32>;
 var<workgroup> tess_back: array<atomic<u32>, TESS_BACK_WORDS>;
 var<workgroup> tess_backface: atomic<u32>;
 
-// Segments (nu, nv) of the patch whose Euclidean camera-space control points are `e`; (0, 0)
-// when it is culled: wholly in front of the near plane or beyond the far one, or (in front of
-// the eye) its projected control points' bound misses the image. A patch crossing the near
-// plane is kept at the most segments: the rasterizer clips its triangles. Otherwise each
-// side's rate is the longest projected control polygon along it (which bounds the curve's
-// length) over mp_size, rounded up, in 1..max_rate. Twin: raster_peer::grid_rate.
-fn grid_rate(e: array<vec3<f32>, 16>) -> vec2<u32> {
+// A patch's grid: `n` = (nu, nv) segments, (0, 0) when culled; `edges` the segments of its
+// boundary curves v = 0, v = 1 (along u, at most nu) and u = 0, u = 1 (along v, at most nv).
+struct GridRate {
+    n: vec2<u32>,
+    edges: vec4<u32>,
+}
+
+// The segments of the patch whose Euclidean camera-space control points are `e`; culled when
+// wholly in front of the near plane or beyond the far one, or (in front of the eye) when its
+// projected control points' bound misses the image. A patch crossing the near plane is kept
+// at the most segments: the rasterizer clips its triangles. Otherwise each direction's rate is
+// the longest projected control polygon along it (which bounds the curve's length) over
+// mp_size, rounded up, in 1..max_rate; and each boundary's rate is its own control polygon's
+// (as a hardware tessellator's outer levels): it depends only on the 4 control points the
+// patch shares with its neighbour there, so both place the same points on the shared curve
+// and no T-junction cracks open (edge_param). Twin: raster_peer::grid_rate.
+fn grid_rate(e: array<vec3<f32>, 16>) -> GridRate {
     var zmin = 3.0e38;
     var zmax = -3.0e38;
     for (var k = 0u; k < 16u; k++) {
         zmin = min(zmin, e[k].z);
         zmax = max(zmax, e[k].z);
     }
-    if zmax < frame.near || zmin > frame.far { return vec2<u32>(0u); }
-    if zmin < frame.near { return vec2<u32>(tess.max_rate); }
+    if zmax < frame.near || zmin > frame.far { return GridRate(vec2<u32>(0u), vec4<u32>(0u)); }
+    if zmin < frame.near { return GridRate(vec2<u32>(tess.max_rate), vec4<u32>(tess.max_rate)); }
     var s: array<vec2<f32>, 16>;
     var lo = vec2<f32>(3.0e38);
     var hi = vec2<f32>(-3.0e38);
@@ -86,19 +98,32 @@ fn grid_rate(e: array<vec3<f32>, 16>) -> vec2<u32> {
         hi = max(hi, s[k]);
     }
     if hi.x < 0.0 || hi.y < 0.0 || lo.x > f32(frame.width) || lo.y > f32(frame.height) {
-        return vec2<u32>(0u);
+        return GridRate(vec2<u32>(0u), vec4<u32>(0u));
     }
-    var len = vec2<f32>(0.0);
+    // Row a along u in .x, column a along v in .y.
+    var len: array<vec2<f32>, 4>;
     for (var a = 0u; a < 4u; a++) {
-        var l = vec2<f32>(0.0);
         for (var b = 0u; b < 3u; b++) {
-            l.x += distance(s[4u * a + b + 1u], s[4u * a + b]);
-            l.y += distance(s[4u * (b + 1u) + a], s[4u * b + a]);
+            len[a].x += distance(s[4u * a + b + 1u], s[4u * a + b]);
+            len[a].y += distance(s[4u * (b + 1u) + a], s[4u * b + a]);
         }
-        len = max(len, l);
     }
+    let n = segments(max(max(len[0], len[1]), max(len[2], len[3])));
+    return GridRate(n, vec4<u32>(segments(vec2<f32>(len[0].x, len[3].x)),
+                                 segments(vec2<f32>(len[0].y, len[3].y))));
+}
+
+// Segments for curves of projected lengths `len` (pixels): one per mp_size, in 1..max_rate.
+fn segments(len: vec2<f32>) -> vec2<u32> {
     let n = min(ceil(len / frame.mp_size), vec2<f32>(f32(tess.max_rate)));
     return vec2<u32>(max(n, vec2<f32>(1.0)));
+}
+
+// The parameter of point i of n along a boundary of `e` <= n segments: round(i e / n) / e in
+// integers, so the boundary's points lie only at its own k / e (several points of the grid
+// coincide there: zero-area triangles); i / n when e = n.
+fn edge_param(i: u32, n: u32, e: u32) -> f32 {
+    return f32((2u * i * e + n) / (2u * n)) / f32(e);
 }
 
 fn tess_is_back(k: u32) -> bool {
@@ -117,7 +142,8 @@ fn tessellate(@builtin(workgroup_id) wg: vec3<u32>,
     if lid == 0u {
         var e: array<vec3<f32>, 16>;
         for (var k = 0u; k < 16u; k++) { e[k] = tess_cp[k].xyz / tess_cp[k].w; }
-        let r = grid_rate(e);
+        let rate = grid_rate(e);
+        let r = rate.n;
         var g = vec4<u32>(0u);
         if r.x == 0u {
             atomicAdd(&tess_counts[T_CULLED], 1u);
@@ -133,11 +159,14 @@ fn tessellate(@builtin(workgroup_id) wg: vec3<u32>,
                 atomicAdd(&tess_counts[T_OVER], 1u);
             }
         }
-        grids[id] = g;
+        grids[2u * id] = g;
+        grids[2u * id + 1u] = rate.edges;
         tess_grid = g;
+        tess_edges = rate.edges;
     }
     let g = workgroupUniformLoad(&tess_grid);
     if g.x == 0u { return; }
+    let edges = tess_edges;
     let nu = g.x;
     let nv = g.y;
     let cols = nu + 1u;
@@ -157,8 +186,14 @@ fn tessellate(@builtin(workgroup_id) wg: vec3<u32>,
     let near = frame.near;
     let scale = 2.0 * frame.focal / (vec2<f32>(f32(frame.width), f32(frame.height)) * near);
     for (var k = lid; k < cols * (nv + 1u); k += 64u) {
-        let u = f32(k % cols) / f32(nu);
-        let v = f32(k / cols) / f32(nv);
+        let i = k % cols;
+        let j = k / cols;
+        var u = f32(i) / f32(nu);
+        var v = f32(j) / f32(nv);
+        if j == 0u { u = edge_param(i, nu, edges.x); }
+        if j == nv { u = edge_param(i, nu, edges.y); }
+        if i == 0u { v = edge_param(j, nv, edges.z); }
+        if i == nu { v = edge_param(j, nv, edges.w); }
         // As dice_grid in dice_shade.wgsl, for the root item (uv = 0..1).
         let e = eval_surface(&cp, &w, rational, u, v);
         let n = patch_normal(&cp, &w, rational, e, u, v, flip);
