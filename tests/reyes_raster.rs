@@ -154,7 +154,7 @@ fn tessellation_equals_the_cpu_evaluation_of_each_patch() {
 /// covered, in both) differ by more than 8 sRGB steps in at most 10% of them (measured: 70 of
 /// 901, 7.8%): nearly all along the lid's rim, where the lid and the body's opening lie within
 /// a pixel of each other and the two tessellations order them differently in depth in spots.
-/// Depth where both cover agrees within 2% (a chord of a curved patch against a finer one).
+/// Depth where both cover agrees within 1% at 95% of those pixels (measured: 1253 of 1268).
 #[test]
 fn teapot_image_is_the_reyes_image_but_at_edges() {
     let s = scene::builtin_teapot();
@@ -211,10 +211,24 @@ fn teapot_image_is_the_reyes_image_but_at_edges() {
         "{off} of {interior} interior pixels"
     );
     assert!(d.psnr_db >= 25.0, "PSNR {:.1} dB", d.psnr_db);
-    // Depth where both cover: the same surface within 2% (different tessellations).
-    let z = (img.depth.iter().zip(&reyes.depth))
+    // Depth where both cover: the same surface within 1% (a chord of a curved patch against
+    // a finer one) but where the two order close surfaces differently or a pixel's nearest
+    // sample is of another surface at an edge.
+    let both: Vec<(f32, f32)> = (img.depth.iter().zip(&reyes.depth))
         .filter(|(a, b)| **a < 1e30 && **b < 1e30)
-        .map(|(a, b)| (a - b).abs() / b)
-        .fold(0f32, f32::max);
-    assert!(z < 0.02, "depth differs by {z}");
+        .map(|(a, b)| (*a, *b))
+        .collect();
+    let close = both
+        .iter()
+        .filter(|(a, b)| (a - b).abs() <= 0.01 * b)
+        .count();
+    eprintln!(
+        "teapot: depth within 1% at {close} of {} pixels",
+        both.len()
+    );
+    assert!(
+        close * 100 >= 95 * both.len(),
+        "depth within 1% at {close} of {}",
+        both.len()
+    );
 }
