@@ -566,6 +566,65 @@ fn bench_prints_its_report_as_json() {
     }
 }
 
+/// `reyes bench --peer raster --frames 2` times the raster peer on the same frames and reports
+/// both renderers: the peer's timing, MSAA count (4 for the 2x2 pixel samples
+/// asked) and its image difference against Reyes on the first and
+/// last frame, in the JSON and in the table. Needs the GPU (lavapipe).
+#[test]
+fn bench_with_the_raster_peer_reports_both() {
+    let dir = scratch("bench-peer");
+    let common = [
+        "bench",
+        "--frames",
+        "2",
+        "--warmup",
+        "1",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--samples",
+        "2",
+        "--turntable",
+        "--peer",
+        "raster",
+    ];
+    let (code, out, err) = reyes_any(&dir, &[&common[..], &["--json"]].concat());
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap_or_else(|e| panic!("{e}: {out}"));
+    assert_eq!(v["frames"], 2);
+    assert!(v["micropolygons"]["median"].as_f64().unwrap() > 100.0);
+    let p = &v["peer"];
+    assert_eq!(p["peer"], "raster");
+    assert_eq!(
+        (p["msaa_samples"].as_u64(), p["msaa_wanted"].as_u64()),
+        (Some(4), Some(4))
+    );
+    assert!(p["wall_ms"]["median"].as_f64().unwrap() > 0.0);
+    assert!(p["gpu_ms"].is_null() || p["gpu_ms"]["median"].as_f64().unwrap() > 0.0);
+    assert!(p["fps"].as_f64().unwrap() > 0.0);
+    assert!(p["triangles"]["median"].as_f64().unwrap() > 1000.0);
+    assert_eq!(p["per_frame"].as_array().unwrap().len(), 2);
+    let d = p["difference"].as_array().unwrap();
+    let angles: Vec<f64> = d.iter().map(|x| x["angle_deg"].as_f64().unwrap()).collect();
+    assert_eq!(angles, [0.0, 180.0]);
+    for x in d {
+        // Same frames, same surfaces: most pixels agree (edges differ; tests/reyes_raster.rs).
+        assert!(x["psnr_db"].as_f64().unwrap() > 20.0, "{x}");
+        assert!(x["over"].as_f64().unwrap() < 0.2, "{x}");
+        assert!(x["covered_peer"].as_u64().unwrap() > 300, "{x}");
+    }
+    let (code, out, err) = reyes_any(&dir, &common);
+    assert_eq!(code, 0, "{err}");
+    for label in [
+        "peer raster: 4x MSAA",
+        "triangles",
+        "image vs Reyes at 0.0 deg: PSNR",
+    ] {
+        assert!(out.contains(label), "no `{label}` in the table: {out}");
+    }
+}
+
 /// Little-endian PFM (`reyes render --float`, `--depth`): width, height, channels and the
 /// samples top row first.
 fn read_pfm(p: &Path) -> (usize, usize, usize, Vec<f32>) {

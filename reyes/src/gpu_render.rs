@@ -56,6 +56,7 @@ pub fn program_for(features: SceneFeatures) -> Result<Program, RunError> {
             &features.wgsl(),
             shaders::COMMON,
             shaders::SHADE,
+            shaders::SURFACE,
             shaders::SAMPLE,
         ]
         .concat(),

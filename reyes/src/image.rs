@@ -5,6 +5,19 @@
 use crate::stages::shade::srgb_encode;
 use std::path::Path;
 
+/// How far one image is from another ([`FrameImage::difference`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImageDifference {
+    /// Peak signal-to-noise ratio of the 8-bit RGBA encodings, dB (infinite when equal).
+    pub psnr_db: f64,
+    /// Share of pixels differing by more than `threshold` steps in some channel.
+    pub over: f64,
+    /// Steps (of 255) a pixel may differ by without counting in `over`.
+    pub threshold: u8,
+    /// Largest difference of a channel, in steps.
+    pub max: u8,
+}
+
 /// Straight (not premultiplied) linear RGBA with coverage as alpha, and the nearest depth per
 /// pixel (3e38 where the background shows).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -44,6 +57,35 @@ impl FrameImage {
         let max = d.iter().copied().max().unwrap_or(0);
         let over = d.iter().filter(|&&v| v > 2).count() as f64 / d.len().max(1) as f64;
         (max, over)
+    }
+
+    /// How far this image is from `reference` (the same size) in their 8-bit encodings
+    /// ([`FrameImage::rgba8`]: colour in sRGB steps, alpha in 1/255): the PSNR over every
+    /// channel of every pixel, and the share of pixels differing by more than `threshold`
+    /// steps in some channel.
+    pub fn difference(&self, reference: &FrameImage, threshold: u8) -> ImageDifference {
+        let (x, y) = (self.rgba8(), reference.rgba8());
+        let mut sq = 0f64;
+        let (mut over, mut max) = (0usize, 0u8);
+        for (p, q) in x.chunks(4).zip(y.chunks(4)) {
+            let d = (0..4).map(|c| p[c].abs_diff(q[c])).max().unwrap();
+            sq += (0..4)
+                .map(|c| (p[c] as f64 - q[c] as f64).powi(2))
+                .sum::<f64>();
+            over += (d > threshold) as usize;
+            max = max.max(d);
+        }
+        let mse = sq / x.len().max(1) as f64;
+        ImageDifference {
+            psnr_db: if mse > 0.0 {
+                10.0 * (255.0f64 * 255.0 / mse).log10()
+            } else {
+                f64::INFINITY
+            },
+            over: over as f64 / (x.len() / 4).max(1) as f64,
+            threshold,
+            max,
+        }
     }
 
     /// Pixels with any coverage.

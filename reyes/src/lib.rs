@@ -15,6 +15,7 @@ pub mod orbit;
 pub mod output;
 pub mod present;
 pub mod progress;
+pub mod raster_peer;
 pub mod realtime;
 pub mod reference;
 pub mod scene;

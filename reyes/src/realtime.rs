@@ -73,6 +73,64 @@ pub struct Orbit {
     pub pad: [u32; 2],
 }
 
+impl Orbit {
+    /// The frame at turntable `angle` (radians) of a scene of `patches` patches turning about
+    /// `centre` ([`orbit::orbit_matrix`]), with `make_roots`'s dispatch row (64 threads a group).
+    pub fn at(centre: glam::DVec3, angle: f64, patches: u32) -> Orbit {
+        Orbit::from_transform(orbit::orbit_transform(centre, angle), patches)
+    }
+
+    /// The frame of camera-space transform `transform` (affine, f64, applied on the GPU in
+    /// f32; e.g. [`crate::camera::ViewCamera::transform`]).
+    pub fn from_transform(transform: DMat4, patches: u32) -> Orbit {
+        let (_, row) = dispatch_2d(patches as u64, 64);
+        Orbit {
+            m: (transform.to_cols_array_2d()).map(|col| col.map(|v| v as f32)),
+            patches,
+            row,
+            pad: [0; 2],
+        }
+    }
+}
+
+/// The scene as the renderers of many frames upload it once (this module's and
+/// [`crate::raster_peer`]'s): the object table of homogeneous control points and the tables of
+/// [`FrameData`] that common.wgsl binds (group 1: frame, materials, lights, patch info,
+/// primitive variables).
+pub(crate) struct SceneTables {
+    /// Homogeneous control points (x w, y w, z w, w), 16 per patch, cp[4*v + u], whose xyz
+    /// are the host's root item and whose w its patch's weight table
+    /// (frame::homogeneous_points: weights scaled to a largest of 1); `objects` in roots.wgsl.
+    pub objects: wgpu::Buffer,
+    pub frame: wgpu::Buffer,
+    pub materials: wgpu::Buffer,
+    pub lights: wgpu::Buffer,
+    pub infos: wgpu::Buffer,
+    pub primvars: wgpu::Buffer,
+}
+
+impl SceneTables {
+    /// Uploads `scene`'s patches and `base`'s tables. Errors: a table beyond the device's
+    /// binding limit.
+    pub(crate) fn upload(
+        gpu: &Gpu,
+        scene: &Scene,
+        base: &FrameData,
+    ) -> Result<SceneTables, RunError> {
+        let objects: Vec<[f32; 4]> = (scene.patches.iter())
+            .flat_map(crate::frame::homogeneous_points)
+            .collect();
+        Ok(SceneTables {
+            objects: gpu.upload("patch table", &objects)?,
+            frame: gpu.upload("frame", &[base.frame])?,
+            materials: gpu.upload("materials", &base.materials)?,
+            lights: gpu.upload("lights", &base.lights)?,
+            infos: gpu.upload("patch info", &base.patch_info)?,
+            primvars: gpu.upload("primvars", &base.primvars)?,
+        })
+    }
+}
+
 /// What a frame brings back to the host besides its status.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Pixels {
@@ -152,7 +210,7 @@ pub struct RealtimeRenderer {
     depth: wgpu::Buffer,
     rgba8: wgpu::Buffer,
     /// Kept alive for the bind groups.
-    _tables: Vec<wgpu::Buffer>,
+    _tables: (SceneTables, Vec<wgpu::Buffer>),
     slots: Vec<Slot>,
     timer: SpanTimer,
     /// The pipelined run; `None` when frames are not pipelined (`not_pipelined` says why).
@@ -183,18 +241,15 @@ impl RealtimeRenderer {
         let renderer = GpuRenderer::for_features(gpu, strategy, false, base.features())?;
         let f = base.frame;
         let n = scene.patches.len() as u32;
-        // The object table: homogeneous control points (x w, y w, z w, w), cp[4*v + u], whose
-        // xyz are the host's root item and whose w its patch's weight table
-        // (frame::homogeneous_points: weights scaled to a largest of 1).
-        let objects: Vec<[f32; 4]> = (scene.patches.iter())
-            .flat_map(crate::frame::homogeneous_points)
-            .collect();
-        let objects = gpu.upload("patch table", &objects)?;
-        let frame_buf = gpu.upload("frame", &[f])?;
-        let materials = gpu.upload("materials", &base.materials)?;
-        let lights = gpu.upload("lights", &base.lights)?;
-        let infos = gpu.upload("patch info", &base.patch_info)?;
-        let primvars = gpu.upload("primvars", &base.primvars)?;
+        let tables = SceneTables::upload(gpu, scene, &base)?;
+        let SceneTables {
+            objects,
+            frame: frame_buf,
+            materials,
+            lights,
+            infos,
+            primvars,
+        } = &tables;
         let pixels_n = f.width as u64 * f.height as u64;
         let spp = (f.spp_x * f.spp_y) as u64;
         let samples = gpu.storage_buffer("samples", pixels_n * spp * 2)?;
@@ -206,7 +261,7 @@ impl RealtimeRenderer {
             "reyes scene",
             &renderer.user_layout,
             &[
-                &frame_buf, &materials, &lights, &infos, &samples, &counters, &primvars,
+                frame_buf, materials, lights, infos, &samples, &counters, primvars,
             ],
         );
         let (resolve, resolve_groups) = resolve_params(&f);
@@ -235,7 +290,7 @@ impl RealtimeRenderer {
             let roots_bind = gpu.bind_buffers(
                 "roots",
                 &roots_pipeline.get_bind_group_layout(0),
-                &[&orbit, &objects, &roots],
+                &[&orbit, objects, &roots],
             );
             slots.push(Slot {
                 orbit,
@@ -261,15 +316,7 @@ impl RealtimeRenderer {
             rgba,
             depth,
             rgba8,
-            _tables: vec![
-                objects,
-                frame_buf,
-                materials,
-                lights,
-                infos,
-                resolve_buf,
-                rgba8_buf,
-            ],
+            _tables: (tables, vec![resolve_buf, rgba8_buf]),
             slots,
             timer: SpanTimer::new(gpu, IN_FLIGHT as u32),
             recorded: None,
@@ -477,15 +524,7 @@ impl RealtimeRenderer {
     /// Records and submits one frame in ring slot `slot`.
     fn submit(&self, gpu: &Gpu, slot: usize, transform: DMat4) -> Result<InFlight, RunError> {
         let s = &self.slots[slot];
-        let (_, row) = dispatch_2d(self.patches as u64, 64);
-        let orbit = Orbit {
-            m: transform
-                .to_cols_array_2d()
-                .map(|col| col.map(|v| v as f32)),
-            patches: self.patches,
-            row,
-            pad: [0; 2],
-        };
+        let orbit = Orbit::from_transform(transform, self.patches);
         gpu.queue
             .write_buffer(&s.orbit, 0, bytemuck::bytes_of(&orbit));
         let recorded = self.recorded.clone();
@@ -700,7 +739,7 @@ impl RealtimeRenderer {
 
 /// A `MAP_READ | COPY_DST` buffer of `words` u32 words (at least 2, an even count: maps are
 /// 8-byte granular).
-fn map_buffer(gpu: &Gpu, label: &str, words: u64) -> Result<wgpu::Buffer, RunError> {
+pub(crate) fn map_buffer(gpu: &Gpu, label: &str, words: u64) -> Result<wgpu::Buffer, RunError> {
     let bytes = words.max(2).next_multiple_of(2) * 4;
     if bytes > gpu.device.limits().max_buffer_size {
         return Err(RunError::Device(format!(
@@ -716,7 +755,7 @@ fn map_buffer(gpu: &Gpu, label: &str, words: u64) -> Result<wgpu::Buffer, RunErr
 }
 
 /// The first `words` words of a mapped buffer; unmaps it.
-fn read_mapped(b: &wgpu::Buffer, words: u64) -> Result<Vec<u32>, RunError> {
+pub(crate) fn read_mapped(b: &wgpu::Buffer, words: u64) -> Result<Vec<u32>, RunError> {
     let out = {
         let view = b
             .slice(..)

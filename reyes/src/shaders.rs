@@ -7,9 +7,13 @@ pub const BOUND: &str = include_str!("../../shaders/reyes/bound.wgsl");
 pub const SPLIT: &str = include_str!("../../shaders/reyes/split.wgsl");
 pub const SHADE: &str = include_str!("../../shaders/reyes/shade.wgsl");
 pub const SAMPLE: &str = include_str!("../../shaders/reyes/sample.wgsl");
+pub const SURFACE: &str = include_str!("../../shaders/reyes/surface.wgsl");
 pub const DICE_SHADE: &str = include_str!("../../shaders/reyes/dice_shade.wgsl");
 pub const RESOLVE: &str = include_str!("../../shaders/reyes/resolve.wgsl");
 pub const ROOTS: &str = include_str!("../../shaders/reyes/roots.wgsl");
 pub const RGBA8: &str = include_str!("../../shaders/reyes/rgba8.wgsl");
 /// The viewer's draw of a frame to a window (`reyes view`; twin: [`crate::present`]).
 pub const PRESENT: &str = include_str!("../../shaders/reyes/present.wgsl");
+pub const TESSELLATE: &str = include_str!("../../shaders/reyes/tessellate.wgsl");
+pub const RASTER_DRAW: &str = include_str!("../../shaders/reyes/raster_draw.wgsl");
+pub const RASTER_RESOLVE: &str = include_str!("../../shaders/reyes/raster_resolve.wgsl");

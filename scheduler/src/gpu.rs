@@ -94,7 +94,8 @@ impl Gpu {
     }
 
     /// Opens a device on `adapter` with `required` features plus those the scheduler benefits
-    /// from when present (`MEMORY_DECORATION_COHERENT`, `TIMESTAMP_QUERY`), the adapter's
+    /// from when present (`MEMORY_DECORATION_COHERENT`, `TIMESTAMP_QUERY`,
+    /// `TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES`), the adapter's
     /// storage and workgroup-memory limits, and 256 invocations per workgroup. Errors:
     /// [`RunError::NoAdapter`] when the adapter lacks `required` or `request_device` fails.
     pub fn from_adapter(adapter: wgpu::Adapter, required: wgpu::Features) -> Result<Gpu, RunError> {
@@ -107,7 +108,11 @@ impl Gpu {
                 required - available
             )));
         }
-        let wanted = wgpu::Features::MEMORY_DECORATION_COHERENT | wgpu::Features::TIMESTAMP_QUERY;
+        // TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES: render targets with the sample counts the
+        // adapter supports beyond WebGPU's 1 and 4 (reyes's raster peer: 8 or 16 MSAA samples).
+        let wanted = wgpu::Features::MEMORY_DECORATION_COHERENT
+            | wgpu::Features::TIMESTAMP_QUERY
+            | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES;
         let features = (available & wanted) | required;
         let alimits = adapter.limits();
         let limits = wgpu::Limits {

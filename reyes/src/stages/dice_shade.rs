@@ -1,4 +1,4 @@
-//! Twin of `shaders/reyes/dice_shade.wgsl`: the grid of points with normals from the patch's
+//! Twin of `shaders/reyes/dice_shade.wgsl` and `surface.wgsl`: the grid of points with normals from the patch's
 //! derivatives, shaded; then every micropolygon sampled.
 
 use super::sample::{Cover, micropolygon_dilation, sample_micropolygon, sample_near_clipped};
@@ -18,7 +18,7 @@ fn bern2(t: f32) -> [f32; 3] {
 
 /// Position, d/du, d/dv of a polynomial patch (`cp` the points) at (u, v). The tangents come from the
 /// hodograph (differences of neighbouring control points), so they are exactly zero where
-/// control points coincide (see `eval_patch` in dice_shade.wgsl).
+/// control points coincide (see `eval_patch` in surface.wgsl).
 pub fn eval_patch(cp: &ControlNet, u: f32, v: f32) -> [Vec3; 3] {
     let (bu, bv, hu, hv) = (bern3(u), bern3(v), bern2(u), bern2(v));
     let (mut p, mut pu, mut pv) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
@@ -39,7 +39,7 @@ pub fn eval_patch(cp: &ControlNet, u: f32, v: f32) -> [Vec3; 3] {
 
 /// Position, d/du, d/dv of a rational item (homogeneous xyz `cp`, weights `w`) at (u, v): the
 /// 4D sum and its hodograph as in [`eval_patch`], then the quotient rule P = X/w,
-/// Pu = (Xu - wu P)/w (`eval_rational` in dice_shade.wgsl).
+/// Pu = (Xu - wu P)/w (`eval_rational` in surface.wgsl).
 pub fn eval_rational(cp: &ControlNet, w: &Weights, u: f32, v: f32) -> [Vec3; 3] {
     let (bu, bv, hu, hv) = (bern3(u), bern3(v), bern2(u), bern2(v));
     let (mut x, mut xu, mut xv) = (Vec4::ZERO, Vec4::ZERO, Vec4::ZERO);
@@ -88,7 +88,7 @@ pub fn net_steps2(cp: &ControlNet) -> [f32; 2] {
 }
 
 /// [`net_steps2`] of a rational item (homogeneous xyz, weights): squares of s_u, s_v with
-/// |Pu| <= 3 s_u, s_u = (wmax du + dwu r) / wmin (`net_steps2_rational` in dice_shade.wgsl
+/// |Pu| <= 3 s_u, s_u = (wmax du + dwu r) / wmin (`net_steps2_rational` in surface.wgsl
 /// derives it).
 pub fn net_steps2_rational(cp: &ControlNet, w: &Weights) -> [f32; 2] {
     let (mut lo, mut hi) = (Vec3::splat(3.0e38), Vec3::splat(-3.0e38));
@@ -124,7 +124,7 @@ pub fn net_steps2_rational(cp: &ControlNet, w: &Weights) -> [f32; 2] {
 /// The outside normal. Where it is degenerate (a vanishing tangent at a collapsed edge, or
 /// parallel tangents) it is taken 1e-3, 1e-2, then 1e-1 of the way to the centre until
 /// |Pu x Pv| reaches 1e-3 of its largest possible value on the patch; with no tangent plane
-/// anywhere (all control points equal) it is the direction to the eye. See dice_shade.wgsl.
+/// anywhere (all control points equal) it is the direction to the eye. See surface.wgsl.
 /// `cp` is an item's net; `w` its weights if its patch is rational ([`item_weights`]).
 pub fn patch_normal(cp: &ControlNet, w: Option<&Weights>, u: f32, v: f32, flip: bool) -> Vec3 {
     patch_normal_at(cp, w, eval_surface(cp, w, u, v), u, v, flip)
@@ -164,7 +164,7 @@ pub fn patch_normal_at(
     if flip { -n } else { n }
 }
 
-/// `color_field` in dice_shade.wgsl: the value at (u, v) of the original patch of the colour
+/// `color_field` in surface.wgsl: the value at (u, v) of the original patch of the colour
 /// field `field` (`PatchInfo::cs` or `os`, not 0) in the primitive-variable table.
 pub fn color_field(table: &[[f32; 4]], field: u32, u: f32, v: f32) -> Vec3 {
     let at = (field >> 2) as usize;
@@ -189,7 +189,7 @@ pub fn color_field(table: &[[f32; 4]], field: u32, u: f32, v: f32) -> Vec3 {
     }
 }
 
-/// `original_uv` in dice_shade.wgsl: (u, v) of the item's own square in its original patch.
+/// `original_uv` in surface.wgsl: (u, v) of the item's own square in its original patch.
 pub fn original_uv(item: &PatchItem, u: f32, v: f32) -> (f32, f32) {
     (
         item.uv[0] + (item.uv[1] - item.uv[0]) * u,

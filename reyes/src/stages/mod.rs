@@ -60,7 +60,7 @@ pub fn set_cp_point(cp: &mut ControlNet, i: usize, p: Vec3) {
 }
 
 /// Homogeneous control point `i` of a rational item, `(x w, y w, z w, w)` (`cp_h` in
-/// dice_shade.wgsl).
+/// surface.wgsl).
 pub fn cp_h(cp: &ControlNet, w: &Weights, i: usize) -> Vec4 {
     cp_point(cp, i).extend(w[i])
 }

@@ -2,10 +2,13 @@
 //! [--strategy NAME] [render options]`: frames of a (turning) scene by the persistent pipelined
 //! renderer (`reyes::realtime`): per-frame wall and GPU ms (median, p95) and frames per second,
 //! as a table or one JSON object ([`BenchReport`], keys in docs/reyes.md). On a terminal a
-//! progress bar counts the frames (`reyes::progress`).
+//! progress bar counts the frames (`reyes::progress`). With `--peer raster`, the raster peer
+//! (`reyes::raster_peer`) timed the same way on the same frames, and its image against the
+//! Reyes image of the first and last timed frame ([`PeerReport`]).
 
-use crate::cli::BenchCmd;
+use crate::cli::{BenchCmd, Peer};
 use reyes::gpu_render::{WARM_UP, required_features};
+use reyes::raster_peer::{PeerFrame, RasterPeer};
 use reyes::realtime::{Pixels, RealtimeFrame, RealtimeRenderer};
 use reyes::stages::C_MICROPOLYGONS;
 use scheduler::Gpu;
@@ -84,6 +87,62 @@ pub struct BenchReport {
     /// Frames rendered again because their fixed sizes did not suffice.
     pub rerendered: u32,
     pub per_frame: Vec<FrameRow>,
+    /// `--peer`: the peer's timing and image difference; absent without it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub peer: Option<PeerReport>,
+}
+
+/// Steps (of 255, in the 8-bit sRGB image) a pixel of the peer may differ from Reyes's without
+/// counting as different (`PeerDifference::over`).
+pub const DIFFERENCE_STEPS: u8 = 8;
+
+/// The peer of `--peer`, timed as the Reyes frames are (same angles, warm-up, pipelining).
+#[derive(Debug, Serialize)]
+pub struct PeerReport {
+    /// `raster`.
+    pub peer: String,
+    /// MSAA samples the peer draws with, and the frame's pixel samples N*M it stands for
+    /// (the nearest count the adapter supports when it cannot do N*M).
+    pub msaa_samples: u32,
+    pub msaa_wanted: u32,
+    pub wall_ms: Summary,
+    pub gpu_ms: Option<Summary>,
+    pub fps: f64,
+    /// Triangles drawn per frame (culled back faces not counted).
+    pub triangles: Summary,
+    /// Frames drawn again because their triangles did not fit the buffers.
+    pub redrawn: u32,
+    /// What the peer draws differently from what the scene asks (transparency drawn opaque).
+    pub warnings: Vec<String>,
+    /// The peer's image against Reyes's, on the first and last timed frame.
+    pub difference: Vec<PeerDifference>,
+    pub per_frame: Vec<PeerRow>,
+}
+
+/// The peer's image against the Reyes image of one frame (`FrameImage::difference`).
+#[derive(Debug, Serialize)]
+pub struct PeerDifference {
+    pub angle_deg: f64,
+    /// PSNR of the 8-bit RGBA images, dB; null when they are equal.
+    pub psnr_db: Option<f64>,
+    /// Share of pixels differing by more than `threshold_steps` in some channel.
+    pub over: f64,
+    pub threshold_steps: u8,
+    /// Largest difference of a channel, in steps.
+    pub max_steps: u8,
+    /// Pixels with any coverage, in each image.
+    pub covered_reyes: usize,
+    pub covered_peer: usize,
+}
+
+/// One timed frame of the peer.
+#[derive(Debug, Serialize)]
+pub struct PeerRow {
+    pub angle_deg: f64,
+    pub wall_ms: f64,
+    pub gpu_ms: Option<f64>,
+    pub triangles: u64,
+    pub redrawn: Option<String>,
 }
 
 pub fn main(a: BenchCmd) -> Result<(), String> {
@@ -124,13 +183,91 @@ pub fn main(a: BenchCmd) -> Result<(), String> {
         reyes::output::write_atomic(out, &reyes::output::png(&img)?)?;
         eprintln!("wrote {}", out.display());
     }
-    let report = report(&a, &name, &gpu, strategy, &r, step, &frames, &timed);
+    let peer = match a.peer {
+        Some(Peer::Raster) => {
+            let o = (&scene, &options);
+            Some(raster_peer(&gpu, o, &all, a.warmup, &timed, &mut r).map_err(|e| e.to_string())?)
+        }
+        None => None,
+    };
+    let mut report = report(&a, &name, &gpu, strategy, &r, step, &frames, &timed);
+    report.peer = peer;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report).unwrap());
     } else {
         print_table(&report);
     }
     Ok(())
+}
+
+/// Times the raster peer on `all` angles (the first `warmup` untimed) and compares its image
+/// with the Reyes renderer's on the first and last of `timed`.
+fn raster_peer(
+    gpu: &Gpu,
+    (scene, options): (&reyes::scene::Scene, &reyes::frame::RenderOptions),
+    all: &[f64],
+    warmup: u32,
+    timed: &[f64],
+    r: &mut RealtimeRenderer,
+) -> Result<PeerReport, scheduler::RunError> {
+    let mut p = RasterPeer::new(gpu, scene, options, Pixels::None)?;
+    let warnings = p.warnings();
+    for w in &warnings {
+        log::warn!("{w}");
+    }
+    let mut frames: Vec<PeerFrame> = p.render(gpu, all)?;
+    frames.drain(..warmup as usize);
+    let mut check = vec![timed[0]];
+    if timed.len() > 1 && timed[timed.len() - 1] != timed[0] {
+        check.push(timed[timed.len() - 1]);
+    }
+    r.set_pixels(gpu, Pixels::Float)?;
+    p.set_pixels(gpu, Pixels::Float)?;
+    let reyes = r.render(gpu, &check)?;
+    let peer = p.render(gpu, &check)?;
+    let difference = (reyes.iter().zip(&peer).zip(&check))
+        .map(|((a, b), angle)| {
+            let (ra, pb) = (a.image.as_ref().unwrap(), b.image.as_ref().unwrap());
+            let d = pb.difference(ra, DIFFERENCE_STEPS);
+            PeerDifference {
+                angle_deg: angle.to_degrees(),
+                psnr_db: d.psnr_db.is_finite().then_some(d.psnr_db),
+                over: d.over,
+                threshold_steps: d.threshold,
+                max_steps: d.max,
+                covered_reyes: ra.covered_pixels(),
+                covered_peer: pb.covered_pixels(),
+            }
+        })
+        .collect();
+    let (_, _, spp) = p.frame_size();
+    let wall: Vec<f64> = frames.iter().map(|f| f.wall_ms).collect();
+    let gpu_ms: Option<Vec<f64>> = frames.iter().map(|f| f.gpu_ms).collect();
+    let tri: Vec<f64> = (frames.iter())
+        .map(|f| f.counts.triangles() as f64)
+        .collect();
+    Ok(PeerReport {
+        peer: "raster".into(),
+        msaa_samples: p.msaa_samples(),
+        msaa_wanted: spp[0] * spp[1],
+        wall_ms: Summary::of(&wall).expect("at least one frame"),
+        gpu_ms: gpu_ms.as_deref().and_then(Summary::of),
+        fps: frames.len() as f64 / (wall.iter().sum::<f64>() / 1e3),
+        triangles: Summary::of(&tri).expect("at least one frame"),
+        redrawn: frames.iter().filter(|f| f.redrawn.is_some()).count() as u32,
+        warnings,
+        difference,
+        per_frame: frames
+            .iter()
+            .map(|f| PeerRow {
+                angle_deg: f.angle.to_degrees(),
+                wall_ms: f.wall_ms,
+                gpu_ms: f.gpu_ms,
+                triangles: f.counts.triangles(),
+                redrawn: f.redrawn.clone(),
+            })
+            .collect(),
+    })
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -180,6 +317,7 @@ fn report(
                 rerendered: f.rerendered.clone(),
             })
             .collect(),
+        peer: None,
     }
 }
 
@@ -224,6 +362,53 @@ fn print_table(r: &BenchReport) {
     reasons.dedup();
     for why in reasons.iter().take(3) {
         println!("  re-rendered: {why}");
+    }
+    if let Some(p) = &r.peer {
+        print_peer(p);
+    }
+}
+
+fn print_peer(p: &PeerReport) {
+    println!(
+        "peer {}: {}x MSAA{}",
+        p.peer,
+        p.msaa_samples,
+        if p.msaa_samples == p.msaa_wanted {
+            String::new()
+        } else {
+            format!(
+                " (the adapter cannot do {}, the frame's pixel samples)",
+                p.msaa_wanted
+            )
+        }
+    );
+    println!("{:<14} {:>10} {:>10}", "", "median", "p95");
+    let row = |label: &str, s: Option<&Summary>| match s {
+        Some(s) => println!("{label:<14} {:>10.3} {:>10.3}", s.median, s.p95),
+        None => println!("{label:<14} {:>10} {:>10}", "n/a", "n/a"),
+    };
+    row("wall ms", Some(&p.wall_ms));
+    row("GPU ms", p.gpu_ms.as_ref());
+    println!("{:<14} {:>10.0}", "triangles", p.triangles.median);
+    println!("{:<14} {:>10.1}", "fps", p.fps);
+    println!(
+        "{:<14} {:>10}",
+        "redrawn",
+        format!("{} of {}", p.redrawn, p.per_frame.len())
+    );
+    for d in &p.difference {
+        println!(
+            "image vs Reyes at {:.1} deg: PSNR {}, {:.2}% of pixels off by more than {}/255 \
+             (max {}), covered {} vs {}",
+            d.angle_deg,
+            d.psnr_db
+                .map_or("inf".to_string(), |v| format!("{v:.1} dB")),
+            d.over * 100.0,
+            d.threshold_steps,
+            d.max_steps,
+            d.covered_peer,
+            d.covered_reyes
+        );
     }
 }
 

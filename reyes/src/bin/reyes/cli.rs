@@ -4,7 +4,7 @@
 //! scene file, a GPU error, a setting the renderer cannot make) are the subcommands' own and
 //! exit 1.
 
-use clap::{Args, Parser, Subcommand, value_parser};
+use clap::{Args, Parser, Subcommand, ValueEnum, value_parser};
 use reyes::accuracy::drift::PathOptions;
 use reyes::accuracy::exact_image::DEFAULT_SAMPLES_PER_AXIS;
 use reyes::frame::RenderOptions;
@@ -275,6 +275,13 @@ pub struct BenchCmd {
     #[arg(short = 'o', long = "output", value_name = "OUT.png")]
     pub out: Option<PathBuf>,
 
+    /// Also time a peer renderer on the same frames and report its image difference against
+    /// the Reyes image of the first and last timed frame. `raster`: the patches tessellated
+    /// in a compute pass and drawn as triangles by the hardware rasterizer with MSAA
+    /// (`reyes::raster_peer`; docs/reyes.md).
+    #[arg(long, value_name = "PEER")]
+    pub peer: Option<Peer>,
+
     #[command(flatten)]
     pub render: RenderArgs,
 }
@@ -301,6 +308,13 @@ pub struct ViewCmd {
 
     #[command(flatten)]
     pub render: RenderArgs,
+}
+
+/// A peer renderer of `reyes bench --peer`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Peer {
+    /// Tessellation to triangles and the hardware rasterizer with MSAA (`reyes::raster_peer`).
+    Raster,
 }
 
 /// `reyes sweep`: every scene x dicing setting x sample count x strategy. Its lists differ

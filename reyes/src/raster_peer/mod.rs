@@ -1,0 +1,891 @@
+//! The raster peer of `reyes bench --peer raster`: what a real-time developer would do instead
+//! of Reyes with the same patches. The patches are tessellated into triangles and drawn by the
+//! hardware rasterizer with MSAA, as engines do on APIs without tessellation shaders (wgpu has
+//! none): a compute pass does the hardware tessellator's work.
+//!
+//! Per frame, pipelined like [`crate::realtime`] (the same uploaded scene tables, the same
+//! [`Orbit`] turntable uniform, at most [`IN_FLIGHT`] frames submitted, the status read a
+//! frame late, no per-frame allocation):
+//! 1. `tessellate` (tessellate.wgsl), one workgroup per patch: its control points turned by
+//!    the frame's transform, culled by their bound (wholly in front of the near plane or
+//!    beyond the far one, or off screen; a patch crossing the near plane is kept: the
+//!    rasterizer clips), a rate per side from the projected control polygon so that
+//!    triangles are about `--mp-size` pixels ([`grid_rate`], at most [`MAX_RATE`] = 64 per
+//!    side, the hardware tessellator's maximum), then every grid point evaluated and shaded
+//!    with Reyes's shading (surface.wgsl, shade.wgsl: the same materials, lights, normals and
+//!    10-bit packed colour as DiceShade) into a [`RasterVertex`], two triangles per quad into
+//!    the index buffer (a quad of a one-sided patch whose four corners face away is culled as
+//!    Reyes's sampling culls it), and the indirect draw;
+//! 2. a render pass (raster_draw.wgsl) draws them indexed-indirect into a multisampled
+//!    colour (`Rgba16Float`, linear) and depth (`Depth32Float`, reversed: nearest greatest)
+//!    target, resolved by the hardware;
+//! 3. `raster_resolve` (raster_resolve.wgsl) makes the image Reyes's resolve makes: straight
+//!    linear RGB with coverage as alpha and the nearest camera-space depth, and rgba8.wgsl the
+//!    8-bit image.
+//!
+//! MSAA samples: the frame's pixel samples N x M when the adapter supports N*M for both
+//! targets ([`msaa_samples`]), else the nearest supported count (WebGPU guarantees 1 and 4).
+//!
+//! What it is not: Reyes's image. Triangles are flat between their vertices where Reyes dices
+//! to micropolygons sized per sub-patch (split until a grid fits), colour is interpolated per
+//! vertex (Gouraud) where Reyes gives a micropolygon the mean of its corners, sample positions
+//! are the hardware's standard pattern where Reyes jitters, there is no crack dilation (a
+//! patch's edge rate differs from its neighbour's, so T-junction cracks can show single
+//! samples), and transparency (Os < 1) is drawn opaque ([`RasterPeer::warnings`]): the peer
+//! has no order-independent transparency.
+//!
+//! Buffers are sized from the unturned frame ([`HEADROOM`] above its needs). A frame whose
+//! patches do not fit draws nothing (the indirect draw is empty), is found a frame late from
+//! its status, and is drawn again alone with buffers grown to its needs
+//! ([`PeerFrame::redrawn`]): a partial frame is never returned.
+
+mod tessellation;
+pub use tessellation::*;
+
+use crate::frame::{Frame, FrameData, RenderOptions};
+use crate::gpu_render::dispatch_2d;
+use crate::image::FrameImage;
+use crate::orbit;
+use crate::realtime::{HEADROOM, IN_FLIGHT, Orbit, Pixels, SceneTables, map_buffer, read_mapped};
+use crate::scene::Scene;
+use crate::shaders;
+use scheduler::timing::SpanTimer;
+use scheduler::{Gpu, RunError, storage_entry};
+use std::collections::VecDeque;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
+
+/// One finished frame of the peer.
+#[derive(Clone, Debug)]
+pub struct PeerFrame {
+    /// Turntable angle, radians.
+    pub angle: f64,
+    /// GPU time from the start of tessellation to the end of the image conversion (plus, for
+    /// a frame drawn again, its first attempt); `None` without timestamp queries.
+    pub gpu_ms: Option<f64>,
+    /// Host time between this frame's completion and the previous one's.
+    pub wall_ms: f64,
+    pub counts: TessCounts,
+    /// Why the frame was drawn again (its patches did not fit the buffers).
+    pub redrawn: Option<String>,
+    /// With [`Pixels::Rgba8`]: the 8-bit image, row-major RGBA.
+    pub rgba8: Option<Vec<u8>>,
+    /// With [`Pixels::Float`]: the f32 image and depth, as Reyes's resolve gives them.
+    pub image: Option<FrameImage>,
+}
+
+/// The MSAA sample count for `wanted` (the frame's N*M pixel samples): `wanted` when the
+/// adapter can render and resolve it for [`COLOR_FORMAT`] and render [`DEPTH_FORMAT`] with it
+/// (beyond WebGPU's 1 and 4 only with `TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES`), else the
+/// nearest count that it can (the larger of two as near).
+pub fn msaa_samples(gpu: &Gpu, wanted: u32) -> u32 {
+    let specific =
+        (gpu.device.features()).contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES);
+    let ok = |n: u32| {
+        if !specific {
+            return n == 1 || n == 4;
+        }
+        let c = gpu.adapter.get_texture_format_features(COLOR_FORMAT).flags;
+        let d = gpu.adapter.get_texture_format_features(DEPTH_FORMAT).flags;
+        c.sample_count_supported(n)
+            && d.sample_count_supported(n)
+            && (n == 1 || c.contains(wgpu::TextureFormatFeatureFlags::MULTISAMPLE_RESOLVE))
+    };
+    [1u32, 2, 4, 8, 16]
+        .into_iter()
+        .filter(|&n| ok(n))
+        .min_by_key(|&n| (n.abs_diff(wanted), u32::MAX - n))
+        .unwrap_or(1)
+}
+
+/// The peer's tessellation of the last frame drawn, read back ([`RasterPeer::geometry`]).
+#[derive(Clone, Debug)]
+pub struct Tessellation {
+    /// Per patch: `[nu, nv, first vertex, first quad]`, `nu = 0` when culled.
+    pub grids: Vec<[u32; 4]>,
+    /// Per patch: its boundaries' segments ([`GridRate::edges`]).
+    pub edges: Vec<[u32; 4]>,
+    pub vertices: Vec<RasterVertex>,
+    /// 6 per quad: triangles (a, b, c) and (a, c, d) of quad corners a b c d.
+    pub indices: Vec<u32>,
+    pub counts: TessCounts,
+}
+
+/// The vertex, index and draw buffers, sized for a number of vertices and quads.
+struct Geometry {
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    counts: wgpu::Buffer,
+    grids: wgpu::Buffer,
+    draw_args: wgpu::Buffer,
+    params: wgpu::Buffer,
+    vertex_capacity: u32,
+    quad_capacity: u32,
+}
+
+/// Buffers of one frame in flight.
+struct Slot {
+    orbit: wgpu::Buffer,
+    tess_bind: wgpu::BindGroup,
+    /// MAP_READ: the tessellation counters and the GPU timestamps.
+    status: wgpu::Buffer,
+    /// MAP_READ, per [`Pixels`].
+    pixels: Vec<wgpu::Buffer>,
+}
+
+struct InFlight {
+    angle: f64,
+    slot: usize,
+    submission: wgpu::SubmissionIndex,
+    maps: Vec<wgpu::Buffer>,
+    mapped: Arc<AtomicUsize>,
+    pixels: Pixels,
+}
+
+/// The raster peer: see the module documentation.
+pub struct RasterPeer {
+    base: FrameData,
+    centre: glam::DVec3,
+    patches: u32,
+    samples: u32,
+    tables: SceneTables,
+    tess_layout: wgpu::BindGroupLayout,
+    tessellate: wgpu::ComputePipeline,
+    finish_draw: wgpu::ComputePipeline,
+    scene_bind: wgpu::BindGroup,
+    draw: wgpu::RenderPipeline,
+    resolve: wgpu::ComputePipeline,
+    resolve_bind: wgpu::BindGroup,
+    rgba8_pipeline: wgpu::ComputePipeline,
+    rgba8_bind: wgpu::BindGroup,
+    color: wgpu::TextureView,
+    /// The single-sample target the hardware resolves into; `None` with one sample.
+    resolved: Option<wgpu::TextureView>,
+    depth_view: wgpu::TextureView,
+    rgba: wgpu::Buffer,
+    depth: wgpu::Buffer,
+    rgba8: wgpu::Buffer,
+    geometry: Geometry,
+    slots: Vec<Slot>,
+    timer: SpanTimer,
+    pixels: Pixels,
+    tess_groups: (u32, u32),
+    resolve_groups: (u32, u32),
+    /// Kept alive for the bind groups.
+    _buffers: Vec<wgpu::Buffer>,
+}
+
+fn buffer(
+    gpu: &Gpu,
+    label: &str,
+    bytes: u64,
+    usage: wgpu::BufferUsages,
+) -> Result<wgpu::Buffer, RunError> {
+    if bytes > gpu.max_binding_bytes() {
+        return Err(RunError::Device(format!(
+            "the raster peer's `{label}` needs {bytes} bytes, more than this device's storage \
+             binding limit of {} bytes (a larger --mp-size needs fewer triangles)",
+            gpu.max_binding_bytes()
+        )));
+    }
+    Ok(gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes.max(16).next_multiple_of(4),
+        usage: usage | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    }))
+}
+
+fn target(
+    gpu: &Gpu,
+    label: &str,
+    f: &Frame,
+    format: wgpu::TextureFormat,
+    samples: u32,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width: f.width,
+            height: f.height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: samples,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
+impl RasterPeer {
+    /// Uploads `scene` for frames of `options`, compiles the stages, and draws the unturned
+    /// frame once to size the buffers ([`HEADROOM`] above its needs). Errors: the options'
+    /// ([`FrameData::new`]) and too many patches ([`MAX_PATCHES`]) as [`RunError::Program`];
+    /// an image larger than the device's render targets, buffers beyond its limits, and those
+    /// of a frame, as [`RunError::Device`] or [`RunError::Timeout`].
+    pub fn new(
+        gpu: &Gpu,
+        scene: &Scene,
+        options: &RenderOptions,
+        pixels: Pixels,
+    ) -> Result<RasterPeer, RunError> {
+        let base = FrameData::new(scene, options).map_err(RunError::Program)?;
+        if scene.patches.len() > MAX_PATCHES {
+            return Err(RunError::Program(format!(
+                "the raster peer draws at most {MAX_PATCHES} patches; the scene has {}",
+                scene.patches.len()
+            )));
+        }
+        let f = base.frame;
+        let side = gpu.device.limits().max_texture_dimension_2d;
+        if f.width > side || f.height > side {
+            return Err(RunError::Device(format!(
+                "the raster peer's render target of {}x{} exceeds this device's {side} pixels",
+                f.width, f.height
+            )));
+        }
+        let n = scene.patches.len() as u32;
+        let samples = msaa_samples(gpu, f.spp_x * f.spp_y);
+        let tables = SceneTables::upload(gpu, scene, &base)?;
+        let ro = |b| storage_entry(b, true);
+        let rw = |b| storage_entry(b, false);
+        let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
+            gpu.device
+                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some(label),
+                    entries,
+                })
+        };
+        // Group 0: orbit, objects (roots.wgsl), then tessellate.wgsl's; group 1: common.wgsl's
+        // tables (frame, materials, lights, patch info, primvars; not the samples, counters).
+        let tess_layout = layout(
+            "raster tessellate",
+            &[ro(0), ro(1), ro(3), rw(4), rw(5), rw(6), rw(7), rw(8)],
+        );
+        let scene_layout = layout("raster scene", &[ro(0), ro(1), ro(2), ro(3), ro(6)]);
+        let pipeline_layout = gpu
+            .device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("raster tessellate"),
+                bind_group_layouts: &[Some(&tess_layout), Some(&scene_layout)],
+                immediate_size: 0,
+            });
+        let src = [
+            &base.features().wgsl(),
+            shaders::PATCH_ITEM,
+            shaders::ROOTS,
+            shaders::COMMON,
+            shaders::SHADE,
+            shaders::SURFACE,
+            shaders::TESSELLATE,
+        ]
+        .concat();
+        let module = gpu.shader("raster tessellate", &src)?;
+        let compute = |entry: &str| {
+            gpu.device
+                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(entry),
+                    layout: Some(&pipeline_layout),
+                    module: &module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    cache: None,
+                })
+        };
+        let tessellate = compute("tessellate");
+        let finish_draw = compute("finish_draw");
+        let scene_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("raster scene"),
+            layout: &scene_layout,
+            entries: &[
+                (0, &tables.frame),
+                (1, &tables.materials),
+                (2, &tables.lights),
+                (3, &tables.infos),
+                (6, &tables.primvars),
+            ]
+            .map(|(binding, b)| wgpu::BindGroupEntry {
+                binding,
+                resource: b.as_entire_binding(),
+            }),
+        });
+        let draw = Self::draw_pipeline(gpu, samples)?;
+        let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        let binding = wgpu::TextureUsages::TEXTURE_BINDING;
+        let mut textures = vec![target(
+            gpu,
+            "raster colour",
+            &f,
+            COLOR_FORMAT,
+            samples,
+            if samples > 1 {
+                attachment
+            } else {
+                attachment | binding
+            },
+        )];
+        if samples > 1 {
+            textures.push(target(
+                gpu,
+                "raster resolved",
+                &f,
+                COLOR_FORMAT,
+                1,
+                attachment | binding,
+            ));
+        }
+        let depth_tex = target(
+            gpu,
+            "raster depth",
+            &f,
+            DEPTH_FORMAT,
+            samples,
+            attachment | binding,
+        );
+        let color = textures[0].create_view(&Default::default());
+        let resolved = textures.get(1).map(|t| t.create_view(&Default::default()));
+        let depth_view = depth_tex.create_view(&Default::default());
+        let pixels_n = f.width as u64 * f.height as u64;
+        let rgba = gpu.storage_buffer("raster rgba", pixels_n * 4)?;
+        let depth = gpu.storage_buffer("raster depth", pixels_n)?;
+        let rgba8 = gpu.storage_buffer("raster rgba8", pixels_n)?;
+        let depth_type = if samples > 1 {
+            "texture_depth_multisampled_2d"
+        } else {
+            "texture_depth_2d"
+        };
+        let src = format!(
+            "alias RasterDepth = {depth_type};\n{}",
+            shaders::RASTER_RESOLVE
+        );
+        let resolve = gpu.compute_pipeline("raster resolve", &src, "raster_resolve")?;
+        let (resolve_groups, row) = dispatch_2d(pixels_n, 256);
+        let params = RasterResolveParams {
+            width: f.width,
+            height: f.height,
+            samples,
+            row,
+            near: f.near,
+            pad: [0; 3],
+        };
+        let params = gpu.upload("raster resolve params", &[params])?;
+        let resolve_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("raster resolve"),
+            layout: &resolve.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(
+                        resolved.as_ref().unwrap_or(&color),
+                    ),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(&depth_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: rgba.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: depth.as_entire_binding(),
+                },
+            ],
+        });
+        let src = [shaders::COMMON, shaders::SHADE, shaders::RGBA8].concat();
+        let rgba8_pipeline = gpu.compute_pipeline("raster rgba8", &src, "to_rgba8")?;
+        let rgba8_params = gpu.upload("raster rgba8 params", &[pixels_n as u32, row, 0, 0])?;
+        let rgba8_bind = gpu.bind_buffers(
+            "raster rgba8",
+            &rgba8_pipeline.get_bind_group_layout(0),
+            &[&rgba8_params, &rgba, &rgba8],
+        );
+        let geometry = Self::geometry_buffers(gpu, n, 4 * n as u64, n as u64)?;
+        let mut slots = Vec::new();
+        for _ in 0..IN_FLIGHT {
+            let orbit = gpu.storage_buffer("raster orbit", (size_of::<Orbit>() / 4) as u64)?;
+            slots.push(Slot {
+                tess_bind: Self::tess_bind(gpu, &tess_layout, &orbit, &tables, &geometry),
+                orbit,
+                status: map_buffer(gpu, "raster status", COUNT_WORDS + SpanTimer::WORDS)?,
+                pixels: Vec::new(),
+            });
+        }
+        // The colour, resolve and depth textures live while their views do.
+        drop(textures);
+        drop(depth_tex);
+        let mut peer = RasterPeer {
+            centre: orbit::scene_centre(scene),
+            patches: n,
+            samples,
+            tess_layout,
+            tessellate,
+            finish_draw,
+            scene_bind,
+            draw,
+            resolve,
+            resolve_bind,
+            rgba8_pipeline,
+            rgba8_bind,
+            color,
+            resolved,
+            depth_view,
+            rgba,
+            depth,
+            rgba8,
+            geometry,
+            slots,
+            timer: SpanTimer::new(gpu, IN_FLIGHT as u32),
+            pixels: Pixels::None,
+            tess_groups: dispatch_2d(n as u64, 1).0,
+            resolve_groups,
+            _buffers: vec![params, rgba8_params],
+            tables,
+            base,
+        };
+        let first = peer.render(gpu, &[0.0])?;
+        peer.fit(gpu, &first[0].counts)?;
+        peer.set_pixels(gpu, pixels)?;
+        Ok(peer)
+    }
+
+    fn draw_pipeline(gpu: &Gpu, samples: u32) -> Result<wgpu::RenderPipeline, RunError> {
+        let src = [shaders::RESOLVE, shaders::RASTER_DRAW].concat();
+        let module = gpu.shader("raster draw", &src)?;
+        let layout = gpu
+            .device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("raster draw"),
+                bind_group_layouts: &[],
+                immediate_size: 0,
+            });
+        let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32];
+        Ok(gpu
+            .device
+            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("raster draw"),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("raster_vertex"),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(wgpu::VertexBufferLayout {
+                        array_stride: size_of::<RasterVertex>() as u64,
+                        step_mode: wgpu::VertexStepMode::Vertex,
+                        attributes: &attributes,
+                    })],
+                },
+                primitive: wgpu::PrimitiveState {
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    // One-sided patches' back faces are culled per quad in tessellate.wgsl,
+                    // as Reyes culls them; the winding of a patch's grid says nothing.
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Greater),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: wgpu::MultisampleState {
+                    count: samples,
+                    mask: !0,
+                    alpha_to_coverage_enabled: false,
+                },
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some("raster_fragment"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: COLOR_FORMAT,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            }))
+    }
+
+    fn geometry_buffers(
+        gpu: &Gpu,
+        patches: u32,
+        vertices: u64,
+        quads: u64,
+    ) -> Result<Geometry, RunError> {
+        let u = wgpu::BufferUsages::empty();
+        let params = TessParams {
+            patches,
+            row: dispatch_2d(patches as u64, 1).1,
+            vertex_capacity: vertices.min(u32::MAX as u64) as u32,
+            quad_capacity: quads.min(u32::MAX as u64 / 6) as u32,
+            max_rate: MAX_RATE,
+            pad: [0; 3],
+        };
+        Ok(Geometry {
+            vertices: buffer(
+                gpu,
+                "raster vertices",
+                vertices * 16,
+                wgpu::BufferUsages::VERTEX,
+            )?,
+            indices: buffer(gpu, "raster indices", quads * 24, wgpu::BufferUsages::INDEX)?,
+            counts: buffer(
+                gpu,
+                "raster counts",
+                COUNT_WORDS * 4,
+                wgpu::BufferUsages::COPY_DST,
+            )?,
+            grids: buffer(gpu, "raster grids", patches.max(1) as u64 * 32, u)?,
+            draw_args: buffer(gpu, "raster draw", 20, wgpu::BufferUsages::INDIRECT)?,
+            params: gpu.upload("raster tessellate params", &[params])?,
+            vertex_capacity: params.vertex_capacity,
+            quad_capacity: params.quad_capacity,
+        })
+    }
+
+    fn tess_bind(
+        gpu: &Gpu,
+        layout: &wgpu::BindGroupLayout,
+        orbit: &wgpu::Buffer,
+        tables: &SceneTables,
+        g: &Geometry,
+    ) -> wgpu::BindGroup {
+        let entries = [
+            (0, orbit),
+            (1, &tables.objects),
+            (3, &g.params),
+            (4, &g.vertices),
+            (5, &g.indices),
+            (6, &g.counts),
+            (7, &g.grids),
+            (8, &g.draw_args),
+        ]
+        .map(|(binding, b)| wgpu::BindGroupEntry {
+            binding,
+            resource: b.as_entire_binding(),
+        });
+        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("raster tessellate"),
+            layout,
+            entries: &entries,
+        })
+    }
+
+    /// Grows the geometry buffers to [`HEADROOM`] above `counts`' needs when they do not hold
+    /// them. Errors: needs beyond the device's limits.
+    fn fit(&mut self, gpu: &Gpu, counts: &TessCounts) -> Result<(), RunError> {
+        let g = &self.geometry;
+        let (v, q) = (counts.vertices as u64, counts.quads as u64);
+        if v <= g.vertex_capacity as u64 && q <= g.quad_capacity as u64 {
+            return Ok(());
+        }
+        let max = gpu.max_binding_bytes();
+        let room = |need: u64, bytes: u64| {
+            ((need as f64 * HEADROOM).ceil() as u64)
+                .min(max / bytes)
+                .max(need)
+        };
+        self.geometry = Self::geometry_buffers(gpu, self.patches, room(v, 16), room(q, 24))?;
+        for s in &mut self.slots {
+            s.tess_bind = Self::tess_bind(
+                gpu,
+                &self.tess_layout,
+                &s.orbit,
+                &self.tables,
+                &self.geometry,
+            );
+        }
+        Ok(())
+    }
+
+    /// The MSAA sample count the peer draws with ([`msaa_samples`]).
+    pub fn msaa_samples(&self) -> u32 {
+        self.samples
+    }
+
+    /// Image width and height in pixels, and Reyes's pixel samples per axis.
+    pub fn frame_size(&self) -> (u32, u32, [u32; 2]) {
+        let f = &self.base.frame;
+        (f.width, f.height, [f.spp_x, f.spp_y])
+    }
+
+    /// Room in the geometry buffers: vertices and quads.
+    pub fn capacity(&self) -> (u32, u32) {
+        (self.geometry.vertex_capacity, self.geometry.quad_capacity)
+    }
+
+    /// What the peer draws differently from what the scene asks: transparency drawn opaque.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut w = Vec::new();
+        if self.base.features().transparent {
+            w.push(
+                "the scene has transparent surfaces (Opacity or \"Os\" below 1): the raster \
+                 peer draws them opaque (it has no order-independent transparency)"
+                    .into(),
+            );
+        }
+        w
+    }
+
+    /// What each frame brings back ([`Pixels`]); allocates its staging buffers (call it
+    /// before [`RasterPeer::render`], not between frames).
+    pub fn set_pixels(&mut self, gpu: &Gpu, pixels: Pixels) -> Result<(), RunError> {
+        let n = self.base.frame.width as u64 * self.base.frame.height as u64;
+        let words: &[u64] = match pixels {
+            Pixels::None => &[],
+            Pixels::Rgba8 => &[n],
+            Pixels::Float => &[4 * n, n],
+        };
+        for s in &mut self.slots {
+            s.pixels = (words.iter())
+                .map(|&w| map_buffer(gpu, "raster pixels", w))
+                .collect::<Result<_, _>>()?;
+        }
+        self.pixels = pixels;
+        Ok(())
+    }
+
+    /// Reads back the tessellation of the last frame drawn (tests).
+    pub fn geometry(&self, gpu: &Gpu) -> Result<Tessellation, RunError> {
+        let g = &self.geometry;
+        let counts = TessCounts::from_words(&gpu.read_words(&g.counts, 0, COUNT_WORDS)?);
+        let grids = gpu.read_words(&g.grids, 0, 8 * self.patches as u64)?;
+        let entries: Vec<[u32; 4]> = grids.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+        let vertices = gpu.read_buffer(
+            &g.vertices,
+            0,
+            16 * counts.vertices.min(g.vertex_capacity) as u64,
+        )?;
+        let indices =
+            gpu.read_words(&g.indices, 0, 6 * counts.quads.min(g.quad_capacity) as u64)?;
+        Ok(Tessellation {
+            grids: entries.iter().step_by(2).copied().collect(),
+            edges: entries.iter().skip(1).step_by(2).copied().collect(),
+            vertices: bytemuck::pod_collect_to_vec(&vertices),
+            indices,
+            counts,
+        })
+    }
+
+    fn pixel_sources(&self) -> Vec<&wgpu::Buffer> {
+        match self.pixels {
+            Pixels::None => vec![],
+            Pixels::Rgba8 => vec![&self.rgba8],
+            Pixels::Float => vec![&self.rgba, &self.depth],
+        }
+    }
+
+    /// Draws one frame per turntable angle (radians), pipelined, and returns them in order.
+    /// Errors: a device error or timeout, and buffers a frame needs beyond the device's limits.
+    pub fn render(&mut self, gpu: &Gpu, angles: &[f64]) -> Result<Vec<PeerFrame>, RunError> {
+        let mut out = Vec::with_capacity(angles.len());
+        let mut flight: VecDeque<InFlight> = VecDeque::new();
+        let mut last = Instant::now();
+        for (i, &angle) in angles.iter().enumerate() {
+            flight.push_back(self.submit(gpu, i % IN_FLIGHT, angle)?);
+            if flight.len() == IN_FLIGHT {
+                let f = flight.pop_front().unwrap();
+                out.push(self.finish(gpu, f, &mut last, false)?);
+            }
+        }
+        while let Some(f) = flight.pop_front() {
+            out.push(self.finish(gpu, f, &mut last, false)?);
+        }
+        Ok(out)
+    }
+
+    /// Records and submits one frame in ring slot `slot`.
+    fn submit(&self, gpu: &Gpu, slot: usize, angle: f64) -> Result<InFlight, RunError> {
+        let s = &self.slots[slot];
+        let orbit = Orbit::at(self.centre, angle, self.patches);
+        gpu.queue
+            .write_buffer(&s.orbit, 0, bytemuck::bytes_of(&orbit));
+        let g = &self.geometry;
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        enc.clear_buffer(&g.counts, 0, None);
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("raster tessellate"),
+                timestamp_writes: self.timer.begin(slot as u32),
+            });
+            pass.set_bind_group(0, &s.tess_bind, &[]);
+            pass.set_bind_group(1, &self.scene_bind, &[]);
+            if self.patches > 0 {
+                pass.set_pipeline(&self.tessellate);
+                pass.dispatch_workgroups(self.tess_groups.0, self.tess_groups.1, 1);
+            }
+            pass.set_pipeline(&self.finish_draw);
+            pass.dispatch_workgroups(1, 1, 1);
+        }
+        {
+            let store = if self.resolved.is_some() {
+                wgpu::StoreOp::Discard
+            } else {
+                wgpu::StoreOp::Store
+            };
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("raster draw"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &self.color,
+                    depth_slice: None,
+                    resolve_target: self.resolved.as_ref(),
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &self.depth_view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(0.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.draw);
+            pass.set_vertex_buffer(0, g.vertices.slice(..));
+            pass.set_index_buffer(g.indices.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed_indirect(&g.draw_args, 0);
+        }
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("raster resolve"),
+                timestamp_writes: self.timer.end(slot as u32),
+            });
+            pass.set_pipeline(&self.resolve);
+            pass.set_bind_group(0, &self.resolve_bind, &[]);
+            pass.dispatch_workgroups(self.resolve_groups.0, self.resolve_groups.1, 1);
+            pass.set_pipeline(&self.rgba8_pipeline);
+            pass.set_bind_group(0, &self.rgba8_bind, &[]);
+            pass.dispatch_workgroups(self.resolve_groups.0, self.resolve_groups.1, 1);
+        }
+        enc.copy_buffer_to_buffer(&g.counts, 0, &s.status, 0, COUNT_WORDS * 4);
+        self.timer
+            .copy(&mut enc, slot as u32, &s.status, COUNT_WORDS);
+        let mut maps = vec![s.status.clone()];
+        for (src, dst) in self.pixel_sources().into_iter().zip(&s.pixels) {
+            enc.copy_buffer_to_buffer(src, 0, dst, 0, src.size());
+            maps.push(dst.clone());
+        }
+        let submission = gpu.queue.submit([enc.finish()]);
+        let mapped = Arc::new(AtomicUsize::new(0));
+        for b in &maps {
+            let done = mapped.clone();
+            b.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+                if r.is_ok() {
+                    done.fetch_add(1, Ordering::Release);
+                }
+            });
+        }
+        Ok(InFlight {
+            angle,
+            slot,
+            submission,
+            maps,
+            mapped,
+            pixels: self.pixels,
+        })
+    }
+
+    /// Waits for a frame (bounded) and reads its status and pixels; a frame whose patches did
+    /// not fit is drawn again alone after the buffers grow (`again`: this is that drawing).
+    fn finish(
+        &mut self,
+        gpu: &Gpu,
+        f: InFlight,
+        last: &mut Instant,
+        again: bool,
+    ) -> Result<PeerFrame, RunError> {
+        let polled = gpu.device.poll(wgpu::PollType::Wait {
+            submission_index: Some(f.submission.clone()),
+            timeout: Some(gpu.timeout),
+        });
+        if let Some(e) = gpu.take_error() {
+            return Err(RunError::Device(format!("a raster peer frame: {e}")));
+        }
+        match polled {
+            Ok(_) => {}
+            Err(wgpu::PollError::Timeout) => {
+                return Err(RunError::Timeout {
+                    what: "a raster peer frame".into(),
+                    seconds: gpu.timeout.as_secs_f64(),
+                });
+            }
+            Err(e) => return Err(RunError::Device(format!("a raster peer frame: {e}"))),
+        }
+        if f.mapped.load(Ordering::Acquire) != f.maps.len() {
+            return Err(RunError::Device(
+                "a raster peer frame finished but its status was not mapped".into(),
+            ));
+        }
+        let status = read_mapped(&f.maps[0], COUNT_WORDS + SpanTimer::WORDS)?;
+        let counts = TessCounts::from_words(&status);
+        let gpu_ms = self.timer.ms(&status[COUNT_WORDS as usize..]);
+        let mut pixels: Vec<Vec<u32>> = Vec::new();
+        for b in &f.maps[1..] {
+            pixels.push(read_mapped(b, b.size() / 4)?);
+        }
+        if counts.over > 0 {
+            if again {
+                return Err(RunError::Device(format!(
+                    "a raster peer frame did not fit buffers grown to its needs ({} vertices, \
+                     {} quads)",
+                    counts.vertices, counts.quads
+                )));
+            }
+            self.fit(gpu, &counts)?;
+            let redo = self.submit(gpu, f.slot, f.angle)?;
+            let mut frame = self.finish(gpu, redo, last, true)?;
+            frame.redrawn = Some(format!(
+                "{} patches did not fit the buffers ({} vertices, {} quads needed)",
+                counts.over, counts.vertices, counts.quads
+            ));
+            frame.gpu_ms = gpu_ms.zip(frame.gpu_ms).map(|(a, b)| a + b);
+            return Ok(frame);
+        }
+        let now = Instant::now();
+        let wall_ms = now.duration_since(*last).as_secs_f64() * 1e3;
+        *last = now;
+        let (w, h) = (self.base.frame.width, self.base.frame.height);
+        let n = (w * h) as usize;
+        let (rgba8, image) = match f.pixels {
+            Pixels::None => (None, None),
+            Pixels::Rgba8 => (Some(bytemuck::cast_slice(&pixels[0][..n]).to_vec()), None),
+            Pixels::Float => {
+                let fl: &[f32] = bytemuck::cast_slice(&pixels[0][..4 * n]);
+                let image = FrameImage {
+                    width: w,
+                    height: h,
+                    rgba: fl.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect(),
+                    depth: pixels[1][..n].iter().map(|&z| f32::from_bits(z)).collect(),
+                };
+                (None, Some(image))
+            }
+        };
+        Ok(PeerFrame {
+            angle: f.angle,
+            gpu_ms,
+            wall_ms,
+            counts,
+            redrawn: None,
+            rgba8,
+            image,
+        })
+    }
+}
