@@ -266,7 +266,7 @@ fn an_empty_world_renders_an_empty_image_with_a_warning() {
     for way in [
         &["--strategy", "megakernel"][..],
         &["--strategy", "multipass"],
-        &["--memory-budget", "64K"],
+        &["--gpu", "--memory-budget", "64K"],
         &["--cpu"],
     ] {
         let out = dir.join("empty.png");
@@ -280,6 +280,32 @@ fn an_empty_world_renders_an_empty_image_with_a_warning() {
         assert_eq!(img.dimensions(), (320, 240), "{way:?}");
         assert!(img.pixels().all(|p| p[3] == 0), "{way:?}: not transparent");
     }
+}
+
+/// On a CPU adapter (lavapipe) a plain `reyes render` renders with the CPU reference and says
+/// why: the same image as `--cpu`, byte for byte; `--gpu` renders on the adapter (the
+/// multi-pass, its default there). Needs the GPU (lavapipe, a CPU adapter).
+#[test]
+fn a_cpu_adapter_renders_with_the_cpu_reference_unless_told() {
+    let dir = scratch("cpu-default");
+    let size = ["--width", "64", "--height", "48"];
+    let (ok, err) = reyes(&dir, &[&["-o", "default.png"][..], &size].concat());
+    assert!(ok, "{err}");
+    assert!(err.contains("note: rendering with the CPU reference"), "{err}");
+    assert!(err.contains("the adapter is a CPU"), "{err}");
+    let (ok, err) = reyes(&dir, &[&["-o", "cpu.png", "--cpu"][..], &size].concat());
+    assert!(ok, "{err}");
+    assert_eq!(png(&dir.join("default.png")), png(&dir.join("cpu.png")));
+    let (ok, err) = reyes(&dir, &[&["-o", "gpu.png", "--gpu"][..], &size].concat());
+    assert!(ok, "{err}");
+    assert!(!err.contains("CPU reference"), "{err}");
+    assert!(err.contains("multipass:") && err.contains("micropolygons"), "{err}");
+    // GPU-only outputs choose the GPU without --gpu; --cpu and --gpu conflict.
+    let (ok, err) = reyes(&dir, &[&["-o", "s.png", "--stats", "s.json"][..], &size].concat());
+    assert!(ok, "{err}");
+    assert!(!err.contains("CPU reference") && dir.join("s.json").is_file(), "{err}");
+    let (code, err) = render_code(&dir, &["--cpu", "--gpu"]);
+    assert_eq!(code, 2, "{err}");
 }
 
 fn field(name: &str) -> String {

@@ -221,7 +221,7 @@ fn a_scripted_view_saves_reyes_render_s_image() {
         err.contains("frame 3:") && err.contains("micropolygons"),
         "{err}"
     );
-    let mut args = vec!["render", "-o", "render.png"];
+    let mut args = vec!["render", "--gpu", "-o", "render.png"];
     args.extend(size);
     run_ok(&dir, None, &args);
     let (v, r) = (png(&dir.join("view.png")), png(&dir.join("render.png")));
@@ -306,6 +306,7 @@ fn keys_save_screenshots_and_a_drag_orbits() {
 
     let args = [
         "render",
+        "--gpu",
         "-o",
         "render.png",
         "--width",

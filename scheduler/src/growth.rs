@@ -36,6 +36,14 @@ impl Anticipation {
     /// would otherwise grow the queues to their limit at once.
     pub const MAX_PER_ROUND: f64 = 16.0;
 
+    /// Largest factor over the refused round's worst case: every byte of a growth is fresh
+    /// device memory, which costs about as much as a refusal per 40 MB on the H200
+    /// (docs/results.md, 2026-12-01), so anticipation stops at twice the plain `2 m`.
+    pub const MAX_FACTOR: f64 = 4.0;
+
+    /// Bytes a growth may anticipate beyond the plain `2 m` (over all queues).
+    pub const MAX_EXTRA_BYTES: u64 = 64 << 20;
+
     /// Starts from the first round's worst-case output `m0` (from the seeds and the declared
     /// emits, known on the host).
     pub fn new(m0: u64) -> Anticipation {
@@ -49,7 +57,7 @@ impl Anticipation {
     /// Records a refusal of `round` (rounds run before it in the whole run) whose worst-case
     /// output was `m` items (all targets), and returns the factor by which that output should
     /// be multiplied to size the queues: `2 × g^(2^h)` for the `h`-th refusal (from 0) and the
-    /// measured growth per round `g`, at most [`Self::MAX_PER_ROUND`]`^4`.
+    /// measured growth per round `g`, at most [`Self::MAX_FACTOR`].
     pub fn refused(&mut self, round: u64, m: u64) -> f64 {
         let (m_prev, r_prev) = self.last;
         let rounds = round.saturating_sub(r_prev).max(1) as f64;
@@ -58,10 +66,7 @@ impl Anticipation {
         self.last = (m.max(1), round);
         let horizon = 2f64.powi(self.refusals.min(8) as i32);
         self.refusals += 1;
-        2.0 * self
-            .per_round
-            .powf(horizon)
-            .min(Self::MAX_PER_ROUND.powi(4))
+        (2.0 * self.per_round.powf(horizon)).min(Self::MAX_FACTOR)
     }
 
     /// Rounds a submission should encode after a refused round of worst-case output `m` was
@@ -90,15 +95,18 @@ mod tests {
         // The capacity 4 m holds two more doublings: refusal expected at the 4th round.
         assert_eq!(a.rounds_until_refusal(4.0, 16), 4);
         // Next refusal: horizon 2 rounds, 2 × 2^2.
-        assert_eq!(a.refused(5, 5120), 8.0);
-        assert_eq!(a.refused(8, 40960), 32.0);
+        assert_eq!(a.refused(5, 5120), Anticipation::MAX_FACTOR);
+        assert_eq!(a.refused(8, 40960), Anticipation::MAX_FACTOR);
         // Not growing: full submissions.
         let mut flat = Anticipation::new(100);
         assert_eq!(flat.refused(3, 100), 2.0);
         assert_eq!(flat.rounds_until_refusal(2.0, 16), 16);
         // A huge jump is believed only up to MAX_PER_ROUND per round.
         let mut jump = Anticipation::new(1);
-        assert_eq!(jump.refused(1, 1 << 30), 2.0 * Anticipation::MAX_PER_ROUND);
+        assert_eq!(jump.refused(1, 1 << 30), Anticipation::MAX_FACTOR);
+        // Slow growth anticipates little: 2 x 1.2.
+        let mut slow = Anticipation::new(1000);
+        assert!((slow.refused(1, 1200) - 2.4).abs() < 1e-12);
     }
 
     #[test]

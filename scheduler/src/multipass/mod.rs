@@ -449,7 +449,10 @@ impl Multipass {
                 }
                 let refused_grew = grown != capacity;
                 for t in 0..nq {
-                    let need = (m[t] as f64 * factor).min(u32::MAX as f64) as u64;
+                    // Per slot: its item in both parities and the emit buffer, and its flag.
+                    let slot_bytes = d.layout.words[t] as u64 * 12 + 4;
+                    let extra = Anticipation::MAX_EXTRA_BYTES / slot_bytes / nq as u64;
+                    let need = ((m[t] as f64 * factor) as u64).min(2 * m[t] + extra);
                     if need > grown[t] as u64 {
                         grown[t] = grow(grown[t], need, max_cap[t]);
                     }

@@ -194,6 +194,11 @@ pub struct RenderCmd {
     #[arg(long, conflicts_with_all = ["strategy", "runs", "stage_times", "stats", "float", "depth", "exr"])]
     pub cpu: bool,
 
+    /// Render on the GPU adapter even when it is a CPU (lavapipe, llvmpipe, WARP), where the
+    /// default is the CPU reference (see `RenderCmd::cpu_by_default`).
+    #[arg(long, conflicts_with = "cpu")]
+    pub gpu: bool,
+
     /// Frames of a sequence to render: N, A-B or a comma list of them (2-3, 2, 1,3)
     /// [default: all].
     #[arg(long, value_name = "N|A-B|A,B,..", value_parser = FrameRanges::parse)]
@@ -205,6 +210,38 @@ pub struct RenderCmd {
 
     #[command(flatten)]
     pub render: RenderArgs,
+}
+
+impl RenderCmd {
+    /// Whether this render asks for something only the GPU path gives: `--gpu`, a strategy,
+    /// timed runs, stage times, statistics, float, depth or EXR output (what `--cpu` refuses).
+    pub fn gpu_only(&self) -> bool {
+        self.gpu
+            || self.render.strategy.is_some()
+            || self.runs > 1
+            || self.stage_times
+            || self.stats.is_some()
+            || self.float.is_some()
+            || self.depth.is_some()
+            || self.exr.is_some()
+    }
+
+    /// Whether to render on the CPU reference although an adapter was found: when the adapter
+    /// is itself a CPU (software Vulkan: lavapipe on two cores renders the 800x600 teapot in
+    /// about 2.5 s where the CPU reference, the same pipeline compiled natively, takes 0.2 s)
+    /// and nothing GPU-only was asked for ([`RenderCmd::gpu_only`]). Says so on stderr.
+    pub fn cpu_by_default(&self, gpu: &scheduler::Gpu) -> bool {
+        let cpu = gpu.info.device_type == scheduler::wgpu::DeviceType::Cpu && !self.gpu_only();
+        if cpu {
+            eprintln!(
+                "note: rendering with the CPU reference (the same pipeline, compiled natively): \
+                 the adapter is a CPU ({}), on which the GPU path is about 10x slower (--gpu \
+                 or --strategy NAME renders on it anyway)",
+                gpu.adapter_name()
+            );
+        }
+        cpu
+    }
 }
 
 /// `reyes measure`: a warm-up frame, 0.5 s of full GPU load (clocks), one more frame, then

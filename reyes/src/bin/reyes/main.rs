@@ -68,7 +68,11 @@ fn run(a: RenderCmd) -> Result<(), String> {
         (false, false) => {
             // One program for every frame: compiled for what they need together.
             let need = (data.iter()).fold(SceneFeatures::default(), |f, d| f.union(d.features()));
-            Some(gpu_renderer(&a, need)?)
+            let gpu = Gpu::from_env_requiring(required_features()).map_err(|e| e.to_string())?;
+            match a.cpu_by_default(&gpu) {
+                true => None,
+                false => Some(gpu_renderer(&a, gpu, need)?),
+            }
         }
         _ => None,
     };
@@ -104,8 +108,11 @@ fn run(a: RenderCmd) -> Result<(), String> {
 }
 
 /// The GPU and its renderer, made once for all frames.
-fn gpu_renderer(a: &RenderCmd, features: SceneFeatures) -> Result<(Gpu, GpuRenderer), String> {
-    let gpu = Gpu::from_env_requiring(required_features()).map_err(|e| e.to_string())?;
+fn gpu_renderer(
+    a: &RenderCmd,
+    gpu: Gpu,
+    features: SceneFeatures,
+) -> Result<(Gpu, GpuRenderer), String> {
     let strategy = a.render.strategy_for(&gpu);
     if a.stage_times && strategy == StrategyKind::Megakernel {
         log::warn!(
