@@ -291,7 +291,10 @@ fn a_cpu_adapter_renders_with_the_cpu_reference_unless_told() {
     let size = ["--width", "64", "--height", "48"];
     let (ok, err) = reyes(&dir, &[&["-o", "default.png"][..], &size].concat());
     assert!(ok, "{err}");
-    assert!(err.contains("note: rendering with the CPU reference"), "{err}");
+    assert!(
+        err.contains("note: rendering with the CPU reference"),
+        "{err}"
+    );
     assert!(err.contains("the adapter is a CPU"), "{err}");
     let (ok, err) = reyes(&dir, &[&["-o", "cpu.png", "--cpu"][..], &size].concat());
     assert!(ok, "{err}");
@@ -299,11 +302,20 @@ fn a_cpu_adapter_renders_with_the_cpu_reference_unless_told() {
     let (ok, err) = reyes(&dir, &[&["-o", "gpu.png", "--gpu"][..], &size].concat());
     assert!(ok, "{err}");
     assert!(!err.contains("CPU reference"), "{err}");
-    assert!(err.contains("multipass:") && err.contains("micropolygons"), "{err}");
+    assert!(
+        err.contains("multipass:") && err.contains("micropolygons"),
+        "{err}"
+    );
     // GPU-only outputs choose the GPU without --gpu; --cpu and --gpu conflict.
-    let (ok, err) = reyes(&dir, &[&["-o", "s.png", "--stats", "s.json"][..], &size].concat());
+    let (ok, err) = reyes(
+        &dir,
+        &[&["-o", "s.png", "--stats", "s.json"][..], &size].concat(),
+    );
     assert!(ok, "{err}");
-    assert!(!err.contains("CPU reference") && dir.join("s.json").is_file(), "{err}");
+    assert!(
+        !err.contains("CPU reference") && dir.join("s.json").is_file(),
+        "{err}"
+    );
     let (code, err) = render_code(&dir, &["--cpu", "--gpu"]);
     assert_eq!(code, 2, "{err}");
 }

@@ -17,6 +17,23 @@ pub struct QueueLayout {
 }
 
 impl QueueLayout {
+    /// Encodes the copy of each `(queue, buffer, count)` seed buffer (its items back to back)
+    /// to the queue's first slots in `items`, a buffer of this layout's words.
+    pub(crate) fn encode_seed_copies(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        seeds: &[(usize, &wgpu::Buffer, u32)],
+        items: &wgpu::Buffer,
+    ) {
+        for &(q, buf, n) in seeds {
+            let bytes = n as u64 * self.words[q] as u64 * 4;
+            if bytes > 0 {
+                let at = self.slot_base[q] as u64 * 4;
+                enc.copy_buffer_to_buffer(buf, 0, items, at, bytes);
+            }
+        }
+    }
+
     pub fn new(program: &Program, capacity: Vec<u32>) -> Result<QueueLayout, RunError> {
         let words: Vec<u32> = program.procs.iter().map(|p| p.words()).collect();
         let (mut w, mut f) = (0u64, 0u64);

@@ -127,18 +127,8 @@ impl Recorded {
         m.kernels.check_user_group(user)?;
         let d = &self.dq;
         enc.clear_buffer(&d.flags, 0, None);
-        for &(q, buf, n) in seeds {
-            if n == 0 {
-                continue;
-            }
-            let w = d.layout.words[q] as u64;
-            enc.copy_buffer_to_buffer(
-                buf,
-                0,
-                &d.slots,
-                d.layout.slot_base[q] as u64 * 4,
-                n as u64 * w * 4,
-            );
+        d.layout.encode_seed_copies(enc, seeds, &d.slots);
+        for &(q, _, n) in seeds.iter().filter(|s| s.2 > 0) {
             enc.copy_buffer_to_buffer(
                 &self.stamps,
                 0,

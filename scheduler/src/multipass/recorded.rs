@@ -86,18 +86,7 @@ impl Recorded {
     ) -> Result<(), RunError> {
         m.kernels.check_user_group(user)?;
         let d = &self.d;
-        for &(q, buf, n) in seeds {
-            let bytes = n as u64 * d.layout.words[q] as u64 * 4;
-            if bytes > 0 {
-                enc.copy_buffer_to_buffer(
-                    buf,
-                    0,
-                    &d.items[0],
-                    d.layout.slot_base[q] as u64 * 4,
-                    bytes,
-                );
-            }
-        }
+        d.layout.encode_seed_copies(enc, seeds, &d.items[0]);
         enc.copy_buffer_to_buffer(&self.ctrl_start, 0, &d.ctrl, 0, d.ctrl.size());
         m.encode_rounds(enc, d, self.rounds, 0, None, None, user);
         enc.copy_buffer_to_buffer(&d.ctrl, 0, status, status_word * 4, d.ctrl.size());
