@@ -9,6 +9,7 @@
 
 mod basis;
 mod bpt;
+mod displacement;
 mod newell;
 mod nurbs;
 mod primvars;
@@ -24,6 +25,10 @@ use std::path::Path;
 
 pub use basis::Basis;
 pub use bpt::parse_bpt;
+pub use displacement::{
+    DISPLACEMENT_NAMES, Displacement, DisplacementMap, DisplacementPattern, MAX_BUMPS_FREQUENCY,
+    MAX_MAP_SIDE,
+};
 pub use newell::parse_newell;
 pub use primvars::{ColorField, Primvars};
 pub use rational::eval_rational_bezier;
@@ -114,6 +119,9 @@ pub struct Patch {
     /// The patch's own `"Cs"` / `"Os"` over its parameter square; `None` (no cost) when the
     /// material's `Color` and `Opacity` apply everywhere.
     pub primvars: Option<Box<Primvars>>,
+    /// Displacement along the normal in DiceShade (RIB `Displacement`); `None` (no cost) for
+    /// the undisplaced surface. Shared by the patches of one request.
+    pub displacement: Option<std::sync::Arc<Displacement>>,
     /// Where the patch came from, for error messages.
     pub source: PatchSource,
 }
