@@ -235,9 +235,11 @@ pub fn displacement_ref(
                     }
                     let size = [m.width, m.height].map(f32::from_bits);
                     table.push([size[0], size[1], 0.0, 0.0]);
-                    table.extend(m.texels.chunks(4).map(|c| {
-                        std::array::from_fn(|k| c.get(k).copied().unwrap_or(0.0))
-                    }));
+                    table.extend(
+                        m.texels
+                            .chunks(4)
+                            .map(|c| std::array::from_fn(|k| c.get(k).copied().unwrap_or(0.0))),
+                    );
                     maps.push((key, at as u32));
                     at as u32
                 }
@@ -590,7 +592,11 @@ fn patch_info(
         flags: p.flip_normal as u32
             | (p.two_sided as u32) << 1
             | if p.is_rational() { PATCH_RATIONAL } else { 0 }
-            | if p.displacement.is_some() { PATCH_DISPLACED } else { 0 },
+            | if p.displacement.is_some() {
+                PATCH_DISPLACED
+            } else {
+                0
+            },
         cs,
         os,
         weights,
@@ -691,7 +697,10 @@ mod tests {
                 ("tile_x0", offset_of!(Frame, tile_x0)),
                 ("tile_h", offset_of!(Frame, tile_h)),
                 ("crack_dilation", offset_of!(Frame, crack_dilation)),
-                ("displacement_normals", offset_of!(Frame, displacement_normals)),
+                (
+                    "displacement_normals",
+                    offset_of!(Frame, displacement_normals),
+                ),
             ],
         );
         check(

@@ -49,7 +49,11 @@ impl DisplacementMap {
             ));
         }
         let luma = img.to_luma32f();
-        let texels = luma.into_raw().into_iter().map(|x| x.clamp(0.0, 1.0)).collect();
+        let texels = luma
+            .into_raw()
+            .into_iter()
+            .map(|x| x.clamp(0.0, 1.0))
+            .collect();
         Ok(DisplacementMap {
             width,
             height,

@@ -92,11 +92,7 @@ impl Interp {
             .parent()
             .map(|d| d.join(file))
             .unwrap_or_else(|| file.into());
-        let path = if beside.exists() {
-            beside
-        } else {
-            file.into()
-        };
+        let path = if beside.exists() { beside } else { file.into() };
         let key = path.to_string_lossy().into_owned();
         if let Some(m) = self.displacement_maps.get(&key) {
             return Ok(m.clone());

@@ -6,7 +6,9 @@
 use super::primvars::Decl;
 use super::syntax::Request;
 use crate::scene::basis::Basis;
-use crate::scene::{Camera, DisplacementPattern, Display, Material, Scene, SceneError, SceneFrame, SurfaceKind};
+use crate::scene::{
+    Camera, DisplacementPattern, Display, Material, Scene, SceneError, SceneFrame, SurfaceKind,
+};
 use glam::{DMat4, DVec3};
 use std::collections::{HashMap, HashSet};
 use std::rc::Rc;

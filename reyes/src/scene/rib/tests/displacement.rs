@@ -17,7 +17,11 @@ fn displacement_and_its_bound_follow_the_attributes() {
     // Scaled by 3: the amount by the mean scale, the declared radius by the largest stretch.
     let d = s.patches[2].displacement.as_ref().unwrap();
     assert!((d.amount - 0.75).abs() < 1e-12, "{}", d.amount);
-    assert!((d.bound - 6.0).abs() < 1e-4 && d.bound >= 6.0, "{}", d.bound);
+    assert!(
+        (d.bound - 6.0).abs() < 1e-4 && d.bound >= 6.0,
+        "{}",
+        d.bound
+    );
     assert!(s.patches[3].displacement.is_none(), "AttributeEnd restores");
     let d = s.patches[4].displacement.as_ref().unwrap();
     assert_eq!((d.amount, d.bound), (1.0, 1.0), "Km defaults to 1");
@@ -48,7 +52,9 @@ fn bad_displacement_values_are_errors_naming_the_line() {
     }
     let e = err(&world("Displacement \"mapped\" \"Km\" 1"));
     assert!(e.contains("t.rib:2") && e.contains("mapname"), "{e}");
-    let e = err(&world("Displacement \"mapped\" \"mapname\" \"no-such-map.png\""));
+    let e = err(&world(
+        "Displacement \"mapped\" \"mapname\" \"no-such-map.png\"",
+    ));
     assert!(
         e.contains("t.rib:2") && e.contains("no-such-map.png"),
         "{e}"
