@@ -326,7 +326,9 @@ pub fn grid_normal(g: &[Vec3], t: usize, nu: u32, nv: u32, fallback: Vec3, flip:
     let dv = g[(j + 1).min(nv) * cols + i] - g[j.saturating_sub(1) * cols + i];
     let n = du.cross(dv);
     let scale = du.dot(du) + dv.dot(dv);
-    if !(n.dot(n) > 1.0e-6 * scale * scale) {
+    // Written so that a NaN falls back too.
+    let regular = n.dot(n) > 1.0e-6 * scale * scale;
+    if !regular {
         return fallback;
     }
     (if flip { -n } else { n }).normalize()
