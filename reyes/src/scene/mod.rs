@@ -511,7 +511,7 @@ mod tests {
         assert_eq!(s.materials.len(), 1);
         assert_eq!(s.materials[0].kind, SurfaceKind::Matte);
         assert_eq!((s.materials[0].ka, s.materials[0].kd), (0.0, 1.0));
-        for req in ["Option", "Imager", "Displacement", "Attribute"] {
+        for req in ["Option", "Imager"] {
             let hits = s
                 .warnings
                 .iter()
@@ -519,6 +519,15 @@ mod tests {
                 .count();
             assert_eq!(hits, 1, "warnings for {req}: {:?}", s.warnings);
         }
+        // Its displacement shader is not a built-in one; its "displacementbound" is read.
+        for skipped in [
+            "skipped unsupported displacement shader \"disp_textured\"",
+            "skipped unsupported attribute \"render\"",
+        ] {
+            let hits = s.warnings.iter().filter(|w| w.contains(skipped)).count();
+            assert_eq!(hits, 1, "warnings for {skipped}: {:?}", s.warnings);
+        }
+        assert!(s.patches.iter().all(|p| p.displacement.is_none()));
         // Its `Declare`s are read (and its declared shader parameters then ignored).
         assert!(!s.warnings.iter().any(|w| w.contains("Declare")));
         assert!(

@@ -102,8 +102,9 @@ impl Interp {
         Ok(map)
     }
 
-    /// `Attribute "displacementbound" "sphere" [r]` (`"coordinatesystem"` must be
-    /// `"object"`, the default); other attributes are skipped with a warning.
+    /// `Attribute "displacementbound" "sphere" [r] ["coordinatesystem" "space"]`, r in
+    /// `"object"` space (the default; also `"shader"`), `"world"` or `"camera"` (also
+    /// `"current"`); other attributes are skipped with a warning.
     pub(super) fn attribute_request(
         &mut self,
         req: &Request,
@@ -116,6 +117,8 @@ impl Interp {
             self.warn_once(req, &format!("Attribute \"{name}\""), &msg);
             return Ok(());
         }
+        let mut radius = None;
+        let mut space = BoundSpace::Object;
         for p in params {
             match p.name {
                 "sphere" => {
@@ -125,21 +128,41 @@ impl Interp {
                             "displacementbound \"sphere\" {r} must be a finite radius >= 0"
                         )));
                     }
-                    self.attrs.displacement_bound = r;
+                    radius = Some(r);
                 }
                 "coordinatesystem" => {
-                    let ok = matches!(p.value, Arg::Str(s) if s == "object")
-                        || matches!(p.value, Arg::Strs(v) if v.len() == 1 && v[0] == "object");
-                    if !ok {
-                        return Err(a.err(format!(
-                            "displacementbound \"coordinatesystem\" {}: only \"object\" is \
-                             supported",
-                            p.value.describe()
-                        )));
-                    }
+                    let name = match p.value {
+                        Arg::Str(s) => Some(s.as_str()),
+                        Arg::Strs(v) if v.len() == 1 => Some(v[0].as_str()),
+                        _ => None,
+                    };
+                    space = match name {
+                        Some("object" | "shader") => BoundSpace::Object,
+                        Some("world") => BoundSpace::World,
+                        Some("camera" | "current") => BoundSpace::Camera,
+                        _ => {
+                            return Err(a.err(format!(
+                                "displacementbound \"coordinatesystem\" {}: expected \"object\", \
+                                 \"shader\", \"world\", \"camera\" or \"current\"",
+                                p.value.describe()
+                            )));
+                        }
+                    };
                 }
                 other => self.ignored_param(req, other),
             }
+        }
+        if let Some(r) = radius {
+            // An object-space radius follows each primitive's transform ([`Self::
+            // displacement`]); one in world or camera space is taken to camera space now.
+            self.attrs.displacement_bound = match space {
+                BoundSpace::Object => (r, 0.0),
+                BoundSpace::World => {
+                    let m = self.world_to_camera.unwrap_or(DMat4::IDENTITY);
+                    (0.0, r * largest_stretch(&DMat3::from_mat4(m)))
+                }
+                BoundSpace::Camera => (0.0, r),
+            };
         }
         Ok(())
     }
@@ -151,13 +174,22 @@ impl Interp {
         let m = DMat3::from_mat4(*ctm);
         let mean_scale = m.determinant().abs().cbrt();
         let amount = km * mean_scale;
-        let bound = (self.attrs.displacement_bound * largest_stretch(&m)).max(amount.abs());
+        let (object, camera) = self.attrs.displacement_bound;
+        let bound = (object * largest_stretch(&m)).max(camera).max(amount.abs());
         Some(Arc::new(Displacement {
             pattern,
             amount,
             bound,
         }))
     }
+}
+
+/// Spaces `"displacementbound"` may be given in.
+#[derive(Clone, Copy)]
+enum BoundSpace {
+    Object,
+    World,
+    Camera,
 }
 
 /// The largest singular value of `m` (how far it moves a point of a unit sphere at most):

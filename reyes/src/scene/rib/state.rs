@@ -34,8 +34,9 @@ pub(super) struct Attributes {
     pub(super) vbasis: Basis,
     /// `Displacement`: the pattern and its `"Km"` (object space); `None` for none.
     pub(super) displacement: Option<(DisplacementPattern, f64)>,
-    /// `Attribute "displacementbound" "sphere"`: radius in object space.
-    pub(super) displacement_bound: f64,
+    /// `Attribute "displacementbound" "sphere"`: the radius in object space (of each
+    /// primitive) or, given in world or camera space, in camera space; the other 0.
+    pub(super) displacement_bound: (f64, f64),
 }
 
 impl Default for Attributes {
@@ -51,7 +52,7 @@ impl Default for Attributes {
             ubasis: Basis::BEZIER,
             vbasis: Basis::BEZIER,
             displacement: None,
-            displacement_bound: 0.0,
+            displacement_bound: (0.0, 0.0),
         }
     }
 }

@@ -29,6 +29,25 @@ fn displacement_and_its_bound_follow_the_attributes() {
     assert!(s.warnings.is_empty(), "{:?}", s.warnings);
 }
 
+/// A bound in world or camera space is taken to camera space where it is given.
+#[test]
+fn a_bound_in_world_or_camera_space() {
+    let s = parse(&format!(
+        "Scale 2 2 2\n{}",
+        world(&format!(
+            "Displacement \"bumps\" \"Km\" 0.1\nScale 5 5 5\n\
+             Attribute \"displacementbound\" \"sphere\" [1] \"coordinatesystem\" [\"world\"]\n{QUAD}\n\
+             Attribute \"displacementbound\" \"sphere\" [1] \"coordinatesystem\" \"camera\"\n{QUAD}"
+        ))
+    ));
+    let b: Vec<f64> = (s.patches.iter())
+        .map(|p| p.displacement.as_ref().unwrap().bound)
+        .collect();
+    assert!((b[0] - 2.0).abs() < 1e-5 && b[0] >= 2.0, "world: {}", b[0]);
+    // Km 0.1 at a scale of 10 is 1: the larger of the two.
+    assert!((b[1] - 1.0).abs() < 1e-9, "camera: {}", b[1]);
+}
+
 #[test]
 fn unknown_displacements_and_attributes_are_skipped_with_a_warning() {
     let s = parse(&world(&format!(
@@ -64,9 +83,9 @@ fn bad_displacement_values_are_errors_naming_the_line() {
     let e = err(&world("Attribute \"displacementbound\" \"sphere\" [1 2]"));
     assert!(e.contains("t.rib:2") && e.contains("sphere"), "{e}");
     let e = err(&world(
-        "Attribute \"displacementbound\" \"sphere\" 1 \"coordinatesystem\" \"world\"",
+        "Attribute \"displacementbound\" \"sphere\" 1 \"coordinatesystem\" \"raster\"",
     ));
-    assert!(e.contains("t.rib:2") && e.contains("object"), "{e}");
+    assert!(e.contains("t.rib:2") && e.contains("\"world\""), "{e}");
 }
 
 /// A PNG map is read once, as luminance in [0, 1], row-major from the top row.
