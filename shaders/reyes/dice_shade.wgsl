@@ -1,6 +1,8 @@
 // DiceShade: 256 threads per grid. Each thread evaluates one grid point of the (nu+1) x (nv+1)
 // grid (position, normal from the patch derivatives, shaded colour) into workgroup memory; then
 // each thread samples one micropolygon (sample.wgsl). Rust twin: reyes/src/stages/dice_shade.rs.
+// A displaced patch's points move along their normal before they are shaded (docs/reyes.md,
+// "Displacement"; only when SCENE_DISPLACEMENT).
 
 // The surface functions (eval_surface, patch_normal, color_field, original_uv) are in
 // surface.wgsl.

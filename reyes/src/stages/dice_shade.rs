@@ -1,5 +1,6 @@
 //! Twin of `shaders/reyes/dice_shade.wgsl` and `surface.wgsl`: the grid of points with normals from the patch's
-//! derivatives, shaded; then every micropolygon sampled.
+//! derivatives, displaced along them for a displaced patch, shaded; then every micropolygon
+//! sampled.
 
 use super::sample::{Cover, micropolygon_dilation, sample_micropolygon, sample_near_clipped};
 use super::{ControlNet, NEAR_CLIP_GRID, Weights, cp_h, cp_point, item_weights, project, shade};
