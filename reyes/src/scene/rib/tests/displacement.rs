@@ -116,3 +116,25 @@ fn a_png_map_is_read_as_luminance() {
         assert!((t - want).abs() < 1e-6, "texel {k}: {t} vs {want}");
     }
 }
+
+/// An OpenEXR map is read through the same path: luminance, clamped to [0, 1].
+#[test]
+fn an_exr_map_is_read_and_clamped() {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("height.exr");
+    let values = [0.0f32, 0.25, 0.5, 2.0];
+    let img = image::Rgb32FImage::from_fn(4, 1, |x, _| image::Rgb([values[x as usize]; 3]));
+    img.save(&exr).unwrap();
+    let rib = dir.path().join("scene.rib");
+    let text = world(&format!(
+        "Displacement \"mapped\" \"mapname\" \"height.exr\"\n{QUAD}"
+    ));
+    let s = parse_rib(&text, rib.to_str().unwrap()).unwrap();
+    let DisplacementPattern::Map(m) = &s.patches[0].displacement.as_ref().unwrap().pattern else {
+        panic!("a map")
+    };
+    assert_eq!((m.width, m.height), (4, 1));
+    for (t, want) in m.texels.iter().zip([0.0, 0.25, 0.5, 1.0]) {
+        assert!((t - want).abs() < 1e-3, "{t} vs {want}");
+    }
+}
