@@ -60,6 +60,8 @@ pub struct Frame {
     pub tile_h: u32,
     /// 1: micropolygons grow by their crack bound; 0 only to show what that buys.
     pub crack_dilation: u32,
+    /// The direction displaced patches move along ([`DisplacementNormals`] as its `u32`).
+    pub displacement_normals: u32,
 }
 
 impl Frame {
@@ -134,6 +136,9 @@ pub struct PatchInfo {
     /// `l` holding the weights of row `v = l` (u = 0..3 in its 4 lanes), as [`root_item`]
     /// scales them (largest 1). 0 for a polynomial patch, read only under [`PATCH_RATIONAL`].
     pub weights: u32,
+    /// A displaced patch's displacement ([`PATCH_DISPLACED`]): the index of its entry in
+    /// [`FrameData::primvars`] ([`displacement_ref`] gives the layout). 0 when undisplaced.
+    pub displacement: u32,
 }
 
 /// Shapes of a colour field in the primitive-variable table (the low 2 bits of
@@ -176,6 +181,85 @@ pub fn field_ref(
 /// and skip that work.
 pub const PATCH_RATIONAL: u32 = 4;
 
+/// Bit of [`PatchInfo::flags`] (`PATCH_DISPLACED` in common.wgsl): DiceShade displaces the
+/// patch's grid points ([`PatchInfo::displacement`]) and Bound grows its bound.
+pub const PATCH_DISPLACED: u32 = 8;
+
+/// Kinds of displacement pattern in a displacement entry (`DISPLACE_*` in common.wgsl).
+pub const DISPLACE_BUMPS: u32 = 0;
+pub const DISPLACE_MAP: u32 = 1;
+
+/// Which normal displaced grid points move along (`--displacement-normals`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum DisplacementNormals {
+    /// The surface normal from the patch's analytic derivatives (Sattler et al.'s eq. 1):
+    /// one direction per point of the original patch, whatever grid computes it, so grids
+    /// that share an edge move it alike.
+    #[default]
+    Exact,
+    /// The normal of the grid's own finite differences (central inside, one-sided at its
+    /// border): neighbouring grids of other rates move a shared edge differently, which
+    /// opens holes. For comparison only.
+    Approximate,
+}
+
+/// Appends the displacement `d` to the table and returns its entry index
+/// ([`PatchInfo::displacement`]): entry `at` = (amount, bound, kind, map entry or bumps
+/// frequency) with the last two as `u32` bits. A map's block (shared by every patch that uses the map; `maps`
+/// remembers where each went) is one entry (width, height as `u32` bits, 0, 0), then its
+/// texels 4 to an entry, row-major from the top row.
+pub fn displacement_ref(
+    table: &mut Vec<[f32; 4]>,
+    maps: &mut Vec<(*const crate::scene::DisplacementMap, u32)>,
+    d: &crate::scene::Displacement,
+) -> Result<u32, String> {
+    use crate::scene::DisplacementPattern;
+    let too_big = |end: u64| {
+        (end * 16 > MAX_FRAME_BUFFER_BYTES).then(|| {
+            format!(
+                "the patches' displacements and primitive variables need more than the \
+                 {MAX_FRAME_BUFFER_BYTES} bytes a GPU table may hold"
+            )
+        })
+    };
+    let (kind, map_at) = match &d.pattern {
+        DisplacementPattern::Bumps { frequency } => (DISPLACE_BUMPS, *frequency),
+        DisplacementPattern::Map(m) => {
+            let key = std::sync::Arc::as_ptr(m);
+            let at = match maps.iter().find(|(k, _)| *k == key) {
+                Some((_, at)) => *at,
+                None => {
+                    let at = table.len() as u64;
+                    if let Some(e) = too_big(at + 1 + m.texels.len().div_ceil(4) as u64) {
+                        return Err(e);
+                    }
+                    let size = [m.width, m.height].map(f32::from_bits);
+                    table.push([size[0], size[1], 0.0, 0.0]);
+                    table.extend(
+                        m.texels
+                            .chunks(4)
+                            .map(|c| std::array::from_fn(|k| c.get(k).copied().unwrap_or(0.0))),
+                    );
+                    maps.push((key, at as u32));
+                    at as u32
+                }
+            };
+            (DISPLACE_MAP, at)
+        }
+    };
+    let at = table.len() as u64;
+    if let Some(e) = too_big(at + 1) {
+        return Err(e);
+    }
+    table.push([
+        d.amount as f32,
+        d.bound as f32,
+        f32::from_bits(kind),
+        f32::from_bits(map_at),
+    ]);
+    Ok(at as u32)
+}
+
 /// Quality and size settings of a render; `None` fields come from the scene.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderOptions {
@@ -198,6 +282,9 @@ pub struct RenderOptions {
     pub memory_budget: Option<u64>,
     /// Grow micropolygons to close cracks (docs/reyes.md); off only for comparisons.
     pub crack_dilation: bool,
+    /// The normal displaced points move along; [`DisplacementNormals::Approximate`] only to
+    /// show the holes it leaves.
+    pub displacement_normals: DisplacementNormals,
 }
 
 impl Default for RenderOptions {
@@ -214,6 +301,7 @@ impl Default for RenderOptions {
             seed: 0x5eed,
             memory_budget: None,
             crack_dilation: true,
+            displacement_normals: DisplacementNormals::Exact,
         }
     }
 }
@@ -242,6 +330,7 @@ impl FrameData {
             rational: (self.patch_info.iter()).any(|i| i.flags & PATCH_RATIONAL != 0),
             primvars: os || self.patch_info.iter().any(|i| i.cs != 0),
             transparent: os || self.materials.iter().any(|m| m.opacity < 1.0),
+            displacement: (self.patch_info.iter()).any(|i| i.flags & PATCH_DISPLACED != 0),
         }
     }
 }
@@ -259,6 +348,8 @@ pub struct SceneFeatures {
     pub primvars: bool,
     /// Some surface is not opaque (a material's `Opacity` or an "Os" below 1).
     pub transparent: bool,
+    /// Some patch is displaced (`PATCH_DISPLACED`).
+    pub displacement: bool,
 }
 
 impl SceneFeatures {
@@ -267,6 +358,7 @@ impl SceneFeatures {
         rational: true,
         primvars: true,
         transparent: true,
+        displacement: true,
     };
 
     /// True when a program compiled for `self` renders every frame that needs `need`.
@@ -274,6 +366,7 @@ impl SceneFeatures {
         (self.rational || !need.rational)
             && (self.primvars || !need.primvars)
             && (self.transparent || !need.transparent)
+            && (self.displacement || !need.displacement)
     }
 
     /// The features either needs.
@@ -282,6 +375,7 @@ impl SceneFeatures {
             rational: self.rational || o.rational,
             primvars: self.primvars || o.primvars,
             transparent: self.transparent || o.transparent,
+            displacement: self.displacement || o.displacement,
         }
     }
 
@@ -289,8 +383,8 @@ impl SceneFeatures {
     pub fn wgsl(self) -> String {
         format!(
             "const SCENE_RATIONAL: bool = {};\nconst SCENE_PRIMVARS: bool = {};\n\
-             const SCENE_TRANSPARENT: bool = {};\n",
-            self.rational, self.primvars, self.transparent
+             const SCENE_TRANSPARENT: bool = {};\nconst SCENE_DISPLACEMENT: bool = {};\n",
+            self.rational, self.primvars, self.transparent, self.displacement
         )
     }
 }
@@ -389,8 +483,9 @@ impl FrameData {
         let focal = width.min(height) as f64 / 2.0 / (fov / 2.0).tan();
         let lights = gpu_lights(scene);
         let mut primvars = Vec::new();
+        let mut maps = Vec::new();
         let patch_info = (scene.patches.iter())
-            .map(|p| patch_info(p, &mut primvars))
+            .map(|p| patch_info(p, &mut primvars, &mut maps))
             .collect::<Result<_, _>>()?;
         let frame = Frame {
             width,
@@ -412,6 +507,7 @@ impl FrameData {
             tile_w: width,
             tile_h: height,
             crack_dilation: o.crack_dilation as u32,
+            displacement_normals: o.displacement_normals as u32,
         };
         Ok(FrameData {
             frame,
@@ -473,7 +569,11 @@ fn gpu_lights(scene: &Scene) -> Vec<GpuLight> {
         .collect()
 }
 
-fn patch_info(p: &Patch, table: &mut Vec<[f32; 4]>) -> Result<PatchInfo, String> {
+fn patch_info(
+    p: &Patch,
+    table: &mut Vec<[f32; 4]>,
+    maps: &mut Vec<(*const crate::scene::DisplacementMap, u32)>,
+) -> Result<PatchInfo, String> {
     let mut field = |f: Option<&crate::scene::ColorField>| f.map_or(Ok(0), |f| field_ref(table, f));
     let vars = p.primvars.as_deref();
     let cs = field(vars.and_then(|v| v.cs.as_ref()))?;
@@ -483,14 +583,24 @@ fn patch_info(p: &Patch, table: &mut Vec<[f32; 4]>) -> Result<PatchInfo, String>
     } else {
         0
     };
+    let displacement = match &p.displacement {
+        Some(d) => displacement_ref(table, maps, d)?,
+        None => 0,
+    };
     Ok(PatchInfo {
         material: p.material,
         flags: p.flip_normal as u32
             | (p.two_sided as u32) << 1
-            | if p.is_rational() { PATCH_RATIONAL } else { 0 },
+            | if p.is_rational() { PATCH_RATIONAL } else { 0 }
+            | if p.displacement.is_some() {
+                PATCH_DISPLACED
+            } else {
+                0
+            },
         cs,
         os,
         weights,
+        displacement,
     })
 }
 
@@ -587,6 +697,10 @@ mod tests {
                 ("tile_x0", offset_of!(Frame, tile_x0)),
                 ("tile_h", offset_of!(Frame, tile_h)),
                 ("crack_dilation", offset_of!(Frame, crack_dilation)),
+                (
+                    "displacement_normals",
+                    offset_of!(Frame, displacement_normals),
+                ),
             ],
         );
         check(
@@ -616,6 +730,7 @@ mod tests {
                 ("cs", offset_of!(PatchInfo, cs)),
                 ("os", offset_of!(PatchInfo, os)),
                 ("weights", offset_of!(PatchInfo, weights)),
+                ("displacement", offset_of!(PatchInfo, displacement)),
             ],
         );
     }

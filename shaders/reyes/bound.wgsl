@@ -42,11 +42,21 @@ fn bound_execute(item: PatchItem, inv: Invocation) {
     var zmin = pts[0].z;
     var zmax = pts[0].z;
     for (var k = 1u; k < 16u; k++) { zmin = min(zmin, pts[k].z); zmax = max(zmax, pts[k].z); }
+    // A displaced patch: each point moves at most r (camera space; "displacementbound"), so
+    // its bound is the control points' hull grown by a ball of radius r: depths by r, and the
+    // screen bound below by the most any control point's ball can reach on screen.
+    var r = 0.0;
+    if SCENE_DISPLACEMENT && (info.flags & PATCH_DISPLACED) != 0u {
+        r = primvars[info.displacement].y;
+        zmin -= r;
+        zmax += r;
+    }
     if zmax < frame.near || zmin > frame.far {
         atomicAdd(&counters[C_CULL_CLIP], 1u);
         return;
     }
-    var all_back = one_sided;
+    // (A displaced surface may face the eye where its patch does not.)
+    var all_back = one_sided && r == 0.0;
     for (var k = 0u; k < 16u; k++) { all_back = all_back && pts[k].w >= 2.0; }
     if all_back {
         atomicAdd(&counters[C_CULL_BACKFACE], 1u);
@@ -60,7 +70,9 @@ fn bound_execute(item: PatchItem, inv: Invocation) {
     if zmin < frame.near {
         // Crossing the near plane: only the part in front can be seen, and its screen bound
         // decides whether anything of it reaches the bucket.
-        let vis = near_visible_bound(&cp);
+        var vis = near_visible_bound(&cp);
+        // Displaced: a ball reaching the near plane reaches the whole image.
+        if r > 0.0 { vis = array<vec2<f32>, 2>(vec2<f32>(-3.0e38), vec2<f32>(3.0e38)); }
         if any(vis[1] < t0) || any(vis[0] > t1) {
             atomicAdd(&counters[C_CULL_OFFSCREEN], 1u);
             return;
@@ -109,6 +121,19 @@ fn bound_execute(item: PatchItem, inv: Invocation) {
     var lo = pts[0].xy;
     var hi = pts[0].xy;
     for (var k = 1u; k < 16u; k++) { lo = min(lo, pts[k].xy); hi = max(hi, pts[k].xy); }
+    if r > 0.0 {
+        // Every control point q has q.z >= zmin + r > r here. A point q + d, |d| <= r, projects
+        // within focal r |q| / (q.z (q.z - r)) of q's projection along x and along y:
+        // |(x + dx)/(z + dz) - x/z| = |dx z - x dz| / (z (z + dz)) <= r |(x, z)| / (z (z - r)).
+        // Perspective maps the hull of the balls onto the hull of their images.
+        var g = 0.0;
+        for (var k = 0u; k < 16u; k++) {
+            let q = cp_point(&cp, k);
+            g = max(g, length(q) / (q.z * (q.z - r)));
+        }
+        lo -= vec2<f32>(frame.focal * r * g);
+        hi += vec2<f32>(frame.focal * r * g);
+    }
     if any(hi < t0) || any(lo > t1) {
         atomicAdd(&counters[C_CULL_OFFSCREEN], 1u);
         return;

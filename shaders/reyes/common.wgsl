@@ -28,6 +28,9 @@ struct Frame {
     tile_h: u32,
     // 1: grow micropolygons by their crack bound (bound.wgsl); 0 only to show what it buys.
     crack_dilation: u32,
+    // Direction displaced grid points move along: DISPLACE_EXACT_NORMALS (the patch's
+    // analytic normal) or DISPLACE_APPROX_NORMALS (the grid's finite differences; holes).
+    displacement_normals: u32,
 }
 
 struct Material {
@@ -62,6 +65,9 @@ struct PatchInfo {
     cs: u32,
     os: u32,
     weights: u32,
+    // A displaced patch's entry in `primvars` (PATCH_DISPLACED; layout at `displacement_at`
+    // in surface.wgsl), 0 when undisplaced.
+    displacement: u32,
 }
 
 @group(1) @binding(0) var<storage, read> frame: Frame;
@@ -107,6 +113,13 @@ const CULL_MARGIN_PX: f32 = 3.0;
 // Bit of PatchInfo.flags: some weight of the patch is not 1. Without it the item's cp are the
 // points themselves: the stages read no weights and divide by nothing.
 const PATCH_RATIONAL: u32 = 4u;
+// Bit of PatchInfo.flags: DiceShade displaces the grid (PatchInfo.displacement) and Bound grows
+// the bound by its radius. Read only when SCENE_DISPLACEMENT.
+const PATCH_DISPLACED: u32 = 8u;
+const DISPLACE_BUMPS: u32 = 0u;
+const DISPLACE_MAP: u32 = 1u;
+const DISPLACE_EXACT_NORMALS: u32 = 0u;
+const DISPLACE_APPROX_NORMALS: u32 = 1u;
 
 fn cp_point(cp: ptr<function, array<f32, 48>>, i: u32) -> vec3<f32> {
     return vec3<f32>((*cp)[3u * i], (*cp)[3u * i + 1u], (*cp)[3u * i + 2u]);

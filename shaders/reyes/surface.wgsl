@@ -183,3 +183,55 @@ fn color_field(field: u32, u: f32, v: f32) -> vec3<f32> {
 fn original_uv(item: PatchItem, u: f32, v: f32) -> vec2<f32> {
     return vec2<f32>(item.uv.x + (item.uv.y - item.uv.x) * u, item.uv.z + (item.uv.w - item.uv.z) * v);
 }
+
+// Displacement (PATCH_DISPLACED; docs/reyes.md, "Displacement"). A displaced patch's entry `at`
+// in `primvars` is (amount, bound, kind, map): the camera-space distance per unit of pattern,
+// the radius Bound grows by, DISPLACE_BUMPS or DISPLACE_MAP (u32 bits), and (u32 bits) the
+// bumps' frequency or the entry of the map's block: (width, height, 0, 0) as u32 bits, then the texels 4 to an entry, row-major from the
+// top row. Twins: displacement_pattern etc. in dice_shade.rs.
+
+const PI: f32 = 3.14159265358979;
+
+// The pattern of entry `at` at (u, v) = q of the original patch, in [0, 1]: "bumps"
+// (sin(pi f u) sin(pi f v))^2 (f bumps per side), 0 on every patch edge; or the map bilinearly (texel centres at
+// (x + 0.5) / width, clamped to the edge texels).
+fn displacement_pattern(at: u32, q: vec2<f32>) -> f32 {
+    let e = primvars[at];
+    if bitcast<u32>(e.z) == DISPLACE_BUMPS {
+        let f = f32(bitcast<u32>(e.w));
+        let s = sin(PI * f * q.x) * sin(PI * f * q.y);
+        return s * s;
+    }
+    let m = bitcast<u32>(e.w);
+    let w = bitcast<u32>(primvars[m].x);
+    let h = bitcast<u32>(primvars[m].y);
+    let x = clamp(q.x * f32(w) - 0.5, 0.0, f32(w - 1u));
+    let y = clamp(q.y * f32(h) - 0.5, 0.0, f32(h - 1u));
+    let x0 = u32(x);
+    let y0 = u32(y);
+    let x1 = min(x0 + 1u, w - 1u);
+    let y1 = min(y0 + 1u, h - 1u);
+    let fx = x - f32(x0);
+    let fy = y - f32(y0);
+    let top = map_texel(m, w, x0, y0) * (1.0 - fx) + map_texel(m, w, x1, y0) * fx;
+    let bottom = map_texel(m, w, x0, y1) * (1.0 - fx) + map_texel(m, w, x1, y1) * fx;
+    return top * (1.0 - fy) + bottom * fy;
+}
+
+// Step of the central differences of a pattern, in the original patch's (u, v).
+const DISPLACE_FD_STEP: f32 = 0.0009765625;
+
+// Central differences (d/du, d/dv) of the pattern of entry `at` at q in the original patch's
+// (u, v), step DISPLACE_FD_STEP (1/1024).
+fn displacement_slope(at: u32, q: vec2<f32>) -> vec2<f32> {
+    let h = DISPLACE_FD_STEP;
+    let du = displacement_pattern(at, q + vec2<f32>(h, 0.0)) - displacement_pattern(at, q - vec2<f32>(h, 0.0));
+    let dv = displacement_pattern(at, q + vec2<f32>(0.0, h)) - displacement_pattern(at, q - vec2<f32>(0.0, h));
+    return vec2<f32>(du, dv) * (0.5 / h);
+}
+
+// Texel (x, y) of the map whose block starts at entry m (w texels per row).
+fn map_texel(m: u32, w: u32, x: u32, y: u32) -> f32 {
+    let k = y * w + x;
+    return primvars[m + 1u + k / 4u][k % 4u];
+}

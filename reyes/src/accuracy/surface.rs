@@ -125,6 +125,7 @@ mod tests {
             flip_normal: false,
             two_sided: true,
             primvars: None,
+            displacement: None,
             source: PatchSource {
                 file: "test".into(),
                 line: 0,

@@ -626,13 +626,21 @@ impl RasterPeer {
         (self.geometry.vertex_capacity, self.geometry.quad_capacity)
     }
 
-    /// What the peer draws differently from what the scene asks: transparency drawn opaque.
+    /// What the peer draws differently from what the scene asks: transparency drawn opaque,
+    /// displacement left out.
     pub fn warnings(&self) -> Vec<String> {
         let mut w = Vec::new();
         if self.base.features().transparent {
             w.push(
                 "the scene has transparent surfaces (Opacity or \"Os\" below 1): the raster \
                  peer draws them opaque (it has no order-independent transparency)"
+                    .into(),
+            );
+        }
+        if self.base.features().displacement {
+            w.push(
+                "the scene has displaced surfaces (`Displacement`): the raster peer draws them \
+                 undisplaced (only the Reyes pipeline's DiceShade displaces)"
                     .into(),
             );
         }

@@ -92,6 +92,7 @@ pub fn rational_sphere(centre: DVec3, radius: f64) -> Vec<Patch> {
                     flip_normal: sx * sy * sz < 0.0,
                     two_sided: true,
                     primvars: None,
+                    displacement: None,
                     source: PatchSource {
                         file: "rational_sphere".into(),
                         line: 0,

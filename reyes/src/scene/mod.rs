@@ -9,6 +9,7 @@
 
 mod basis;
 mod bpt;
+mod displacement;
 mod newell;
 mod nurbs;
 mod primvars;
@@ -24,6 +25,10 @@ use std::path::Path;
 
 pub use basis::Basis;
 pub use bpt::parse_bpt;
+pub use displacement::{
+    DISPLACEMENT_NAMES, Displacement, DisplacementMap, DisplacementPattern, MAX_BUMPS_FREQUENCY,
+    MAX_MAP_SIDE,
+};
 pub use newell::parse_newell;
 pub use primvars::{ColorField, Primvars};
 pub use rational::eval_rational_bezier;
@@ -114,6 +119,9 @@ pub struct Patch {
     /// The patch's own `"Cs"` / `"Os"` over its parameter square; `None` (no cost) when the
     /// material's `Color` and `Opacity` apply everywhere.
     pub primvars: Option<Box<Primvars>>,
+    /// Displacement along the normal in DiceShade (RIB `Displacement`); `None` (no cost) for
+    /// the undisplaced surface. Shared by the patches of one request.
+    pub displacement: Option<std::sync::Arc<Displacement>>,
     /// Where the patch came from, for error messages.
     pub source: PatchSource,
 }
@@ -503,7 +511,7 @@ mod tests {
         assert_eq!(s.materials.len(), 1);
         assert_eq!(s.materials[0].kind, SurfaceKind::Matte);
         assert_eq!((s.materials[0].ka, s.materials[0].kd), (0.0, 1.0));
-        for req in ["Option", "Imager", "Displacement", "Attribute"] {
+        for req in ["Option", "Imager"] {
             let hits = s
                 .warnings
                 .iter()
@@ -511,6 +519,15 @@ mod tests {
                 .count();
             assert_eq!(hits, 1, "warnings for {req}: {:?}", s.warnings);
         }
+        // Its displacement shader is not a built-in one; its "displacementbound" is read.
+        for skipped in [
+            "skipped unsupported displacement shader \"disp_textured\"",
+            "skipped unsupported attribute \"render\"",
+        ] {
+            let hits = s.warnings.iter().filter(|w| w.contains(skipped)).count();
+            assert_eq!(hits, 1, "warnings for {skipped}: {:?}", s.warnings);
+        }
+        assert!(s.patches.iter().all(|p| p.displacement.is_none()));
         // Its `Declare`s are read (and its declared shader parameters then ignored).
         assert!(!s.warnings.iter().any(|w| w.contains("Declare")));
         assert!(

@@ -98,6 +98,7 @@ pub(crate) fn frame(patches: Vec<ObjectPatch>, flip_normal: bool) -> Scene {
             flip_normal,
             two_sided: true,
             primvars: None,
+            displacement: None,
             source,
         })
         .collect();

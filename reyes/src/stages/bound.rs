@@ -65,12 +65,16 @@ pub fn bound(item: &PatchItem, f: &Frame, info: &PatchInfo, primvars: &[[f32; 4]
             (Vec2::from(s), p.z)
         })
         .collect();
-    let zmin = pts.iter().map(|p| p.1).fold(pts[0].1, f32::min);
-    let zmax = pts.iter().map(|p| p.1).fold(pts[0].1, f32::max);
+    let mut zmin = pts.iter().map(|p| p.1).fold(pts[0].1, f32::min);
+    let mut zmax = pts.iter().map(|p| p.1).fold(pts[0].1, f32::max);
+    // A displaced patch's bound grows by its radius r (see bound.wgsl).
+    let r = displacement_radius(info, primvars);
+    zmin -= r;
+    zmax += r;
     if zmax < f.near || zmin > f.far {
         return Decision::Cull(Cull::Clip);
     }
-    if info.flags & 2 == 0 && backfacing(&item.cp, info.flags & 1 != 0) {
+    if info.flags & 2 == 0 && r == 0.0 && backfacing(&item.cp, info.flags & 1 != 0) {
         return Decision::Cull(Cull::Backface);
     }
     let depth = item.splits();
@@ -79,7 +83,11 @@ pub fn bound(item: &PatchItem, f: &Frame, info: &PatchInfo, primvars: &[[f32; 4]
         Vec2::new((f.tile_x0 + f.tile_w) as f32, (f.tile_y0 + f.tile_h) as f32) + CULL_MARGIN_PX;
     let misses = |lo: Vec2, hi: Vec2| hi.x < t0.x || hi.y < t0.y || lo.x > t1.x || lo.y > t1.y;
     if zmin < f.near {
-        let (lo, hi) = near_visible_bound(f, cp);
+        let (lo, hi) = if r > 0.0 {
+            (Vec2::splat(-3.0e38), Vec2::splat(3.0e38))
+        } else {
+            near_visible_bound(f, cp)
+        };
         if misses(lo, hi) {
             return Decision::Cull(Cull::Offscreen);
         }
@@ -119,8 +127,17 @@ pub fn bound(item: &PatchItem, f: &Frame, info: &PatchInfo, primvars: &[[f32; 4]
             depth_limited: false,
         };
     }
-    let lo = pts.iter().fold(pts[0].0, |a, p| a.min(p.0));
-    let hi = pts.iter().fold(pts[0].0, |a, p| a.max(p.0));
+    let mut lo = pts.iter().fold(pts[0].0, |a, p| a.min(p.0));
+    let mut hi = pts.iter().fold(pts[0].0, |a, p| a.max(p.0));
+    if r > 0.0 {
+        let mut g = 0f32;
+        for k in 0..16 {
+            let q = cp_point(cp, k);
+            g = g.max(q.length() / (q.z * (q.z - r)));
+        }
+        lo -= Vec2::splat(f.focal * r * g);
+        hi += Vec2::splat(f.focal * r * g);
+    }
     if misses(lo, hi) {
         return Decision::Cull(Cull::Offscreen);
     }
@@ -152,6 +169,16 @@ pub fn bound(item: &PatchItem, f: &Frame, info: &PatchInfo, primvars: &[[f32; 4]
     Decision::Dice {
         item: g,
         depth_limited: split != 0,
+    }
+}
+
+/// The radius a displaced patch's points move at most (camera space), 0 when undisplaced:
+/// the `bound` of its displacement entry ([`crate::frame::displacement_ref`]).
+pub fn displacement_radius(info: &PatchInfo, primvars: &[[f32; 4]]) -> f32 {
+    if info.flags & crate::frame::PATCH_DISPLACED != 0 {
+        primvars[info.displacement as usize][1]
+    } else {
+        0.0
     }
 }
 

@@ -1,9 +1,13 @@
 //! Twin of `shaders/reyes/dice_shade.wgsl` and `surface.wgsl`: the grid of points with normals from the patch's
-//! derivatives, shaded; then every micropolygon sampled.
+//! derivatives, displaced along them for a displaced patch, shaded; then every micropolygon
+//! sampled.
 
 use super::sample::{Cover, micropolygon_dilation, sample_micropolygon, sample_near_clipped};
 use super::{ControlNet, NEAR_CLIP_GRID, Weights, cp_h, cp_point, item_weights, project, shade};
-use crate::frame::{FIELD_BILINEAR, FIELD_FLAT, FrameData, PatchInfo, PatchItem};
+use crate::frame::{
+    DISPLACE_BUMPS, DisplacementNormals, FIELD_BILINEAR, FIELD_FLAT, FrameData, PATCH_DISPLACED,
+    PatchInfo, PatchItem,
+};
 use glam::{Vec2, Vec3, Vec4};
 
 fn bern3(t: f32) -> [f32; 4] {
@@ -216,38 +220,158 @@ pub fn micropolygon_cover(item: &PatchItem, data: &FrameData, [i, j, nu, nv]: [u
 
 /// Grid points (x, y in pixels, z, packed colour bits as f32), row-major, (nu+1) x (nv+1);
 /// for a grid marked [`NEAR_CLIP_GRID`], x, y, z in camera space (projected after clipping).
+/// A displaced patch's points move along their normal first, and shade with the normal of
+/// the displaced grid (`dice_grid` in dice_shade.wgsl).
 pub fn dice(item: &PatchItem, data: &FrameData) -> (u32, u32, Vec<[f32; 4]>) {
-    let f = &data.frame;
     let (nu, nv) = (item.rates & 255, (item.rates >> 8) & 255);
     let info = data.patch_info[item.patch_id as usize];
-    let m = &data.materials[info.material as usize];
-    let mut grid = Vec::with_capacity(((nu + 1) * (nv + 1)) as usize);
+    let points = ((nu + 1) * (nv + 1)) as usize;
     // Each GPU thread blossoms the same weights (rational patches only).
     let weights = item_weights(item, &info, &data.primvars);
     let w = weights.as_ref();
-    for t in 0..(nu + 1) * (nv + 1) {
-        let u = (t % (nu + 1)) as f32 / nu as f32;
-        let v = (t / (nu + 1)) as f32 / nv as f32;
-        let e = eval_surface(&item.cp, w, u, v);
-        let n = patch_normal_at(&item.cp, w, e, u, v, info.flags & 1 != 0);
-        let cs = if info.cs != 0 {
-            let (uo, vo) = original_uv(item, u, v);
-            color_field(&data.primvars, info.cs, uo, vo)
-        } else {
-            Vec3::from(m.color)
-        };
-        let c = shade::shade(e[0], n, m, cs, &data.lights);
-        let back = n.dot(e[0]) > 0.0;
-        let color = f32::from_bits(shade::pack_color(c, back));
-        if item.rates & NEAR_CLIP_GRID != 0 {
-            grid.push([e[0].x, e[0].y, e[0].z, color]);
-        } else {
-            let z = e[0].z.max(f.near);
-            let s = project(f, Vec3::new(e[0].x, e[0].y, z));
-            grid.push([s[0], s[1], z, color]);
-        }
+    let flip = info.flags & 1 != 0;
+    let uv = |t: usize| {
+        (
+            (t % (nu as usize + 1)) as f32 / nu as f32,
+            (t / (nu as usize + 1)) as f32 / nv as f32,
+        )
+    };
+    let surface: Vec<([Vec3; 3], Vec3)> = (0..points)
+        .map(|t| {
+            let (u, v) = uv(t);
+            let e = eval_surface(&item.cp, w, u, v);
+            (e, patch_normal_at(&item.cp, w, e, u, v, flip))
+        })
+        .collect();
+    if info.flags & PATCH_DISPLACED == 0 {
+        let grid = (0..points)
+            .map(|t| {
+                let (u, v) = uv(t);
+                shade_point(item, data, surface[t].0[0], surface[t].1, u, v)
+            })
+            .collect();
+        return (nu, nv, grid);
     }
+    let at = info.displacement as usize;
+    let undisplaced: Vec<Vec3> = surface.iter().map(|s| s.0[0]).collect();
+    let approx = data.frame.displacement_normals == DisplacementNormals::Approximate as u32;
+    let amount = data.primvars[at][0];
+    let mut dirs = Vec::with_capacity(points);
+    let mut moved = Vec::with_capacity(points);
+    let mut normals = Vec::with_capacity(points);
+    for (t, (e, n)) in surface.iter().enumerate() {
+        let (u, v) = uv(t);
+        let (qu, qv) = original_uv(item, u, v);
+        let mut dir = n.normalize();
+        let mut ns = *n;
+        if approx {
+            dir = grid_normal(&undisplaced, t, nu, nv, dir, flip);
+        } else {
+            let span = Vec2::new(item.uv[1] - item.uv[0], item.uv[3] - item.uv[2]);
+            let dq = displacement_slope(&data.primvars, at, qu, qv) * amount * span;
+            let s = if flip { -1.0 } else { 1.0 };
+            ns = *n + s * (dq.y * e[1].cross(dir) + dq.x * dir.cross(e[2]));
+        }
+        let d = amount * displacement_pattern(&data.primvars, at, qu, qv);
+        dirs.push(dir);
+        normals.push(ns);
+        moved.push(e[0] + dir * d);
+    }
+    let grid = (0..points)
+        .map(|t| {
+            let (u, v) = uv(t);
+            let ns = if approx {
+                grid_normal(&moved, t, nu, nv, dirs[t], flip)
+            } else {
+                normals[t]
+            };
+            shade_point(item, data, moved[t], ns, u, v)
+        })
+        .collect();
     (nu, nv, grid)
+}
+
+/// `shade_point` in dice_shade.wgsl: grid point (u, v) of `item` at camera-space `p` with
+/// normal `n`, shaded, as (x, y in pixels, z, colour bits), or camera space for a grid
+/// crossing the near plane.
+fn shade_point(item: &PatchItem, data: &FrameData, p: Vec3, n: Vec3, u: f32, v: f32) -> [f32; 4] {
+    let f = &data.frame;
+    let info = data.patch_info[item.patch_id as usize];
+    let m = &data.materials[info.material as usize];
+    let cs = if info.cs != 0 {
+        let (uo, vo) = original_uv(item, u, v);
+        color_field(&data.primvars, info.cs, uo, vo)
+    } else {
+        Vec3::from(m.color)
+    };
+    let c = shade::shade(p, n, m, cs, &data.lights);
+    let back = n.dot(p) > 0.0;
+    let color = f32::from_bits(shade::pack_color(c, back));
+    if item.rates & NEAR_CLIP_GRID != 0 {
+        [p.x, p.y, p.z, color]
+    } else {
+        let z = p.z.max(f.near);
+        let s = project(f, Vec3::new(p.x, p.y, z));
+        [s[0], s[1], z, color]
+    }
+}
+
+/// `grid_normal` in dice_shade.wgsl: the outside normal of point `t` of the nu x nv grid
+/// `g` (camera space) from its central differences (one-sided on the border), or `fallback`
+/// where they are degenerate.
+pub fn grid_normal(g: &[Vec3], t: usize, nu: u32, nv: u32, fallback: Vec3, flip: bool) -> Vec3 {
+    let (nu, nv) = (nu as usize, nv as usize);
+    let cols = nu + 1;
+    let (i, j) = (t % cols, t / cols);
+    let du = g[j * cols + (i + 1).min(nu)] - g[j * cols + i.saturating_sub(1)];
+    let dv = g[(j + 1).min(nv) * cols + i] - g[j.saturating_sub(1) * cols + i];
+    let n = du.cross(dv);
+    let scale = du.dot(du) + dv.dot(dv);
+    // Written so that a NaN falls back too.
+    let regular = n.dot(n) > 1.0e-6 * scale * scale;
+    if !regular {
+        return fallback;
+    }
+    (if flip { -n } else { n }).normalize()
+}
+
+/// `DISPLACE_FD_STEP` in surface.wgsl: the step of [`displacement_slope`]'s differences.
+pub const DISPLACE_FD_STEP: f32 = 1.0 / 1024.0;
+
+/// `displacement_slope` in surface.wgsl: central differences (d/du, d/dv) of the pattern at
+/// (u, v) of the original patch.
+pub fn displacement_slope(table: &[[f32; 4]], at: usize, u: f32, v: f32) -> Vec2 {
+    let h = DISPLACE_FD_STEP;
+    let p = |u, v| displacement_pattern(table, at, u, v);
+    let du = p(u + h, v) - p(u - h, v);
+    let dv = p(u, v + h) - p(u, v - h);
+    Vec2::new(du, dv) * (0.5 / h)
+}
+
+/// `displacement_pattern` in surface.wgsl: the pattern of the displacement entry `at` of
+/// `table` at (u, v) of the original patch, in [0, 1].
+pub fn displacement_pattern(table: &[[f32; 4]], at: usize, u: f32, v: f32) -> f32 {
+    use std::f32::consts::PI;
+    let e = table[at];
+    if e[2].to_bits() == DISPLACE_BUMPS {
+        let f = e[3].to_bits() as f32;
+        let s = (PI * f * u).sin() * (PI * f * v).sin();
+        return s * s;
+    }
+    let m = e[3].to_bits() as usize;
+    let (w, h) = (table[m][0].to_bits(), table[m][1].to_bits());
+    let x = (u * w as f32 - 0.5).clamp(0.0, (w - 1) as f32);
+    let y = (v * h as f32 - 0.5).clamp(0.0, (h - 1) as f32);
+    let (x0, y0) = (x as u32, y as u32);
+    let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
+    let (fx, fy) = (x - x0 as f32, y - y0 as f32);
+    let texel = |x: u32, y: u32| {
+        let k = (y * w + x) as usize;
+        table[m + 1 + k / 4][k % 4]
+    };
+    let top = texel(x0, y0) * (1.0 - fx) + texel(x1, y0) * fx;
+    let bottom = texel(x0, y1) * (1.0 - fx) + texel(x1, y1) * fx;
+    top * (1.0 - fy) + bottom * fy
 }
 
 /// Dices, shades and samples one grid into `samples`; returns (micropolygons, back-face culled).

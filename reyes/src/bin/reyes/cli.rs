@@ -7,7 +7,7 @@
 use clap::{Args, Parser, Subcommand, ValueEnum, value_parser};
 use reyes::accuracy::drift::PathOptions;
 use reyes::accuracy::exact_image::DEFAULT_SAMPLES_PER_AXIS;
-use reyes::frame::RenderOptions;
+use reyes::frame::{DisplacementNormals, RenderOptions};
 use reyes::scene::FrameRanges;
 use scheduler::StrategyKind;
 use std::path::PathBuf;
@@ -112,6 +112,11 @@ pub struct RenderArgs {
     #[arg(long)]
     pub no_crack_dilation: bool,
 
+    /// The normal displaced patches move along: exact (from the patch's derivatives) or
+    /// approximate (the grid's finite differences, which leave holes; for comparisons only).
+    #[arg(long, value_enum, default_value_t = DisplacementNormals::Exact)]
+    pub displacement_normals: DisplacementNormals,
+
     /// GPU strategy: megakernel, multipass or multipass-host [default: megakernel; multipass
     /// on a CPU adapter such as lavapipe, where it is several times faster].
     #[arg(long, value_name = "NAME", value_parser = parse_strategy)]
@@ -150,6 +155,7 @@ impl RenderArgs {
             max_depth: self.max_depth,
             memory_budget: self.memory_budget,
             crack_dilation: !self.no_crack_dilation,
+            displacement_normals: self.displacement_normals,
             ..RenderOptions::default()
         }
     }

@@ -28,9 +28,11 @@
 //! arguments), [`state`] (options, attributes and the block stack), [`requests`] (the one
 //! dispatch over request names), [`frames`] (frame and world blocks: the sequence of frames),
 //! [`shading`] (surfaces, lights, the material table), [`patches`] (the patch primitives
-//! and their conversion to Bezier patches), [`quadrics`] (the quadric primitives) and
+//! and their conversion to Bezier patches), [`displacement`] (`Displacement` and
+//! `"displacementbound"`), [`quadrics`] (the quadric primitives) and
 //! [`primvars`] (`Declare` and the `"Cs"` / `"Os"` primitive variables of patches).
 
+mod displacement;
 mod frames;
 mod input;
 mod lexer;

@@ -81,6 +81,7 @@ impl Interp {
             )));
         }
         let material = self.material();
+        let displacement = self.displacement(ctm);
         self.scene.patches.push(Patch {
             cp,
             w,
@@ -88,6 +89,7 @@ impl Interp {
             flip_normal: self.attrs.orientation_rh,
             two_sided: self.attrs.two_sided,
             primvars: None,
+            displacement,
             source: PatchSource {
                 file: a.req.file.to_string(),
                 line: a.req.line,

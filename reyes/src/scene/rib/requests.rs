@@ -50,6 +50,8 @@ pub(super) const KNOWN: &[&str] = &[
     "Color",
     "Opacity",
     "Surface",
+    "Displacement",
+    "Attribute",
     "LightSource",
     "Sides",
     "Orientation",
@@ -99,6 +101,8 @@ impl Interp {
             }
             "Declare" => self.declare(req, a),
             "Surface" => self.surface(req, a),
+            "Displacement" => self.displacement_request(req, a),
+            "Attribute" => self.attribute_request(req, a),
             "LightSource" => self.light(req, a),
             "Patch" => self.patch(req, a),
             "PatchMesh" => self.patch_mesh(req, a),

@@ -6,7 +6,9 @@
 use super::primvars::Decl;
 use super::syntax::Request;
 use crate::scene::basis::Basis;
-use crate::scene::{Camera, Display, Material, Scene, SceneError, SceneFrame, SurfaceKind};
+use crate::scene::{
+    Camera, DisplacementPattern, Display, Material, Scene, SceneError, SceneFrame, SurfaceKind,
+};
 use glam::{DMat4, DVec3};
 use std::collections::{HashMap, HashSet};
 use std::rc::Rc;
@@ -30,6 +32,11 @@ pub(super) struct Attributes {
     pub(super) surface: Material,
     pub(super) ubasis: Basis,
     pub(super) vbasis: Basis,
+    /// `Displacement`: the pattern and its `"Km"` (object space); `None` for none.
+    pub(super) displacement: Option<(DisplacementPattern, f64)>,
+    /// `Attribute "displacementbound" "sphere"`: the radius in object space (of each
+    /// primitive) or, given in world or camera space, in camera space; the other 0.
+    pub(super) displacement_bound: (f64, f64),
 }
 
 impl Default for Attributes {
@@ -44,6 +51,8 @@ impl Default for Attributes {
             surface: Material::standard(SurfaceKind::Matte),
             ubasis: Basis::BEZIER,
             vbasis: Basis::BEZIER,
+            displacement: None,
+            displacement_bound: (0.0, 0.0),
         }
     }
 }
@@ -145,6 +154,8 @@ pub(super) struct Interp {
     pub(super) motion: Option<bool>,
     /// `Declare`d primitive variables by name (global, not saved by blocks).
     pub(super) declared: HashMap<String, Decl>,
+    /// Displacement maps read so far, by path (each file read once).
+    pub(super) displacement_maps: HashMap<String, std::sync::Arc<crate::scene::DisplacementMap>>,
 }
 
 impl Interp {
@@ -164,6 +175,7 @@ impl Interp {
             current_material: None,
             motion: None,
             declared: HashMap::new(),
+            displacement_maps: HashMap::new(),
         }
     }
 

@@ -1,6 +1,7 @@
 //! Tests of the RIB interpreter, one file per concern like the interpreter's.
 
 mod archives;
+mod displacement;
 mod frames;
 mod hostile;
 mod nupatch;

@@ -8,7 +8,7 @@ fn one_warning_per_skipped_request_kind() {
     let s = parse(&format!(
         "set -x\nHider \"hidden\"\nHider \"zbuffer\"\nOption \"x\" \"y\" [1]\n{}",
         world(
-            "Attribute \"a\" \"b\" [1]\nAttribute \"c\" \"d\" [2]\nPatch \"bilinear\" \"P\" [0 0 0 1 0 0 0 1 0 1 1 0] \"N\" [0 0 1 0 0 1 0 0 1 0 0 1]"
+            "Attribute \"a\" \"b\" [1]\nAttribute \"a\" \"d\" [2]\nPatch \"bilinear\" \"P\" [0 0 0 1 0 0 0 1 0 1 1 0] \"N\" [0 0 1 0 0 1 0 0 1 0 0 1]"
         )
     ));
     assert_eq!(
@@ -17,7 +17,7 @@ fn one_warning_per_skipped_request_kind() {
             "t.rib:1: skipped unsupported request `set`",
             "t.rib:2: skipped unsupported request `Hider`",
             "t.rib:4: skipped unsupported request `Option`",
-            "t.rib:6: skipped unsupported request `Attribute`",
+            "t.rib:6: skipped unsupported attribute \"a\"",
             "t.rib:8: ignored parameter \"N\" of `Patch`",
         ]
     );

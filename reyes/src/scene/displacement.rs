@@ -1,0 +1,77 @@
+//! Displacement: what RIB's `Displacement` request and the `"displacementbound"` attribute
+//! give a patch. DiceShade moves every grid point along the surface normal by
+//! `amount * pattern(u, v)`, (u, v) the parameters of the original patch (docs/reyes.md,
+//! "Displacement").
+
+use std::path::Path;
+use std::sync::Arc;
+
+/// Built-in displacement shaders, by the names RIB's `Displacement` request uses.
+pub const DISPLACEMENT_NAMES: &[&str] = &["bumps", "mapped"];
+
+/// Most texels on a side of a displacement map (its size is packed in 16 bits per side).
+pub const MAX_MAP_SIDE: u32 = 16384;
+
+/// The scalar field a displacement scales: values in [0, 1] over the original patch's (u, v).
+#[derive(Clone, Debug, PartialEq)]
+pub enum DisplacementPattern {
+    /// `"bumps"`: (sin(pi f u) sin(pi f v))^2 with f = `frequency` (RIB `"frequency"`, a
+    /// whole number 1..=[`MAX_BUMPS_FREQUENCY`], default 1): f x f bumps per patch, 0 on every
+    /// patch edge, so neighbouring patches agree wherever they meet.
+    Bumps { frequency: u32 },
+    /// `"mapped"` with `"mapname"`: an image's luminance, sampled bilinearly at (u, v) (texel
+    /// centres at (x + 0.5) / width, clamped at the edges; v = 0 is the image's top row).
+    Map(Arc<DisplacementMap>),
+}
+
+/// Most bumps per patch side of [`DisplacementPattern::Bumps`].
+pub const MAX_BUMPS_FREQUENCY: u32 = 64;
+
+/// A displacement map: luminance per texel, row-major from the top row, in [0, 1].
+#[derive(Clone, Debug, PartialEq)]
+pub struct DisplacementMap {
+    pub width: u32,
+    pub height: u32,
+    pub texels: Vec<f32>,
+}
+
+impl DisplacementMap {
+    /// Reads a PNG (8 or 16 bit, any channels) or OpenEXR image through the `image` crate and
+    /// keeps its luminance (for EXR, clamped to [0, 1]). Errors name the file.
+    pub fn load(path: &Path) -> Result<DisplacementMap, String> {
+        let img = image::open(path)
+            .map_err(|e| format!("cannot read the displacement map {}: {e}", path.display()))?;
+        let (width, height) = (img.width(), img.height());
+        if width == 0 || height == 0 || width > MAX_MAP_SIDE || height > MAX_MAP_SIDE {
+            return Err(format!(
+                "the displacement map {} is {width}x{height}: each side must be 1..={MAX_MAP_SIDE}",
+                path.display()
+            ));
+        }
+        let luma = img.to_luma32f();
+        let texels = luma
+            .into_raw()
+            .into_iter()
+            .map(|x| x.clamp(0.0, 1.0))
+            .collect();
+        Ok(DisplacementMap {
+            width,
+            height,
+            texels,
+        })
+    }
+}
+
+/// A patch's displacement, in camera space.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Displacement {
+    pub pattern: DisplacementPattern,
+    /// Camera-space distance per unit of the pattern: `"Km"` times the object-to-camera
+    /// transform's mean scale (the cube root of its determinant's magnitude; exact for
+    /// rotations, translations and uniform scales). Negative moves inward.
+    pub amount: f64,
+    /// Camera-space radius every point may move: the larger of `"displacementbound"`'s
+    /// sphere (object space, times the transform's largest stretch) and |amount| (the
+    /// pattern's values lie in [0, 1]), so a bound given too small never culls what shows.
+    pub bound: f64,
+}
