@@ -6,16 +6,20 @@
 //! Per frame, pipelined like [`crate::realtime`] (the same uploaded scene tables, the same
 //! [`Orbit`] turntable uniform, at most [`IN_FLIGHT`] frames submitted, the status read a
 //! frame late, no per-frame allocation):
-//! 1. `tessellate` (tessellate.wgsl), one workgroup per patch: its control points turned by
-//!    the frame's transform, culled by their bound (wholly in front of the near plane or
-//!    beyond the far one, or off screen; a patch crossing the near plane is kept: the
-//!    rasterizer clips), a rate per side from the projected control polygon so that
-//!    triangles are about `--mp-size` pixels ([`grid_rate`], at most [`MAX_RATE`] = 64 per
-//!    side, the hardware tessellator's maximum), then every grid point evaluated and shaded
-//!    with Reyes's shading (surface.wgsl, shade.wgsl: the same materials, lights, normals and
-//!    10-bit packed colour as DiceShade) into a [`RasterVertex`], two triangles per quad into
-//!    the index buffer (a quad of a one-sided patch whose four corners face away is culled as
-//!    Reyes's sampling culls it), and the indirect draw;
+//! 1. tessellation (tessellate.wgsl), three dispatches that fill the GPU: `tess_rates`, one
+//!    thread per patch, turns its control points by the frame's transform, culls them by
+//!    their bound (wholly in front of the near plane or beyond the far one, or off screen; a
+//!    patch crossing the near plane is kept: the rasterizer clips), takes a rate per side from
+//!    the projected control polygon so that triangles are about `--mp-size` pixels
+//!    ([`grid_rate`], at most [`MAX_RATE`] = 64 per side, the hardware tessellator's maximum),
+//!    takes room for its points and quads with atomics and appends a tile per [`TESS_TILE`]
+//!    grid points to the tile list, whose indirect dispatch one thread writes; `tess_points`,
+//!    a workgroup per tile and a thread per grid point, evaluates and shades the point with
+//!    Reyes's shading (surface.wgsl, shade.wgsl: the same materials, lights, normals and
+//!    10-bit packed colour as DiceShade) into a [`RasterVertex`]; `tess_quads`, a thread per
+//!    quad over the same tiles, writes two triangles per quad into the index buffer (a quad
+//!    of a one-sided patch whose four corners face away is culled as Reyes's sampling culls
+//!    it); then the indirect draw;
 //! 2. a render pass (raster_draw.wgsl) draws them indexed-indirect into a multisampled
 //!    colour (`Rgba16Float`, linear) and depth (`Depth32Float`, reversed: nearest greatest)
 //!    target, resolved by the hardware;
@@ -235,7 +239,17 @@ impl RasterPeer {
         // tables (frame, materials, lights, patch info, primvars; not the samples, counters).
         let tess_layout = layout(
             "raster tessellate",
-            &[ro(0), ro(1), ro(3), rw(4), rw(5), rw(6), rw(7), rw(8), rw(9)],
+            &[
+                ro(0),
+                ro(1),
+                ro(3),
+                rw(4),
+                rw(5),
+                rw(6),
+                rw(7),
+                rw(8),
+                rw(9),
+            ],
         );
         let scene_layout = layout("raster scene", &[ro(0), ro(1), ro(2), ro(3), ro(6)]);
         let pipeline_layout = gpu

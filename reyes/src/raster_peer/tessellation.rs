@@ -94,6 +94,9 @@ pub struct TessCounts {
     pub backface: u32,
     /// Patches that did not fit the buffers (the frame is then drawn again).
     pub over: u32,
+    /// Tiles of [`TESS_TILE`] grid points (and quads) of one patch: the workgroups of each of
+    /// the point and quad dispatches.
+    pub tiles: u32,
 }
 
 impl TessCounts {
@@ -105,6 +108,7 @@ impl TessCounts {
             culled: w[3],
             backface: w[4],
             over: w[5],
+            tiles: w[6],
         }
     }
 
