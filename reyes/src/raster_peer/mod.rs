@@ -6,16 +6,20 @@
 //! Per frame, pipelined like [`crate::realtime`] (the same uploaded scene tables, the same
 //! [`Orbit`] turntable uniform, at most [`IN_FLIGHT`] frames submitted, the status read a
 //! frame late, no per-frame allocation):
-//! 1. `tessellate` (tessellate.wgsl), one workgroup per patch: its control points turned by
-//!    the frame's transform, culled by their bound (wholly in front of the near plane or
-//!    beyond the far one, or off screen; a patch crossing the near plane is kept: the
-//!    rasterizer clips), a rate per side from the projected control polygon so that
-//!    triangles are about `--mp-size` pixels ([`grid_rate`], at most [`MAX_RATE`] = 64 per
-//!    side, the hardware tessellator's maximum), then every grid point evaluated and shaded
-//!    with Reyes's shading (surface.wgsl, shade.wgsl: the same materials, lights, normals and
-//!    10-bit packed colour as DiceShade) into a [`RasterVertex`], two triangles per quad into
-//!    the index buffer (a quad of a one-sided patch whose four corners face away is culled as
-//!    Reyes's sampling culls it), and the indirect draw;
+//! 1. tessellation (tessellate.wgsl), three dispatches that fill the GPU: `tess_rates`, one
+//!    thread per patch, turns its control points by the frame's transform, culls them by
+//!    their bound (wholly in front of the near plane or beyond the far one, or off screen; a
+//!    patch crossing the near plane is kept: the rasterizer clips), takes a rate per side from
+//!    the projected control polygon so that triangles are about `--mp-size` pixels
+//!    ([`grid_rate`], at most [`MAX_RATE`] = 64 per side, the hardware tessellator's maximum),
+//!    takes room for its points and quads with atomics and appends a tile per [`TESS_TILE`]
+//!    grid points to the tile list, whose indirect dispatch one thread writes; `tess_points`,
+//!    a workgroup per tile and a thread per grid point, evaluates and shades the point with
+//!    Reyes's shading (surface.wgsl, shade.wgsl: the same materials, lights, normals and
+//!    10-bit packed colour as DiceShade) into a [`RasterVertex`]; `tess_quads`, a thread per
+//!    quad over the same tiles, writes two triangles per quad into the index buffer (a quad
+//!    of a one-sided patch whose four corners face away is culled as Reyes's sampling culls
+//!    it); then the indirect draw;
 //! 2. a render pass (raster_draw.wgsl) draws them indexed-indirect into a multisampled
 //!    colour (`Rgba16Float`, linear) and depth (`Depth32Float`, reversed: nearest greatest)
 //!    target, resolved by the hardware;
@@ -34,19 +38,21 @@
 //! samples), and transparency (Os < 1) is drawn opaque ([`RasterPeer::warnings`]): the peer
 //! has no order-independent transparency.
 //!
-//! Buffers are sized from the unturned frame ([`HEADROOM`] above its needs). A frame whose
+//! Buffers are sized from the unturned frame ([`HEADROOM`](crate::realtime::HEADROOM) above its needs). A frame whose
 //! patches do not fit draws nothing (the indirect draw is empty), is found a frame late from
 //! its status, and is drawn again alone with buffers grown to its needs
 //! ([`PeerFrame::redrawn`]): a partial frame is never returned.
 
+mod geometry;
 mod tessellation;
+use geometry::Geometry;
 pub use tessellation::*;
 
 use crate::frame::{Frame, FrameData, RenderOptions};
 use crate::gpu_render::dispatch_2d;
 use crate::image::FrameImage;
 use crate::orbit;
-use crate::realtime::{HEADROOM, IN_FLIGHT, Orbit, Pixels, SceneTables, map_buffer, read_mapped};
+use crate::realtime::{IN_FLIGHT, Orbit, Pixels, SceneTables, map_buffer, read_mapped};
 use crate::scene::Scene;
 use crate::shaders;
 use scheduler::timing::SpanTimer;
@@ -112,18 +118,6 @@ pub struct Tessellation {
     pub counts: TessCounts,
 }
 
-/// The vertex, index and draw buffers, sized for a number of vertices and quads.
-struct Geometry {
-    vertices: wgpu::Buffer,
-    indices: wgpu::Buffer,
-    counts: wgpu::Buffer,
-    grids: wgpu::Buffer,
-    draw_args: wgpu::Buffer,
-    params: wgpu::Buffer,
-    vertex_capacity: u32,
-    quad_capacity: u32,
-}
-
 /// Buffers of one frame in flight.
 struct Slot {
     orbit: wgpu::Buffer,
@@ -151,7 +145,8 @@ pub struct RasterPeer {
     samples: u32,
     tables: SceneTables,
     tess_layout: wgpu::BindGroupLayout,
-    tessellate: wgpu::ComputePipeline,
+    /// `tess_rates`, `tile_dispatch`, `tess_points`, `tess_quads`.
+    tessellate: [wgpu::ComputePipeline; 4],
     finish_draw: wgpu::ComputePipeline,
     scene_bind: wgpu::BindGroup,
     draw: wgpu::RenderPipeline,
@@ -170,31 +165,11 @@ pub struct RasterPeer {
     slots: Vec<Slot>,
     timer: SpanTimer,
     pixels: Pixels,
+    /// `tess_rates`'s workgroups (one thread per patch).
     tess_groups: (u32, u32),
     resolve_groups: (u32, u32),
     /// Kept alive for the bind groups.
     _buffers: Vec<wgpu::Buffer>,
-}
-
-fn buffer(
-    gpu: &Gpu,
-    label: &str,
-    bytes: u64,
-    usage: wgpu::BufferUsages,
-) -> Result<wgpu::Buffer, RunError> {
-    if bytes > gpu.max_binding_bytes() {
-        return Err(RunError::Device(format!(
-            "the raster peer's `{label}` needs {bytes} bytes, more than this device's storage \
-             binding limit of {} bytes (a larger --mp-size needs fewer triangles)",
-            gpu.max_binding_bytes()
-        )));
-    }
-    Ok(gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some(label),
-        size: bytes.max(16).next_multiple_of(4),
-        usage: usage | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    }))
 }
 
 fn target(
@@ -223,7 +198,7 @@ fn target(
 
 impl RasterPeer {
     /// Uploads `scene` for frames of `options`, compiles the stages, and draws the unturned
-    /// frame once to size the buffers ([`HEADROOM`] above its needs). Errors: the options'
+    /// frame once to size the buffers ([`HEADROOM`](crate::realtime::HEADROOM) above its needs). Errors: the options'
     /// ([`FrameData::new`]) and too many patches ([`MAX_PATCHES`]) as [`RunError::Program`];
     /// an image larger than the device's render targets, buffers beyond its limits, and those
     /// of a frame, as [`RunError::Device`] or [`RunError::Timeout`].
@@ -264,7 +239,17 @@ impl RasterPeer {
         // tables (frame, materials, lights, patch info, primvars; not the samples, counters).
         let tess_layout = layout(
             "raster tessellate",
-            &[ro(0), ro(1), ro(3), rw(4), rw(5), rw(6), rw(7), rw(8)],
+            &[
+                ro(0),
+                ro(1),
+                ro(3),
+                rw(4),
+                rw(5),
+                rw(6),
+                rw(7),
+                rw(8),
+                rw(9),
+            ],
         );
         let scene_layout = layout("raster scene", &[ro(0), ro(1), ro(2), ro(3), ro(6)]);
         let pipeline_layout = gpu
@@ -296,7 +281,12 @@ impl RasterPeer {
                     cache: None,
                 })
         };
-        let tessellate = compute("tessellate");
+        let tessellate = [
+            compute("tess_rates"),
+            compute("tile_dispatch"),
+            compute("tess_points"),
+            compute("tess_quads"),
+        ];
         let finish_draw = compute("finish_draw");
         let scene_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("raster scene"),
@@ -446,7 +436,7 @@ impl RasterPeer {
             slots,
             timer: SpanTimer::new(gpu, IN_FLIGHT as u32),
             pixels: Pixels::None,
-            tess_groups: dispatch_2d(n as u64, 1).0,
+            tess_groups: dispatch_2d(n as u64, 64).0,
             resolve_groups,
             _buffers: vec![params, rgba8_params],
             tables,
@@ -516,98 +506,6 @@ impl RasterPeer {
                 multiview_mask: None,
                 cache: None,
             }))
-    }
-
-    fn geometry_buffers(
-        gpu: &Gpu,
-        patches: u32,
-        vertices: u64,
-        quads: u64,
-    ) -> Result<Geometry, RunError> {
-        let u = wgpu::BufferUsages::empty();
-        let params = TessParams {
-            patches,
-            row: dispatch_2d(patches as u64, 1).1,
-            vertex_capacity: vertices.min(u32::MAX as u64) as u32,
-            quad_capacity: quads.min(u32::MAX as u64 / 6) as u32,
-            max_rate: MAX_RATE,
-            pad: [0; 3],
-        };
-        Ok(Geometry {
-            vertices: buffer(
-                gpu,
-                "raster vertices",
-                vertices * 16,
-                wgpu::BufferUsages::VERTEX,
-            )?,
-            indices: buffer(gpu, "raster indices", quads * 24, wgpu::BufferUsages::INDEX)?,
-            counts: buffer(
-                gpu,
-                "raster counts",
-                COUNT_WORDS * 4,
-                wgpu::BufferUsages::COPY_DST,
-            )?,
-            grids: buffer(gpu, "raster grids", patches.max(1) as u64 * 32, u)?,
-            draw_args: buffer(gpu, "raster draw", 20, wgpu::BufferUsages::INDIRECT)?,
-            params: gpu.upload("raster tessellate params", &[params])?,
-            vertex_capacity: params.vertex_capacity,
-            quad_capacity: params.quad_capacity,
-        })
-    }
-
-    fn tess_bind(
-        gpu: &Gpu,
-        layout: &wgpu::BindGroupLayout,
-        orbit: &wgpu::Buffer,
-        tables: &SceneTables,
-        g: &Geometry,
-    ) -> wgpu::BindGroup {
-        let entries = [
-            (0, orbit),
-            (1, &tables.objects),
-            (3, &g.params),
-            (4, &g.vertices),
-            (5, &g.indices),
-            (6, &g.counts),
-            (7, &g.grids),
-            (8, &g.draw_args),
-        ]
-        .map(|(binding, b)| wgpu::BindGroupEntry {
-            binding,
-            resource: b.as_entire_binding(),
-        });
-        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("raster tessellate"),
-            layout,
-            entries: &entries,
-        })
-    }
-
-    /// Grows the geometry buffers to [`HEADROOM`] above `counts`' needs when they do not hold
-    /// them. Errors: needs beyond the device's limits.
-    fn fit(&mut self, gpu: &Gpu, counts: &TessCounts) -> Result<(), RunError> {
-        let g = &self.geometry;
-        let (v, q) = (counts.vertices as u64, counts.quads as u64);
-        if v <= g.vertex_capacity as u64 && q <= g.quad_capacity as u64 {
-            return Ok(());
-        }
-        let max = gpu.max_binding_bytes();
-        let room = |need: u64, bytes: u64| {
-            ((need as f64 * HEADROOM).ceil() as u64)
-                .min(max / bytes)
-                .max(need)
-        };
-        self.geometry = Self::geometry_buffers(gpu, self.patches, room(v, 16), room(q, 24))?;
-        for s in &mut self.slots {
-            s.tess_bind = Self::tess_bind(
-                gpu,
-                &self.tess_layout,
-                &s.orbit,
-                &self.tables,
-                &self.geometry,
-            );
-        }
-        Ok(())
     }
 
     /// The MSAA sample count the peer draws with ([`msaa_samples`]).
@@ -724,6 +622,7 @@ impl RasterPeer {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&g.counts, 0, None);
         {
+            // One thread per patch: rates, culling, room and tiles; then the tiles' dispatch.
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("raster tessellate"),
                 timestamp_writes: self.timer.begin(slot as u32),
@@ -731,8 +630,24 @@ impl RasterPeer {
             pass.set_bind_group(0, &s.tess_bind, &[]);
             pass.set_bind_group(1, &self.scene_bind, &[]);
             if self.patches > 0 {
-                pass.set_pipeline(&self.tessellate);
+                pass.set_pipeline(&self.tessellate[0]);
                 pass.dispatch_workgroups(self.tess_groups.0, self.tess_groups.1, 1);
+            }
+            pass.set_pipeline(&self.tessellate[1]);
+            pass.dispatch_workgroups(1, 1, 1);
+        }
+        enc.copy_buffer_to_buffer(&g.counts, DISPATCH_WORD * 4, &g.tile_args, 0, 12);
+        {
+            // One thread per grid point, then per quad, over the tiles; the indirect draw.
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("raster dice"),
+                timestamp_writes: None,
+            });
+            pass.set_bind_group(0, &s.tess_bind, &[]);
+            pass.set_bind_group(1, &self.scene_bind, &[]);
+            for p in &self.tessellate[2..] {
+                pass.set_pipeline(p);
+                pass.dispatch_workgroups_indirect(&g.tile_args, 0);
             }
             pass.set_pipeline(&self.finish_draw);
             pass.dispatch_workgroups(1, 1, 1);

@@ -27,7 +27,7 @@ pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct TessParams {
     pub patches: u32,
-    /// Workgroups per row of the 2D dispatch (one workgroup per patch).
+    /// Threads per row of `tess_rates`'s 2D dispatch (one thread per patch).
     pub row: u32,
     /// Vertices the vertex buffer holds.
     pub vertex_capacity: u32,
@@ -35,7 +35,9 @@ pub struct TessParams {
     pub quad_capacity: u32,
     /// Most segments per grid side ([`MAX_RATE`]).
     pub max_rate: u32,
-    pub pad: [u32; 3],
+    /// Tiles (64 grid points and quads of one patch) the tile list holds.
+    pub tile_capacity: u32,
+    pub pad: [u32; 2],
 }
 
 /// A vertex of the peer's triangles (`RasterVertex` in tessellate.wgsl; 16 bytes): the clip
@@ -66,8 +68,16 @@ pub struct RasterResolveParams {
     pub pad: [u32; 3],
 }
 
-/// Words of the tessellation counters (`tess_counts` in tessellate.wgsl).
-pub(crate) const COUNT_WORDS: u64 = 8;
+/// Words of the tessellation counters (`tess_counts` in tessellate.wgsl): the counts, then
+/// at [`DISPATCH_WORD`] the indirect dispatch of the tiles.
+pub(crate) const COUNT_WORDS: u64 = 12;
+
+/// Where the tiles' indirect dispatch (x, y, z workgroups) lies in the counters (`T_DISPATCH`).
+pub(crate) const DISPATCH_WORD: u64 = 8;
+
+/// Grid points (and quads) per tile: one workgroup of `tess_points` and `tess_quads`
+/// (`TESS_TILE` in tessellate.wgsl).
+pub const TESS_TILE: u32 = 64;
 
 /// What a frame's tessellation counted (`T_*` in tessellate.wgsl).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -84,6 +94,9 @@ pub struct TessCounts {
     pub backface: u32,
     /// Patches that did not fit the buffers (the frame is then drawn again).
     pub over: u32,
+    /// Tiles of [`TESS_TILE`] grid points (and quads) of one patch: the workgroups of each of
+    /// the point and quad dispatches.
+    pub tiles: u32,
 }
 
 impl TessCounts {
@@ -95,6 +108,7 @@ impl TessCounts {
             culled: w[3],
             backface: w[4],
             over: w[5],
+            tiles: w[6],
         }
     }
 
@@ -270,6 +284,7 @@ mod tests {
                 ("vertex_capacity", offset_of!(TessParams, vertex_capacity)),
                 ("quad_capacity", offset_of!(TessParams, quad_capacity)),
                 ("max_rate", offset_of!(TessParams, max_rate)),
+                ("tile_capacity", offset_of!(TessParams, tile_capacity)),
             ],
         );
         check(

@@ -142,6 +142,9 @@ pub struct PeerRow {
     pub wall_ms: f64,
     pub gpu_ms: Option<f64>,
     pub triangles: u64,
+    /// Tessellation tiles (64 grid points of one patch): the workgroups of the point and of
+    /// the quad dispatch.
+    pub tiles: u32,
     pub redrawn: Option<String>,
 }
 
@@ -264,6 +267,7 @@ fn raster_peer(
                 wall_ms: f.wall_ms,
                 gpu_ms: f.gpu_ms,
                 triangles: f.counts.triangles(),
+                tiles: f.counts.tiles,
                 redrawn: f.redrawn.clone(),
             })
             .collect(),
