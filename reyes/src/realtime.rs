@@ -612,23 +612,7 @@ impl RealtimeRenderer {
         f: InFlight,
         last: &mut Instant,
     ) -> Result<RealtimeFrame, RunError> {
-        let polled = gpu.device.poll(wgpu::PollType::Wait {
-            submission_index: Some(f.submission.clone()),
-            timeout: Some(gpu.timeout),
-        });
-        if let Some(e) = gpu.take_error() {
-            return Err(RunError::Device(format!("a pipelined frame: {e}")));
-        }
-        match polled {
-            Ok(_) => {}
-            Err(wgpu::PollError::Timeout) => {
-                return Err(RunError::Timeout {
-                    what: "a pipelined frame".into(),
-                    seconds: gpu.timeout.as_secs_f64(),
-                });
-            }
-            Err(e) => return Err(RunError::Device(format!("a pipelined frame: {e}"))),
-        }
+        gpu.wait_for(Some(f.submission.clone()), "a pipelined frame")?;
         if f.mapped.load(Ordering::Acquire) != f.maps.len() {
             return Err(RunError::Device(
                 "a frame finished but its status was not mapped".into(),

@@ -160,8 +160,18 @@ impl Gpu {
     /// Waits for all submitted work, bounded by `self.timeout`. A wgpu error recorded since
     /// the last wait (see [`Gpu::take_error`]) is returned as [`RunError::Device`].
     pub fn wait(&self, what: &str) -> Result<(), RunError> {
+        self.wait_for(None, what)
+    }
+
+    /// [`Gpu::wait`] for one submission (`None`: all submitted work), bounded by
+    /// `self.timeout`; `what` names the work in the error.
+    pub fn wait_for(
+        &self,
+        submission: Option<wgpu::SubmissionIndex>,
+        what: &str,
+    ) -> Result<(), RunError> {
         let polled = self.device.poll(wgpu::PollType::Wait {
-            submission_index: None,
+            submission_index: submission,
             timeout: Some(self.timeout),
         });
         if let Some(e) = self.take_error() {

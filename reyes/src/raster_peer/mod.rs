@@ -735,23 +735,7 @@ impl RasterPeer {
         last: &mut Instant,
         again: bool,
     ) -> Result<PeerFrame, RunError> {
-        let polled = gpu.device.poll(wgpu::PollType::Wait {
-            submission_index: Some(f.submission.clone()),
-            timeout: Some(gpu.timeout),
-        });
-        if let Some(e) = gpu.take_error() {
-            return Err(RunError::Device(format!("a raster peer frame: {e}")));
-        }
-        match polled {
-            Ok(_) => {}
-            Err(wgpu::PollError::Timeout) => {
-                return Err(RunError::Timeout {
-                    what: "a raster peer frame".into(),
-                    seconds: gpu.timeout.as_secs_f64(),
-                });
-            }
-            Err(e) => return Err(RunError::Device(format!("a raster peer frame: {e}"))),
-        }
+        gpu.wait_for(Some(f.submission.clone()), "a raster peer frame")?;
         if f.mapped.load(Ordering::Acquire) != f.maps.len() {
             return Err(RunError::Device(
                 "a raster peer frame finished but its status was not mapped".into(),
