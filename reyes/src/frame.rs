@@ -60,6 +60,8 @@ pub struct Frame {
     pub tile_h: u32,
     /// 1: micropolygons grow by their crack bound; 0 only to show what that buys.
     pub crack_dilation: u32,
+    /// How micropolygons are rasterized: [`RasterMode::gpu_code`] (`RASTER_*` in common.wgsl).
+    pub raster: u32,
 }
 
 impl Frame {
@@ -198,7 +200,56 @@ pub struct RenderOptions {
     pub memory_budget: Option<u64>,
     /// Grow micropolygons to close cracks (docs/reyes.md); off only for comparisons.
     pub crack_dilation: bool,
+    /// How micropolygons are rasterized ([`RasterMode`]).
+    pub raster: RasterMode,
 }
+
+/// How a micropolygon becomes samples (Sattler & Steinberger, "Reyes Rendering on the GPU",
+/// section 4.2; docs/reyes.md, *Rasterization modes*).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum RasterMode {
+    /// Bounding-box rasterization, the paper's "proper rasterization": every jittered
+    /// sub-sample under the micropolygon's screen bound is tested against its two triangles.
+    /// Leaves no holes between micropolygons that meet.
+    #[default]
+    BoundingBox,
+    /// The paper's naive mode: one sample per micropolygon, the jittered sub-sample nearest its
+    /// centre (the mean of its 4 projected corners), at the mean depth of its corners. Fast, but
+    /// leaves holes wherever micropolygons are larger than the sample spacing.
+    NearestSample,
+}
+
+impl RasterMode {
+    /// The value of [`Frame::raster`] (`RASTER_BBOX`, `RASTER_NEAREST` in common.wgsl).
+    pub fn gpu_code(self) -> u32 {
+        match self {
+            RasterMode::BoundingBox => RASTER_BBOX,
+            RasterMode::NearestSample => RASTER_NEAREST,
+        }
+    }
+
+    /// The mode of a [`Frame::raster`] value (anything but `RASTER_NEAREST` is bounding-box).
+    pub fn from_gpu_code(code: u32) -> RasterMode {
+        if code == RASTER_NEAREST {
+            RasterMode::NearestSample
+        } else {
+            RasterMode::BoundingBox
+        }
+    }
+
+    /// The command line's and the statistics' name: `bbox` or `nearest`.
+    pub fn name(self) -> &'static str {
+        match self {
+            RasterMode::BoundingBox => "bbox",
+            RasterMode::NearestSample => "nearest",
+        }
+    }
+}
+
+/// [`Frame::raster`] of [`RasterMode::BoundingBox`].
+pub const RASTER_BBOX: u32 = 0;
+/// [`Frame::raster`] of [`RasterMode::NearestSample`].
+pub const RASTER_NEAREST: u32 = 1;
 
 impl Default for RenderOptions {
     fn default() -> Self {
@@ -214,6 +265,7 @@ impl Default for RenderOptions {
             seed: 0x5eed,
             memory_budget: None,
             crack_dilation: true,
+            raster: RasterMode::BoundingBox,
         }
     }
 }
@@ -412,6 +464,7 @@ impl FrameData {
             tile_w: width,
             tile_h: height,
             crack_dilation: o.crack_dilation as u32,
+            raster: o.raster.gpu_code(),
         };
         Ok(FrameData {
             frame,
@@ -587,6 +640,7 @@ mod tests {
                 ("tile_x0", offset_of!(Frame, tile_x0)),
                 ("tile_h", offset_of!(Frame, tile_h)),
                 ("crack_dilation", offset_of!(Frame, crack_dilation)),
+                ("raster", offset_of!(Frame, raster)),
             ],
         );
         check(

@@ -28,7 +28,14 @@ struct Frame {
     tile_h: u32,
     // 1: grow micropolygons by their crack bound (bound.wgsl); 0 only to show what it buys.
     crack_dilation: u32,
+    // How micropolygons are rasterized: RASTER_BBOX or RASTER_NEAREST (sample.wgsl).
+    raster: u32,
 }
+
+// Frame.raster: every sub-sample under the micropolygon's bound, tested against its triangles.
+const RASTER_BBOX: u32 = 0u;
+// Frame.raster: only the sub-sample nearest the micropolygon's centre (the paper's naive mode).
+const RASTER_NEAREST: u32 = 1u;
 
 struct Material {
     color: vec3<f32>,
