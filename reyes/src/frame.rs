@@ -294,6 +294,7 @@ impl FrameData {
             rational: (self.patch_info.iter()).any(|i| i.flags & PATCH_RATIONAL != 0),
             primvars: os || self.patch_info.iter().any(|i| i.cs != 0),
             transparent: os || self.materials.iter().any(|m| m.opacity < 1.0),
+            nearest_raster: self.frame.raster == RASTER_NEAREST,
         }
     }
 }
@@ -311,6 +312,10 @@ pub struct SceneFeatures {
     pub primvars: bool,
     /// Some surface is not opaque (a material's `Opacity` or an "Os" below 1).
     pub transparent: bool,
+    /// The frame is rasterized with [`RasterMode::NearestSample`] (`SCENE_NEAREST_RASTER`):
+    /// without it the program holds bounding-box rasterization alone, so the default mode
+    /// runs exactly the code it ran before the option existed.
+    pub nearest_raster: bool,
 }
 
 impl SceneFeatures {
@@ -319,6 +324,7 @@ impl SceneFeatures {
         rational: true,
         primvars: true,
         transparent: true,
+        nearest_raster: true,
     };
 
     /// True when a program compiled for `self` renders every frame that needs `need`.
@@ -326,6 +332,7 @@ impl SceneFeatures {
         (self.rational || !need.rational)
             && (self.primvars || !need.primvars)
             && (self.transparent || !need.transparent)
+            && (self.nearest_raster || !need.nearest_raster)
     }
 
     /// The features either needs.
@@ -334,6 +341,7 @@ impl SceneFeatures {
             rational: self.rational || o.rational,
             primvars: self.primvars || o.primvars,
             transparent: self.transparent || o.transparent,
+            nearest_raster: self.nearest_raster || o.nearest_raster,
         }
     }
 
@@ -341,8 +349,8 @@ impl SceneFeatures {
     pub fn wgsl(self) -> String {
         format!(
             "const SCENE_RATIONAL: bool = {};\nconst SCENE_PRIMVARS: bool = {};\n\
-             const SCENE_TRANSPARENT: bool = {};\n",
-            self.rational, self.primvars, self.transparent
+             const SCENE_TRANSPARENT: bool = {};\nconst SCENE_NEAREST_RASTER: bool = {};\n",
+            self.rational, self.primvars, self.transparent, self.nearest_raster
         )
     }
 }

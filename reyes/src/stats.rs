@@ -7,7 +7,8 @@ use crate::gpu_render::GpuFrame;
 use crate::stages as s;
 use serde::{Deserialize, Serialize};
 
-fn default_raster() -> String {
+/// `raster` of statistics written before `--raster` existed: `bbox`.
+pub fn default_raster() -> String {
     RasterMode::BoundingBox.name().to_string()
 }
 

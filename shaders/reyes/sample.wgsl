@@ -119,7 +119,8 @@ fn sample_micropolygon(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, g
                        cover: Cover) {
     let color = micropolygon_color(a, b, c, d, two_sided);
     if color == CULLED || !(cover.alpha > 0.0) { return; }
-    if frame.raster == RASTER_NEAREST {
+    // SCENE_NEAREST_RASTER (SceneFeatures): a program for bbox frames holds no nearest code.
+    if SCENE_NEAREST_RASTER && frame.raster == RASTER_NEAREST {
         sample_nearest(a, b, c, d, color, cover);
         return;
     }
