@@ -119,7 +119,8 @@ fn sample_micropolygon(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, g
                        cover: Cover) {
     let color = micropolygon_color(a, b, c, d, two_sided);
     if color == CULLED || !(cover.alpha > 0.0) { return; }
-    // SCENE_NEAREST_RASTER (SceneFeatures): a program for bbox frames holds no nearest code.
+    // SCENE_NEAREST_RASTER (SceneFeatures): false in a program for bbox frames, which then
+    // compiles to the bounding-box code alone.
     if SCENE_NEAREST_RASTER && frame.raster == RASTER_NEAREST {
         sample_nearest(a, b, c, d, color, cover);
         return;
@@ -159,6 +160,8 @@ fn sample_micropolygon(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, g
 // in the image. Sample (sx, sy) of pixel (px, py) lies in its stratum, cell (px * spp_x + sx,
 // py * spp_y + sy) of the grid of cells 1/spp_x by 1/spp_y pixels, so the nearest is within
 // the stratum cell's diagonal of the centre: only the cells that reach that far are searched.
+// That reach is at most sqrt(2) px (1x1 samples), inside Bound's CULL_MARGIN_PX (3 px), so a
+// bucket never culls a micropolygon whose nearest sample it holds: bucketed renders agree.
 fn sample_nearest(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, color: u32,
                   cover: Cover) {
     let centre = (a.xy + b.xy + c.xy + d.xy) * 0.25;
