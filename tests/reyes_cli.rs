@@ -208,7 +208,7 @@ fn help_and_version() {
     let dir = scratch("help");
     let (code, out, err) = reyes_any(&dir, &["--help"]);
     assert_eq!(code, 0, "{err}");
-    for cmd in ["render", "measure", "sweep", "drift"] {
+    for cmd in ["render", "measure", "holes", "sweep", "drift"] {
         assert!(out.contains(cmd), "{out}");
     }
     let (code, out, _) = reyes_any(&dir, &["--version"]);
@@ -218,6 +218,8 @@ fn help_and_version() {
         ("render", "--memory-budget <BYTES[K|M|G]>"),
         ("render", "[default: 1]"),
         ("measure", "--ref-samples <N>"),
+        ("render", "--raster <MODE>"),
+        ("holes", "--reference <REF>"),
         ("sweep", "[default: 0.5,0.71,1,1.41,2,4]"),
         ("drift", "[default: 1920]"),
     ] {
@@ -246,6 +248,8 @@ fn bad_values_name_their_flag() {
         &["sweep", "--mp-sizes", "1,nan"],
         &["sweep", "--runs", "0"],
         &["drift", "--paths", "many"],
+        &["render", "--raster", "round"],
+        &["holes", "--reference", "guess"],
     ] {
         let (code, _, err) = reyes_any(&dir, args);
         assert_eq!(code, 2, "{args:?}: {err}");
@@ -318,6 +322,45 @@ fn a_cpu_adapter_renders_with_the_cpu_reference_unless_told() {
     );
     let (code, err) = render_code(&dir, &["--cpu", "--gpu"]);
     assert_eq!(code, 2, "{err}");
+}
+
+/// `reyes holes --json`: the teapot at 2 px micropolygons in nearest mode has holes against
+/// the exact coverage and against a bbox render alike; in bbox mode it has none. Needs the GPU
+/// (lavapipe).
+#[test]
+fn holes_reports_what_nearest_mode_leaves_empty() {
+    let dir = scratch("holes");
+    let run = |extra: &[&str]| -> serde_json::Value {
+        let mut args = vec![
+            "holes",
+            "teapot",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--mp-size",
+            "2",
+            "--strategy",
+            "multipass",
+            "--ref-samples",
+            "2",
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        let (code, out, err) = reyes_any(&dir, &args);
+        assert_eq!(code, 0, "{extra:?}: {err}");
+        serde_json::from_str(out.trim()).unwrap_or_else(|e| panic!("{extra:?}: {e}: {out}"))
+    };
+    let bbox = run(&["--raster", "bbox"]);
+    assert_eq!(bbox["raster"], "bbox");
+    assert!(bbox["interior_px"].as_u64().unwrap() > 300, "{bbox}");
+    assert_eq!(bbox["hole_px"], 0, "{bbox}");
+    for reference in ["exact", "bbox"] {
+        let v = run(&["--raster", "nearest", "--reference", reference]);
+        assert_eq!(v["reference"], reference);
+        assert!(v["hole_sample_share"].as_f64().unwrap() > 0.5, "{v}");
+        assert!(v["hole_px"].as_u64().unwrap() > 0, "{v}");
+    }
 }
 
 fn field(name: &str) -> String {

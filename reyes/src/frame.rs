@@ -62,6 +62,8 @@ pub struct Frame {
     pub crack_dilation: u32,
     /// The direction displaced patches move along ([`DisplacementNormals`] as its `u32`).
     pub displacement_normals: u32,
+    /// How micropolygons are rasterized: [`RasterMode::gpu_code`] (`RASTER_*` in common.wgsl).
+    pub raster: u32,
 }
 
 impl Frame {
@@ -285,7 +287,56 @@ pub struct RenderOptions {
     /// The normal displaced points move along; [`DisplacementNormals::Approximate`] only to
     /// show the holes it leaves.
     pub displacement_normals: DisplacementNormals,
+    /// How micropolygons are rasterized ([`RasterMode`]).
+    pub raster: RasterMode,
 }
+
+/// How a micropolygon becomes samples (Sattler & Steinberger, "Reyes Rendering on the GPU",
+/// section 4.2; docs/reyes.md, *Rasterization modes*).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum RasterMode {
+    /// Bounding-box rasterization, the paper's "proper rasterization": every jittered
+    /// sub-sample under the micropolygon's screen bound is tested against its two triangles.
+    /// Leaves no holes between micropolygons that meet.
+    #[default]
+    BoundingBox,
+    /// The paper's naive mode: one sample per micropolygon, the jittered sub-sample nearest its
+    /// centre (the mean of its 4 projected corners), at the mean depth of its corners. Fast, but
+    /// leaves holes wherever micropolygons are larger than the sample spacing.
+    NearestSample,
+}
+
+impl RasterMode {
+    /// The value of [`Frame::raster`] (`RASTER_BBOX`, `RASTER_NEAREST` in common.wgsl).
+    pub fn gpu_code(self) -> u32 {
+        match self {
+            RasterMode::BoundingBox => RASTER_BBOX,
+            RasterMode::NearestSample => RASTER_NEAREST,
+        }
+    }
+
+    /// The mode of a [`Frame::raster`] value (anything but `RASTER_NEAREST` is bounding-box).
+    pub fn from_gpu_code(code: u32) -> RasterMode {
+        if code == RASTER_NEAREST {
+            RasterMode::NearestSample
+        } else {
+            RasterMode::BoundingBox
+        }
+    }
+
+    /// The command line's and the statistics' name: `bbox` or `nearest`.
+    pub fn name(self) -> &'static str {
+        match self {
+            RasterMode::BoundingBox => "bbox",
+            RasterMode::NearestSample => "nearest",
+        }
+    }
+}
+
+/// [`Frame::raster`] of [`RasterMode::BoundingBox`].
+pub const RASTER_BBOX: u32 = 0;
+/// [`Frame::raster`] of [`RasterMode::NearestSample`].
+pub const RASTER_NEAREST: u32 = 1;
 
 impl Default for RenderOptions {
     fn default() -> Self {
@@ -302,6 +353,7 @@ impl Default for RenderOptions {
             memory_budget: None,
             crack_dilation: true,
             displacement_normals: DisplacementNormals::Exact,
+            raster: RasterMode::BoundingBox,
         }
     }
 }
@@ -331,6 +383,7 @@ impl FrameData {
             primvars: os || self.patch_info.iter().any(|i| i.cs != 0),
             transparent: os || self.materials.iter().any(|m| m.opacity < 1.0),
             displacement: (self.patch_info.iter()).any(|i| i.flags & PATCH_DISPLACED != 0),
+            nearest_raster: self.frame.raster == RASTER_NEAREST,
         }
     }
 }
@@ -350,6 +403,10 @@ pub struct SceneFeatures {
     pub transparent: bool,
     /// Some patch is displaced (`PATCH_DISPLACED`).
     pub displacement: bool,
+    /// The frame is rasterized with [`RasterMode::NearestSample`] (`SCENE_NEAREST_RASTER`):
+    /// without it the program holds bounding-box rasterization alone, so the default mode
+    /// runs exactly the code it ran before the option existed.
+    pub nearest_raster: bool,
 }
 
 impl SceneFeatures {
@@ -359,6 +416,7 @@ impl SceneFeatures {
         primvars: true,
         transparent: true,
         displacement: true,
+        nearest_raster: true,
     };
 
     /// True when a program compiled for `self` renders every frame that needs `need`.
@@ -367,6 +425,7 @@ impl SceneFeatures {
             && (self.primvars || !need.primvars)
             && (self.transparent || !need.transparent)
             && (self.displacement || !need.displacement)
+            && (self.nearest_raster || !need.nearest_raster)
     }
 
     /// The features either needs.
@@ -376,6 +435,7 @@ impl SceneFeatures {
             primvars: self.primvars || o.primvars,
             transparent: self.transparent || o.transparent,
             displacement: self.displacement || o.displacement,
+            nearest_raster: self.nearest_raster || o.nearest_raster,
         }
     }
 
@@ -383,8 +443,8 @@ impl SceneFeatures {
     pub fn wgsl(self) -> String {
         format!(
             "const SCENE_RATIONAL: bool = {};\nconst SCENE_PRIMVARS: bool = {};\n\
-             const SCENE_TRANSPARENT: bool = {};\nconst SCENE_DISPLACEMENT: bool = {};\n",
-            self.rational, self.primvars, self.transparent, self.displacement
+             const SCENE_TRANSPARENT: bool = {};\nconst SCENE_DISPLACEMENT: bool = {};\nconst SCENE_NEAREST_RASTER: bool = {};\n",
+            self.rational, self.primvars, self.transparent, self.displacement, self.nearest_raster
         )
     }
 }
@@ -508,6 +568,7 @@ impl FrameData {
             tile_h: height,
             crack_dilation: o.crack_dilation as u32,
             displacement_normals: o.displacement_normals as u32,
+            raster: o.raster.gpu_code(),
         };
         Ok(FrameData {
             frame,
@@ -701,6 +762,7 @@ mod tests {
                     "displacement_normals",
                     offset_of!(Frame, displacement_normals),
                 ),
+                ("raster", offset_of!(Frame, raster)),
             ],
         );
         check(

@@ -2,10 +2,15 @@
 //! (`serde` derive), so a mistyped or missing key is a compile error rather than a silent
 //! null; the keys, units and meanings are tabled in docs/reyes.md (*Statistics*).
 
-use crate::frame::{FrameData, PatchItem};
+use crate::frame::{FrameData, PatchItem, RasterMode};
 use crate::gpu_render::GpuFrame;
 use crate::stages as s;
 use serde::{Deserialize, Serialize};
+
+/// `raster` of statistics written before `--raster` existed: `bbox`.
+pub fn default_raster() -> String {
+    RasterMode::BoundingBox.name().to_string()
+}
 
 /// What one GPU frame did and cost. Counts are of the whole frame (every bucket); times in
 /// milliseconds; sizes in bytes.
@@ -24,6 +29,10 @@ pub struct FrameStats {
     pub mp_size_px: f64,
     /// Fixed-bound dicing's screen bound (px); null for adaptive dicing.
     pub bound_px: Option<f64>,
+    /// Micropolygon rasterization (`--raster`): `bbox` or `nearest` (`RasterMode::name`);
+    /// `bbox` when read from JSON written before the option existed.
+    #[serde(default = "default_raster")]
+    pub raster: String,
     /// Root patches of the scene.
     pub patches_in: usize,
     /// Bound procedure executions.
@@ -208,6 +217,7 @@ pub fn frame_stats(
         pixel_samples: [f.spp_x, f.spp_y],
         mp_size_px: f.mp_size as f64,
         bound_px: (f.bound_px > 0.0).then_some(f.bound_px as f64),
+        raster: RasterMode::from_gpu_code(f.raster).name().to_string(),
         patches_in: data.items.len(),
         bounds: executed(0),
         splits: executed(1) + executed(2),

@@ -31,7 +31,14 @@ struct Frame {
     // Direction displaced grid points move along: DISPLACE_EXACT_NORMALS (the patch's
     // analytic normal) or DISPLACE_APPROX_NORMALS (the grid's finite differences; holes).
     displacement_normals: u32,
+    // How micropolygons are rasterized: RASTER_BBOX or RASTER_NEAREST (sample.wgsl).
+    raster: u32,
 }
+
+// Frame.raster: every sub-sample under the micropolygon's bound, tested against its triangles.
+const RASTER_BBOX: u32 = 0u;
+// Frame.raster: only the sub-sample nearest the micropolygon's centre (the paper's naive mode).
+const RASTER_NEAREST: u32 = 1u;
 
 struct Material {
     color: vec3<f32>,

@@ -1,6 +1,8 @@
 // Sampling: one micropolygon (a bilinear quad of grid points, flat colour) against the jittered
 // sub-samples under its screen bound, with an inside test per triangle and a depth test by
-// 64-bit atomicMax. Rust twin: reyes/src/stages/sample.rs.
+// 64-bit atomicMax: bounding-box rasterization (RASTER_BBOX, Sattler & Steinberger 4.2). Or,
+// with frame.raster = RASTER_NEAREST, the paper's naive mode: only the sub-sample nearest the
+// micropolygon's centre (sample_nearest). Rust twin: reyes/src/stages/sample.rs.
 
 fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 { return a.x * b.y - a.y * b.x; }
 
@@ -117,6 +119,12 @@ fn sample_micropolygon(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, g
                        cover: Cover) {
     let color = micropolygon_color(a, b, c, d, two_sided);
     if color == CULLED || !(cover.alpha > 0.0) { return; }
+    // SCENE_NEAREST_RASTER (SceneFeatures): false in a program for bbox frames, which then
+    // compiles to the bounding-box code alone.
+    if SCENE_NEAREST_RASTER && frame.raster == RASTER_NEAREST {
+        sample_nearest(a, b, c, d, color, cover);
+        return;
+    }
     let g = max(max(grow.x, grow.y), max(grow.z, grow.w));
     let lo = min(min(a.xy, b.xy), min(c.xy, d.xy)) - vec2<f32>(g);
     let hi = max(max(a.xy, b.xy), max(c.xy, d.xy)) + vec2<f32>(g);
@@ -144,6 +152,46 @@ fn sample_micropolygon(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, g
             }
         }
     }
+}
+
+// RASTER_NEAREST: the micropolygon (corners projected, depth in .z) writes one sample, the
+// jittered sub-sample nearest its centre (the mean of its corners; the first in row-major order
+// of the image's sample grid on a tie) at the mean depth of its corners, when the centre lies
+// in the image. Sample (sx, sy) of pixel (px, py) lies in its stratum, cell (px * spp_x + sx,
+// py * spp_y + sy) of the grid of cells 1/spp_x by 1/spp_y pixels, so the nearest is within
+// the stratum cell's diagonal of the centre: only the cells that reach that far are searched.
+// That reach is at most sqrt(2) px (1x1 samples), inside Bound's CULL_MARGIN_PX (3 px), so a
+// bucket never culls a micropolygon whose nearest sample it holds: bucketed renders agree.
+fn sample_nearest(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>, color: u32,
+                  cover: Cover) {
+    let centre = (a.xy + b.xy + c.xy + d.xy) * 0.25;
+    let size = vec2<f32>(f32(frame.width), f32(frame.height));
+    if !(all(centre >= vec2<f32>(0.0)) && all(centre < size)) { return; }
+    let spp = vec2<u32>(frame.spp_x, frame.spp_y);
+    let cell = 1.0 / vec2<f32>(spp);
+    let reach = length(cell);
+    let cells = vec2<u32>(frame.width, frame.height) * spp;
+    let k0 = vec2<u32>(max((centre - vec2<f32>(reach)) / cell, vec2<f32>(0.0)));
+    let k1 = min(vec2<u32>((centre + vec2<f32>(reach)) / cell), cells - vec2<u32>(1u));
+    var best = vec2<u32>(0u);
+    var best_d2 = 3.0e38;
+    for (var ky = k0.y; ky <= k1.y; ky++) {
+        for (var kx = k0.x; kx <= k1.x; kx++) {
+            let q = sample_position(kx / spp.x, ky / spp.y, kx % spp.x, ky % spp.y);
+            let e = q - centre;
+            let d2 = e.x * e.x + e.y * e.y;
+            if d2 < best_d2 {
+                best_d2 = d2;
+                best = vec2<u32>(kx, ky);
+            }
+        }
+    }
+    let p = best / spp;
+    let s = best % spp;
+    let t0 = vec2<u32>(frame.tile_x0, frame.tile_y0);
+    if any(p < t0) || any(p >= t0 + vec2<u32>(frame.tile_w, frame.tile_h)) { return; }
+    if !covers(cover, sample_id(p.x, p.y, s.x, s.y)) { return; }
+    write_sample(p.x, p.y, s.x, s.y, (a.z + b.z + c.z + d.z) * 0.25, color);
 }
 
 // Pixels beyond the image edge that clipped polygons keep: wider than Bound's cull margin plus

@@ -92,6 +92,9 @@ pub struct Settings {
     pub mp_size_px: f64,
     /// Fixed-bound dicing's bound (px); null for adaptive dicing.
     pub bound_px: Option<f64>,
+    /// Micropolygon rasterization, `bbox` or `nearest` (as in `FrameStats`).
+    #[serde(default = "crate::stats::default_raster")]
+    pub raster: String,
 }
 
 /// The f64 reference render on the exact surfaces.
@@ -132,6 +135,7 @@ impl Measurement<'_> {
                 pixel_samples: s.pixel_samples,
                 mp_size_px: s.mp_size_px,
                 bound_px: s.bound_px,
+                raster: s.raster.clone(),
             },
             gpu_ms: s.gpu_ms,
             wall_ms: s.wall_ms,

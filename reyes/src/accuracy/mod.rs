@@ -3,6 +3,7 @@
 pub mod drift;
 pub mod exact_image;
 pub mod geometry;
+pub mod holes;
 pub mod image_error;
 pub mod measure;
 pub mod parallel;

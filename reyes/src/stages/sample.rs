@@ -1,7 +1,8 @@
-//! Twin of `shaders/reyes/sample.wgsl`: jittered sub-samples, inside test, depth by max-key.
+//! Twin of `shaders/reyes/sample.wgsl`: jittered sub-samples, inside test, depth by max-key;
+//! bounding-box rasterization or the nearest sample ([`crate::frame::RasterMode`]).
 
 use super::reyes_hash;
-use crate::frame::Frame;
+use crate::frame::{Frame, RASTER_NEAREST};
 use glam::{Vec2, Vec3, Vec4};
 
 fn cross2(a: Vec2, b: Vec2) -> f32 {
@@ -204,6 +205,10 @@ pub fn sample_micropolygon(
     if !(cover.alpha > 0.0) {
         return true;
     }
+    if f.raster == RASTER_NEAREST {
+        sample_nearest(&q, color, cover, f, samples);
+        return true;
+    }
     let xy = q.map(|v| Vec2::new(v[0], v[1]));
     let g = grow[0].max(grow[1]).max(grow[2].max(grow[3]));
     let lo = xy[0].min(xy[1]).min(xy[2].min(xy[3])) - Vec2::splat(g);
@@ -216,6 +221,54 @@ pub fn sample_micropolygon(
         if z < 0.0 { triangle_depth(&acd, s) } else { z }
     });
     true
+}
+
+/// `sample_nearest` in sample.wgsl ([`crate::frame::RasterMode::NearestSample`]): quad `q`
+/// (projected corners, depth in `[2]`) writes only the jittered sub-sample nearest its centre
+/// (the mean of its corners; the first in row-major order of the image's sample grid on a tie),
+/// at the mean depth of its corners, when the centre lies in the image and the sample in the
+/// bucket. Searches the stratum cells within one cell diagonal of the centre, which hold the
+/// nearest sample since the centre's own cell's sample is at most that far.
+fn sample_nearest(q: &[[f32; 4]; 4], color: u32, cover: Cover, f: &Frame, samples: &mut [u64]) {
+    let centre = (xy(q[0]) + xy(q[1]) + xy(q[2]) + xy(q[3])) * 0.25;
+    let size = Vec2::new(f.width as f32, f.height as f32);
+    if !(centre.x >= 0.0 && centre.y >= 0.0 && centre.x < size.x && centre.y < size.y) {
+        return;
+    }
+    let spp = [f.spp_x, f.spp_y];
+    let cell = Vec2::ONE / Vec2::new(spp[0] as f32, spp[1] as f32);
+    let reach = cell.length();
+    let cells = [f.width * spp[0], f.height * spp[1]];
+    let lo = ((centre - Vec2::splat(reach)) / cell).max(Vec2::ZERO);
+    let hi = (centre + Vec2::splat(reach)) / cell;
+    let k0 = [lo.x as u32, lo.y as u32];
+    let k1 = [
+        (hi.x as u32).min(cells[0] - 1),
+        (hi.y as u32).min(cells[1] - 1),
+    ];
+    let (mut best, mut best_d2) = ([0, 0], 3.0e38_f32);
+    for ky in k0[1]..=k1[1] {
+        for kx in k0[0]..=k1[0] {
+            let s = sample_position(f, kx / spp[0], ky / spp[1], kx % spp[0], ky % spp[1]);
+            let e = s - centre;
+            let d2 = e.x * e.x + e.y * e.y;
+            if d2 < best_d2 {
+                best_d2 = d2;
+                best = [kx, ky];
+            }
+        }
+    }
+    let [px, py] = [best[0] / spp[0], best[1] / spp[1]];
+    let [sx, sy] = [best[0] % spp[0], best[1] % spp[1]];
+    if px < f.tile_x0 || py < f.tile_y0 || px >= f.tile_x0 + f.tile_w || py >= f.tile_y0 + f.tile_h
+    {
+        return;
+    }
+    if !covers(f, cover, sample_id(f, px, py, sx, sy)) {
+        return;
+    }
+    let z = (q[0][2] + q[1][2] + q[2][2] + q[3][2]) * 0.25;
+    write_sample(f, samples, [px, py, sx, sy], z, color);
 }
 
 /// `GUARD_BAND_PX` in sample.wgsl: clipped polygons keep this much beyond the image's edges.
@@ -337,4 +390,102 @@ fn sample_clipped_triangle(
         }
         z
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::{RASTER_BBOX, RASTER_NEAREST};
+    use bytemuck::Zeroable;
+
+    fn frame(spp: [u32; 2], raster: u32) -> Frame {
+        Frame {
+            width: 9,
+            height: 7,
+            spp_x: spp[0],
+            spp_y: spp[1],
+            seed: 0x5eed,
+            tile_w: 9,
+            tile_h: 7,
+            raster,
+            ..Frame::zeroed()
+        }
+    }
+
+    /// Nearest mode writes exactly the sub-sample nearest the quad's centre, found here by
+    /// brute force over every sample of the image, for quads all over (and off) the image and
+    /// for square and oblong strata; bbox mode writes every sample inside the quad.
+    #[test]
+    fn nearest_mode_writes_the_one_sample_nearest_the_centre() {
+        let mut rng = 0x1234_5678u32;
+        let mut next = || {
+            rng = reyes_hash(rng);
+            (rng >> 8) as f32 / 16777216.0
+        };
+        for spp in [[1, 1], [2, 2], [4, 1], [1, 3], [3, 5]] {
+            let f = frame(spp, RASTER_NEAREST);
+            let n = (f.width * f.height * f.spp_x * f.spp_y) as usize;
+            for _ in 0..300 {
+                let (cx, cy, r) = (next() * 11.0 - 1.0, next() * 9.0 - 1.0, next() * 2.0);
+                let q: [[f32; 4]; 4] = std::array::from_fn(|k| {
+                    let a = k as f32 * std::f32::consts::FRAC_PI_2 + next();
+                    [cx + r * a.cos(), cy + r * a.sin(), 2.0 + k as f32, 0.0]
+                });
+                let mut samples = vec![0u64; n];
+                let cover = Cover::new(1.0, 0);
+                assert!(sample_micropolygon(
+                    q,
+                    [0.0; 4],
+                    true,
+                    cover,
+                    &f,
+                    &mut samples
+                ));
+                let written: Vec<usize> = (0..n).filter(|&i| samples[i] != 0).collect();
+                let c = (xy(q[0]) + xy(q[1]) + xy(q[2]) + xy(q[3])) * 0.25;
+                let inside = c.x >= 0.0 && c.y >= 0.0 && c.x < 9.0 && c.y < 7.0;
+                if !inside {
+                    assert!(
+                        written.is_empty(),
+                        "centre {c} off the image wrote {written:?}"
+                    );
+                    continue;
+                }
+                let mut best = (f32::MAX, 0usize);
+                for py in 0..f.height {
+                    for px in 0..f.width {
+                        for sy in 0..f.spp_y {
+                            for sx in 0..f.spp_x {
+                                let d = sample_position(&f, px, py, sx, sy).distance(c);
+                                let id = sample_id(&f, px, py, sx, sy) as usize;
+                                if d < best.0 {
+                                    best = (d, id);
+                                }
+                            }
+                        }
+                    }
+                }
+                assert_eq!(written, vec![best.1], "spp {spp:?}, centre {c}");
+                // At the mean depth of the corners: 2, 3, 4, 5.
+                assert_eq!(samples[best.1], sample_key(3.5, samples[best.1] as u32));
+            }
+        }
+    }
+
+    /// The same quad in bbox mode covers every sample inside it: about its area in samples.
+    #[test]
+    fn bbox_mode_writes_every_sample_inside() {
+        let f = frame([2, 2], RASTER_BBOX);
+        let n = (9 * 7 * 4) as usize;
+        let mut samples = vec![0u64; n];
+        let q = [
+            [1.0, 1.0, 1.0, 0.0],
+            [6.0, 1.0, 1.0, 0.0],
+            [6.0, 5.0, 1.0, 0.0],
+            [1.0, 5.0, 1.0, 0.0],
+        ];
+        sample_micropolygon(q, [0.0; 4], true, Cover::new(1.0, 0), &f, &mut samples);
+        // 5 x 4 pixels of 4 samples, jittered in their strata: exactly those.
+        assert_eq!(samples.iter().filter(|k| **k != 0).count(), 80);
+    }
 }

@@ -7,7 +7,7 @@
 use clap::{Args, Parser, Subcommand, ValueEnum, value_parser};
 use reyes::accuracy::drift::PathOptions;
 use reyes::accuracy::exact_image::DEFAULT_SAMPLES_PER_AXIS;
-use reyes::frame::{DisplacementNormals, RenderOptions};
+use reyes::frame::{DisplacementNormals, RasterMode, RenderOptions};
 use reyes::scene::FrameRanges;
 use scheduler::StrategyKind;
 use std::path::PathBuf;
@@ -36,6 +36,11 @@ pub enum Command {
     /// as a table or JSON.
     #[command(allow_negative_numbers = true, args_override_self = true)]
     Measure(MeasureCmd),
+    /// Holes of a frame (GPU render, --raster mode) against a reference coverage: pixels and
+    /// sub-samples left empty where the exact surfaces (or a bbox render) cover the pixel and
+    /// its 8 neighbours; one table row or JSON.
+    #[command(after_help = HOLES_ROW, allow_negative_numbers = true, args_override_self = true)]
+    Holes(HolesCmd),
     /// Speed against error over quality settings: writes sweep.csv, sweep.md, sweep.png and sweep.svg.
     #[command(allow_negative_numbers = true, args_override_self = true)]
     Sweep(SweepCmd),
@@ -65,6 +70,7 @@ impl Command {
         match self {
             Command::Render(_) => "render",
             Command::Measure(_) => "measure",
+            Command::Holes(_) => "holes",
             Command::Sweep(_) => "sweep",
             Command::Drift(_) => "drift",
             Command::Bench(_) => "bench",
@@ -117,6 +123,12 @@ pub struct RenderArgs {
     #[arg(long, value_enum, default_value_t = DisplacementNormals::Exact)]
     pub displacement_normals: DisplacementNormals,
 
+    /// Micropolygon rasterization: bbox (every sub-sample under its screen bound, tested
+    /// against its two triangles) or nearest (only the sub-sample nearest its centre, the
+    /// paper's naive mode: leaves holes where micropolygons outgrow the sample spacing).
+    #[arg(long, value_name = "MODE", value_enum, default_value_t = Raster::Bbox)]
+    pub raster: Raster,
+
     /// GPU strategy: megakernel, multipass or multipass-host [default: megakernel; multipass
     /// on a CPU adapter such as lavapipe, where it is several times faster].
     #[arg(long, value_name = "NAME", value_parser = parse_strategy)]
@@ -156,6 +168,7 @@ impl RenderArgs {
             memory_budget: self.memory_budget,
             crack_dilation: !self.no_crack_dilation,
             displacement_normals: self.displacement_normals,
+            raster: self.raster.mode(),
             ..RenderOptions::default()
         }
     }
@@ -351,6 +364,64 @@ pub struct ViewCmd {
 
     #[command(flatten)]
     pub render: RenderArgs,
+}
+
+const HOLES_ROW: &str = "The table row: | scene | raster | width x height | pixel samples | \
+mp size (px) | reference | micropolygons | interior px | hole px | hole samples | hole sample \
+share |";
+
+/// `reyes holes`.
+#[derive(Debug, Args)]
+pub struct HolesCmd {
+    /// A RIB (.rib, .rib.gz), Newell or .bpt scene file, or `teapot` (built in)
+    /// [default: teapot].
+    #[arg(value_name = "SCENE")]
+    pub scene: Option<PathBuf>,
+
+    /// The coverage holes are counted against: exact (the f64 surfaces, without displacement)
+    /// or bbox (a bounding-box render of the same frame: for displaced surfaces).
+    #[arg(long, value_name = "REF", value_enum, default_value_t = HoleReference::Exact)]
+    pub reference: HoleReference,
+
+    /// Samples per pixel axis of the exact reference coverage (1..=64).
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_SAMPLES_PER_AXIS,
+          value_parser = value_parser!(u32).range(1..=64))]
+    pub ref_samples: u32,
+
+    /// Print one JSON object instead of the table row.
+    #[arg(long)]
+    pub json: bool,
+
+    #[command(flatten)]
+    pub render: RenderArgs,
+}
+
+/// `reyes holes --reference`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum HoleReference {
+    /// The exact f64 coverage of the scene's patches (`reyes::reference::coverage`).
+    Exact,
+    /// A bounding-box render of the same frame.
+    Bbox,
+}
+
+/// `--raster`: [`RasterMode`] on the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Raster {
+    /// Bounding-box rasterization ([`RasterMode::BoundingBox`]).
+    Bbox,
+    /// One sample per micropolygon, nearest its centre ([`RasterMode::NearestSample`]).
+    Nearest,
+}
+
+impl Raster {
+    /// The renderer's mode.
+    pub fn mode(self) -> RasterMode {
+        match self {
+            Raster::Bbox => RasterMode::BoundingBox,
+            Raster::Nearest => RasterMode::NearestSample,
+        }
+    }
 }
 
 /// A peer renderer of `reyes bench --peer`.

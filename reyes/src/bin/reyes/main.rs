@@ -6,6 +6,7 @@ mod bench;
 mod cli;
 mod drift;
 mod frames;
+mod holes;
 mod measure;
 mod sweep;
 mod view;
@@ -246,6 +247,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(a) => run(a),
         Command::Measure(a) => measure::main(a),
+        Command::Holes(a) => holes::main(a),
         Command::Sweep(a) => sweep::main(a),
         Command::Drift(a) => drift::main(a),
         Command::Bench(a) => bench::main(a),

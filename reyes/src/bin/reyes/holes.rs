@@ -1,0 +1,105 @@
+//! `reyes holes [SCENE] [render options] [--reference exact|bbox] [--ref-samples N] [--json]`:
+//! renders a frame on the GPU in the `--raster` mode asked for and counts its holes
+//! (`reyes::accuracy::holes`) against a reference coverage: the exact f64 surfaces, or a
+//! bounding-box render of the same frame (for surfaces the exact reference does not know, such
+//! as displaced ones). Prints one table row or JSON object (docs/reyes.md, *Rasterization
+//! modes*).
+
+use crate::cli::{HoleReference, HolesCmd};
+use crate::measure::load_scene;
+use reyes::accuracy::holes::{Holes, coverage_of, holes};
+use reyes::frame::{FrameData, RasterMode, RenderOptions};
+use reyes::gpu_render::{GpuRenderer, required_features};
+use reyes::stages;
+use scheduler::Gpu;
+use serde::Serialize;
+
+/// What `reyes holes --json` prints.
+#[derive(Debug, Serialize)]
+struct HolesReport {
+    scene: String,
+    /// `--raster`: `bbox` or `nearest`.
+    raster: &'static str,
+    /// `exact` or `bbox`.
+    reference: &'static str,
+    width: u32,
+    height: u32,
+    pixel_samples: [u32; 2],
+    mp_size_px: f64,
+    micropolygons: u64,
+    covered_px: usize,
+    #[serde(flatten)]
+    holes: Holes,
+}
+
+/// Runs the subcommand.
+pub fn main(a: HolesCmd) -> Result<(), String> {
+    let (scene, name) = load_scene(a.scene.as_deref())?;
+    for w in &scene.warnings {
+        log::warn!("{w}");
+    }
+    let options = a.render.options();
+    let data = FrameData::new(&scene, &options)?;
+    let gpu = Gpu::from_env_requiring(required_features()).map_err(|e| e.to_string())?;
+    let renderer =
+        GpuRenderer::for_features(&gpu, a.render.strategy_for(&gpu), false, data.features())
+            .map_err(|e| e.to_string())?;
+    let frame = renderer.render(&gpu, &data).map_err(|e| e.to_string())?;
+    let f = &data.frame;
+    let reference = match a.reference {
+        HoleReference::Exact => {
+            reyes::reference::coverage(&scene, f.width, f.height, a.ref_samples)
+        }
+        HoleReference::Bbox => {
+            let bbox = FrameData::new(
+                &scene,
+                &RenderOptions {
+                    raster: RasterMode::BoundingBox,
+                    ..options.clone()
+                },
+            )?;
+            let g = renderer.render(&gpu, &bbox).map_err(|e| e.to_string())?;
+            coverage_of(&g.image)
+        }
+    };
+    let report = HolesReport {
+        scene: name,
+        raster: options.raster.name(),
+        reference: match a.reference {
+            HoleReference::Exact => "exact",
+            HoleReference::Bbox => "bbox",
+        },
+        width: f.width,
+        height: f.height,
+        pixel_samples: [f.spp_x, f.spp_y],
+        mp_size_px: f.mp_size as f64,
+        micropolygons: frame.counters[stages::C_MICROPOLYGONS],
+        covered_px: frame.image.covered_pixels(),
+        holes: holes(&frame.image, &reference, f.spp_x * f.spp_y),
+    };
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string(&report).map_err(|e| e.to_string())?
+        );
+    } else {
+        let r = &report;
+        println!(
+            "| {} | {} | {}x{} | {}x{} | {} | {} | {} | {} | {} | {} | {:.4} |",
+            r.scene,
+            r.raster,
+            r.width,
+            r.height,
+            r.pixel_samples[0],
+            r.pixel_samples[1],
+            r.mp_size_px,
+            r.reference,
+            r.micropolygons,
+            r.holes.interior_px,
+            r.holes.hole_px,
+            r.holes.hole_samples,
+            r.holes.hole_sample_share
+        );
+    }
+    Ok(())
+}
