@@ -1,6 +1,7 @@
 # Session 17, third run: the raster peer after its tessellation was spread over the GPU
 # (tiles of 64 grid points), and frames before/after with displacement merged (reyes-prev =
-# f72f1a6; Killeroo's `Attribute "displacementbound"` is read now).
+# f72f1a6; Killeroo's `Attribute "displacementbound"` is read now), and the rasterization
+# modes (issue 14 item 2: bbox against nearest, Killeroo and teapot, two micropolygon sizes).
 source .devbin/setup.sh
 R=$OUT/r; mkdir -p $R
 K=$B/data/rib/killeroo.rib; U=$B/data/rib/uteapot.rib
@@ -32,6 +33,12 @@ for rep in 1 2 3; do
   done
  done
 done
+for sc in teapot killeroo; do S=teapot; [ $sc = killeroo ] && S=$K
+  for s in 1 0.5; do for m in bbox nearest; do n=raster-$sc-$s-$m
+    timeout 120 $B/reyes bench $S --width 1920 --height 1080 --mp-size $s --raster $m --frames 100 --json > $R/$n.json 2> $R/$n.log
+    python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(sys.argv[2], 'wall %.3f gpu %.3f fps %.0f' % (d['wall_ms']['median'], d['gpu_ms']['median'], d['fps']))" $R/$n.json $n >> $R/raster.txt 2>&1
+  done; done
+done
 md5sum $R/*.png > $R/md5.txt
 tar czf $OUT/results.tgz -C $OUT r
-cat $R/bench.txt $R/frames.txt; awk '{print $1}' $R/md5.txt | sort | uniq -c
+cat $R/bench.txt $R/frames.txt $R/raster.txt; awk '{print $1}' $R/md5.txt | sort | uniq -c
