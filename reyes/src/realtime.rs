@@ -167,6 +167,21 @@ pub struct RealtimeFrame {
     pub image: Option<FrameImage>,
 }
 
+/// Maps every buffer of `maps` for reading; the counter reaches `maps.len()` once all are
+/// mapped (a frame's status and pixels, read a frame late).
+pub(crate) fn map_for_read(maps: &[wgpu::Buffer]) -> Arc<AtomicUsize> {
+    let mapped = Arc::new(AtomicUsize::new(0));
+    for b in maps {
+        let done = mapped.clone();
+        b.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+            if r.is_ok() {
+                done.fetch_add(1, Ordering::Release);
+            }
+        });
+    }
+    mapped
+}
+
 /// Buffers of one frame in flight.
 struct Slot {
     orbit: wgpu::Buffer,
@@ -584,15 +599,7 @@ impl RealtimeRenderer {
             }
         }
         let submission = gpu.queue.submit([enc.finish()]);
-        let mapped = Arc::new(AtomicUsize::new(0));
-        for b in &maps {
-            let done = mapped.clone();
-            b.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-                if r.is_ok() {
-                    done.fetch_add(1, Ordering::Release);
-                }
-            });
-        }
+        let mapped = map_for_read(&maps);
         Ok(InFlight {
             transform,
             slot,

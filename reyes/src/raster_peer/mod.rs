@@ -707,15 +707,7 @@ impl RasterPeer {
             maps.push(dst.clone());
         }
         let submission = gpu.queue.submit([enc.finish()]);
-        let mapped = Arc::new(AtomicUsize::new(0));
-        for b in &maps {
-            let done = mapped.clone();
-            b.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-                if r.is_ok() {
-                    done.fetch_add(1, Ordering::Release);
-                }
-            });
-        }
+        let mapped = crate::realtime::map_for_read(&maps);
         Ok(InFlight {
             angle,
             slot,
