@@ -52,15 +52,15 @@ pub enum Command {
     #[command(allow_negative_numbers = true, args_override_self = true)]
     Bench(BenchCmd),
     /// Open a window on a scene: orbit, pan and zoom with the mouse, keys for strategy and
-    /// quality, frame times in the title, S saves a screenshot (controls below).
+    /// quality, frame times in the title, S saves a screenshot (`reyes view --help` lists the controls).
     #[command(after_help = VIEW_CONTROLS, allow_negative_numbers = true, args_override_self = true)]
     View(ViewCmd),
 }
 
 const VIEW_CONTROLS: &str = "Controls: left drag orbits about the scene's centre; right or \
 middle drag pans; the wheel zooms (dollies towards the centre); M cycles the strategy \
-(megakernel, multipass, multipass-host); [ and ] halve and double the micropolygon size (by \
-sqrt 2); 1-4 set NxN pixel samples, + and - add or remove one per axis; R resets the camera; \
+(megakernel, multipass, multipass-host); [ and ] divide and multiply the micropolygon size \
+by sqrt 2; 1-4 set NxN pixel samples, + and - add or remove one per axis; R resets the camera; \
 S saves a screenshot PNG; Esc or Q quits. The title shows frames per second, wall and GPU \
 milliseconds, micropolygons, the strategy, micropolygon size and samples.";
 
@@ -214,7 +214,7 @@ pub struct RenderCmd {
     pub cpu: bool,
 
     /// Render on the GPU adapter even when it is a CPU (lavapipe, llvmpipe, WARP), where the
-    /// default is the CPU reference (see `RenderCmd::cpu_by_default`).
+    /// default is the CPU reference when nothing GPU-only is asked for.
     #[arg(long, conflicts_with = "cpu")]
     pub gpu: bool,
 
@@ -254,8 +254,8 @@ impl RenderCmd {
         if cpu {
             eprintln!(
                 "note: rendering with the CPU reference (the same pipeline, compiled natively): \
-                 the adapter is a CPU ({}), on which the GPU path is about 10x slower (--gpu \
-                 or --strategy NAME renders on it anyway)",
+                 the adapter is a CPU ({}), on which the GPU path is 10-40x slower (--gpu or \
+                 --strategy NAME renders on it anyway)",
                 gpu.adapter_name()
             );
         }
