@@ -182,6 +182,30 @@ pub(crate) fn map_for_read(maps: &[wgpu::Buffer]) -> Arc<AtomicUsize> {
     mapped
 }
 
+/// After a frame's submission finished: waits until every buffer of [`map_for_read`] is
+/// mapped. wgpu may run a map callback on a later poll than the one that saw the submission
+/// finish, so this polls once more, then waits for all submitted work (bounded), before
+/// reporting a frame that finished unmapped as [`RunError::Device`].
+pub(crate) fn await_mapped(
+    gpu: &Gpu,
+    mapped: &AtomicUsize,
+    n: usize,
+    what: &str,
+) -> Result<(), RunError> {
+    if mapped.load(Ordering::Acquire) != n {
+        let _ = gpu.device.poll(wgpu::PollType::Poll);
+    }
+    if mapped.load(Ordering::Acquire) != n {
+        gpu.wait_for(None, what)?;
+    }
+    if mapped.load(Ordering::Acquire) != n {
+        return Err(RunError::Device(format!(
+            "{what} finished but its status was not mapped"
+        )));
+    }
+    Ok(())
+}
+
 /// Buffers of one frame in flight.
 struct Slot {
     orbit: wgpu::Buffer,
@@ -620,11 +644,7 @@ impl RealtimeRenderer {
         last: &mut Instant,
     ) -> Result<RealtimeFrame, RunError> {
         gpu.wait_for(Some(f.submission.clone()), "a pipelined frame")?;
-        if f.mapped.load(Ordering::Acquire) != f.maps.len() {
-            return Err(RunError::Device(
-                "a frame finished but its status was not mapped".into(),
-            ));
-        }
+        await_mapped(gpu, &f.mapped, f.maps.len(), "a pipelined frame")?;
         let Some(rec) = f.recorded else {
             let why = self.not_pipelined.clone().unwrap_or_default();
             return self.render_again(gpu, f.slot, f.transform, why, None, last);

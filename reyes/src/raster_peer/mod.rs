@@ -59,7 +59,7 @@ use scheduler::timing::SpanTimer;
 use scheduler::{Gpu, RunError, storage_entry};
 use std::collections::VecDeque;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::AtomicUsize;
 use std::time::Instant;
 
 /// One finished frame of the peer.
@@ -728,11 +728,7 @@ impl RasterPeer {
         again: bool,
     ) -> Result<PeerFrame, RunError> {
         gpu.wait_for(Some(f.submission.clone()), "a raster peer frame")?;
-        if f.mapped.load(Ordering::Acquire) != f.maps.len() {
-            return Err(RunError::Device(
-                "a raster peer frame finished but its status was not mapped".into(),
-            ));
-        }
+        crate::realtime::await_mapped(gpu, &f.mapped, f.maps.len(), "a raster peer frame")?;
         let status = read_mapped(&f.maps[0], COUNT_WORDS + SpanTimer::WORDS)?;
         let counts = TessCounts::from_words(&status);
         let gpu_ms = self.timer.ms(&status[COUNT_WORDS as usize..]);
