@@ -2,7 +2,8 @@
 // running it, and publishing what it emitted, until no work is left in this launch.
 // The protocol and why it is correct under WGSL's relaxed atomics: docs/scheduler.md.
 // Generated code before this file: NQ/THREADS/WORDS/EMITS tables, the procedures, the
-// `sched_slot_*` word accessors over `slots`, `sched_execute`, and `enqueue_*`.
+// `sched_slot_*` and `sched_ob_*` word and vec4 accessors over `slots` and `outbox`,
+// `sched_execute`, and `enqueue_*`.
 
 // ---- ctrl layout (u32 words); host twin: scheduler/src/megakernel/layout.rs ----
 const QSTRIDE: u32 = 16u;
@@ -56,7 +57,7 @@ const CMD_EXIT: u32 = 2u;
 
 @group(0) @binding(0) var<storage, read_write> ctrl: array<atomic<u32>>;
 @group(0) @binding(2) var<storage, read_write> flags: array<atomic<u32>>;
-@group(0) @binding(3) var<storage, read_write> outbox: array<u32>;
+@group(0) @binding(3) var<storage, read_write> outbox: array<vec4<u32>>;
 @group(0) @binding(4) var<storage, read> params: array<u32>;
 
 var<workgroup> wg_cmd: u32;
@@ -76,8 +77,6 @@ var<private> sched_batch_n: u32;
 var<private> sched_outbox: u32;
 var<private> sched_blocked: bool;
 
-fn sched_ob_load_word(i: u32) -> u32 { return outbox[i]; }
-fn sched_ob_store_word(i: u32, w: u32) { outbox[i] = w; }
 
 fn sched_raise(code: u32, a: u32, b: u32) {
     if atomicExchange(&ctrl[gw(G_ERROR)], code) == 0u {
@@ -279,13 +278,20 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         }
         workgroupBarrier();
 
-        // 4. Copy the payloads into the reserved slots.
+        // 4. Copy the payloads into the reserved slots, coalesced: 16 bytes per thread where the
+        //    item is a whole number of vec4s (queue regions and outbox parts are 16-byte aligned).
         for (var t = 0u; t < NQ; t++) {
             let words = wg_emit_n[t] * WORDS[t];
             let dst = q_slot_base(t) + wg_emit_base[t] * WORDS[t];
             let src = sched_outbox + ob_off(q, t);
-            for (var w = lid; w < words; w += 256u) {
-                sched_slot_store_word(dst + w, outbox[src + w]);
+            if WORDS[t] % 4u == 0u {
+                for (var w = lid * 4u; w < words; w += 1024u) {
+                    sched_slot_store_vec4(dst + w, sched_ob_load_vec4(src + w));
+                }
+            } else {
+                for (var w = lid; w < words; w += 256u) {
+                    sched_slot_store_word(dst + w, sched_ob_load_word(src + w));
+                }
             }
         }
         storageBarrier(); // release: payloads before the flags that publish them

@@ -41,19 +41,15 @@ fn q_at_limit(q: u32) -> bool { return params[13u + q * 8u] != 0u; }
 const SCAN_BLOCK: u32 = 1024u; // flags per scan workgroup: 256 threads x 4
 
 @group(0) @binding(0) var<storage, read_write> mp_ctrl: array<atomic<u32>>;
-@group(0) @binding(1) var<storage, read_write> items_in: array<u32>;
-@group(0) @binding(2) var<storage, read_write> items_out: array<u32>;
-@group(0) @binding(3) var<storage, read_write> emit: array<u32>;
+@group(0) @binding(1) var<storage, read_write> items_in: array<vec4<u32>>;
+@group(0) @binding(2) var<storage, read_write> items_out: array<vec4<u32>>;
+@group(0) @binding(3) var<storage, read_write> emit: array<vec4<u32>>;
 @group(0) @binding(4) var<storage, read_write> emit_flags: array<u32>;
 @group(0) @binding(5) var<storage, read_write> sums: array<u32>;
 @group(0) @binding(6) var<storage, read> params: array<u32>;
 // Group 2: bound only to mp_plan, so no dispatch reads its own arguments as storage.
 @group(2) @binding(0) var<storage, read_write> indirect: array<u32>;
 
-fn mp_in_load_word(i: u32) -> u32 { return items_in[i]; }
-fn mp_in_store_word(i: u32, w: u32) { items_in[i] = w; }
-fn mp_emit_load_word(i: u32) -> u32 { return emit[i]; }
-fn mp_emit_store_word(i: u32, w: u32) { emit[i] = w; }
 
 var<workgroup> wg_n: u32;
 var<workgroup> wg_k: u32;
@@ -210,7 +206,7 @@ fn run_procedure(q: u32, lid: u32, wid: u32, nwg: u32) {
         let live = idx >= keep && idx < n;
         if idx < keep {
             let at = q_in_base(q) + idx * WORDS[q];
-            for (var w = thread; w < WORDS[q]; w += THREADS[q]) { items_out[at + w] = items_in[at + w]; }
+            for (var w = thread; w < WORDS[q]; w += THREADS[q]) { mp_out_store_word(at + w, mp_in_load_word(at + w)); }
         }
         for (var t = thread; t < NQ; t += THREADS[q]) { atomicStore(&wg_item_emits[slot * NQ + t], 0u); }
         if live {
@@ -290,7 +286,11 @@ fn scan_scatter(t: u32, lid: u32, b: u32) {
         if f[k] != 0u {
             let src = q_emit_base(t) + (i + k) * WORDS[t];
             let to = q_in_base(t) + dst * WORDS[t];
-            for (var w = 0u; w < WORDS[t]; w++) { items_out[to + w] = emit[src + w]; }
+            if WORDS[t] % 4u == 0u {
+                for (var w = 0u; w < WORDS[t]; w += 4u) { mp_out_store_vec4(to + w, mp_emit_load_vec4(src + w)); }
+            } else {
+                for (var w = 0u; w < WORDS[t]; w++) { mp_out_store_word(to + w, mp_emit_load_word(src + w)); }
+            }
             dst += 1u;
         }
     }

@@ -26,14 +26,10 @@ fn q_base(q: u32) -> u32 { return params[q * 4u + 1u]; }
 
 @group(0) @binding(0) var<storage, read> counts_in: array<u32>;
 @group(0) @binding(1) var<storage, read_write> counts_out: array<atomic<u32>>;
-@group(0) @binding(2) var<storage, read_write> items_in: array<u32>;
-@group(0) @binding(3) var<storage, read_write> items_out: array<u32>;
+@group(0) @binding(2) var<storage, read_write> items_in: array<vec4<u32>>;
+@group(0) @binding(3) var<storage, read_write> items_out: array<vec4<u32>>;
 @group(0) @binding(4) var<storage, read> params: array<u32>;
 
-fn mp_in_load_word(i: u32) -> u32 { return items_in[i]; }
-fn mp_in_store_word(i: u32, w: u32) { items_in[i] = w; }
-fn mp_out_load_word(i: u32) -> u32 { return items_out[i]; }
-fn mp_out_store_word(i: u32, w: u32) { items_out[i] = w; }
 
 var<workgroup> wg_n: u32;
 var<workgroup> wg_item_emits: array<atomic<u32>, 256u * NQ>;

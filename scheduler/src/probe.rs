@@ -222,7 +222,8 @@ impl<'a> Probe<'a> {
 
 /// Compiles `program`'s shared WGSL with enqueue stubs and checks it (see the module docs).
 /// Every error is a [`RunError::Program`] naming the procedure, part and line it is about.
-pub(crate) fn check(program: &Program) -> Result<(), RunError> {
+/// Returns performance notes ([`Program::notes`](crate::Program::notes)).
+pub(crate) fn check(program: &Program) -> Result<Vec<String>, RunError> {
     let probe = Probe::new(program);
     let module = naga::front::wgsl::parse_str(&probe.text).map_err(|e| {
         let spans: Vec<(Span, String)> = e.labels().map(|(s, l)| (s, l.to_string())).collect();
@@ -234,12 +235,12 @@ pub(crate) fn check(program: &Program) -> Result<(), RunError> {
             None => report,
         })
     })?;
-    naga::valid::Validator::new(
+    let info = naga::valid::Validator::new(
         naga::valid::ValidationFlags::all(),
         naga::valid::Capabilities::all(),
     )
-    .validate(&module)
-    .map_err(|e| {
+    .validate(&module);
+    let info = info.map_err(|e| {
         // naga's chain runs from the function to the innermost cause: lead with the cause.
         let mut chain = vec![e.as_inner().to_string()];
         let mut source: &dyn std::error::Error = e.as_inner();
@@ -253,7 +254,53 @@ pub(crate) fn check(program: &Program) -> Result<(), RunError> {
     })?;
     check_execute_functions(&probe, &module)?;
     check_enqueue_targets(&probe, &module)?;
-    check_user_bindings(&probe, &module)
+    check_user_bindings(&probe, &module)?;
+    Ok(dynamic_item_indexing(&probe, &module, &info))
+}
+
+/// Notes for each run-time index into an array or matrix reached from an execute function's
+/// `item` parameter without a `var` in between: naga's SPIR-V backend spills the indexed value
+/// to a temporary at every such access (`spill_to_internal_variable` in naga's `back/spv`).
+fn dynamic_item_indexing(
+    probe: &Probe,
+    module: &naga::Module,
+    info: &naga::valid::ModuleInfo,
+) -> Vec<String> {
+    let mut notes = Vec::new();
+    for p in &probe.program.procs {
+        let name = &p.proc.name;
+        let Some(h) = function(module, &format!("{name}_execute")) else {
+            continue;
+        };
+        let f = &module.functions[h];
+        for (e, expr) in f.expressions.iter() {
+            let naga::Expression::Access { base, .. } = *expr else {
+                continue;
+            };
+            let mut root = base;
+            while let naga::Expression::Access { base, .. }
+            | naga::Expression::AccessIndex { base, .. } = f.expressions[root]
+            {
+                root = base;
+            }
+            let indexed = info[h][base].ty.inner_with(&module.types);
+            let spills = matches!(
+                indexed,
+                naga::TypeInner::Array { .. } | naga::TypeInner::Matrix { .. }
+            );
+            if spills && matches!(f.expressions[root], naga::Expression::FunctionArgument(0)) {
+                let at = probe
+                    .locate(f.expressions.get_span(e))
+                    .map(|(at, ..)| format!(" ({at})"))
+                    .unwrap_or_default();
+                notes.push(format!(
+                    "procedure `{name}`: a run-time index into an array of its item{at} copies the \
+                     whole array at every access (naga's SPIR-V); copy the item into a `var` first"
+                ));
+            }
+        }
+    }
+    notes
 }
 
 fn function(module: &naga::Module, name: &str) -> Option<Handle<naga::Function>> {
@@ -489,6 +536,30 @@ mod tests {
 
     fn sink() -> Procedure {
         Procedure::new("sink", word(), 1).body("fn sink_execute(item: Word, inv: Invocation) {}")
+    }
+
+    #[test]
+    fn a_run_time_index_into_the_item_parameter_is_noted_and_a_var_copy_is_not() {
+        let item = ItemType::new("Row", "struct Row { n: u32, w: array<u32, 8> }");
+        let body = |b: &str| {
+            Program::new(
+                vec![Procedure::new("row", item.clone(), 1).body(b)],
+                UserBindings::none(),
+            )
+            .unwrap()
+        };
+        let slow = body(
+            "fn row_execute(item: Row, inv: Invocation) {\n    var s = 0u;\n    \
+             for (var i = 0u; i < item.n; i++) { s += item.w[i]; }\n}",
+        );
+        assert_eq!(slow.notes().len(), 1, "{:?}", slow.notes());
+        let n = &slow.notes()[0];
+        assert!(n.contains("procedure `row`") && n.contains("line 3"), "{n}");
+        let fast = body(
+            "fn row_execute(item_value: Row, inv: Invocation) {\n    var item = item_value;\n    \
+             var s = item.w[3];\n    for (var i = 0u; i < item.n; i++) { s += item.w[i]; }\n}",
+        );
+        assert!(fast.notes().is_empty(), "{:?}", fast.notes());
     }
 
     #[test]

@@ -42,6 +42,8 @@ pub struct Program {
     pub procs: Vec<ProcInfo>,
     /// The user's resources (bind group 1).
     pub user: UserBindings,
+    /// Performance notes on the bodies, found by [`Program::new`] (see [`Program::notes`]).
+    notes: Vec<String>,
 }
 
 impl Program {
@@ -113,12 +115,28 @@ impl Program {
                 emits,
             });
         }
-        let program = Program { procs, user };
+        let mut program = Program {
+            procs,
+            user,
+            notes: Vec::new(),
+        };
         // Compile the shared part once on its own, so that an error names the procedure and a
         // line of its body, not a line of a strategy's generated shader; then check what naga
         // parsed: every `<name>_execute`, enqueue targets against `.emits`, user bindings.
-        crate::probe::check(&program)?;
+        program.notes = crate::probe::check(&program)?;
+        for n in &program.notes {
+            log::warn!("{n}");
+        }
         Ok(program)
+    }
+
+    /// What [`Program::new`] found slow in the bodies, one sentence each, also logged as
+    /// warnings (`log`): today, a body that indexes an array or matrix of its `item` parameter
+    /// with a run-time index. naga's SPIR-V output copies the whole array to a temporary at
+    /// every such access (a value cannot be indexed dynamically in SPIR-V); copy the item
+    /// into a `var` once and index that (docs/scheduler.md, "Writing fast procedures").
+    pub fn notes(&self) -> &[String] {
+        &self.notes
     }
 
     /// Number of procedures, which is the number of queues.

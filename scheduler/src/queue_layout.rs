@@ -39,9 +39,12 @@ impl QueueLayout {
         let (mut w, mut f) = (0u64, 0u64);
         let (mut slot_base, mut flag_base) = (Vec::new(), Vec::new());
         for (c, wd) in capacity.iter().zip(&words) {
+            // Every region starts on a 16-byte boundary: the shaders move items that are a
+            // whole number of vec4s 16 bytes at a time (`wgsl::moves_by_vec4`), and the item
+            // buffers are `array<vec4<u32>>`, so their size is a multiple of 16 bytes too.
             slot_base.push(w as u32);
             flag_base.push(f as u32);
-            w += *c as u64 * *wd as u64;
+            w = (w + *c as u64 * *wd as u64).next_multiple_of(4);
             f += *c as u64;
         }
         if w >= u32::MAX as u64 / 2 {
@@ -63,7 +66,9 @@ impl QueueLayout {
     /// largest storage binding the device allows (all queues live in one binding), so that a
     /// queue that would not fit is reported as an overflow instead of failing buffer creation.
     pub fn capacity_limits(program: &Program, max_binding_bytes: u64, configured: u32) -> Vec<u32> {
-        let share = max_binding_bytes / 4 / program.queue_count().max(1) as u64;
+        // Less the alignment padding of each region (under 16 bytes).
+        let share =
+            (max_binding_bytes / program.queue_count().max(1) as u64).saturating_sub(16) / 4;
         program
             .procs
             .iter()
@@ -82,7 +87,9 @@ impl QueueLayout {
         words_copies: u64,
     ) -> Vec<u32> {
         let Some(budget) = budget else { return limits };
-        let share = budget / program.queue_count().max(1) as u64;
+        // Less the alignment padding of each copy of the region (under 16 bytes each).
+        let share =
+            (budget / program.queue_count().max(1) as u64).saturating_sub(16 * words_copies);
         limits
             .into_iter()
             .zip(&program.procs)

@@ -202,31 +202,86 @@ fn flatten(
     Ok(())
 }
 
+/// Whether items of `layout` move as 16-byte vectors: their size is a whole number of
+/// `vec4<u32>`. Queue regions and outboxes start on 16-byte boundaries
+/// (`QueueLayout::new`), so such an item's first word is always 4-aligned.
+pub(crate) fn moves_by_vec4(layout: &StructLayout) -> bool {
+    layout.words() % 4 == 0
+}
+
 /// Generates `fn {prefix}_load_{T}(base: u32) -> T` and `fn {prefix}_store_{T}(base: u32, v: T)`
-/// over the word accessors `{prefix}_load_word(i) -> u32` and `{prefix}_store_word(i, w)`.
+/// over the word accessors `{prefix}_load_word(i) -> u32` and `{prefix}_store_word(i, w)`, or,
+/// for items that [`moves_by_vec4`], over `{prefix}_load_vec4(i) -> vec4<u32>` and
+/// `{prefix}_store_vec4(i, v)` (i a 4-aligned word index).
+///
+/// Why vectors: a one-thread item is read and written by its own thread, so a warp touches 32
+/// items at a stride of the item size. Word by word, each of those accesses is its own memory
+/// transaction; 16 bytes at a time there are a quarter as many (on the H200 the 256-byte items
+/// of the large-payload tree moved several times faster: docs/results.md, session 18).
 pub(crate) fn load_store_fns(layout: &StructLayout, prefix: &str) -> String {
     let t = &layout.name;
+    let cast_in = |l: &Leaf, w: String| match l.kind {
+        ScalarKind::U32 => w,
+        ScalarKind::I32 => format!("bitcast<i32>({w})"),
+        ScalarKind::F32 => format!("bitcast<f32>({w})"),
+    };
+    let cast_out = |l: &Leaf| match l.kind {
+        ScalarKind::U32 => format!("v{}", l.path),
+        _ => format!("bitcast<u32>(v{})", l.path),
+    };
     let mut s = format!("fn {prefix}_load_{t}(base: u32) -> {t} {{\n    var v: {t};\n");
-    for l in &layout.leaves {
-        let w = format!("{prefix}_load_word(base + {}u)", l.word);
-        let e = match l.kind {
-            ScalarKind::U32 => w,
-            ScalarKind::I32 => format!("bitcast<i32>({w})"),
-            ScalarKind::F32 => format!("bitcast<f32>({w})"),
-        };
-        s += &format!("    v{} = {e};\n", l.path);
+    if moves_by_vec4(layout) {
+        for g in 0..layout.words() / 4 {
+            s += &format!("    let g{g} = {prefix}_load_vec4(base + {}u);\n", g * 4);
+        }
+        for l in &layout.leaves {
+            let w = format!("g{}[{}]", l.word / 4, l.word % 4);
+            s += &format!("    v{} = {};\n", l.path, cast_in(l, w));
+        }
+    } else {
+        for l in &layout.leaves {
+            let w = format!("{prefix}_load_word(base + {}u)", l.word);
+            s += &format!("    v{} = {};\n", l.path, cast_in(l, w));
+        }
     }
     s += "    return v;\n}\n";
     s += &format!("fn {prefix}_store_{t}(base: u32, v: {t}) {{\n");
-    for l in &layout.leaves {
-        let e = match l.kind {
-            ScalarKind::U32 => format!("v{}", l.path),
-            _ => format!("bitcast<u32>(v{})", l.path),
-        };
-        s += &format!("    {prefix}_store_word(base + {}u, {e});\n", l.word);
+    if moves_by_vec4(layout) {
+        // Padding words (between members) have no leaf: they are stored as 0.
+        let mut words = vec!["0u".to_string(); layout.words() as usize];
+        for l in &layout.leaves {
+            words[l.word as usize] = cast_out(l);
+        }
+        for (g, c) in words.chunks(4).enumerate() {
+            s += &format!(
+                "    {prefix}_store_vec4(base + {}u, vec4<u32>({}));\n",
+                g * 4,
+                c.join(", ")
+            );
+        }
+    } else {
+        for l in &layout.leaves {
+            s += &format!(
+                "    {prefix}_store_word(base + {}u, {});\n",
+                l.word,
+                cast_out(l)
+            );
+        }
     }
     s += "}\n";
     s
+}
+
+/// WGSL accessors `{prefix}_load_word`, `{prefix}_store_word`, `{prefix}_load_vec4` and
+/// `{prefix}_store_vec4` over `buffer`, a storage `array<vec4<u32>>` addressed in u32 words
+/// (`*_vec4` take a 4-aligned word index).
+pub(crate) fn vec4_word_accessors(prefix: &str, buffer: &str) -> String {
+    format!(
+        "fn {prefix}_load_word(i: u32) -> u32 {{ return {buffer}[i >> 2u][i & 3u]; }}\n\
+         fn {prefix}_store_word(i: u32, sched_w: u32) {{ {buffer}[i >> 2u][i & 3u] = sched_w; }}\n\
+         fn {prefix}_load_vec4(i: u32) -> vec4<u32> {{ return {buffer}[i >> 2u]; }}\n\
+         fn {prefix}_store_vec4(i: u32, sched_v: vec4<u32>) {{ {buffer}[i >> 2u] = sched_v; }}\n"
+    )
 }
 
 #[cfg(test)]
@@ -271,13 +326,20 @@ mod tests {
 
     #[test]
     fn generated_load_store_is_valid_wgsl() {
+        // Item (20 words) moves by vec4; Odd (3 words) word by word.
+        let odd = "struct Odd { a: u32, b: f32, c: i32 }";
         let l = struct_layout(SRC, "Item").unwrap();
+        let o = struct_layout(odd, "Odd").unwrap();
+        assert!(moves_by_vec4(&l) && !moves_by_vec4(&o));
+        let item_fns = load_store_fns(&l, "q");
+        assert!(item_fns.contains("q_load_vec4(base + 16u)"), "{item_fns}");
+        assert!(!load_store_fns(&o, "q").contains("vec4"));
         let src = format!(
-            "{SRC}\n@group(0) @binding(0) var<storage, read_write> w: array<u32>;\n\
-             fn q_load_word(i: u32) -> u32 {{ return w[i]; }}\n\
-             fn q_store_word(i: u32, x: u32) {{ w[i] = x; }}\n{}\n\
-             @compute @workgroup_size(1) fn main() {{ q_store_Item(20u, q_load_Item(0u)); }}",
-            load_store_fns(&l, "q")
+            "{SRC}\n{odd}\n@group(0) @binding(0) var<storage, read_write> buf: array<vec4<u32>>;\n\
+             {}{item_fns}{}\n\
+             @compute @workgroup_size(1) fn main() {{ q_store_Item(20u, q_load_Item(0u)); q_store_Odd(41u, q_load_Odd(1u)); }}",
+            vec4_word_accessors("q", "buf"),
+            load_store_fns(&o, "q")
         );
         validate("test", &src).unwrap();
     }

@@ -179,9 +179,10 @@ impl Megakernel {
             let mut off = 0;
             for t in 0..nq {
                 ob_off[q * nq + t] = off;
-                off += batch * p.emits[t] * program.procs[t].words();
+                // 16-byte aligned parts, so items that move by vec4 stay aligned.
+                off += (batch * p.emits[t] * program.procs[t].words()).next_multiple_of(4);
             }
-            outbox_stride = outbox_stride.max(off);
+            outbox_stride = outbox_stride.max(off).next_multiple_of(4);
         }
         let source = wgsl::source(program, gpu.coherent);
         let entries = [

@@ -10,14 +10,18 @@ pub fn source(program: &Program, coherent: bool) -> String {
     let mut s = program.tables_wgsl();
     s += &program.common_wgsl();
     if coherent {
-        s += "@group(0) @binding(1) @coherent var<storage, read_write> slots: array<u32>;\n\
-              fn sched_slot_load_word(i: u32) -> u32 { return slots[i]; }\n\
-              fn sched_slot_store_word(i: u32, w: u32) { slots[i] = w; }\n";
+        s += "@group(0) @binding(1) @coherent var<storage, read_write> slots: array<vec4<u32>>;\n";
+        s += &crate::wgsl::vec4_word_accessors("sched_slot", "slots");
     } else {
         s += "@group(0) @binding(1) var<storage, read_write> slots: array<atomic<u32>>;\n\
               fn sched_slot_load_word(i: u32) -> u32 { return atomicLoad(&slots[i]); }\n\
-              fn sched_slot_store_word(i: u32, w: u32) { atomicStore(&slots[i], w); }\n";
+              fn sched_slot_store_word(i: u32, w: u32) { atomicStore(&slots[i], w); }\n\
+              fn sched_slot_load_vec4(i: u32) -> vec4<u32> {\n    \
+                  return vec4<u32>(atomicLoad(&slots[i]), atomicLoad(&slots[i + 1u]), atomicLoad(&slots[i + 2u]), atomicLoad(&slots[i + 3u]));\n}\n\
+              fn sched_slot_store_vec4(i: u32, v: vec4<u32>) {\n    \
+                  for (var k = 0u; k < 4u; k++) { atomicStore(&slots[i + k], v[k]); }\n}\n";
     }
+    s += &crate::wgsl::vec4_word_accessors("sched_ob", "outbox");
     s += &program.execute_switch("sched_slot");
     // The outbox only needs typed stores; loads of the same prefix are generated and unused.
     let mut seen = Vec::new();

@@ -87,6 +87,8 @@ struct HostRounds {
 pub(crate) fn source(program: &Program) -> String {
     let mut s = program.tables_wgsl();
     s += &program.common_wgsl();
+    s += &crate::wgsl::vec4_word_accessors("mp_in", "items_in");
+    s += &crate::wgsl::vec4_word_accessors("mp_out", "items_out");
     s += &program.execute_switch("mp_in");
     let mut seen = Vec::new();
     for p in &program.procs {

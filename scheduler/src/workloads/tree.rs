@@ -380,8 +380,8 @@ impl TreeParams {
         let branch = Procedure::new("branch", item.clone(), 1)
             .emits("branch", k)
             .emits("leaf", k)
-            .body(BRANCH_WGSL);
-        let leaf = Procedure::new("leaf", item, 1).body(LEAF_WGSL);
+            .body(&unrolled(BRANCH_WGSL, p));
+        let leaf = Procedure::new("leaf", item, 1).body(&unrolled(LEAF_WGSL, p));
         Program::new(vec![branch, leaf], user)
     }
 
@@ -419,8 +419,16 @@ fn tree_children(id: u32, depth: u32) -> u32 {
 }
 "#;
 
+// The bodies as written: loops over the payload. `TreeParams::program` unrolls them (`unrolled`)
+// for the program's payload size, as a CUDA compiler unrolls loops of constant trip count; the
+// Vulkan driver keeps such a loop, and with it the payload in local memory instead of
+// registers (1.6x the GPU time of the large-payload tree on the H200: docs/results.md,
+// session 18). Both copy the item into a `var` first: indexing the `item` parameter (a value)
+// with a run-time index makes naga's SPIR-V copy the whole array to a temporary at every access
+// (`Program::new` warns of it; docs/scheduler.md, "Writing fast procedures").
 const BRANCH_WGSL: &str = r#"
-fn branch_execute(item: TreeNode, inv: Invocation) {
+fn branch_execute(item_value: TreeNode, inv: Invocation) {
+    var item = item_value;
     var x = item.id;
     for (var i = 0u; i < tree_cfg[4]; i++) { x = tree_hash(x + i); }
     let c = tree_children(item.id, item.depth);
@@ -438,8 +446,9 @@ fn branch_execute(item: TreeNode, inv: Invocation) {
 "#;
 
 const LEAF_WGSL: &str = r#"
-fn leaf_execute(item: TreeNode, inv: Invocation) {
+fn leaf_execute(item_value: TreeNode, inv: Invocation) {
     if !inv.live { return; }
+    var item = item_value;
     var h = tree_hash(item.id ^ (item.depth << 24u));
     for (var w = 0u; w < TREE_P; w++) { h = tree_hash(h ^ item.payload[w]); }
     // Spread over buckets: one counter for a million leaves would serialise the GPU.
@@ -449,6 +458,28 @@ fn leaf_execute(item: TreeNode, inv: Invocation) {
     atomicXor(&tree_out[b + 2u], tree_hash(h));
 }
 "#;
+
+/// `body` with its payload loops (`for (var w = 0u; w < TREE_P; w++) { ... }`, one statement
+/// each, no nested braces) unrolled for `p` payload words.
+fn unrolled(body: &str, p: u32) -> String {
+    let head = "for (var w = 0u; w < TREE_P; w++) {";
+    let mut out = String::new();
+    let mut rest = body;
+    while let Some(at) = rest.find(head) {
+        out += &rest[..at];
+        let after = &rest[at + head.len()..];
+        let end = after.find('}').expect("a one-statement payload loop");
+        let stmt = after[..end].trim();
+        for w in 0..p {
+            out += &stmt
+                .replace("[w]", &format!("[{w}u]"))
+                .replace("(w *", &format!("({w}u *"));
+            out += " ";
+        }
+        rest = &after[end + 1..];
+    }
+    out + rest
+}
 
 /// The tree's GPU resources: its output buckets and their bind group.
 pub struct TreeRun {
@@ -544,6 +575,23 @@ impl TreeRun {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn payload_loops_unroll_to_one_statement_per_word() {
+        let b = super::unrolled(super::BRANCH_WGSL, 3);
+        assert!(!b.contains("TREE_P"), "{b}");
+        assert!(
+            b.contains(
+                "child.payload[2u] = tree_hash(item.payload[2u] ^ child.id ^ (2u * 0x85ebca6bu));"
+            ),
+            "{b}"
+        );
+        let l = super::unrolled(super::LEAF_WGSL, 2);
+        assert!(
+            l.contains("h = tree_hash(h ^ item.payload[1u]);") && !l.contains("TREE_P"),
+            "{l}"
+        );
+    }
+
     use super::*;
 
     #[test]
