@@ -41,6 +41,7 @@ const P_PROBE: u32 = 2u;
 const P_POLICY: u32 = 3u;      // 0 = priority order, 1 = oldest batch first (FIFO)
 const P_OUTBOX_STRIDE: u32 = 4u;
 const P_BATCH_STEPS: u32 = 5u;
+const P_IDLE_BACKOFF: u32 = 6u; // longest pause of an idle workgroup between polls (loop trips)
 fn q_cap(q: u32) -> u32 { return params[8u + q * 4u]; }
 fn q_slot_base(q: u32) -> u32 { return params[9u + q * 4u]; }
 fn q_flag_base(q: u32) -> u32 { return params[10u + q * 4u]; }
@@ -76,6 +77,15 @@ var<private> sched_active: bool;
 var<private> sched_batch_n: u32;
 var<private> sched_outbox: u32;
 var<private> sched_blocked: bool;
+var<private> sched_pause_sink: u32;
+
+// An idle workgroup's pause before it polls again: a loop of `trips` dependent multiply-adds,
+// touching no memory, so idle workgroups do not crowd the L2 lines every claim needs.
+fn idle_pause(trips: u32) {
+    var x = sched_pause_sink;
+    for (var i = 0u; i < trips; i++) { x = x * 1664525u + 1013904223u; }
+    sched_pause_sink = x;
+}
 
 
 fn sched_raise(code: u32, a: u32, b: u32) {
@@ -206,6 +216,7 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
     }
     sched_outbox = wid.x * params[P_OUTBOX_STRIDE];
     var idle = 0u;
+    var streak = 0u;
     var iter = 0u;
     // Bounded far below lavapipe's silent 65,535-iteration cut; the host relaunches if needed.
     for (; iter < params[P_MAX_ITERS]; iter++) {
@@ -216,7 +227,13 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         if lid < NQ { atomicStore(&wg_emit_count[lid], 0u); }
         let cmd = workgroupUniformLoad(&wg_cmd);
         if cmd == CMD_EXIT { break; }
-        if cmd == CMD_IDLE { idle++; continue; }
+        if cmd == CMD_IDLE {
+            idle++;
+            streak = min(streak * 2u + 1u, params[P_IDLE_BACKOFF]);
+            idle_pause(streak);
+            continue;
+        }
+        streak = 0u;
         let q = workgroupUniformLoad(&wg_q);
         let h = workgroupUniformLoad(&wg_h);
         let n = workgroupUniformLoad(&wg_n);
@@ -316,5 +333,7 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
     if lid == 0u {
         if idle > 0u { atomicAdd(&ctrl[gw(G_IDLE)], idle); }
         if iter >= params[P_MAX_ITERS] { atomicAdd(&ctrl[gw(G_ITER_EXITS)], 1u); }
+        // Keeps the pauses from being optimised away (never true in practice).
+        if sched_pause_sink == 0x9e3779b9u { atomicAdd(&ctrl[gw(G_IDLE)], 1u); }
     }
 }

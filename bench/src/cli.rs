@@ -121,6 +121,11 @@ pub struct Cli {
           help_heading = "Scheduler")]
     pub batch_steps: u32,
 
+    /// Longest pause of an idle megakernel workgroup between polls, in loop trips (0: none).
+    #[arg(long, default_value_t = 64, value_parser = value_parser!(u32).range(0..=30000),
+          help_heading = "Scheduler")]
+    pub idle_backoff: u32,
+
     /// Queue slots at the start of a run [default: from the problem size].
     #[arg(long, value_name = "SLOTS", value_parser = value_parser!(u32).range(1..),
           help_heading = "Scheduler")]
@@ -225,6 +230,7 @@ impl Cli {
         GpuConfig {
             workgroups: self.workgroups,
             batch_steps: self.batch_steps,
+            idle_backoff: self.idle_backoff,
             capacity: self.capacity,
         }
     }

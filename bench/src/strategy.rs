@@ -126,6 +126,8 @@ pub struct GpuConfig {
     pub workgroups: Option<u32>,
     /// Megakernel workgroup steps per claimed batch (at least 1).
     pub batch_steps: u32,
+    /// Longest pause of an idle megakernel workgroup (`MegakernelConfig::idle_backoff`).
+    pub idle_backoff: u32,
     /// Queue slots at the start of a run; `None` lets the workload choose from its size.
     pub capacity: Option<u32>,
 }
@@ -135,6 +137,7 @@ impl Default for GpuConfig {
         GpuConfig {
             workgroups: None,
             batch_steps: 1,
+            idle_backoff: MegakernelConfig::default().idle_backoff,
             capacity: None,
         }
     }
@@ -163,6 +166,7 @@ pub fn compile(
                     .map_or(Workgroups::Probe { max: 4096 }, Workgroups::Fixed),
                 policy: policy.queue_policy(),
                 batch_steps: config.batch_steps,
+                idle_backoff: config.idle_backoff,
                 initial_capacity: capacity,
                 ..Default::default()
             },

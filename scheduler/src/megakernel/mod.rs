@@ -74,6 +74,13 @@ pub struct MegakernelConfig {
     pub max_iterations: u32,
     /// Polls of one slot's flag before it is abandoned to the next launch.
     pub spin_limit: u32,
+    /// Longest pause of an idle workgroup between two polls for work, in trips of a loop of
+    /// one multiply-add (about 4 clocks each); the pause doubles per idle turn up to this and
+    /// ends at the first claimed batch. Idle workgroups polling without a pause crowd the L2
+    /// lines of the queue counters that every claim needs: on the H200, 64 made the deep tree
+    /// 25% faster and no tree slower (docs/results.md, session 18). 0 polls without a pause
+    /// (and is what lavapipe gets: its loop limiter counts the pause's trips).
+    pub idle_backoff: u32,
     /// Slots per queue at the start of a run (at least twice the seeds).
     pub initial_capacity: u32,
     /// A queue grows (at least doubling) up to this many slots, and never past its share of
@@ -91,6 +98,7 @@ impl Default for MegakernelConfig {
             batch_steps: 1,
             max_iterations: 16_384,
             spin_limit: 4096,
+            idle_backoff: 64,
             initial_capacity: 1 << 16,
             max_capacity: 1 << 26,
             max_launches: 10_000,
@@ -145,8 +153,9 @@ impl Megakernel {
     /// Compiles `program` for the megakernel on `gpu`.
     ///
     /// On lavapipe (adapter name `llvmpipe`) `max_iterations` and `spin_limit` are lowered to
-    /// [`LAVAPIPE_MAX_ITERATIONS`] and [`LAVAPIPE_SPIN_LIMIT`]. Errors: [`RunError::Program`] for
-    /// `max_iterations` or `spin_limit` outside `1..=30000`, an unknown procedure name in
+    /// [`LAVAPIPE_MAX_ITERATIONS`] and [`LAVAPIPE_SPIN_LIMIT`], and `idle_backoff` to 0. Errors:
+    /// [`RunError::Program`] for `max_iterations` or `spin_limit` outside `1..=30000`,
+    /// `idle_backoff` above 30,000, an unknown procedure name in
     /// [`QueuePolicy::Priority`], or WGSL that does not compile with the generated code (e.g.
     /// user WGSL that reuses a template identifier).
     pub fn new(
@@ -160,6 +169,10 @@ impl Megakernel {
             // its first test. A persistent launch must stay far below that, bodies included.
             config.max_iterations = config.max_iterations.min(LAVAPIPE_MAX_ITERATIONS);
             config.spin_limit = config.spin_limit.min(LAVAPIPE_SPIN_LIMIT);
+            config.idle_backoff = 0;
+        }
+        if config.idle_backoff > 30_000 {
+            return Err(RunError::Program("idle_backoff must be 0..=30000".into()));
         }
         if config.max_iterations == 0 || config.max_iterations > 30_000 {
             return Err(RunError::Program(
@@ -279,6 +292,7 @@ impl Megakernel {
         p[P_POLICY] = matches!(self.config.policy, QueuePolicy::Fifo) as u32;
         p[P_OUTBOX_STRIDE] = self.outbox_stride;
         p[P_BATCH_STEPS] = self.config.batch_steps.max(1);
+        p[P_IDLE_BACKOFF] = self.config.idle_backoff;
         for q in 0..nq {
             p[P_QUEUES + q * 4] = layout.capacity[q];
             p[P_QUEUES + q * 4 + 1] = layout.slot_base[q];
