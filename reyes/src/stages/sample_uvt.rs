@@ -141,11 +141,8 @@ fn uvt_test(
     f: &Frame,
     samples: &mut [u64],
     m: &MovedQuad,
-    px: u32,
-    py: u32,
-    k: u32,
-    color: u32,
-    cover: Cover,
+    [px, py, k]: [u32; 3],
+    (color, cover): (u32, Cover),
 ) {
     let (sx, sy) = (k % f.spp_x, k / f.spp_x);
     let q = sample_position(f, px, py, sx, sy);
@@ -189,7 +186,7 @@ pub fn sample_micropolygon_uvt(
     let Some(color) = micropolygon_color(&q0, two_sided) else {
         return false;
     };
-    if !(cover.alpha > 0.0) {
+    if cover.alpha.is_nan() || cover.alpha <= 0.0 {
         return true;
     }
     let spp = f.spp_x * f.spp_y;
@@ -201,7 +198,7 @@ pub fn sample_micropolygon_uvt(
             };
             for py in p0[1]..=p1[1] {
                 for px in p0[0]..=p1[0] {
-                    uvt_test(f, samples, &m, px, py, k, color, cover);
+                    uvt_test(f, samples, &m, [px, py, k], (color, cover));
                 }
             }
         }
@@ -225,7 +222,7 @@ pub fn sample_micropolygon_uvt(
                     if px < p0[0] || px > p1[0] || py < p0[1] || py > p1[1] {
                         continue;
                     }
-                    uvt_test(f, samples, &m, px, py, k, color, cover);
+                    uvt_test(f, samples, &m, [px, py, k], (color, cover));
                 }
             }
         }
@@ -244,7 +241,7 @@ pub fn sample_micropolygon_uvt(
                     for k in 0..spp {
                         let s = uvt_table_sample(f, px, py, k, spp);
                         let m = moved_quad(f, &q0, &q1, s, grow);
-                        uvt_test(f, samples, &m, px, py, k, color, cover);
+                        uvt_test(f, samples, &m, [px, py, k], (color, cover));
                     }
                 }
             }

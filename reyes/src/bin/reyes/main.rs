@@ -112,8 +112,7 @@ fn run(a: RenderCmd) -> Result<(), String> {
             &seq.warnings,
             data,
             outputs,
-            gpu.as_ref(),
-            reference.as_ref(),
+            (gpu.as_ref(), reference.as_ref()),
             &bar,
         )?;
     }
@@ -138,15 +137,18 @@ fn gpu_renderer(
     Ok((gpu, renderer))
 }
 
-/// Renders one frame to its outputs, on the CPU twin when `gpu` is `None`.
+/// `--compare-to`'s file and image.
+type Reference = (std::path::PathBuf, FrameImage);
+
+/// Renders one frame to its outputs, on the CPU twin when `gpu` is `None`; with a
+/// `reference` (`--compare-to`), reports the image error against it.
 fn render_frame(
     a: &RenderCmd,
     scene: &Scene,
     file_warnings: &[String],
     data: &FrameData,
     out: &frames::Outputs,
-    gpu: Option<&(Gpu, GpuRenderer)>,
-    reference: Option<&(std::path::PathBuf, FrameImage)>,
+    (gpu, reference): (Option<&(Gpu, GpuRenderer)>, Option<&Reference>),
     progress: &indicatif::ProgressBar,
 ) -> Result<(), String> {
     let Some((gpu, renderer)) = gpu else {
@@ -240,7 +242,7 @@ fn render_frame(
 /// `--compare-to`: the image error of `image` against the reference, printed (stderr) and
 /// returned for the statistics. Errors when the sizes differ.
 fn compare_to(
-    (path, reference): &(std::path::PathBuf, FrameImage),
+    (path, reference): &Reference,
     image: &FrameImage,
 ) -> Result<reyes::stats::ImageErrorStats, String> {
     if (reference.width, reference.height) != (image.width, image.height) {
