@@ -996,3 +996,93 @@ fn progress_bar_is_drawn_on_a_terminal() {
     assert!(text.contains("2/2 ETA "), "no bar in {text:?}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `--spin`, `--dof` and `--sampling` give a frame motion blur and depth of field (its
+/// statistics say how it was sampled), and `--compare-to` reports the image error against a
+/// reference EXR, in the statistics too; bad values name their flag or file.
+#[test]
+fn motion_blur_and_depth_of_field_from_the_command_line() {
+    let dir = scratch("motion");
+    let common = [
+        "teapot",
+        "--width",
+        "40",
+        "--height",
+        "30",
+        "--strategy",
+        "multipass",
+        "--spin",
+        "20",
+        "--dof",
+        "2,1,5",
+        "--sampling",
+        "bbox",
+    ];
+    fn with<'a>(common: &[&'a str], more: &[&'a str]) -> Vec<&'a str> {
+        [common, more].concat()
+    }
+    let with = |more: &[&'static str]| with(&common, more);
+    let (ok, err) = reyes(
+        &dir,
+        &with(&["--samples", "4", "--exr", "ref.exr", "-o", "ref.png"]),
+    );
+    assert!(ok, "{err}");
+    let (ok, err) = reyes(
+        &dir,
+        &with(&[
+            "--samples",
+            "1",
+            "--compare-to",
+            "ref.exr",
+            "--stats",
+            "s.json",
+            "-o",
+            "f.png",
+        ]),
+    );
+    assert!(ok, "{err}");
+    assert!(err.contains("image error against ref.exr: PSNR"), "{err}");
+    let text = std::fs::read_to_string(dir.join("s.json")).unwrap();
+    let s: reyes::stats::FrameStats = serde_json::from_str(&text).unwrap();
+    let uvt = s.uvt.expect("uvt statistics");
+    assert_eq!(uvt.sampling, "bbox");
+    assert_eq!(uvt.moving_patches, s.patches_in);
+    assert!(uvt.coc_scale_px > 0.0);
+    let e = s.image_error.expect("image error statistics");
+    assert!(e.psnr_db.is_finite() && e.psnr_db > 10.0, "{e:?}");
+    assert!(e.flip_mean > 0.0 && e.flip_mean < 0.5, "{e:?}");
+    let docs =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/reyes.md")).unwrap();
+    for key in ["uvt", "image_error"] {
+        assert!(
+            docs.contains(&format!("`{key}`")),
+            "`{key}` is not in docs/reyes.md"
+        );
+    }
+    let (code, err) = render_code(&dir, &with(&["--compare-to", "missing.exr", "-o", "m.png"]));
+    assert!(
+        code == 1 && err.contains("--compare-to missing.exr"),
+        "{code}: {err}"
+    );
+    let mut small = with(&["--compare-to", "ref.exr", "-o", "m.png"]);
+    small[2] = "20";
+    let (code, err) = render_code(&dir, &small);
+    assert!(
+        code == 1 && err.contains("the reference is 40x30, the frame 20x30"),
+        "{code}: {err}"
+    );
+    assert!(!dir.join("m.png").exists());
+    for (flag, value) in [
+        ("--dof", "2,1"),
+        ("--dof", "2,0,4"),
+        ("--il-tile", "5"),
+        ("--spin", "nan"),
+    ] {
+        let (code, err) = render_code(&dir, &["teapot", flag, value]);
+        assert!(
+            code == 2 && err.contains(flag),
+            "{flag} {value}: {code}: {err}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -26,6 +26,7 @@ fn sphere() -> Scene {
             fov_deg: 40.0,
             near: 0.1,
             far: 100.0,
+            ..Camera::default()
         },
         // One-sided: the far half's quads are culled as facing away.
         patches: rational_sphere(glam::DVec3::new(0.3, -0.2, 4.0), 1.0)

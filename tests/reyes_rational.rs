@@ -36,6 +36,7 @@ fn sphere_scene(centre: DVec3, radius: f64, two_sided: bool) -> Scene {
             fov_deg: FOV,
             near: 0.1,
             far: 100.0,
+            ..Camera::default()
         },
         patches,
         materials: vec![Material::standard(SurfaceKind::Plastic)],

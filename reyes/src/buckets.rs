@@ -69,6 +69,10 @@ pub fn quarter(t: Tile) -> Option<Vec<Tile>> {
 /// has no screen bound yet. `w`: the item's weights if its patch is rational
 /// (`stages::item_weights`).
 pub fn may_reach(f: &Frame, item: &PatchItem, w: Option<&Weights>, t: Tile) -> bool {
+    // Motion blur and depth of field move patches beyond this bound: Bound culls them.
+    if f.uvt != crate::frame::UVT_OFF {
+        return true;
+    }
     let mut lo = [f32::INFINITY; 2];
     let mut hi = [f32::NEG_INFINITY; 2];
     for k in 0..16 {

@@ -64,6 +64,69 @@ pub struct Frame {
     pub displacement_normals: u32,
     /// How micropolygons are rasterized: [`RasterMode::gpu_code`] (`RASTER_*` in common.wgsl).
     pub raster: u32,
+    /// Time and lens sampling (motion blur, depth of field): [`UVT_OFF`] when the frame has
+    /// neither, else the algorithm ([`Sampling::gpu_code`], `UVT_*` in common.wgsl).
+    pub uvt: u32,
+    /// Interleave UVT: the tile side K in pixels (2..=4).
+    pub il_tile: u32,
+    /// Interleave UVT: the number P of sample permutations the tiles choose from.
+    pub il_perms: u32,
+    /// Depth of field: the signed circle of confusion of camera-space depth z is
+    /// `coc_scale * (inv_focus - 1 / z)` pixels (focal length in pixels times the lens radius;
+    /// 0 without depth of field).
+    pub coc_scale: f32,
+    /// 1 / the focal distance (camera space).
+    pub inv_focus: f32,
+}
+
+/// [`Frame::uvt`]: no time or lens sampling; the sampler of a still pinhole frame runs.
+pub const UVT_OFF: u32 = 0;
+/// [`Frame::uvt`] of [`Sampling::Simple`].
+pub const UVT_SIMPLE: u32 = 1;
+/// [`Frame::uvt`] of [`Sampling::Interleave`].
+pub const UVT_INTERLEAVE: u32 = 2;
+/// [`Frame::uvt`] of [`Sampling::BoundingBox`].
+pub const UVT_BBOX: u32 = 3;
+
+/// How a frame with motion blur or depth of field samples time and the lens (Sattler &
+/// Steinberger, "Reyes Rendering on the GPU", section 3.3; docs/reyes.md, "Motion blur and
+/// depth of field"). Each pixel keeps its `PixelSamples` sub-samples; each sub-sample gets one
+/// (lens u, lens v, time) triple, which the algorithms assign differently.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]
+pub enum Sampling {
+    /// Simple UVT: the same S triples in every pixel (S = samples per pixel); each
+    /// micropolygon is moved to each triple and rasterized into that triple's sub-sample.
+    /// Ghost images when S is small.
+    #[default]
+    Simple,
+    /// Interleave UVT: K x K pixel tiles share K^2 S triples, each sub-sample of the tile one of
+    /// them, assigned by one of P permutations chosen per tile (the paper's eq. 2-3). Noise
+    /// instead of ghosts.
+    Interleave,
+    /// Bounding box: one pass over the micropolygon's bound grown by its motion and circle of
+    /// confusion; each pixel's triples come from a 64 x 64 pixel table repeated over the image.
+    #[value(name = "bbox")]
+    BoundingBox,
+}
+
+impl Sampling {
+    /// The value of [`Frame::uvt`] for a frame that has motion or depth of field.
+    pub fn gpu_code(self) -> u32 {
+        match self {
+            Sampling::Simple => UVT_SIMPLE,
+            Sampling::Interleave => UVT_INTERLEAVE,
+            Sampling::BoundingBox => UVT_BBOX,
+        }
+    }
+
+    /// The command line's and the statistics' name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Sampling::Simple => "simple",
+            Sampling::Interleave => "interleave",
+            Sampling::BoundingBox => "bbox",
+        }
+    }
 }
 
 impl Frame {
@@ -141,6 +204,28 @@ pub struct PatchInfo {
     /// A displaced patch's displacement ([`PATCH_DISPLACED`]): the index of its entry in
     /// [`FrameData::primvars`] ([`displacement_ref`] gives the layout). 0 when undisplaced.
     pub displacement: u32,
+    /// A moving patch's motion ([`PATCH_MOVING`]): the index of 3 entries of
+    /// [`FrameData::primvars`], the rows of the camera-space affine map from its points at
+    /// shutter open to those at shutter close ([`motion_ref`]). 0 when it does not move.
+    pub motion: u32,
+}
+
+/// Bit of [`PatchInfo::flags`] (`PATCH_MOVING` in common.wgsl): the patch moves over the
+/// shutter ([`PatchInfo::motion`]).
+pub const PATCH_MOVING: u32 = 16;
+
+/// Appends the affine part of the camera-space motion `m` (shutter open to close) to the table
+/// as 3 rows `[m_r0, m_r1, m_r2, t_r]` and returns the first entry's index.
+pub fn motion_ref(table: &mut Vec<[f32; 4]>, m: &glam::DMat4) -> Result<u32, String> {
+    let at = table.len() as u64;
+    if (at + 3) * 16 > MAX_FRAME_BUFFER_BYTES {
+        return Err(format!(
+            "the patches' motion and primitive variables need more than the \
+             {MAX_FRAME_BUFFER_BYTES} bytes a GPU table may hold"
+        ));
+    }
+    table.extend((0..3).map(|r| std::array::from_fn(|c| m.col(c)[r] as f32)));
+    Ok(at as u32)
 }
 
 /// Shapes of a colour field in the primitive-variable table (the low 2 bits of
@@ -289,6 +374,12 @@ pub struct RenderOptions {
     pub displacement_normals: DisplacementNormals,
     /// How micropolygons are rasterized ([`RasterMode`]).
     pub raster: RasterMode,
+    /// How time and the lens are sampled when the scene has motion or depth of field.
+    pub sampling: Sampling,
+    /// Interleave UVT's tile side K (2..=4).
+    pub il_tile: u32,
+    /// Interleave UVT's number of permutations P (1..=1024).
+    pub il_perms: u32,
 }
 
 /// How a micropolygon becomes samples (Sattler & Steinberger, "Reyes Rendering on the GPU",
@@ -354,6 +445,9 @@ impl Default for RenderOptions {
             crack_dilation: true,
             displacement_normals: DisplacementNormals::Exact,
             raster: RasterMode::BoundingBox,
+            sampling: Sampling::Simple,
+            il_tile: 2,
+            il_perms: 64,
         }
     }
 }
@@ -384,6 +478,7 @@ impl FrameData {
             transparent: os || self.materials.iter().any(|m| m.opacity < 1.0),
             displacement: (self.patch_info.iter()).any(|i| i.flags & PATCH_DISPLACED != 0),
             nearest_raster: self.frame.raster == RASTER_NEAREST,
+            uvt: self.frame.uvt != UVT_OFF,
         }
     }
 }
@@ -407,6 +502,10 @@ pub struct SceneFeatures {
     /// without it the program holds bounding-box rasterization alone, so the default mode
     /// runs exactly the code it ran before the option existed.
     pub nearest_raster: bool,
+    /// The frame samples time or the lens (`SCENE_UVT`: motion blur or depth of field):
+    /// without it none of that code is compiled, and a still pinhole frame runs exactly the
+    /// sampler it ran before.
+    pub uvt: bool,
 }
 
 impl SceneFeatures {
@@ -417,6 +516,7 @@ impl SceneFeatures {
         transparent: true,
         displacement: true,
         nearest_raster: true,
+        uvt: true,
     };
 
     /// True when a program compiled for `self` renders every frame that needs `need`.
@@ -426,6 +526,7 @@ impl SceneFeatures {
             && (self.transparent || !need.transparent)
             && (self.displacement || !need.displacement)
             && (self.nearest_raster || !need.nearest_raster)
+            && (self.uvt || !need.uvt)
     }
 
     /// The features either needs.
@@ -436,6 +537,7 @@ impl SceneFeatures {
             transparent: self.transparent || o.transparent,
             displacement: self.displacement || o.displacement,
             nearest_raster: self.nearest_raster || o.nearest_raster,
+            uvt: self.uvt || o.uvt,
         }
     }
 
@@ -443,8 +545,14 @@ impl SceneFeatures {
     pub fn wgsl(self) -> String {
         format!(
             "const SCENE_RATIONAL: bool = {};\nconst SCENE_PRIMVARS: bool = {};\n\
-             const SCENE_TRANSPARENT: bool = {};\nconst SCENE_DISPLACEMENT: bool = {};\nconst SCENE_NEAREST_RASTER: bool = {};\n",
-            self.rational, self.primvars, self.transparent, self.displacement, self.nearest_raster
+             const SCENE_TRANSPARENT: bool = {};\nconst SCENE_DISPLACEMENT: bool = {};\nconst SCENE_NEAREST_RASTER: bool = {};\n\
+             const SCENE_UVT: bool = {};\n",
+            self.rational,
+            self.primvars,
+            self.transparent,
+            self.displacement,
+            self.nearest_raster,
+            self.uvt
         )
     }
 }
@@ -492,6 +600,15 @@ pub fn check_quality(o: &RenderOptions) -> Result<(), String> {
         return Err(format!(
             "screen bound {b:?} px is not supported: it must be at least {min_bound} px (grids \
              of 15x15 micropolygons of at least {MIN_MP_SIZE} px) and finite"
+        ));
+    }
+    if !(2..=4).contains(&o.il_tile) {
+        return Err(format!("interleave tile {} must be 2, 3 or 4", o.il_tile));
+    }
+    if !(1..=1024).contains(&o.il_perms) {
+        return Err(format!(
+            "interleave permutations {} must be 1..=1024",
+            o.il_perms
         ));
     }
     Ok(())
@@ -544,7 +661,7 @@ impl FrameData {
         let lights = gpu_lights(scene);
         let mut primvars = Vec::new();
         let mut maps = Vec::new();
-        let patch_info = (scene.patches.iter())
+        let patch_info: Vec<PatchInfo> = (scene.patches.iter())
             .map(|p| patch_info(p, &mut primvars, &mut maps))
             .collect::<Result<_, _>>()?;
         let frame = Frame {
@@ -569,7 +686,29 @@ impl FrameData {
             crack_dilation: o.crack_dilation as u32,
             displacement_normals: o.displacement_normals as u32,
             raster: o.raster.gpu_code(),
+            uvt: UVT_OFF,
+            il_tile: o.il_tile,
+            il_perms: o.il_perms,
+            coc_scale: 0.0,
+            inv_focus: 0.0,
         };
+        let mut frame = frame;
+        let moving = patch_info
+            .iter()
+            .any(|i: &PatchInfo| i.flags & PATCH_MOVING != 0);
+        if let Some(d) = &scene.camera.depth_of_field {
+            frame.coc_scale = (focal * d.lens_radius()) as f32;
+            frame.inv_focus = (1.0 / d.focal_distance) as f32;
+        }
+        if moving || frame.coc_scale > 0.0 {
+            if o.raster == RasterMode::NearestSample {
+                return Err(
+                    "motion blur and depth of field need bounding-box rasterization (--raster bbox)"
+                        .to_string(),
+                );
+            }
+            frame.uvt = o.sampling.gpu_code();
+        }
         Ok(FrameData {
             frame,
             materials: scene.materials.iter().map(gpu_material).collect(),
@@ -648,6 +787,10 @@ fn patch_info(
         Some(d) => displacement_ref(table, maps, d)?,
         None => 0,
     };
+    let motion = match &p.motion {
+        Some(m) => motion_ref(table, m)?,
+        None => 0,
+    };
     Ok(PatchInfo {
         material: p.material,
         flags: p.flip_normal as u32
@@ -657,11 +800,13 @@ fn patch_info(
                 PATCH_DISPLACED
             } else {
                 0
-            },
+            }
+            | if p.motion.is_some() { PATCH_MOVING } else { 0 },
         cs,
         os,
         weights,
         displacement,
+        motion,
     })
 }
 
@@ -763,6 +908,11 @@ mod tests {
                     offset_of!(Frame, displacement_normals),
                 ),
                 ("raster", offset_of!(Frame, raster)),
+                ("uvt", offset_of!(Frame, uvt)),
+                ("il_tile", offset_of!(Frame, il_tile)),
+                ("il_perms", offset_of!(Frame, il_perms)),
+                ("coc_scale", offset_of!(Frame, coc_scale)),
+                ("inv_focus", offset_of!(Frame, inv_focus)),
             ],
         );
         check(
@@ -793,6 +943,7 @@ mod tests {
                 ("os", offset_of!(PatchInfo, os)),
                 ("weights", offset_of!(PatchInfo, weights)),
                 ("displacement", offset_of!(PatchInfo, displacement)),
+                ("motion", offset_of!(PatchInfo, motion)),
             ],
         );
     }

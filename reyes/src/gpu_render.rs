@@ -47,7 +47,8 @@ pub fn program_for(features: SceneFeatures) -> Result<Program, RunError> {
         .emits("bound", 2)
         .body("");
     let diceshade = Procedure::new("diceshade", item.clone(), 256)
-        .shared("vec4<f32>", 256)
+        // With SCENE_UVT the points at shutter close follow the open ones (sample_uvt.wgsl).
+        .shared("vec4<f32>", if features.uvt { 512 } else { 256 })
         .body(shaders::DICE_SHADE);
     // dicesmall_execute is defined in dice_shade.wgsl and shares diceshade_shared.
     let dicesmall = Procedure::new("dicesmall", item, 64).body("");
@@ -58,6 +59,7 @@ pub fn program_for(features: SceneFeatures) -> Result<Program, RunError> {
             shaders::SHADE,
             shaders::SURFACE,
             shaders::SAMPLE,
+            shaders::SAMPLE_UVT,
         ]
         .concat(),
         // 0-3 frame, materials, lights, patch info; 4-5 samples, counters; 6 primvars.

@@ -155,6 +155,40 @@ impl FrameImage {
         Ok(out.into_inner())
     }
 
+    /// Reads an OpenEXR image as [`FrameImage::exr`] writes it: channels R, G, B
+    /// (premultiplied), A and optionally Z, in f32 or f16, first layer. Errors name the file.
+    pub fn read_exr(path: &Path) -> Result<FrameImage, String> {
+        use exr::prelude::*;
+        let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+        let image = read_all_flat_layers_from_file(path).map_err(|e| err(&e))?;
+        let layer = (image.layer_data.first()).ok_or_else(|| err(&"no image layer"))?;
+        let (w, h) = (layer.size.width(), layer.size.height());
+        let channel = |name: &str| {
+            (layer.channel_data.list.iter())
+                .find(|c| c.name.eq(name))
+                .map(|c| c.sample_data.values_as_f32().collect::<Vec<f32>>())
+        };
+        let need = |name: &str| channel(name).ok_or_else(|| err(&format!("no {name} channel")));
+        let (r, g, b, a) = (need("R")?, need("G")?, need("B")?, need("A")?);
+        let z = channel("Z").unwrap_or_else(|| vec![f32::INFINITY; w * h]);
+        let rgba = (0..w * h)
+            .map(|i| {
+                let s = if a[i] > 0.0 { 1.0 / a[i] } else { 0.0 };
+                [r[i] * s, g[i] * s, b[i] * s, a[i]]
+            })
+            .collect();
+        let depth = z
+            .iter()
+            .map(|&z| if z.is_finite() { z } else { 3e38 })
+            .collect();
+        Ok(FrameImage {
+            width: w as u32,
+            height: h as u32,
+            rgba,
+            depth,
+        })
+    }
+
     /// [`FrameImage::exr`] written to `path` (atomically).
     pub fn write_exr(&self, path: &Path) -> Result<(), String> {
         crate::output::write_atomic(path, &self.exr()?)

@@ -42,13 +42,18 @@ pub fn orbit_matrix(centre: DVec3, angle: f64) -> [[f32; 4]; 4] {
 }
 
 /// `scene` turned by `angle` radians about its centre ([`scene_centre`]), control points
-/// transformed in f64: the host reference of a GPU turntable frame. Lights do not move.
+/// transformed in f64 (a moving patch's motion D becomes M D M^-1): the host reference of a
+/// GPU turntable frame. Lights do not move.
 pub fn orbit_scene(scene: &Scene, angle: f64) -> Scene {
     let m = orbit_transform(scene_centre(scene), angle);
+    let inv = m.inverse();
     let mut out = scene.clone();
     for p in &mut out.patches {
         for c in &mut p.cp {
             *c = m.transform_point3(*c);
+        }
+        if let Some(d) = &mut p.motion {
+            **d = m * **d * inv;
         }
     }
     out

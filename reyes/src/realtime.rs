@@ -28,6 +28,10 @@
 //! was rendered again ([`RealtimeFrame::rerendered`]); the fixed sizes then grow to what that
 //! render needed. A wrong frame is never returned.
 //!
+//! Motion blur: a moving patch's motion (camera space, [`crate::scene::Patch::motion`]) is
+//! seen by a frame of camera transform T as T D T^-1; a frame whose transform differs from the
+//! last one's rewrites the primitive-variable table that holds them (one upload per frame).
+//!
 //! Not pipelined (every frame by [`GpuRenderer::render`] from GPU-made roots, each reported as
 //! rendered again with the reason): the host-driven multi-pass (it plans rounds on the host),
 //! and a memory budget too small for the whole frame's samples (those frames need buckets).
@@ -260,6 +264,26 @@ pub struct RealtimeRenderer {
     roots_groups: (u32, u32),
     resolve_groups: (u32, u32),
     rgba8_groups: (u32, u32),
+    /// Moving patches' motion (motion blur): each one's entry in the primitive-variable table
+    /// and its camera-space map from shutter open to close under the unturned camera. A frame
+    /// of transform T moves by T D T^-1 ([`motion_primvars`]); the table on the GPU holds the
+    /// rows of the transform in `motion_written`.
+    motion: Vec<(u32, DMat4)>,
+    motion_written: std::cell::Cell<DMat4>,
+}
+
+/// `base`'s primitive-variable table with each moving patch's motion `d` (at entry `at`) as
+/// seen by a frame of camera-space transform `t`: `t d t^-1`.
+fn motion_primvars(base: &[[f32; 4]], motion: &[(u32, DMat4)], t: DMat4) -> Vec<[f32; 4]> {
+    let mut table = base.to_vec();
+    let inv = t.inverse();
+    for &(at, d) in motion {
+        let m = t * d * inv;
+        for r in 0..3 {
+            table[at as usize + r] = std::array::from_fn(|c| m.col(c)[r] as f32);
+        }
+    }
+    table
 }
 
 const STATUS_COUNTERS: u64 = COUNTERS as u64;
@@ -367,6 +391,10 @@ impl RealtimeRenderer {
             roots_groups,
             resolve_groups,
             rgba8_groups,
+            motion: (scene.patches.iter().zip(&base.patch_info))
+                .filter_map(|(p, i)| p.motion.as_deref().map(|m| (i.motion, *m)))
+                .collect(),
+            motion_written: std::cell::Cell::new(DMat4::IDENTITY),
             base,
         };
         r.set_pixels(gpu, pixels)?;
@@ -566,6 +594,13 @@ impl RealtimeRenderer {
         let orbit = Orbit::from_transform(transform, self.patches);
         gpu.queue
             .write_buffer(&s.orbit, 0, bytemuck::bytes_of(&orbit));
+        if !self.motion.is_empty() && self.motion_written.get() != transform {
+            // Queue order: the frames already submitted read the table before this write.
+            let table = motion_primvars(&self.base.primvars, &self.motion, transform);
+            gpu.queue
+                .write_buffer(&self._tables.0.primvars, 0, bytemuck::cast_slice(&table));
+            self.motion_written.set(transform);
+        }
         let recorded = self.recorded.clone();
         let timer_slot = slot as u32;
         let mut enc = gpu.device.create_command_encoder(&Default::default());
@@ -714,6 +749,7 @@ impl RealtimeRenderer {
         let roots = gpu.read_buffer(&self.slots[slot].roots, 0, bytes)?;
         let data = FrameData {
             items: bytemuck::pod_collect_to_vec(&roots),
+            primvars: motion_primvars(&self.base.primvars, &self.motion, transform),
             ..self.base.clone()
         };
         let g = self.renderer.render(gpu, &data)?;

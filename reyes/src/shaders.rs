@@ -7,6 +7,8 @@ pub const BOUND: &str = include_str!("../../shaders/reyes/bound.wgsl");
 pub const SPLIT: &str = include_str!("../../shaders/reyes/split.wgsl");
 pub const SHADE: &str = include_str!("../../shaders/reyes/shade.wgsl");
 pub const SAMPLE: &str = include_str!("../../shaders/reyes/sample.wgsl");
+/// Sampling in time and on the lens (motion blur, depth of field): `sample_uvt.wgsl`.
+pub const SAMPLE_UVT: &str = include_str!("../../shaders/reyes/sample_uvt.wgsl");
 pub const SURFACE: &str = include_str!("../../shaders/reyes/surface.wgsl");
 pub const DICE_SHADE: &str = include_str!("../../shaders/reyes/dice_shade.wgsl");
 pub const RESOLVE: &str = include_str!("../../shaders/reyes/resolve.wgsl");

@@ -102,6 +102,39 @@ pub struct FrameStats {
     /// `reyes render --runs`: each timed frame's times; absent elsewhere.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub runs: Option<RunSummary>,
+    /// Motion blur and depth of field: how time and the lens were sampled; absent for a
+    /// still pinhole frame.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uvt: Option<UvtStats>,
+    /// `reyes render --compare-to`: the image error against the reference; absent elsewhere.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub image_error: Option<ImageErrorStats>,
+}
+
+/// How a frame with motion blur or depth of field sampled time and the lens.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct UvtStats {
+    /// `simple`, `interleave` or `bbox` (`Sampling::name`).
+    pub sampling: String,
+    /// Interleave UVT's tile side K (pixels) and permutations P.
+    pub il_tile: u32,
+    pub il_perms: u32,
+    /// Root patches that move over the shutter.
+    pub moving_patches: usize,
+    /// Focal length (px) times lens radius: the circle of confusion's scale (0: no depth of
+    /// field).
+    pub coc_scale_px: f64,
+}
+
+/// The image error against a reference image (`reyes::accuracy::image_error`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ImageErrorStats {
+    /// The reference file.
+    pub reference: String,
+    /// PSNR in dB over 8-bit sRGB composited over black (null when identical: infinite).
+    pub psnr_db: f64,
+    /// Mean of FLIP's error map, in [0, 1].
+    pub flip_mean: f64,
 }
 
 /// Patches and micropolygons culled, by reason.
@@ -258,6 +291,21 @@ pub fn frame_stats(
         queue_bytes_allocated: g.run.queue_bytes,
         sample_bytes: g.sample_bytes,
         memory_budget: data.memory_budget,
+        uvt: (f.uvt != crate::frame::UVT_OFF).then(|| UvtStats {
+            sampling: match f.uvt {
+                crate::frame::UVT_INTERLEAVE => "interleave",
+                crate::frame::UVT_BBOX => "bbox",
+                _ => "simple",
+            }
+            .to_string(),
+            il_tile: f.il_tile,
+            il_perms: f.il_perms,
+            moving_patches: (data.patch_info.iter())
+                .filter(|i| i.flags & crate::frame::PATCH_MOVING != 0)
+                .count(),
+            coc_scale_px: f.coc_scale as f64,
+        }),
+        image_error: None,
         buckets: g.buckets,
         buckets_recut: g.buckets_recut,
         scheduler_runs: g.runs,

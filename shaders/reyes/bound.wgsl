@@ -51,12 +51,25 @@ fn bound_execute(item: PatchItem, inv: Invocation) {
         zmin -= r;
         zmax += r;
     }
-    if zmax < frame.near || zmin > frame.far {
+    // Motion blur or depth of field: culling uses the bound over the shutter and the lens
+    // (uvt_bound); splitting and dicing the patch at shutter open.
+    var moving = false;
+    var ub = array<vec2<f32>, 2>(vec2<f32>(0.0), vec2<f32>(0.0));
+    var uz = vec2<f32>(zmin, zmax);
+    var ucoc = 0.0;
+    if SCENE_UVT && frame.uvt != UVT_OFF {
+        moving = (info.flags & PATCH_MOVING) != 0u;
+        let u = uvt_bound(&cp, info, r, zmin, zmax);
+        ub = array<vec2<f32>, 2>(u[0].xy, u[0].zw);
+        uz = u[1].xy;
+        ucoc = u[1].z;
+    }
+    if uz.y < frame.near || uz.x > frame.far {
         atomicAdd(&counters[C_CULL_CLIP], 1u);
         return;
     }
-    // (A displaced surface may face the eye where its patch does not.)
-    var all_back = one_sided && r == 0.0;
+    // (A displaced surface may face the eye where its patch does not; a moving one may turn.)
+    var all_back = one_sided && r == 0.0 && !moving;
     for (var k = 0u; k < 16u; k++) { all_back = all_back && pts[k].w >= 2.0; }
     if all_back {
         atomicAdd(&counters[C_CULL_BACKFACE], 1u);
@@ -71,8 +84,11 @@ fn bound_execute(item: PatchItem, inv: Invocation) {
         // Crossing the near plane: only the part in front can be seen, and its screen bound
         // decides whether anything of it reaches the bucket.
         var vis = near_visible_bound(&cp);
-        // Displaced: a ball reaching the near plane reaches the whole image.
-        if r > 0.0 { vis = array<vec2<f32>, 2>(vec2<f32>(-3.0e38), vec2<f32>(3.0e38)); }
+        // Displaced: a ball reaching the near plane reaches the whole image (and so may a
+        // patch that moves or is blurred by the lens).
+        if r > 0.0 || (SCENE_UVT && frame.uvt != UVT_OFF) {
+            vis = array<vec2<f32>, 2>(vec2<f32>(-3.0e38), vec2<f32>(3.0e38));
+        }
         if any(vis[1] < t0) || any(vis[0] > t1) {
             atomicAdd(&counters[C_CULL_OFFSCREEN], 1u);
             return;
@@ -134,7 +150,13 @@ fn bound_execute(item: PatchItem, inv: Invocation) {
         lo -= vec2<f32>(frame.focal * r * g);
         hi += vec2<f32>(frame.focal * r * g);
     }
-    if any(hi < t0) || any(lo > t1) {
+    var clo = lo;
+    var chi = hi;
+    if SCENE_UVT && frame.uvt != UVT_OFF {
+        clo = min(lo - vec2<f32>(ucoc), ub[0]);
+        chi = max(hi + vec2<f32>(ucoc), ub[1]);
+    }
+    if any(chi < t0) || any(clo > t1) {
         atomicAdd(&counters[C_CULL_OFFSCREEN], 1u);
         return;
     }
@@ -168,6 +190,47 @@ fn bound_execute(item: PatchItem, inv: Invocation) {
     } else {
         enqueue_diceshade(g);
     }
+}
+
+// Motion blur and depth of field: the screen bound (lo.xy, hi.xy in [0]) and depth range ([1].xy)
+// of the patch over the shutter and the lens. The patch at shutter close is the hull of its
+// control points under the motion (an affine map keeps the hull), a displaced one grown by r
+// times the map's Frobenius norm (at least its largest stretch); a point moves linearly
+// between its two positions, the bound holds both. The screen bound then grows by the largest
+// circle of confusion over the depth range (|coc| is monotonic in depth on either side of the
+// focal plane). A shutter-close point behind the near plane: the whole image.
+// `cp`: Euclidean points; (zmin, zmax): the depths at shutter open, displacement included.
+fn uvt_bound(cp: ptr<function, array<f32, 48>>, info: PatchInfo, r: f32, zmin: f32, zmax: f32)
+    -> array<vec4<f32>, 2> {
+    var lo = vec2<f32>(3.0e38);
+    var hi = vec2<f32>(-3.0e38);
+    var z = vec2<f32>(zmin, zmax);
+    if (info.flags & PATCH_MOVING) != 0u {
+        let m0 = primvars[info.motion].xyz;
+        let m1 = primvars[info.motion + 1u].xyz;
+        let m2 = primvars[info.motion + 2u].xyz;
+        let r1 = r * sqrt(dot(m0, m0) + dot(m1, m1) + dot(m2, m2));
+        var g = 0.0;
+        var near = false;
+        for (var k = 0u; k < 16u; k++) {
+            let q = moved_point(info.motion, cp_point(cp, k));
+            z = vec2<f32>(min(z.x, q.z - r1), max(z.y, q.z + r1));
+            if q.z - r1 < frame.near { near = true; continue; }
+            let s = project(q);
+            lo = min(lo, s);
+            hi = max(hi, s);
+            if r1 > 0.0 { g = max(g, length(q) / (q.z * (q.z - r1))); }
+        }
+        lo -= vec2<f32>(frame.focal * r1 * g);
+        hi += vec2<f32>(frame.focal * r1 * g);
+        if near { lo = vec2<f32>(-3.0e38); hi = vec2<f32>(3.0e38); }
+    }
+    // Depths below the near plane are never sampled (DiceShade clamps them to it).
+    let zn = max(z.x, frame.near);
+    let c = max(abs(coc(zn)), abs(coc(max(z.y, zn))));
+    // bound_execute grows the shutter-open bound by c too and takes the union.
+    return array<vec4<f32>, 2>(vec4<f32>(lo - vec2<f32>(c), hi + vec2<f32>(c)),
+        vec4<f32>(z, c, 0.0));
 }
 
 // Screen bound (lo, hi) of the part of the patch in front of the near plane. The patch lies in

@@ -33,7 +33,22 @@ struct Frame {
     displacement_normals: u32,
     // How micropolygons are rasterized: RASTER_BBOX or RASTER_NEAREST (sample.wgsl).
     raster: u32,
+    // Time and lens sampling: UVT_OFF (no motion blur or depth of field) or the algorithm,
+    // UVT_SIMPLE, UVT_INTERLEAVE or UVT_BBOX (sample_uvt.wgsl); read only when SCENE_UVT.
+    uvt: u32,
+    // Interleave UVT: tile side K in pixels, and the number P of permutations.
+    il_tile: u32,
+    il_perms: u32,
+    // Depth of field: the signed circle of confusion of depth z is
+    // coc_scale * (inv_focus - 1 / z) pixels (0 without depth of field).
+    coc_scale: f32,
+    inv_focus: f32,
 }
+
+const UVT_OFF: u32 = 0u;
+const UVT_SIMPLE: u32 = 1u;
+const UVT_INTERLEAVE: u32 = 2u;
+const UVT_BBOX: u32 = 3u;
 
 // Frame.raster: every sub-sample under the micropolygon's bound, tested against its triangles.
 const RASTER_BBOX: u32 = 0u;
@@ -75,6 +90,9 @@ struct PatchInfo {
     // A displaced patch's entry in `primvars` (PATCH_DISPLACED; layout at `displacement_at`
     // in surface.wgsl), 0 when undisplaced.
     displacement: u32,
+    // A moving patch's motion (PATCH_MOVING): 3 entries of `primvars`, the rows of the
+    // camera-space affine map from shutter open to shutter close; 0 when still.
+    motion: u32,
 }
 
 @group(1) @binding(0) var<storage, read> frame: Frame;
@@ -123,6 +141,9 @@ const PATCH_RATIONAL: u32 = 4u;
 // Bit of PatchInfo.flags: DiceShade displaces the grid (PatchInfo.displacement) and Bound grows
 // the bound by its radius. Read only when SCENE_DISPLACEMENT.
 const PATCH_DISPLACED: u32 = 8u;
+// Bit of PatchInfo.flags: the patch moves over the shutter (PatchInfo.motion). Read only when
+// SCENE_UVT.
+const PATCH_MOVING: u32 = 16u;
 const DISPLACE_BUMPS: u32 = 0u;
 const DISPLACE_MAP: u32 = 1u;
 const DISPLACE_EXACT_NORMALS: u32 = 0u;
@@ -205,6 +226,23 @@ fn project(p: vec3<f32>) -> vec2<f32> {
         0.5 * f32(frame.width) + frame.focal * p.x / p.z,
         0.5 * f32(frame.height) - frame.focal * p.y / p.z,
     );
+}
+
+// Point p (camera space, at shutter open) at shutter close: the affine map at `at` in
+// primvars (PatchInfo.motion). Rust twin: stages::motion::moved_point.
+fn moved_point(at: u32, p: vec3<f32>) -> vec3<f32> {
+    let r0 = primvars[at];
+    let r1 = primvars[at + 1u];
+    let r2 = primvars[at + 2u];
+    return vec3<f32>(r0.x * p.x + r0.y * p.y + r0.z * p.z + r0.w,
+                     r1.x * p.x + r1.y * p.y + r1.z * p.z + r1.w,
+                     r2.x * p.x + r2.y * p.y + r2.z * p.z + r2.w);
+}
+
+// The signed circle of confusion, in pixels, of camera-space depth z > 0 (thin lens): a lens
+// position l in the unit disc moves the point's image by coc(z) * l.
+fn coc(z: f32) -> f32 {
+    return frame.coc_scale * (frame.inv_focus - 1.0 / z);
 }
 
 fn reyes_hash(x: u32) -> u32 {

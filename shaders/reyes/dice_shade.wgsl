@@ -1,6 +1,9 @@
 // DiceShade: 256 threads per grid. Each thread evaluates one grid point of the (nu+1) x (nv+1)
 // grid (position, normal from the patch derivatives, shaded colour) into workgroup memory; then
 // each thread samples one micropolygon (sample.wgsl). Rust twin: reyes/src/stages/dice_shade.rs.
+// With motion blur or depth of field (SCENE_UVT) workgroup memory holds each point at shutter
+// open and, UVT_CLOSE further on, at shutter close: the patch's motion applied to the
+// camera-space point (after displacement), shaded once, at shutter open.
 // A displaced patch's points move along their normal before they are shaded (docs/reyes.md,
 // "Displacement"; only when SCENE_DISPLACEMENT).
 
@@ -103,7 +106,14 @@ fn dice_grid(item: PatchItem, inv: Invocation, threads: u32) {
         let c = diceshade_shared[base + (j + 1u) * cols + i + 1u];
         let d = diceshade_shared[base + (j + 1u) * cols + i];
         let grow = micropolygon_dilation(item.dilate, i, j, nu, nv);
-        if (item.rates & NEAR_CLIP_GRID) != 0u {
+        if SCENE_UVT && frame.uvt != UVT_OFF && (item.rates & NEAR_CLIP_GRID) == 0u {
+            // Motion blur or depth of field (sample_uvt.wgsl): the corners at shutter close too.
+            let at = base + UVT_CLOSE;
+            sample_micropolygon_uvt(a, b, c, d, diceshade_shared[at + j * cols + i],
+                diceshade_shared[at + j * cols + i + 1u],
+                diceshade_shared[at + (j + 1u) * cols + i + 1u],
+                diceshade_shared[at + (j + 1u) * cols + i], grow, two_sided, cover);
+        } else if (item.rates & NEAR_CLIP_GRID) != 0u {
             sample_near_clipped(a, b, c, d, grow, two_sided, cover);
         } else {
             sample_micropolygon(a, b, c, d, grow, two_sided, cover);
@@ -130,6 +140,13 @@ fn shade_point(item: PatchItem, info: PatchInfo, at: u32, p: vec3<f32>, n: vec3<
     } else {
         let z = max(p.z, frame.near);
         diceshade_shared[at] = vec4<f32>(project(vec3<f32>(p.xy, z)), z, color);
+        if SCENE_UVT && frame.uvt != UVT_OFF {
+            // The point at shutter close (sample_uvt.wgsl), after the open points.
+            var p1 = p;
+            if (info.flags & PATCH_MOVING) != 0u { p1 = moved_point(info.motion, p); }
+            let z1 = max(p1.z, frame.near);
+            diceshade_shared[UVT_CLOSE + at] = vec4<f32>(project(vec3<f32>(p1.xy, z1)), z1, 0.0);
+        }
     }
 }
 

@@ -126,6 +126,7 @@ mod tests {
             two_sided: true,
             primvars: None,
             displacement: None,
+            motion: None,
             source: PatchSource {
                 file: "test".into(),
                 line: 0,

@@ -525,7 +525,7 @@ impl RasterPeer {
     }
 
     /// What the peer draws differently from what the scene asks: transparency drawn opaque,
-    /// displacement left out.
+    /// displacement, motion blur and depth of field left out.
     pub fn warnings(&self) -> Vec<String> {
         let mut w = Vec::new();
         if self.base.features().transparent {
@@ -539,6 +539,13 @@ impl RasterPeer {
             w.push(
                 "the scene has displaced surfaces (`Displacement`): the raster peer draws them \
                  undisplaced (only the Reyes pipeline's DiceShade displaces)"
+                    .into(),
+            );
+        }
+        if self.base.features().uvt {
+            w.push(
+                "the scene has motion blur or depth of field: the raster peer draws it at \
+                 shutter open through a pinhole (only the Reyes pipeline samples time and lens)"
                     .into(),
             );
         }

@@ -93,6 +93,7 @@ pub fn rational_sphere(centre: DVec3, radius: f64) -> Vec<Patch> {
                     two_sided: true,
                     primvars: None,
                     displacement: None,
+                    motion: None,
                     source: PatchSource {
                         file: "rational_sphere".into(),
                         line: 0,

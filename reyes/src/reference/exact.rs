@@ -559,6 +559,7 @@ mod tests {
                 two_sided: true,
                 primvars: None,
                 displacement: None,
+                motion: None,
                 source: PatchSource {
                     file: "test".into(),
                     line: 0,
@@ -567,7 +568,12 @@ mod tests {
             })
             .collect();
         Scene {
-            camera: Camera { fov_deg, near, far },
+            camera: Camera {
+                fov_deg,
+                near,
+                far,
+                ..Camera::default()
+            },
             patches,
             ..Scene::default()
         }

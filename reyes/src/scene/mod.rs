@@ -17,6 +17,7 @@ mod quadric;
 pub(crate) mod rational;
 mod rib;
 mod sequence;
+mod spin;
 mod teapot;
 
 use glam::{DMat4, DVec3};
@@ -34,6 +35,7 @@ pub use primvars::{ColorField, Primvars};
 pub use rational::eval_rational_bezier;
 pub use rib::{load_rib, open_rib, parse_rib, parse_rib_frames};
 pub use sequence::{Display, FrameRanges, FrameSequence, SceneFrame};
+pub use spin::spin;
 pub use teapot::{builtin_teapot, teapot_object_patches};
 
 /// RenderMan's `RI_EPSILON`, the default near clipping distance.
@@ -51,6 +53,37 @@ pub struct Camera {
     pub near: f64,
     /// Far clipping distance along z, as given by `Clipping` (default [`RI_INFINITY`]).
     pub far: f64,
+    /// `Shutter open close`: the times the shutter opens and closes (default 0, 0). Motion
+    /// blocks' times are on the same axis ([`Patch::motion`]).
+    pub shutter: (f64, f64),
+    /// `DepthOfField`: a thin lens; `None` (the default) for a pinhole camera.
+    pub depth_of_field: Option<DepthOfField>,
+    /// World to camera (the transform current at `WorldBegin`; identity for scenes without a
+    /// world block): gives world axes in camera space, e.g. for [`spin`].
+    pub world_to_camera: glam::DMat4,
+}
+
+/// RenderMan's `DepthOfField fstop focallength focaldistance`: a thin lens of focal length
+/// `focal_length` and aperture diameter `focal_length / fstop`, focused at camera-space depth
+/// `focal_distance` (both in camera-space units). A point at depth z is seen through the lens
+/// as a disc (circle of confusion) of radius `focal_px * (focal_length / (2 fstop)) *
+/// |1/focal_distance - 1/z|` pixels, `focal_px` the image's focal length in pixels
+/// (docs/reyes.md, "Motion blur and depth of field").
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DepthOfField {
+    /// The f-number: aperture diameter = focal length / fstop; positive.
+    pub fstop: f64,
+    /// Positive, camera-space units.
+    pub focal_length: f64,
+    /// Depth of the plane in focus, camera-space units; positive.
+    pub focal_distance: f64,
+}
+
+impl DepthOfField {
+    /// The lens radius in camera-space units.
+    pub fn lens_radius(&self) -> f64 {
+        0.5 * self.focal_length / self.fstop
+    }
 }
 
 impl Default for Camera {
@@ -59,6 +92,9 @@ impl Default for Camera {
             fov_deg: 90.0,
             near: RI_EPSILON,
             far: RI_INFINITY,
+            shutter: (0.0, 0.0),
+            depth_of_field: None,
+            world_to_camera: glam::DMat4::IDENTITY,
         }
     }
 }
@@ -122,6 +158,11 @@ pub struct Patch {
     /// Displacement along the normal in DiceShade (RIB `Displacement`); `None` (no cost) for
     /// the undisplaced surface. Shared by the patches of one request.
     pub displacement: Option<std::sync::Arc<Displacement>>,
+    /// Motion over the shutter (RIB `MotionBegin` around transforms): the camera-space
+    /// affine map taking the patch at shutter open (`cp`) to the patch at shutter close; a
+    /// point at shutter fraction t is the linear interpolation of the two (docs/reyes.md,
+    /// "Motion blur and depth of field"). `None` for a patch that does not move.
+    pub motion: Option<Box<glam::DMat4>>,
     /// Where the patch came from, for error messages.
     pub source: PatchSource,
 }

@@ -99,6 +99,7 @@ pub(crate) fn frame(patches: Vec<ObjectPatch>, flip_normal: bool) -> Scene {
             two_sided: true,
             primvars: None,
             displacement: None,
+            motion: None,
             source,
         })
         .collect();

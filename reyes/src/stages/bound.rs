@@ -71,10 +71,16 @@ pub fn bound(item: &PatchItem, f: &Frame, info: &PatchInfo, primvars: &[[f32; 4]
     let r = displacement_radius(info, primvars);
     zmin -= r;
     zmax += r;
-    if zmax < f.near || zmin > f.far {
+    // Motion blur or depth of field: culling uses the bound over the shutter and the lens
+    // (`uvt_bound` in bound.wgsl); splitting and dicing the patch at shutter open.
+    let uvt = (f.uvt != crate::frame::UVT_OFF)
+        .then(|| super::sample_uvt::uvt_bound(f, cp, info, primvars, r, (zmin, zmax)));
+    let moving = uvt.is_some() && info.flags & crate::frame::PATCH_MOVING != 0;
+    let (uzmin, uzmax) = uvt.map_or((zmin, zmax), |u| u.2);
+    if uzmax < f.near || uzmin > f.far {
         return Decision::Cull(Cull::Clip);
     }
-    if info.flags & 2 == 0 && r == 0.0 && backfacing(&item.cp, info.flags & 1 != 0) {
+    if info.flags & 2 == 0 && r == 0.0 && !moving && backfacing(&item.cp, info.flags & 1 != 0) {
         return Decision::Cull(Cull::Backface);
     }
     let depth = item.splits();
@@ -83,7 +89,7 @@ pub fn bound(item: &PatchItem, f: &Frame, info: &PatchInfo, primvars: &[[f32; 4]
         Vec2::new((f.tile_x0 + f.tile_w) as f32, (f.tile_y0 + f.tile_h) as f32) + CULL_MARGIN_PX;
     let misses = |lo: Vec2, hi: Vec2| hi.x < t0.x || hi.y < t0.y || lo.x > t1.x || lo.y > t1.y;
     if zmin < f.near {
-        let (lo, hi) = if r > 0.0 {
+        let (lo, hi) = if r > 0.0 || uvt.is_some() {
             (Vec2::splat(-3.0e38), Vec2::splat(3.0e38))
         } else {
             near_visible_bound(f, cp)
@@ -138,7 +144,14 @@ pub fn bound(item: &PatchItem, f: &Frame, info: &PatchInfo, primvars: &[[f32; 4]
         lo -= Vec2::splat(f.focal * r * g);
         hi += Vec2::splat(f.focal * r * g);
     }
-    if misses(lo, hi) {
+    let (clo, chi) = match uvt {
+        Some((ulo, uhi, _, c)) => (
+            (lo - Vec2::splat(c)).min(ulo),
+            (hi + Vec2::splat(c)).max(uhi),
+        ),
+        None => (lo, hi),
+    };
+    if misses(clo, chi) {
         return Decision::Cull(Cull::Offscreen);
     }
     let (mut lu, mut lv) = (0f32, 0f32);

@@ -223,6 +223,12 @@ pub fn micropolygon_cover(item: &PatchItem, data: &FrameData, [i, j, nu, nv]: [u
 /// A displaced patch's points move along their normal first, and shade with the normal of
 /// the displaced grid (`dice_grid` in dice_shade.wgsl).
 pub fn dice(item: &PatchItem, data: &FrameData) -> (u32, u32, Vec<[f32; 4]>) {
+    let (nu, nv, grid, _) = dice_points(item, data);
+    (nu, nv, grid)
+}
+
+/// [`dice`], and each grid point's camera-space position (after displacement).
+pub fn dice_points(item: &PatchItem, data: &FrameData) -> (u32, u32, Vec<[f32; 4]>, Vec<Vec3>) {
     let (nu, nv) = (item.rates & 255, (item.rates >> 8) & 255);
     let info = data.patch_info[item.patch_id as usize];
     let points = ((nu + 1) * (nv + 1)) as usize;
@@ -250,7 +256,7 @@ pub fn dice(item: &PatchItem, data: &FrameData) -> (u32, u32, Vec<[f32; 4]>) {
                 shade_point(item, data, surface[t].0[0], surface[t].1, u, v)
             })
             .collect();
-        return (nu, nv, grid);
+        return (nu, nv, grid, surface.iter().map(|s| s.0[0]).collect());
     }
     let at = info.displacement as usize;
     let undisplaced: Vec<Vec3> = surface.iter().map(|s| s.0[0]).collect();
@@ -288,7 +294,7 @@ pub fn dice(item: &PatchItem, data: &FrameData) -> (u32, u32, Vec<[f32; 4]>) {
             shade_point(item, data, moved[t], ns, u, v)
         })
         .collect();
-    (nu, nv, grid)
+    (nu, nv, grid, moved)
 }
 
 /// `shade_point` in dice_shade.wgsl: grid point (u, v) of `item` at camera-space `p` with
@@ -376,8 +382,29 @@ pub fn displacement_pattern(table: &[[f32; 4]], at: usize, u: f32, v: f32) -> f3
 
 /// Dices, shades and samples one grid into `samples`; returns (micropolygons, back-face culled).
 pub fn dice_shade(item: &PatchItem, data: &FrameData, samples: &mut [u64]) -> (u32, u32) {
-    let (nu, nv, g) = dice(item, data);
-    let two_sided = data.patch_info[item.patch_id as usize].flags & 2 != 0;
+    let (nu, nv, g, points) = dice_points(item, data);
+    let info = data.patch_info[item.patch_id as usize];
+    let two_sided = info.flags & 2 != 0;
+    let f = &data.frame;
+    // Motion blur or depth of field: each point at shutter close too (`shade_point` in
+    // dice_shade.wgsl).
+    let uvt = f.uvt != crate::frame::UVT_OFF && item.rates & NEAR_CLIP_GRID == 0;
+    let close: Vec<[f32; 4]> = if uvt {
+        (points.iter())
+            .map(|&p| {
+                let p1 = if info.flags & crate::frame::PATCH_MOVING != 0 {
+                    super::sample_uvt::moved_point(&data.primvars, info.motion, p)
+                } else {
+                    p
+                };
+                let z1 = p1.z.max(f.near);
+                let s = project(f, Vec3::new(p1.x, p1.y, z1));
+                [s[0], s[1], z1, 0.0]
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
     let cols = (nu + 1) as usize;
     let mut culled = 0;
     for t in 0..(nu * nv) as usize {
@@ -395,6 +422,19 @@ pub fn dice_shade(item: &PatchItem, data: &FrameData, samples: &mut [u64]) -> (u
         };
         let grow = micropolygon_dilation(item.dilate, i as u32, j as u32, nu, nv);
         let cover = micropolygon_cover(item, data, [i as u32, j as u32, nu, nv]);
+        if uvt {
+            let q1 = [
+                close[j * cols + i],
+                close[j * cols + i + 1],
+                close[(j + 1) * cols + i + 1],
+                close[(j + 1) * cols + i],
+            ];
+            let sample = super::sample_uvt::sample_micropolygon_uvt;
+            if !sample(q, q1, grow, two_sided, cover, f, samples) {
+                culled += 1;
+            }
+            continue;
+        }
         if !sample(q, grow, two_sided, cover, &data.frame, samples) {
             culled += 1;
         }

@@ -6,6 +6,7 @@ pub mod bound;
 pub mod dice_shade;
 pub mod resolve;
 pub mod sample;
+pub mod sample_uvt;
 pub mod shade;
 pub mod split;
 

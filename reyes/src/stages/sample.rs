@@ -15,6 +15,8 @@ pub fn sample_id(f: &Frame, px: u32, py: u32, sx: u32, sy: u32) -> u32 {
     ((py * f.width + px) * f.spp_y + sy) * f.spp_x + sx
 }
 
+/// `sample_position` in sample.wgsl: sub-sample (sx, sy) of pixel (px, py), stratified and
+/// jittered by a hash.
 pub fn sample_position(f: &Frame, px: u32, py: u32, sx: u32, sy: u32) -> Vec2 {
     let h = reyes_hash(sample_id(f, px, py, sx, sy) ^ f.seed);
     let j = Vec2::new((h & 0xffff) as f32, (h >> 16) as f32) / 65536.0;
@@ -23,7 +25,7 @@ pub fn sample_position(f: &Frame, px: u32, py: u32, sx: u32, sy: u32) -> Vec2 {
 }
 
 /// `Triangle` in sample.wgsl: the inside test's per-triangle values, computed once.
-struct Triangle {
+pub(super) struct Triangle {
     a: [f32; 4],
     b: [f32; 4],
     c: [f32; 4],
@@ -37,7 +39,7 @@ fn xy(p: [f32; 4]) -> Vec2 {
 }
 
 /// `grow`: pixels to grow the edges opposite a, b and c (bc, ca, ab).
-fn triangle_setup(a: [f32; 4], b: [f32; 4], c: [f32; 4], grow: [f32; 3]) -> Triangle {
+pub(super) fn triangle_setup(a: [f32; 4], b: [f32; 4], c: [f32; 4], grow: [f32; 3]) -> Triangle {
     let (pa, pb, pc) = (xy(a), xy(b), xy(c));
     Triangle {
         a,
@@ -70,7 +72,7 @@ pub fn micropolygon_dilation(packed: u32, i: u32, j: u32, nu: u32, nv: u32) -> [
 /// `ROUNDING_DILATE_PX` in common.wgsl: the growth of edges inside a grid.
 pub const ROUNDING_DILATE_PX: f32 = 1.0e-3;
 
-fn triangle_depth(t: &Triangle, q: Vec2) -> f32 {
+pub(super) fn triangle_depth(t: &Triangle, q: Vec2) -> f32 {
     if t.area.abs() < 1.0e-12 {
         return -1.0;
     }
@@ -101,7 +103,7 @@ pub fn sample_key(z: f32, color: u32) -> u64 {
 
 /// `micropolygon_color` in sample.wgsl: the average of the corners' packed colours; `None`
 /// when the micropolygon is one-sided and all four corners face away.
-fn micropolygon_color(q: &[[f32; 4]; 4], two_sided: bool) -> Option<u32> {
+pub(super) fn micropolygon_color(q: &[[f32; 4]; 4], two_sided: bool) -> Option<u32> {
     let c = q.map(|v| v[3].to_bits());
     if !two_sided && (c[0] & c[1] & c[2] & c[3] & (1 << 30)) != 0 {
         return None;
@@ -143,7 +145,13 @@ pub fn covers(f: &Frame, c: Cover, id: u32) -> bool {
 }
 
 /// Keeps the nearest key at sub-sample (sx, sy) of pixel (px, py) of the bucket.
-fn write_sample(f: &Frame, samples: &mut [u64], [px, py, sx, sy]: [u32; 4], z: f32, color: u32) {
+pub(super) fn write_sample(
+    f: &Frame,
+    samples: &mut [u64],
+    [px, py, sx, sy]: [u32; 4],
+    z: f32,
+    color: u32,
+) {
     let pixel = (py - f.tile_y0) * f.tile_w + px - f.tile_x0;
     let idx = (pixel * f.spp_x * f.spp_y + sy * f.spp_x + sx) as usize;
     samples[idx] = samples[idx].max(sample_key(z, color));

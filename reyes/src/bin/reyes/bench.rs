@@ -149,7 +149,8 @@ pub struct PeerRow {
 }
 
 pub fn main(a: BenchCmd) -> Result<(), String> {
-    let (scene, name) = crate::measure::load_scene(a.scene.as_deref())?;
+    let (mut scene, name) = crate::measure::load_scene(a.scene.as_deref())?;
+    a.render.change_scene(&mut scene)?;
     for w in &scene.warnings {
         log::warn!("{w}");
     }

@@ -7,8 +7,8 @@
 use clap::{Args, Parser, Subcommand, ValueEnum, value_parser};
 use reyes::accuracy::drift::PathOptions;
 use reyes::accuracy::exact_image::DEFAULT_SAMPLES_PER_AXIS;
-use reyes::frame::{DisplacementNormals, RasterMode, RenderOptions};
-use reyes::scene::FrameRanges;
+use reyes::frame::{DisplacementNormals, RasterMode, RenderOptions, Sampling};
+use reyes::scene::{DepthOfField, FrameRanges, Scene};
 use scheduler::StrategyKind;
 use std::path::PathBuf;
 
@@ -133,6 +133,36 @@ pub struct RenderArgs {
     /// on a CPU adapter such as lavapipe, where it is several times faster].
     #[arg(long, value_name = "NAME", value_parser = parse_strategy)]
     pub strategy: Option<StrategyKind>,
+
+    /// How motion blur and depth of field sample time and the lens (each pixel's --samples
+    /// sub-samples get one (lens, time) sample each): simple (Simple UVT: the same samples in
+    /// every pixel; ghosts when few), interleave (Interleave UVT: KxK pixel tiles share K^2
+    /// times as many, permuted per tile; noise instead) or bbox (Bounding box: one pass over
+    /// the micropolygon's bound grown by its motion and blur, per-pixel samples from a
+    /// repeated 64x64 table). Scenes without motion or depth of field ignore it.
+    #[arg(long, value_name = "ALGORITHM", value_enum, default_value_t = Sampling::Simple)]
+    pub sampling: Sampling,
+
+    /// Interleave UVT's tile side K in pixels: 2, 3 or 4.
+    #[arg(long, value_name = "K", default_value_t = RenderOptions::default().il_tile,
+          value_parser = value_parser!(u32).range(2..=4))]
+    pub il_tile: u32,
+
+    /// Interleave UVT's number of sample permutations the tiles choose from (1..=1024).
+    #[arg(long, value_name = "P", default_value_t = RenderOptions::default().il_perms,
+          value_parser = value_parser!(u32).range(1..=1024))]
+    pub il_perms: u32,
+
+    /// Spin the scene by DEG degrees over the shutter about the world's z axis through the
+    /// centre of its bound (motion blur without editing the file; composed with the file's
+    /// own motion).
+    #[arg(long, value_name = "DEG", value_parser = finite_f64)]
+    pub spin: Option<f64>,
+
+    /// Depth of field: RenderMan's `DepthOfField fstop focallength focaldistance` (lengths in
+    /// camera-space units), replacing the file's.
+    #[arg(long, value_name = "FSTOP,FOCALLENGTH,DIST", value_parser = parse_dof)]
+    pub dof: Option<DepthOfField>,
 }
 
 impl RenderArgs {
@@ -169,8 +199,22 @@ impl RenderArgs {
             crack_dilation: !self.no_crack_dilation,
             displacement_normals: self.displacement_normals,
             raster: self.raster.mode(),
+            sampling: self.sampling,
+            il_tile: self.il_tile,
+            il_perms: self.il_perms,
             ..RenderOptions::default()
         }
+    }
+
+    /// What `--spin` and `--dof` change in a loaded scene.
+    pub fn change_scene(&self, scene: &mut Scene) -> Result<(), String> {
+        if let Some(deg) = self.spin {
+            reyes::scene::spin(scene, deg).map_err(|e| format!("--spin: {e}"))?;
+        }
+        if let Some(d) = self.dof {
+            scene.camera.depth_of_field = Some(d);
+        }
+        Ok(())
     }
 }
 
@@ -226,6 +270,11 @@ pub struct RenderCmd {
     /// GPU frames to time (N > 1: after a warm-up; median ± MAD reported).
     #[arg(long, value_name = "N", default_value_t = 1, value_parser = value_parser!(u32).range(1..))]
     pub runs: u32,
+
+    /// Report the image error (PSNR, FLIP) against a reference image of the same size, an
+    /// OpenEXR file as --exr writes it (e.g. a many-sample render); also in --stats.
+    #[arg(long, value_name = "REF.exr")]
+    pub compare_to: Option<PathBuf>,
 
     #[command(flatten)]
     pub render: RenderArgs,
@@ -568,6 +617,28 @@ fn parse_bytes(v: &str) -> Result<u64, String> {
             "--memory-budget: `{v}` is not a positive byte count like 64M"
         )),
     }
+}
+
+/// `--dof FSTOP,FOCALLENGTH,DIST`: three positive finite numbers.
+fn parse_dof(v: &str) -> Result<DepthOfField, String> {
+    let n: Vec<f64> = v
+        .split(',')
+        .map(|s| {
+            s.trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite() && *x > 0.0)
+        })
+        .collect::<Option<_>>()
+        .filter(|n: &Vec<f64>| n.len() == 3)
+        .ok_or(format!(
+            "`{v}` is not FSTOP,FOCALLENGTH,DIST (three positive numbers, e.g. 2.8,0.05,4)"
+        ))?;
+    Ok(DepthOfField {
+        fstop: n[0],
+        focal_length: n[1],
+        focal_distance: n[2],
+    })
 }
 
 fn parse_strategy(v: &str) -> Result<StrategyKind, String> {

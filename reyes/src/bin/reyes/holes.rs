@@ -34,7 +34,8 @@ struct HolesReport {
 
 /// Runs the subcommand.
 pub fn main(a: HolesCmd) -> Result<(), String> {
-    let (scene, name) = load_scene(a.scene.as_deref())?;
+    let (mut scene, name) = load_scene(a.scene.as_deref())?;
+    a.render.change_scene(&mut scene)?;
     for w in &scene.warnings {
         log::warn!("{w}");
     }

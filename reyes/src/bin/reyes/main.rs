@@ -15,6 +15,7 @@ use clap::Parser;
 use cli::{Cli, Command, RenderCmd};
 use reyes::frame::{FrameData, SceneFeatures};
 use reyes::gpu_render::{GpuRenderer, required_features};
+use reyes::image::FrameImage;
 use reyes::scene::{self, FrameSequence, Scene};
 use reyes::stats::{RunSummary, frame_stats};
 use scheduler::{Gpu, StrategyKind};
@@ -43,7 +44,18 @@ fn load_sequence(a: &RenderCmd) -> Result<(FrameSequence, String), String> {
 /// Renders every selected frame of the scene; the whole file is read (and every output name
 /// decided) before the first frame renders, so a bad file writes nothing.
 fn run(a: RenderCmd) -> Result<(), String> {
-    let (seq, stem) = load_sequence(&a)?;
+    let (mut seq, stem) = load_sequence(&a)?;
+    for f in &mut seq.frames {
+        a.render.change_scene(&mut f.scene)?;
+    }
+    // The reference of --compare-to, read before anything renders.
+    let reference = match &a.compare_to {
+        Some(p) => Some((
+            p.clone(),
+            FrameImage::read_exr(p).map_err(|e| format!("--compare-to {e}"))?,
+        )),
+        None => None,
+    };
     for w in &seq.warnings {
         log::warn!("{w}");
     }
@@ -100,7 +112,7 @@ fn run(a: RenderCmd) -> Result<(), String> {
             &seq.warnings,
             data,
             outputs,
-            gpu.as_ref(),
+            (gpu.as_ref(), reference.as_ref()),
             &bar,
         )?;
     }
@@ -125,19 +137,26 @@ fn gpu_renderer(
     Ok((gpu, renderer))
 }
 
-/// Renders one frame to its outputs, on the CPU twin when `gpu` is `None`.
+/// `--compare-to`'s file and image.
+type Reference = (std::path::PathBuf, FrameImage);
+
+/// Renders one frame to its outputs, on the CPU twin when `gpu` is `None`; with a
+/// `reference` (`--compare-to`), reports the image error against it.
 fn render_frame(
     a: &RenderCmd,
     scene: &Scene,
     file_warnings: &[String],
     data: &FrameData,
     out: &frames::Outputs,
-    gpu: Option<&(Gpu, GpuRenderer)>,
+    (gpu, reference): (Option<&(Gpu, GpuRenderer)>, Option<&Reference>),
     progress: &indicatif::ProgressBar,
 ) -> Result<(), String> {
     let Some((gpu, renderer)) = gpu else {
         let r = reyes::cpu_render::render_cpu(data);
         progress.inc(1);
+        if let Some(reference) = reference {
+            compare_to(reference, &r.image)?;
+        }
         // The CPU twin keeps the GPU's counters: the same frame warnings.
         for w in reyes::warnings::frame_warnings(data, &r.counters) {
             log::warn!("{w}");
@@ -183,6 +202,9 @@ fn render_frame(
         .collect();
     let mut stats = frame_stats(data, &frame, &gpu.adapter_name(), &all_warnings);
     stats.runs = Some(RunSummary::of(&times));
+    if let Some(reference) = reference {
+        stats.image_error = Some(compare_to(reference, &frame.image)?);
+    }
     frame.image.write_png(&out.image)?;
     if let Some(p) = &out.float {
         frame.image.write_pfm(p)?;
@@ -215,6 +237,36 @@ fn render_frame(
         times_text(stats.runs.as_ref(), stats.gpu_ms, frame.wall_ms)
     ));
     Ok(())
+}
+
+/// `--compare-to`: the image error of `image` against the reference, printed (stderr) and
+/// returned for the statistics. Errors when the sizes differ.
+fn compare_to(
+    (path, reference): &Reference,
+    image: &FrameImage,
+) -> Result<reyes::stats::ImageErrorStats, String> {
+    if (reference.width, reference.height) != (image.width, image.height) {
+        return Err(format!(
+            "--compare-to {}: the reference is {}x{}, the frame {}x{}",
+            path.display(),
+            reference.width,
+            reference.height,
+            image.width,
+            image.height
+        ));
+    }
+    let e = reyes::accuracy::image_error::image_error(reference, image);
+    reyes::progress::note(format!(
+        "image error against {}: PSNR {:.2} dB, FLIP mean {:.4}",
+        path.display(),
+        e.psnr_db,
+        e.flip_mean
+    ));
+    Ok(reyes::stats::ImageErrorStats {
+        reference: path.display().to_string(),
+        psnr_db: e.psnr_db,
+        flip_mean: e.flip_mean,
+    })
 }
 
 /// The frame's times as `reyes render` prints them: one run's GPU and wall ms; of several

@@ -49,7 +49,8 @@ pub fn timed_frames(
 /// Runs the subcommand.
 pub fn main(a: MeasureCmd) -> Result<(), String> {
     let (json, ref_samples, reference_png) = (a.json, a.ref_samples, &a.reference_png);
-    let (scene, name) = load_scene(a.scene.as_deref())?;
+    let (mut scene, name) = load_scene(a.scene.as_deref())?;
+    a.render.change_scene(&mut scene)?;
     for w in &scene.warnings {
         log::warn!("{w}");
     }

@@ -41,7 +41,8 @@ const MP_SIZE_RANGE: (f32, f32) = (0.125, 64.0);
 const PIXELS_PER_STEP: f64 = 40.0;
 
 pub fn main(a: ViewCmd) -> Result<(), String> {
-    let (scene, name) = crate::measure::load_scene(a.scene.as_deref())?;
+    let (mut scene, name) = crate::measure::load_scene(a.scene.as_deref())?;
+    a.render.change_scene(&mut scene)?;
     for w in &scene.warnings {
         log::warn!("{w}");
     }

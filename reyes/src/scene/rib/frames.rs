@@ -89,13 +89,16 @@ impl Interp {
     pub(super) fn world_end(&mut self, req: &Request, a: &mut Args) -> Result<(), SceneError> {
         a.done()?;
         self.pop(Block::World, req)?;
-        self.world_to_camera = None;
+        let world_to_camera = self.world_to_camera.take().unwrap_or_default();
         let o = &self.options;
         let scene = Scene {
             width: o.width,
             height: o.height,
             pixel_samples: o.pixel_samples,
-            camera: o.camera.clone(),
+            camera: crate::scene::Camera {
+                world_to_camera,
+                ..o.camera.clone()
+            },
             ..std::mem::take(&mut self.scene)
         };
         self.materials.clear();

@@ -29,13 +29,14 @@
 //! dispatch over request names), [`frames`] (frame and world blocks: the sequence of frames),
 //! [`shading`] (surfaces, lights, the material table), [`patches`] (the patch primitives
 //! and their conversion to Bezier patches), [`displacement`] (`Displacement` and
-//! `"displacementbound"`), [`quadrics`] (the quadric primitives) and
+//! `"displacementbound"`), [`quadrics`] (the quadric primitives), [`motion`] (`Shutter`, `DepthOfField`, motion blocks) and
 //! [`primvars`] (`Declare` and the `"Cs"` / `"Os"` primitive variables of patches).
 
 mod displacement;
 mod frames;
 mod input;
 mod lexer;
+mod motion;
 mod patches;
 mod primvars;
 mod quadrics;
@@ -98,21 +99,20 @@ fn read(mut reader: Reader) -> Result<FrameSequence, SceneError> {
             }
             continue;
         }
-        if let Some(first_done) = it.motion {
-            if req.name == "MotionEnd" {
-                it.motion = None;
-                continue;
-            }
-            if first_done {
-                continue;
-            }
-            it.motion = Some(true);
+        if it.motion.is_some() && req.name != "MotionEnd" && it.motion_request(&req)? {
+            continue;
         }
         if req.name == "ReadArchive" {
             reader.read_archive(&req)?;
             continue;
         }
         it.request(&req)?;
+    }
+    if let Some(m) = &it.motion {
+        return Err(reader.eof_error(format!(
+            "unexpected end of file inside `MotionBegin` (line {})",
+            m.line
+        )));
     }
     if let Some(open) = it.stack.last() {
         return Err(reader.eof_error(format!(

@@ -90,6 +90,7 @@ impl Interp {
             two_sided: self.attrs.two_sided,
             primvars: None,
             displacement,
+            motion: self.attrs.motion(),
             source: PatchSource {
                 file: a.req.file.to_string(),
                 line: a.req.line,

@@ -60,6 +60,8 @@ pub(super) const KNOWN: &[&str] = &[
     "ObjectEnd",
     "MotionBegin",
     "MotionEnd",
+    "Shutter",
+    "DepthOfField",
     "ReadArchive",
     "MakeShadow",
     "Declare",
@@ -109,19 +111,9 @@ impl Interp {
             "NuPatch" => self.nu_patch(req, a),
             name if QUADRICS.contains(&name) => self.quadric(req, a),
             "ObjectEnd" => Err(a.err("without a matching `ObjectBegin`")),
-            "MotionBegin" => {
-                if self.motion.is_some() {
-                    return Err(a.err("nested `MotionBegin`"));
-                }
-                self.warn_once(
-                    req,
-                    "MotionBegin",
-                    "motion blocks are not supported: using the first time sample of each",
-                );
-                self.motion = Some(false);
-                Ok(())
-            }
-            "MotionEnd" => Err(a.err("without a matching `MotionBegin`")),
+            "MotionBegin" => self.motion_begin(req, a),
+            "MotionEnd" => self.motion_end(req),
+            "Shutter" | "DepthOfField" => self.lens_option(req, a),
             "MakeShadow" => {
                 self.make_shadow(req);
                 Ok(())
@@ -214,6 +206,7 @@ impl Interp {
         let m = match req.name.as_str() {
             "Identity" => {
                 a.done()?;
+                self.attrs.ctm_close = None;
                 self.set_ctm(self.world_to_camera.unwrap_or(DMat4::IDENTITY));
                 return Ok(());
             }
@@ -223,6 +216,7 @@ impl Interp {
                 // Row-major row-vector matrix == column-major column-vector matrix.
                 let m = DMat4::from_cols_slice(&v);
                 if req.name == "Transform" {
+                    self.attrs.ctm_close = None;
                     self.set_ctm(self.world_to_camera.unwrap_or(DMat4::IDENTITY) * m);
                     return Ok(());
                 }

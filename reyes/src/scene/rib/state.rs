@@ -23,6 +23,9 @@ pub(super) const MAX_NESTING: usize = 1024;
 pub(super) struct Attributes {
     /// Object to camera, column-vector convention.
     pub(super) ctm: DMat4,
+    /// Object to camera at shutter close when it differs from `ctm` (a `MotionBegin` block
+    /// moved a transform: see `motion.rs`), `None` when the transform does not move.
+    pub(super) ctm_close: Option<DMat4>,
     /// RenderMan's current orientation: true = right-handed.
     pub(super) orientation_rh: bool,
     pub(super) two_sided: bool,
@@ -44,6 +47,7 @@ impl Default for Attributes {
     fn default() -> Self {
         Attributes {
             ctm: DMat4::IDENTITY,
+            ctm_close: None,
             orientation_rh: false,
             two_sided: true,
             color: DVec3::ONE,
@@ -150,8 +154,8 @@ pub(super) struct Interp {
     pub(super) materials: HashMap<(SurfaceKind, [u64; 13]), u32>,
     /// Material of the current attributes, once looked up.
     pub(super) current_material: Option<u32>,
-    /// Inside `MotionBegin`: whether the first (used) time sample has been seen.
-    pub(super) motion: Option<bool>,
+    /// The open `MotionBegin` block.
+    pub(super) motion: Option<super::motion::MotionBlock>,
     /// `Declare`d primitive variables by name (global, not saved by blocks).
     pub(super) declared: HashMap<String, Decl>,
     /// Displacement maps read so far, by path (each file read once).
@@ -194,7 +198,11 @@ impl Interp {
         self.attrs.ctm = m;
     }
 
+    /// Applies `m` first to points, at shutter open and (when moving) at shutter close.
     pub(super) fn concat(&mut self, m: DMat4) {
+        if let Some(c) = &mut self.attrs.ctm_close {
+            *c *= m;
+        }
         self.set_ctm(self.attrs.ctm * m);
     }
 
@@ -245,6 +253,7 @@ impl Interp {
         }
         if block == Block::Transform {
             self.set_ctm(saved.attrs.ctm);
+            self.attrs.ctm_close = saved.attrs.ctm_close;
         } else {
             self.attrs = saved.attrs;
             self.current_material = None;

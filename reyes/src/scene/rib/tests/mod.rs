@@ -4,6 +4,7 @@ mod archives;
 mod displacement;
 mod frames;
 mod hostile;
+mod motion;
 mod nupatch;
 mod patches;
 mod primvars;

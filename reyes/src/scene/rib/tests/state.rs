@@ -14,7 +14,8 @@ fn defaults() {
         crate::scene::Camera {
             fov_deg: 90.0,
             near: 1e-10,
-            far: 1e38
+            far: 1e38,
+            ..Default::default()
         }
     );
     assert!(s.patches.is_empty() && s.lights.is_empty() && s.warnings.is_empty());
@@ -34,7 +35,8 @@ fn options() {
         crate::scene::Camera {
             fov_deg: 40.0,
             near: 0.5,
-            far: 100.0
+            far: 100.0,
+            ..Default::default()
         }
     );
     let s = parse(&format!(

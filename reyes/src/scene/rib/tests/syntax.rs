@@ -31,7 +31,9 @@ fn object_and_motion_blocks() {
     )));
     assert_eq!(s.patches.len(), 1);
     assert!(close(s.patches[0].cp[0], DVec3::X));
-    assert_eq!(s.warnings.len(), 2);
+    // Shutter 0 0 (the default): the transform at time 0, no motion.
+    assert!(s.patches[0].motion.is_none());
+    assert_eq!(s.warnings.len(), 1);
     assert!(err(&world("ObjectBegin 1")).contains("inside `ObjectBegin`"));
 }
 
