@@ -178,6 +178,20 @@ impl GpuRenderer {
                     ..Default::default()
                 },
             )?,
+            // lavapipe ends every loop of an invocation after 65,535 iterations in total over
+            // the persistent loop and what it nests; blurred micropolygons sample in loops that
+            // grow with the blur, so there each launch runs one turn (the host relaunches).
+            StrategyKind::Megakernel if features.uvt && gpu.info.name.contains("llvmpipe") => {
+                Scheduler::megakernel(
+                    gpu,
+                    &program,
+                    scheduler::MegakernelConfig {
+                        initial_capacity: INITIAL_CAPACITY,
+                        max_iterations: 1,
+                        ..Default::default()
+                    },
+                )?
+            }
             _ => Scheduler::new(gpu, &program, strategy, INITIAL_CAPACITY)?,
         };
         Self::from_scheduler(gpu, program, scheduler, features)
