@@ -206,7 +206,7 @@ fn flatten(
 /// `vec4<u32>`. Queue regions and outboxes start on 16-byte boundaries
 /// (`QueueLayout::new`), so such an item's first word is always 4-aligned.
 pub(crate) fn moves_by_vec4(layout: &StructLayout) -> bool {
-    layout.words() % 4 == 0
+    layout.words().is_multiple_of(4)
 }
 
 /// Generates `fn {prefix}_load_{T}(base: u32) -> T` and `fn {prefix}_store_{T}(base: u32, v: T)`
