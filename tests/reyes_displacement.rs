@@ -48,17 +48,7 @@ fn render_everywhere(data: &FrameData) -> FrameImage {
 /// The megakernel's image of `data`, asserting that the multipass strategy gives the same
 /// bits (the CPU twin is checked by the other tests; this saves its time on lavapipe).
 fn render_gpu(data: &FrameData) -> FrameImage {
-    let a = renderer(StrategyKind::Megakernel)
-        .render(gpu(), data)
-        .unwrap();
-    let b = renderer(StrategyKind::Multipass)
-        .render(gpu(), data)
-        .unwrap();
-    assert!(
-        a.image == b.image,
-        "multipass image differs from megakernel"
-    );
-    a.image
+    common::render_both_strategies(data).0.image
 }
 
 /// A unit sphere 4 units in front of the eye, `displacement` RIB lines before it.

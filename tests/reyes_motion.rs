@@ -43,18 +43,9 @@ fn options(sampling: Sampling, spp: u32) -> RenderOptions {
     }
 }
 
-/// The megakernel's image, asserting that multipass gives the same bits.
+/// The megakernel's image, asserting that multipass gives the same bits and counters.
 fn render_gpu(data: &FrameData) -> FrameImage {
-    let a = renderer(StrategyKind::Megakernel)
-        .render(gpu(), data)
-        .unwrap();
-    let b = renderer(StrategyKind::Multipass)
-        .render(gpu(), data)
-        .unwrap();
-    assert!(
-        a.image == b.image,
-        "multipass image differs from megakernel"
-    );
+    let (a, b) = common::render_both_strategies(data);
     assert_eq!(a.counters, b.counters, "counters");
     a.image
 }

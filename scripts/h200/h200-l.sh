@@ -6,18 +6,7 @@
 source .devbin/setup.sh
 R=$OUT/r; mkdir -p $R
 K=$B/data/rib/killeroo.rib
-q() { python3 -c "
-import json,sys
-rs=[json.loads(l) for l in open(sys.argv[1]) if l.startswith('{')]
-by={}
-for r in rs: by.setdefault(r['strategy'],[]).append(r)
-out=[]
-for k,v in by.items():
-  if k=='cpu': continue
-  g=sorted(x['gpu_ms'] for x in v if x.get('gpu_ms') is not None); ok=all(x['verified'] for x in v)
-  out.append('%s %.3f%s' % (k, g[len(g)//2] if g else -1, '' if ok else ' UNVERIFIED'))
-print('%-34s' % sys.argv[2], ' | '.join(out))
-" $1 $2; }
+q() { python3 scripts/h200/medians.py "$1" "$2"; }
 for rep in 1 2; do
 for p in large-payload binary irregular deep heavy-work; do
   for v in before loop unroll; do

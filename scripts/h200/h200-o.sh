@@ -5,17 +5,7 @@ source .devbin/setup.sh
 R=$OUT/r; mkdir -p $R
 K=$B/data/rib/killeroo.rib
 WGPU_ADAPTER_NAME=H200 timeout 200 $B/scheduler_gpu --test-threads 1 > $R/scheduler_gpu.txt 2>&1; echo "scheduler_gpu rc=$?" >> $R/tests.txt
-q() { python3 -c "
-import json,sys
-rs=[json.loads(l) for l in open(sys.argv[1]) if l.startswith('{')]
-by={}
-for r in rs: by.setdefault(r['strategy'],[]).append(r)
-out=[]
-for k,v in by.items():
-  g=sorted(x['gpu_ms'] if x.get('gpu_ms') is not None else x['wall_ms'] for x in v); ok=all(x['verified'] for x in v)
-  out.append('%s %.3f%s' % (k, g[len(g)//2], '' if ok else ' UNVERIFIED'))
-print('%-30s' % sys.argv[2], ' | '.join(out))
-" $1 $2; }
+q() { python3 scripts/h200/medians.py "$1" "$2"; }
 for v in before after; do S=$B/schedbench-exp; [ $v = before ] && S=$B/schedbench
   for p in binary irregular deep large-payload heavy-work; do
     n=tree-$p-$v

@@ -5,8 +5,8 @@
 
 #![allow(dead_code)] // each test binary uses its own subset
 
-use reyes::frame::RenderOptions;
-use reyes::gpu_render::{GpuRenderer, required_features};
+use reyes::frame::{FrameData, RenderOptions};
+use reyes::gpu_render::{GpuFrame, GpuRenderer, required_features};
 use reyes::image::FrameImage;
 use scheduler::{Gpu, StrategyKind};
 use std::sync::OnceLock;
@@ -29,6 +29,15 @@ pub fn renderer(kind: StrategyKind) -> &'static GpuRenderer {
         StrategyKind::MultipassHost => &MPH,
     };
     cell.get_or_init(|| GpuRenderer::new(gpu(), kind).unwrap())
+}
+
+/// The megakernel's and the multi-pass strategy's frames of `data`, asserting that their
+/// images are the same, bit for bit.
+pub fn render_both_strategies(data: &FrameData) -> (GpuFrame, GpuFrame) {
+    let a = renderer(StrategyKind::Megakernel).render(gpu(), data).unwrap();
+    let b = renderer(StrategyKind::Multipass).render(gpu(), data).unwrap();
+    assert!(a.image == b.image, "multipass image differs from megakernel");
+    (a, b)
 }
 
 pub fn small(w: u32, h: u32) -> RenderOptions {
