@@ -363,6 +363,42 @@ fn holes_reports_what_nearest_mode_leaves_empty() {
     }
 }
 
+/// `reyes holes` without --json prints a header row and its markdown rule over the row (one
+/// cell per column), and the row alone with --no-header. Needs the GPU (lavapipe).
+#[test]
+fn holes_table_has_a_header() {
+    let dir = scratch("holes-table");
+    let base = [
+        "holes",
+        "teapot",
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--mp-size",
+        "2",
+        "--strategy",
+        "multipass",
+        "--ref-samples",
+        "1",
+    ];
+    let (code, out, err) = reyes_any(&dir, &base);
+    assert_eq!(code, 0, "{err}");
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines.len(), 3, "{out}");
+    assert!(lines[0].starts_with("| scene | raster |"), "{out}");
+    assert!(lines[1].starts_with("| --- |"), "{out}");
+    assert!(lines[2].starts_with("| teapot | bbox |"), "{out}");
+    let cells = |l: &str| l.matches('|').count();
+    assert_eq!(cells(lines[0]), cells(lines[1]), "{out}");
+    assert_eq!(cells(lines[0]), cells(lines[2]), "{out}");
+    let mut args = base.to_vec();
+    args.push("--no-header");
+    let (code, out, err) = reyes_any(&dir, &args);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(out.lines().collect::<Vec<_>>(), [lines[2]], "{out}");
+}
+
 fn field(name: &str) -> String {
     let p = reyes::shared_data_dir().join("field").join(name);
     assert!(p.is_file(), "{} is missing", p.display());
@@ -731,6 +767,44 @@ fn read_pfm(p: &Path) -> (usize, usize, usize, Vec<f32>) {
 /// the rendered frame's colour (premultiplied), alpha and depth exactly: read back with the
 /// `exr` crate against the `--float` and `--depth` PFMs and the PNG of the same render. Needs
 /// the GPU (lavapipe).
+/// `--stats`: a scheduler run timed as one carries the megakernel's note on why its stages are
+/// not timed apart only under the megakernel; multi-pass (without --stage-times) has none.
+/// Needs the GPU (lavapipe).
+#[test]
+fn only_megakernel_stats_carry_the_schedule_note() {
+    let dir = scratch("stats-note");
+    for strategy in ["multipass", "megakernel"] {
+        let json = format!("{strategy}.json");
+        let (ok, err) = reyes(
+            &dir,
+            &[
+                "teapot",
+                "--width",
+                "40",
+                "--height",
+                "30",
+                "--gpu",
+                "--strategy",
+                strategy,
+                "-o",
+                "f.png",
+                "--stats",
+                &json,
+            ],
+        );
+        assert!(ok, "{strategy}: {err}");
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join(&json)).unwrap()).unwrap();
+        let stages = &v["gpu_ms_per_stage"];
+        assert!(stages.get("schedule").is_some(), "{strategy}: {stages}");
+        let note = stages.get("note").and_then(|n| n.as_str());
+        match strategy {
+            "megakernel" => assert!(note.unwrap().contains("megakernel"), "{stages}"),
+            _ => assert_eq!(note, None, "{strategy}: {stages}"),
+        }
+    }
+}
+
 #[test]
 fn stats_and_exr_hold_the_rendered_frame() {
     let dir = scratch("exr");

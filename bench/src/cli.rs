@@ -40,8 +40,9 @@ pub struct Cli {
     #[arg(long, value_enum)]
     pub workload: Option<WorkloadName>,
 
-    /// megakernel, megakernel-fifo, multipass, cpu (the workload's rayon implementation), a
-    /// workload's own baseline, or all (the megakernel under --policy).
+    /// megakernel, megakernel-fifo, multipass, multipass-host (rounds planned by the host
+    /// from read-back queue counts), cpu (the workload's rayon implementation),
+    /// a workload's own baseline (e.g. bfs's frontier), or all (the megakernel under --policy).
     #[arg(long, default_value = "all", conflicts_with = "suite")]
     pub strategy: String,
 
@@ -267,6 +268,25 @@ mod tests {
         let e = parse(&["--workgroups", "0"]).unwrap_err().to_string();
         assert!(e.contains("--workgroups"), "{e}");
         assert_eq!(parse(&["--help"]).unwrap_err().exit_code(), 0);
+    }
+
+    /// `--strategy`'s help names every strategy every workload has (a new user missed
+    /// multipass-host there).
+    #[test]
+    fn strategy_help_names_every_strategy() {
+        let cmd = Cli::command();
+        let arg = cmd
+            .get_arguments()
+            .find(|a| a.get_id() == "strategy")
+            .unwrap();
+        let help = arg.get_long_help().or(arg.get_help()).unwrap().to_string();
+        for s in crate::strategy::Strategy::all_for(&[]) {
+            assert!(
+                help.contains(&s.name()),
+                "{} missing from: {help}",
+                s.name()
+            );
+        }
     }
 
     #[test]

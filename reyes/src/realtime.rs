@@ -146,6 +146,47 @@ pub enum Pixels {
     Float,
 }
 
+impl Pixels {
+    /// Words (u32) of each read-back buffer a frame of `pixels` pixels brings back: none, the
+    /// packed 8-bit sRGB image (1 a pixel), or the f32 RGBA image (4) and depth (1).
+    pub fn read_back_words(self, pixels: u64) -> Vec<u64> {
+        match self {
+            Pixels::None => Vec::new(),
+            Pixels::Rgba8 => vec![pixels],
+            Pixels::Float => vec![4 * pixels, pixels],
+        }
+    }
+
+    /// The GPU buffers a frame copies back, in [`Self::read_back_words`]' order: `rgba8`, or
+    /// `rgba` and `depth`.
+    pub(crate) fn sources<'a>(
+        self,
+        rgba8: &'a wgpu::Buffer,
+        rgba: &'a wgpu::Buffer,
+        depth: &'a wgpu::Buffer,
+    ) -> Vec<&'a wgpu::Buffer> {
+        match self {
+            Pixels::None => vec![],
+            Pixels::Rgba8 => vec![rgba8],
+            Pixels::Float => vec![rgba, depth],
+        }
+    }
+
+    /// The mapped read-back buffers of one frame slot ([`Self::read_back_words`]), shared by
+    /// the pipelined Reyes renderer and the raster peer. Errors: [`RunError::Device`] for a
+    /// buffer larger than the device allows.
+    pub(crate) fn read_back_buffers(
+        self,
+        gpu: &Gpu,
+        label: &str,
+        pixels: u64,
+    ) -> Result<Vec<wgpu::Buffer>, RunError> {
+        (self.read_back_words(pixels).into_iter())
+            .map(|w| map_buffer(gpu, label, w))
+            .collect()
+    }
+}
+
 /// One finished frame.
 #[derive(Clone, Debug)]
 pub struct RealtimeFrame {
@@ -465,15 +506,8 @@ impl RealtimeRenderer {
     /// between frames: call it before [`RealtimeRenderer::render`]).
     pub fn set_pixels(&mut self, gpu: &Gpu, pixels: Pixels) -> Result<(), RunError> {
         let n = self.base.frame.width as u64 * self.base.frame.height as u64;
-        let words: &[u64] = match pixels {
-            Pixels::None => &[],
-            Pixels::Rgba8 => &[n],
-            Pixels::Float => &[4 * n, n],
-        };
         for s in &mut self.slots {
-            s.pixels = (words.iter())
-                .map(|&w| map_buffer(gpu, "frame pixels", w))
-                .collect::<Result<_, _>>()?;
+            s.pixels = pixels.read_back_buffers(gpu, "frame pixels", n)?;
         }
         self.pixels = pixels;
         Ok(())
@@ -510,11 +544,7 @@ impl RealtimeRenderer {
 
     /// The GPU buffers [`Pixels`] copies back: rgba8, or rgba and depth.
     fn pixel_sources(&self) -> Vec<&wgpu::Buffer> {
-        match self.pixels {
-            Pixels::None => vec![],
-            Pixels::Rgba8 => vec![&self.rgba8],
-            Pixels::Float => vec![&self.rgba, &self.depth],
-        }
+        (self.pixels).sources(&self.rgba8, &self.rgba, &self.depth)
     }
 
     fn pixels_n(&self) -> u64 {
@@ -817,6 +847,15 @@ pub(crate) fn read_mapped(b: &wgpu::Buffer, words: u64) -> Result<Vec<u32>, RunE
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// One read-back buffer per source buffer, each sized for its pixels: 1 word a pixel for
+    /// packed sRGB and depth, 4 for f32 RGBA.
+    #[test]
+    fn read_back_words_per_pixels_mode() {
+        assert!(Pixels::None.read_back_words(6).is_empty());
+        assert_eq!(Pixels::Rgba8.read_back_words(6), [6]);
+        assert_eq!(Pixels::Float.read_back_words(6), [24, 6]);
+    }
 
     #[test]
     fn orbit_matches_its_wgsl_layout() {

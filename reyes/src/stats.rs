@@ -178,8 +178,10 @@ pub enum StageTimes {
     },
     Whole {
         schedule: Option<f64>,
-        /// Why the stages are not timed apart.
-        note: String,
+        /// Why the stages are not timed apart: only the megakernel's, whose stages share one
+        /// launch (multi-pass without `--stage-times` has none).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        note: Option<String>,
         resolve: Option<f64>,
     },
 }
@@ -329,12 +331,21 @@ fn stage_times(g: &GpuFrame) -> StageTimes {
         },
         _ => StageTimes::Whole {
             schedule: g.run.gpu_ms,
-            note: "stages interleave inside one megakernel launch; multipass --stage-times \
-                   times each procedure"
-                .into(),
+            note: whole_note(&g.run.strategy),
             resolve: g.resolve_gpu_ms,
         },
     }
+}
+
+/// The note beside a scheduler run timed as one: the megakernel's stages interleave in one
+/// launch and cannot be timed apart; other strategies (multi-pass without `--stage-times`) can,
+/// so they carry none.
+fn whole_note(strategy: &str) -> Option<String> {
+    (strategy == "megakernel").then(|| {
+        "stages interleave inside one megakernel launch; multipass --stage-times times each \
+         procedure"
+            .into()
+    })
 }
 
 #[cfg(test)]
@@ -378,11 +389,33 @@ mod tests {
         assert_eq!(back, t);
         let w = StageTimes::Whole {
             schedule: Some(1.5),
-            note: "n".into(),
+            note: Some("n".into()),
             resolve: Some(0.5),
         };
         let back: StageTimes = serde_json::from_str(&serde_json::to_string(&w).unwrap()).unwrap();
         assert_eq!(back, w);
+    }
+
+    /// Only the megakernel explains why its stages are not timed apart; a multi-pass run timed
+    /// as one writes no note (a new user read the megakernel's note in multipass stats).
+    #[test]
+    fn only_the_megakernel_carries_the_schedule_note() {
+        assert!(
+            whole_note("megakernel")
+                .unwrap()
+                .contains("megakernel launch")
+        );
+        for s in ["multipass", "multipass-host"] {
+            assert_eq!(whole_note(s), None, "{s}");
+            let w = StageTimes::Whole {
+                schedule: Some(1.0),
+                note: whole_note(s),
+                resolve: None,
+            };
+            let v = serde_json::to_value(&w).unwrap();
+            assert!(v.get("note").is_none(), "{s}: {v}");
+            assert_eq!(serde_json::from_value::<StageTimes>(v).unwrap(), w);
+        }
     }
 
     #[test]

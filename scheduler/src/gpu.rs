@@ -316,13 +316,20 @@ impl Gpu {
     /// Compiles WGSL, turning a validation error into a `RunError` that carries the message
     /// (naga's error names the line), instead of a panic in wgpu's error handler.
     pub fn shader(&self, label: &str, source: &str) -> Result<wgpu::ShaderModule, RunError> {
+        let start = std::time::Instant::now();
         crate::wgsl::validate(label, source)?;
-        Ok(self
+        let module = self
             .device
             .create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some(label),
                 source: wgpu::ShaderSource::Wgsl(source.into()),
-            }))
+            });
+        log::debug!(
+            "shader module `{label}` ({} bytes of WGSL): {:.1} ms",
+            source.len(),
+            start.elapsed().as_secs_f64() * 1e3
+        );
+        Ok(module)
     }
 
     /// A compute pipeline of one entry point of a WGSL source, its layout derived from the
@@ -334,7 +341,8 @@ impl Gpu {
         entry: &str,
     ) -> Result<wgpu::ComputePipeline, RunError> {
         let module = self.shader(label, source)?;
-        Ok(self
+        let start = std::time::Instant::now();
+        let p = self
             .device
             .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(label),
@@ -343,6 +351,18 @@ impl Gpu {
                 entry_point: Some(entry),
                 compilation_options: Default::default(),
                 cache: None,
-            }))
+            });
+        log_pipeline_time(label, entry, start);
+        Ok(p)
     }
+}
+
+/// Logs (debug) how long creating the pipeline of `entry` in module `label` took since `start`:
+/// WGSL to SPIR-V and the driver's own compile (on lavapipe, SPIR-V to NIR; the NIR to LLVM
+/// step may wait for the first dispatch and Mesa's shader cache).
+pub(crate) fn log_pipeline_time(label: &str, entry: &str, start: std::time::Instant) {
+    log::debug!(
+        "pipeline `{label}::{entry}`: {:.1} ms",
+        start.elapsed().as_secs_f64() * 1e3
+    );
 }

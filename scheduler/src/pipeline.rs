@@ -63,20 +63,29 @@ impl Kernels {
                 immediate_size: 0,
             });
         let uses2 = |ep: &str| group2.is_some_and(|(_, eps)| eps.contains(&ep));
-        let pipelines = entry_points
-            .iter()
-            .map(|ep| {
-                gpu.device
-                    .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                        label: Some(ep),
-                        layout: Some(if uses2(ep) { &layout2 } else { &layout }),
-                        module: &module,
-                        entry_point: Some(ep),
-                        compilation_options: Default::default(),
-                        cache: None,
-                    })
-            })
-            .collect();
+        let create = |ep: &str| {
+            let start = std::time::Instant::now();
+            let p = gpu
+                .device
+                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(ep),
+                    layout: Some(if uses2(ep) { &layout2 } else { &layout }),
+                    module: &module,
+                    entry_point: Some(ep),
+                    compilation_options: Default::default(),
+                    cache: None,
+                });
+            crate::gpu::log_pipeline_time(label, ep, start);
+            p
+        };
+        let threads = std::thread::available_parallelism()
+            .map_or(1, |n| n.get())
+            .min(entry_points.len());
+        let pipelines = if threads <= 1 {
+            entry_points.iter().map(|ep| create(ep)).collect()
+        } else {
+            in_parallel(entry_points, threads, create)
+        };
         Ok(Kernels {
             group0,
             group2: g2,
@@ -110,6 +119,51 @@ impl Kernels {
                 "the run got a user bind group but the program declares no user bindings".into(),
             )),
             _ => Ok(()),
+        }
+    }
+}
+
+/// `f` of every item, on `threads` threads that each take the next item not yet taken (the
+/// drivers' pipeline compiles differ in length by 10x), in the items' order. Pipeline creation
+/// may run on several threads at once (wgpu's `Device` is `Sync`; Vulkan lets pipelines be
+/// created concurrently): on lavapipe, which turns each entry point's SPIR-V into NIR on the
+/// calling thread, this divides multi-pass's pipeline creation by about the core count.
+fn in_parallel<T: Send>(items: &[&str], threads: usize, f: impl Fn(&str) -> T + Sync) -> Vec<T> {
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let mut done: Vec<(usize, T)> = std::thread::scope(|scope| {
+        let workers: Vec<_> = (0..threads)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut mine = Vec::new();
+                    loop {
+                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some(item) = items.get(i) else {
+                            return mine;
+                        };
+                        mine.push((i, f(item)));
+                    }
+                })
+            })
+            .collect();
+        (workers.into_iter())
+            .flat_map(|w| w.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+            .collect()
+    });
+    done.sort_by_key(|(i, _)| *i);
+    done.into_iter().map(|(_, t)| t).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every item once, in order, whatever the thread count.
+    #[test]
+    fn in_parallel_keeps_the_items_order() {
+        let items = ["a", "bb", "ccc", "dddd", "eeeee"];
+        for threads in 1..=7 {
+            let got = in_parallel(&items, threads, |s| s.len());
+            assert_eq!(got, [1, 2, 3, 4, 5], "{threads} threads");
         }
     }
 }

@@ -556,15 +556,8 @@ impl RasterPeer {
     /// before [`RasterPeer::render`], not between frames).
     pub fn set_pixels(&mut self, gpu: &Gpu, pixels: Pixels) -> Result<(), RunError> {
         let n = self.base.frame.width as u64 * self.base.frame.height as u64;
-        let words: &[u64] = match pixels {
-            Pixels::None => &[],
-            Pixels::Rgba8 => &[n],
-            Pixels::Float => &[4 * n, n],
-        };
         for s in &mut self.slots {
-            s.pixels = (words.iter())
-                .map(|&w| map_buffer(gpu, "raster pixels", w))
-                .collect::<Result<_, _>>()?;
+            s.pixels = pixels.read_back_buffers(gpu, "raster pixels", n)?;
         }
         self.pixels = pixels;
         Ok(())
@@ -593,11 +586,7 @@ impl RasterPeer {
     }
 
     fn pixel_sources(&self) -> Vec<&wgpu::Buffer> {
-        match self.pixels {
-            Pixels::None => vec![],
-            Pixels::Rgba8 => vec![&self.rgba8],
-            Pixels::Float => vec![&self.rgba, &self.depth],
-        }
+        (self.pixels).sources(&self.rgba8, &self.rgba, &self.depth)
     }
 
     /// Draws one frame per turntable angle (radians), pipelined, and returns them in order.

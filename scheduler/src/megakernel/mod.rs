@@ -244,10 +244,15 @@ impl Megakernel {
             let Workgroups::Probe { max } = self.config.workgroups else {
                 unreachable!()
             };
-            self.workgroups.store(
-                self.probe(gpu, max.max(1), user)?,
-                std::sync::atomic::Ordering::Relaxed,
+            let start = Instant::now();
+            let n = self.probe(gpu, max.max(1), user)?;
+            log::debug!(
+                "megakernel co-residency probe: {n} workgroups of at most {max}, {:.1} ms (the \
+                 first launch: includes the driver's deferred compile)",
+                start.elapsed().as_secs_f64() * 1e3
             );
+            self.workgroups
+                .store(n, std::sync::atomic::Ordering::Relaxed);
         }
         Ok(self.workgroups.load(std::sync::atomic::Ordering::Relaxed))
     }

@@ -79,7 +79,8 @@ pub struct BenchReport {
     pub wall_ms: Summary,
     /// Per-frame GPU time (first pass start to last pass end); null without timestamps.
     pub gpu_ms: Option<Summary>,
-    /// Per-frame wall minus GPU time: what the host adds.
+    /// Per-frame wall minus GPU time: what the host adds. As measured, never clamped: it can be
+    /// below 0 ([`WALL_BELOW_GPU`]).
     pub wall_minus_gpu_ms: Option<Summary>,
     /// Timed frames over the sum of their wall times.
     pub fps: f64,
@@ -354,6 +355,9 @@ fn print_table(r: &BenchReport) {
     row("wall ms", Some(&r.wall_ms));
     row("GPU ms", r.gpu_ms.as_ref());
     row("wall - GPU ms", r.wall_minus_gpu_ms.as_ref());
+    if let Some(note) = wall_minus_gpu_note(r.wall_minus_gpu_ms.as_ref()) {
+        println!("{note}");
+    }
     println!("{:<14} {:>10.0}", "micropolygons", r.micropolygons.median);
     println!("{:<14} {:>10.1}", "fps", r.fps);
     println!(
@@ -371,6 +375,19 @@ fn print_table(r: &BenchReport) {
     if let Some(p) = &r.peer {
         print_peer(p);
     }
+}
+
+/// Why "wall - GPU" can be below 0. It is printed as measured rather than clamped at 0: a clamp
+/// would bias its median and p95 upwards and hide the frames where the two clocks disagree.
+pub const WALL_BELOW_GPU: &str = "note: wall - GPU below 0: a frame's GPU time spans its first \
+pass's start to its last pass's end on the GPU's timestamp clock, its wall time the host's \
+interval between two frame completions; with frames in flight together (pipelined) or clocks \
+that drift (a CPU adapter's timestamps), the first can exceed the second. Shown as measured, \
+not clamped.";
+
+/// The note printed under the table when any frame's wall - GPU time was below 0.
+fn wall_minus_gpu_note(s: Option<&Summary>) -> Option<&'static str> {
+    s.filter(|s| s.min < 0.0).map(|_| WALL_BELOW_GPU)
 }
 
 fn print_peer(p: &PeerReport) {
@@ -429,5 +446,20 @@ mod tests {
         let s = Summary::of(&[3.0]).unwrap();
         assert_eq!((s.median, s.p95), (3.0, 3.0));
         assert!(Summary::of(&[]).is_none());
+    }
+
+    /// A negative wall - GPU is kept as measured (not clamped) and explained by a note; none
+    /// when every frame's host time covered its GPU time, or without timestamps.
+    #[test]
+    fn negative_wall_minus_gpu_is_kept_and_explained() {
+        let wall = [10.0, 12.0, 11.0];
+        let gpu = [10.5, 9.0, 9.5];
+        let diff: Vec<f64> = wall.iter().zip(gpu).map(|(w, g)| w - g).collect();
+        let s = Summary::of(&diff).unwrap();
+        assert_eq!(s.min, -0.5);
+        assert_eq!(wall_minus_gpu_note(Some(&s)), Some(WALL_BELOW_GPU));
+        let s = Summary::of(&[0.0, 3.0]).unwrap();
+        assert_eq!(wall_minus_gpu_note(Some(&s)), None);
+        assert_eq!(wall_minus_gpu_note(None), None);
     }
 }

@@ -415,9 +415,21 @@ pub struct ViewCmd {
     pub render: RenderArgs,
 }
 
-const HOLES_ROW: &str = "The table row: | scene | raster | width x height | pixel samples | \
-mp size (px) | reference | micropolygons | interior px | hole px | hole samples | hole sample \
-share |";
+/// The columns of `reyes holes`' table (a macro so that the help text can include them).
+macro_rules! holes_columns {
+    () => {
+        "| scene | raster | width x height | pixel samples | mp size (px) | reference | \
+         micropolygons | interior px | hole px | hole samples | hole sample share |"
+    };
+}
+
+/// The header row of `reyes holes`' table.
+pub const HOLES_COLUMNS: &str = holes_columns!();
+
+const HOLES_ROW: &str = concat!(
+    "The table: a header row and its markdown rule (not with --no-header), then one row: ",
+    holes_columns!()
+);
 
 /// `reyes holes`.
 #[derive(Debug, Args)]
@@ -440,6 +452,10 @@ pub struct HolesCmd {
     /// Print one JSON object instead of the table row.
     #[arg(long)]
     pub json: bool,
+
+    /// Print the table row without its header (to append rows of several runs to one table).
+    #[arg(long, conflicts_with = "json")]
+    pub no_header: bool,
 
     #[command(flatten)]
     pub render: RenderArgs,

@@ -2,10 +2,10 @@
 //! renders a frame on the GPU in the `--raster` mode asked for and counts its holes
 //! (`reyes::accuracy::holes`) against a reference coverage: the exact f64 surfaces, or a
 //! bounding-box render of the same frame (for surfaces the exact reference does not know, such
-//! as displaced ones). Prints one table row or JSON object (docs/reyes.md, *Rasterization
+//! as displaced ones). Prints a table (header and one row) or a JSON object (docs/reyes.md, *Rasterization
 //! modes*).
 
-use crate::cli::{HoleReference, HolesCmd};
+use crate::cli::{HOLES_COLUMNS, HoleReference, HolesCmd};
 use crate::measure::load_scene;
 use reyes::accuracy::holes::{Holes, coverage_of, holes};
 use reyes::frame::{FrameData, RasterMode, RenderOptions};
@@ -85,6 +85,10 @@ pub fn main(a: HolesCmd) -> Result<(), String> {
         );
     } else {
         let r = &report;
+        if !a.no_header {
+            println!("{HOLES_COLUMNS}");
+            println!("{}", markdown_rule(HOLES_COLUMNS));
+        }
         println!(
             "| {} | {} | {}x{} | {}x{} | {} | {} | {} | {} | {} | {} | {:.4} |",
             r.scene,
@@ -103,4 +107,24 @@ pub fn main(a: HolesCmd) -> Result<(), String> {
         );
     }
     Ok(())
+}
+
+/// The markdown rule under a header row: `| --- |` for each of its columns.
+fn markdown_rule(header: &str) -> String {
+    let columns = header.matches('|').count().saturating_sub(1);
+    format!("|{}", " --- |".repeat(columns))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rule_has_a_cell_per_column() {
+        assert_eq!(markdown_rule("| a | b |"), "| --- | --- |");
+        assert_eq!(
+            markdown_rule(HOLES_COLUMNS).matches('|').count(),
+            HOLES_COLUMNS.matches('|').count()
+        );
+    }
 }
