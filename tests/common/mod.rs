@@ -34,9 +34,16 @@ pub fn renderer(kind: StrategyKind) -> &'static GpuRenderer {
 /// The megakernel's and the multi-pass strategy's frames of `data`, asserting that their
 /// images are the same, bit for bit.
 pub fn render_both_strategies(data: &FrameData) -> (GpuFrame, GpuFrame) {
-    let a = renderer(StrategyKind::Megakernel).render(gpu(), data).unwrap();
-    let b = renderer(StrategyKind::Multipass).render(gpu(), data).unwrap();
-    assert!(a.image == b.image, "multipass image differs from megakernel");
+    let a = renderer(StrategyKind::Megakernel)
+        .render(gpu(), data)
+        .unwrap();
+    let b = renderer(StrategyKind::Multipass)
+        .render(gpu(), data)
+        .unwrap();
+    assert!(
+        a.image == b.image,
+        "multipass image differs from megakernel"
+    );
     (a, b)
 }
 
