@@ -155,7 +155,7 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
     if let Some(((first, a), rest)) = gpu_timed.split_first() {
         for (c, b) in rest {
             println!(
-                "ratio {}/{} GPU time: {:.2}x (same run)",
+                "ratio {}/{} GPU time: {:.2}x (medians of this invocation)",
                 c.strategy,
                 first.strategy,
                 b / a

@@ -258,21 +258,20 @@ pub(crate) fn check(program: &Program) -> Result<Vec<String>, RunError> {
     Ok(dynamic_item_indexing(&probe, &module, &info))
 }
 
-/// Notes for each run-time index into an array or matrix reached from an execute function's
-/// `item` parameter without a `var` in between: naga's SPIR-V backend spills the indexed value
-/// to a temporary at every such access (`spill_to_internal_variable` in naga's `back/spv`).
+/// Notes for each run-time index into an array or matrix reached from a parameter (a value)
+/// of a function the user wrote (bodies and user WGSL; an execute function's `item`, or a
+/// helper's), without a `var` in between: naga's SPIR-V backend spills the indexed value to a
+/// temporary at every such access (`spill_to_internal_variable` in naga's `back/spv`).
 fn dynamic_item_indexing(
     probe: &Probe,
     module: &naga::Module,
     info: &naga::valid::ModuleInfo,
 ) -> Vec<String> {
     let mut notes = Vec::new();
-    for p in &probe.program.procs {
-        let name = &p.proc.name;
-        let Some(h) = function(module, &format!("{name}_execute")) else {
+    for (h, f) in module.functions.iter() {
+        if probe.is_generated(module.functions.get_span(h)) {
             continue;
-        };
-        let f = &module.functions[h];
+        }
         for (e, expr) in f.expressions.iter() {
             let naga::Expression::Access { base, .. } = *expr else {
                 continue;
@@ -288,16 +287,24 @@ fn dynamic_item_indexing(
                 indexed,
                 naga::TypeInner::Array { .. } | naga::TypeInner::Matrix { .. }
             );
-            if spills && matches!(f.expressions[root], naga::Expression::FunctionArgument(0)) {
-                let at = probe
-                    .locate(f.expressions.get_span(e))
-                    .map(|(at, ..)| format!(" ({at})"))
-                    .unwrap_or_default();
-                notes.push(format!(
-                    "procedure `{name}`: a run-time index into an array of its item{at} copies the \
-                     whole array at every access (naga's SPIR-V); copy the item into a `var` first"
-                ));
+            let naga::Expression::FunctionArgument(arg) = f.expressions[root] else {
+                continue;
+            };
+            if !spills {
+                continue;
             }
+            let fname = f.name.as_deref().unwrap_or("?");
+            let param = f.arguments[arg as usize].name.as_deref().unwrap_or("?");
+            let at = probe
+                .locate(f.expressions.get_span(e))
+                .map(|(at, ..)| format!("{at}: "))
+                .unwrap_or_default();
+            notes.push(format!(
+                "{at}a run-time index into an array of `{param}`, a parameter of `{fname}` (a \
+                 value), copies the whole array at every access (naga's SPIR-V). Copy it into a \
+                 `var` under another name once (e.g. `fn {fname}({param}_value: ...) {{ var {param} = \
+                 {param}_value; ...`) and index that (docs/scheduler.md, \"Writing fast procedures\")"
+            ));
         }
     }
     notes
@@ -560,6 +567,17 @@ mod tests {
              var s = item.w[3];\n    for (var i = 0u; i < item.n; i++) { s += item.w[i]; }\n}",
         );
         assert!(fast.notes().is_empty(), "{:?}", fast.notes());
+        // Through a helper that takes the item (or an array of it) by value: the same copy.
+        let helper = body(
+            "fn sum(r: Row) -> u32 {\n    var s = 0u;\n    for (var i = 0u; i < r.n; i++) { s += r.w[i]; }\n    return s;\n}\n\
+             fn row_execute(item: Row, inv: Invocation) { let s = sum(item); }",
+        );
+        assert_eq!(helper.notes().len(), 1, "{:?}", helper.notes());
+        let n = &helper.notes()[0];
+        assert!(
+            n.contains("`r`, a parameter of `sum`") && n.contains("line 3"),
+            "{n}"
+        );
     }
 
     #[test]

@@ -130,9 +130,10 @@ impl Program {
         Ok(program)
     }
 
-    /// What [`Program::new`] found slow in the bodies, one sentence each, also logged as
-    /// warnings (`log`): today, a body that indexes an array or matrix of its `item` parameter
-    /// with a run-time index. naga's SPIR-V output copies the whole array to a temporary at
+    /// What [`Program::new`] found slow in the bodies and user WGSL, one note each, also logged
+    /// as warnings through `log` (visible only with a logger at warn level: env_logger shows
+    /// errors only unless told, e.g. `RUST_LOG=warn`): today, a run-time index into an array
+    /// or matrix of a parameter (the `item` of an execute function, or a helper's). naga's SPIR-V output copies the whole array to a temporary at
     /// every such access (a value cannot be indexed dynamically in SPIR-V); copy the item
     /// into a `var` once and index that (docs/scheduler.md, "Writing fast procedures").
     pub fn notes(&self) -> &[String] {

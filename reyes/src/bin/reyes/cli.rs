@@ -47,8 +47,8 @@ pub enum Command {
     /// f32 split drift against f64 over 0-24 split levels, in pixels (CPU).
     #[command(allow_negative_numbers = true, args_override_self = true)]
     Drift(DriftCmd),
-    /// Time frames of a turning scene, pipelined on the GPU: per-frame wall and GPU ms (median,
-    /// p95) and frames per second, as a table or JSON.
+    /// Time frames of a scene (turning about its centre with --turntable), pipelined on the GPU:
+    /// per-frame wall and GPU ms (median, p95) and frames per second, as a table or JSON.
     #[command(allow_negative_numbers = true, args_override_self = true)]
     Bench(BenchCmd),
     /// Open a window on a scene: orbit, pan and zoom with the mouse, keys for strategy and
@@ -120,7 +120,7 @@ pub struct RenderArgs {
 
     /// The normal displaced patches move along: exact (from the patch's derivatives) or
     /// approximate (the grid's finite differences, which leave holes; for comparisons only).
-    #[arg(long, value_enum, default_value_t = DisplacementNormals::Exact)]
+    #[arg(long, value_enum, value_name = "NORMALS", default_value_t = DisplacementNormals::Exact)]
     pub displacement_normals: DisplacementNormals,
 
     /// Micropolygon rasterization: bbox (every sub-sample under its screen bound, tested
@@ -473,9 +473,9 @@ pub enum HoleReference {
 /// `--raster`: [`RasterMode`] on the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum Raster {
-    /// Bounding-box rasterization ([`RasterMode::BoundingBox`]).
+    /// Bounding-box rasterization: every sub-sample under the micropolygon's screen bound.
     Bbox,
-    /// One sample per micropolygon, nearest its centre ([`RasterMode::NearestSample`]).
+    /// One sample per micropolygon, nearest its centre.
     Nearest,
 }
 
@@ -648,7 +648,7 @@ fn parse_dof(v: &str) -> Result<DepthOfField, String> {
         .collect::<Option<_>>()
         .filter(|n: &Vec<f64>| n.len() == 3)
         .ok_or(format!(
-            "`{v}` is not FSTOP,FOCALLENGTH,DIST (three positive numbers, e.g. 2.8,0.05,4)"
+            "`{v}` is not FSTOP,FOCALLENGTH,DIST (three positive numbers in camera-space units, e.g. 2.8,50,454 for killeroo.rib, whose camera is 454 units from the model)"
         ))?;
     Ok(DepthOfField {
         fstop: n[0],
