@@ -152,7 +152,9 @@ fn render_frame(
     progress: &indicatif::ProgressBar,
 ) -> Result<(), String> {
     let Some((gpu, renderer)) = gpu else {
+        let t0 = std::time::Instant::now();
         let r = reyes::cpu_render::render_cpu(data);
+        let secs = t0.elapsed().as_secs_f64();
         progress.inc(1);
         if let Some(reference) = reference {
             compare_to(reference, &r.image)?;
@@ -162,7 +164,13 @@ fn render_frame(
             log::warn!("{w}");
         }
         r.image.write_png(&out.image)?;
-        reyes::progress::note(format!("wrote {} (CPU reference)", out.image.display()));
+        reyes::progress::note(format!(
+            "wrote {} ({}x{}, CPU reference, {:.2} s)",
+            out.image.display(),
+            r.image.width,
+            r.image.height,
+            secs
+        ));
         return Ok(());
     };
     // One frame makes the image; with --runs N > 1, N frames are timed after a warm-up
