@@ -1,9 +1,10 @@
 // Persistent megakernel: every workgroup loops, claiming a batch from one procedure queue,
 // running it, and publishing what it emitted, until no work is left in this launch.
 // The protocol and why it is correct under WGSL's relaxed atomics: docs/scheduler.md.
-// Generated code before this file: NQ/THREADS/WORDS/EMITS tables, the procedures, the
-// `sched_slot_*` and `sched_ob_*` word and vec4 accessors over `slots` and `outbox`,
-// `sched_execute`, and `enqueue_*`.
+// Generated code before this file: NQ/THREADS/WORDS/EMITS tables, ITEMS_PLANAR, the
+// procedures, the `sched_slot_*` and `sched_ob_*` word and vec4 accessors over `slots` and
+// `outbox`, `sched_execute`, `mk_execute` / `mk_outbox_item` / `mk_outbox_stride` (where items
+// are in the program's item layout: scheduler/src/item_layout.rs), and `enqueue_*`.
 
 // ---- ctrl layout (u32 words); host twin: scheduler/src/megakernel/layout.rs ----
 const QSTRIDE: u32 = 16u;
@@ -47,6 +48,10 @@ fn q_slot_base(q: u32) -> u32 { return params[9u + q * 4u]; }
 fn q_flag_base(q: u32) -> u32 { return params[10u + q * 4u]; }
 fn prio(i: u32) -> u32 { return params[8u + NQ * 4u + i]; }
 fn ob_off(q: u32, t: u32) -> u32 { return params[8u + NQ * 5u + q * NQ + t]; }
+// Most items a batch of q claims; host twin: the outbox sizing in Megakernel::new.
+fn batch_max(q: u32) -> u32 { return min((256u / THREADS[q]) * params[P_BATCH_STEPS], MAX_BATCH); }
+// Items the outbox part (q, t) holds: a batch's worst-case output to t.
+fn ob_cap(q: u32, t: u32) -> u32 { return batch_max(q) * EMITS[q * NQ + t]; }
 
 const MAX_BATCH: u32 = 1024u;
 const EMPTY: u32 = 0u;            // slot flag: not written yet
@@ -87,7 +92,6 @@ fn idle_pause(trips: u32) {
     sched_pause_sink = x;
 }
 
-
 fn sched_raise(code: u32, a: u32, b: u32) {
     if atomicExchange(&ctrl[gw(G_ERROR)], code) == 0u {
         atomicStore(&ctrl[gw(G_ERR_A)], a);
@@ -103,7 +107,7 @@ fn sched_outbox_slot(t: u32) -> u32 {
         sched_raise(ERR_EMIT, sched_proc, t);
         return 0xffffffffu;
     }
-    return sched_outbox + ob_off(sched_proc, t) + j * WORDS[t];
+    return mk_outbox_item(sched_proc, t, j);
 }
 
 fn release_budget(q: u32, n: u32, upto: u32) {
@@ -142,8 +146,7 @@ fn reserve_budget(q: u32, n: u32) -> bool {
 fn try_claim(q: u32) -> bool {
     let avail = bitcast<i32>(atomicLoad(&ctrl[q * QSTRIDE + Q_COUNT]));
     if avail <= 0 { return false; }
-    let bmax = min((256u / THREADS[q]) * params[P_BATCH_STEPS], MAX_BATCH);
-    let want = min(u32(avail), bmax);
+    let want = min(u32(avail), batch_max(q));
     if !reserve_budget(q, want) { return false; }
     let old = bitcast<i32>(atomicSub(&ctrl[q * QSTRIDE + Q_COUNT], want));
     let got = u32(clamp(old, 0, i32(want)));
@@ -261,8 +264,7 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         for (var first = 0u; first < n; first += per_step) {
             let idx = first + slot;
             sched_active = idx < n && wg_ready[min(idx, MAX_BATCH - 1u)] != 0u;
-            let base = q_slot_base(q) + (h + idx) * WORDS[q];
-            sched_execute(q, base, Invocation(lid % THREADS[q], slot, sched_active));
+            mk_execute(q, h + idx, Invocation(lid % THREADS[q], slot, sched_active));
             // The next step may reuse the body's workgroup memory: all threads finish this one first.
             workgroupBarrier();
         }
@@ -295,13 +297,38 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         }
         workgroupBarrier();
 
-        // 4. Copy the payloads into the reserved slots, coalesced: 16 bytes per thread where the
-        //    item is a whole number of vec4s (queue regions and outbox parts are 16-byte aligned).
+        // 4. Copy the payloads into the reserved slots, coalesced: planar items a plane at a
+        //    time; interleaved ones 16 bytes per thread where the item is a whole number of vec4s
+        //    (queue regions and outbox parts are 16-byte aligned).
         for (var t = 0u; t < NQ; t++) {
-            let words = wg_emit_n[t] * WORDS[t];
+            let k = wg_emit_n[t];
+            let words = k * WORDS[t];
             let dst = q_slot_base(t) + wg_emit_base[t] * WORDS[t];
             let src = sched_outbox + ob_off(q, t);
-            if WORDS[t] % 4u == 0u {
+            if ITEMS_PLANAR {
+                // Plane by plane, four planes per trip: four independent loads in flight.
+                let cap = q_cap(t);
+                let ob = ob_cap(q, t);
+                let to = q_slot_base(t) + wg_emit_base[t];
+                var plane = 0u;
+                for (; plane + 4u <= WORDS[t]; plane += 4u) {
+                    for (var j = lid; j < k; j += 256u) {
+                        let a = sched_ob_load_word(src + plane * ob + j);
+                        let b = sched_ob_load_word(src + (plane + 1u) * ob + j);
+                        let c = sched_ob_load_word(src + (plane + 2u) * ob + j);
+                        let d = sched_ob_load_word(src + (plane + 3u) * ob + j);
+                        sched_slot_store_word(to + plane * cap + j, a);
+                        sched_slot_store_word(to + (plane + 1u) * cap + j, b);
+                        sched_slot_store_word(to + (plane + 2u) * cap + j, c);
+                        sched_slot_store_word(to + (plane + 3u) * cap + j, d);
+                    }
+                }
+                for (; plane < WORDS[t]; plane++) {
+                    for (var j = lid; j < k; j += 256u) {
+                        sched_slot_store_word(to + plane * cap + j, sched_ob_load_word(src + plane * ob + j));
+                    }
+                }
+            } else if WORDS[t] % 4u == 0u {
                 for (var w = lid * 4u; w < words; w += 1024u) {
                     sched_slot_store_vec4(dst + w, sched_ob_load_vec4(src + w));
                 }

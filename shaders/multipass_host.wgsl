@@ -6,7 +6,8 @@
 // can hold the round's worst case (sum over procedures of inputs x declared emits) and grows it
 // first if not, so an append never passes the capacity. Order within a queue is not kept.
 // Generated before this file: tables, procedures, `mp_in_*` / `mp_out_*` accessors,
-// `sched_execute`, `enqueue_*`, and one entry point per procedure.
+// `sched_execute`, `mp_execute` (item i of queue q's region, in the program's item layout:
+// scheduler/src/item_layout.rs), `enqueue_*`, and one entry point per procedure.
 
 // ---- counts buffers; host twin: scheduler/src/multipass/host.rs ----
 // counts_in[q]: inputs of queue q this round runs (the previous round's appends, or the host's
@@ -66,7 +67,7 @@ fn sched_append_slot(t: u32) -> u32 {
 fn run_procedure(q: u32, lid: u32, wid: u32, nwg: u32) {
     if lid == 0u { wg_n = counts_in[q]; }
     let n = workgroupUniformLoad(&wg_n);
-    let base = q_base(q) + counts_in[H_SKIP + q] * WORDS[q];
+    let skip = counts_in[H_SKIP + q];
     let per_step = 256u / THREADS[q];
     let slot = lid / THREADS[q];
     let thread = lid % THREADS[q];
@@ -78,7 +79,7 @@ fn run_procedure(q: u32, lid: u32, wid: u32, nwg: u32) {
         sched_proc = q;
         sched_slot = slot;
         sched_active = live;
-        sched_execute(q, base + idx * WORDS[q], Invocation(thread, slot, live));
+        mp_execute(q, skip + idx, Invocation(thread, slot, live));
         workgroupBarrier();
     }
 }

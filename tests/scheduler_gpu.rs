@@ -83,6 +83,31 @@ fn stress_configs() -> Vec<(&'static str, MegakernelConfig)> {
             },
         ),
         (
+            // The same in planar items: live items move plane by plane on the device (growth)
+            // and through the host.
+            "planar items, tiny queues, short launches, impatient waits",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(3),
+                batch_steps: 2,
+                max_iterations: 24,
+                spin_limit: 1,
+                initial_capacity: 16,
+                item_layout: Some(ItemLayout::Planar),
+                ..base.clone()
+            },
+        ),
+        (
+            "planar items, roomy queues, very short launches",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(3),
+                max_iterations: 6,
+                spin_limit: 2,
+                initial_capacity: 1 << 15,
+                item_layout: Some(ItemLayout::Planar),
+                ..base.clone()
+            },
+        ),
+        (
             "oversubscribed",
             MegakernelConfig {
                 workgroups: Workgroups::Fixed(24),
@@ -110,6 +135,8 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
     let (mut runs, mut multi_launch, mut grown, mut abandoned) = (0, 0, 0, 0);
     // Megakernel runs whose live items moved on the device (a growth) or through the host.
     let (mut device_moved, mut host_moved) = (0, 0);
+    // The same, of megakernels with planar items (moved plane by plane).
+    let (mut planar_device_moved, mut planar_host_moved) = (0, 0);
     for payload in [1u32, 62] {
         let shape = TreeParams {
             roots: 1,
@@ -154,6 +181,19 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
             "multipass-host".into(),
             Scheduler::new(&gpu, &tree.program, StrategyKind::MultipassHost, 1 << 12).unwrap(),
         ));
+        schedulers.push((
+            "multipass-host, planar items, tiny queues".into(),
+            Scheduler::multipass_host(
+                &gpu,
+                &tree.program,
+                HostMultipassConfig {
+                    initial_capacity: 16,
+                    item_layout: Some(ItemLayout::Planar),
+                    ..Default::default()
+                },
+            )
+            .unwrap(),
+        ));
         for _ in 0..25 {
             let fanout = if rng.below(3) == 0 {
                 Fanout::Fixed(1 + rng.below(2))
@@ -189,6 +229,10 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
                 multi_launch += (mk && stats.launches > 1) as u32;
                 device_moved += (mk && stats.queue_growths > 0) as u32;
                 host_moved += (mk && stats.submits > stats.launches) as u32;
+                if name.starts_with("planar") {
+                    planar_device_moved += (stats.queue_growths > 0) as u32;
+                    planar_host_moved += (stats.submits > stats.launches) as u32;
+                }
                 grown += (stats.queue_growths > 0) as u32;
                 abandoned += (stats.abandoned > 0) as u32;
             }
@@ -197,7 +241,8 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
     eprintln!(
         "{runs} runs: {multi_launch} needed several launches, {grown} grew a queue, {abandoned} \
          abandoned a wait; megakernel compactions: {device_moved} runs on the device, \
-         {host_moved} on the host"
+         {host_moved} on the host ({planar_device_moved} and {planar_host_moved} of them with \
+         planar items)"
     );
     assert!(runs >= 250, "only {runs} runs");
     // The hard paths must have been exercised, or this test proves little.
@@ -206,8 +251,9 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
         "{multi_launch} multi-launch, {grown} grown"
     );
     assert!(
-        device_moved > 10 && host_moved > 10,
-        "compactions: {device_moved} on the device, {host_moved} on the host"
+        device_moved > 10 && host_moved > 10 && planar_device_moved > 5 && planar_host_moved > 5,
+        "compactions: {device_moved} on the device, {host_moved} on the host (planar: \
+         {planar_device_moved}, {planar_host_moved})"
     );
 }
 
@@ -323,17 +369,20 @@ fn multi_pass_rounds_that_cannot_fit_a_queue_at_its_limit_run_in_part_and_stay_e
         },
     )
     .unwrap();
-    let mph = Scheduler::multipass_host(
-        &gpu,
-        &run.program,
-        HostMultipassConfig {
-            initial_capacity: 16,
-            max_capacity: 32,
-            ..Default::default()
-        },
-    )
-    .unwrap();
-    for s in [mp, mph] {
+    let mph = |item_layout| {
+        Scheduler::multipass_host(
+            &gpu,
+            &run.program,
+            HostMultipassConfig {
+                initial_capacity: 16,
+                max_capacity: 32,
+                item_layout: Some(item_layout),
+                ..Default::default()
+            },
+        )
+        .unwrap()
+    };
+    for s in [mp, mph(ItemLayout::Interleaved), mph(ItemLayout::Planar)] {
         let (stats, result) = run.run(&gpu, &s).unwrap();
         assert_eq!(result, reference, "{stats:?}");
         assert!(stats.partial_rounds > 0, "{stats:?}");
@@ -530,19 +579,24 @@ fn every_thread_that_calls_enqueue_adds_an_item_on_every_strategy() {
 /// A run recorded without host waits ([`RecordedRun`]): sized from a full run of the same work,
 /// recorded twice into one encoder from seeds in a device buffer, each status says it finished
 /// with the CPU's count; sized to its seeds, its status says it did not (never a silent partial
-/// run); seeds other than those it was made for are refused.
+/// run); seeds other than those it was made for are refused. Items are three words that must
+/// agree (a node splits only if they do), so a word misplaced on the way into a queue, in
+/// either item layout, changes the count.
 #[test]
 fn recorded_runs_finish_like_a_run_or_say_they_did_not() {
     let gpu = gpu();
-    let word = ItemType::new("Word", "struct Word { v: u32 }");
-    let split = Procedure::new("split", word, 1).emits("split", 2).body(
-        "fn split_execute(item: Word, inv: Invocation) { if item.v > 0u { \
-         enqueue_split(Word(item.v - 1u)); enqueue_split(Word(item.v - 1u)); } }",
+    let node = ItemType::new("Node", "struct Node { v: u32, a: u32, b: u32 }");
+    let split = Procedure::new("split", node, 1).emits("split", 2).body(
+        "fn node(v: u32) -> Node { return Node(v, v * 3u + 1u, v ^ 0x55u); }\n\
+         fn split_execute(item: Node, inv: Invocation) {\n\
+             if item.v > 0u && item.a == item.v * 3u + 1u && item.b == (item.v ^ 0x55u) {\n\
+                 enqueue_split(node(item.v - 1u)); enqueue_split(node(item.v - 1u)); } }",
     );
     let program = Program::new(vec![split], UserBindings::none()).unwrap();
-    let roots = [3u32, 5, 6, 0, 11];
+    let vs = [3u32, 5, 6, 0, 11];
+    let roots: Vec<[u32; 3]> = vs.iter().map(|&v| [v, v * 3 + 1, v ^ 0x55]).collect();
     // A root v is a full binary tree of depth v: 2^(v+1) - 1 items.
-    let expected: u64 = roots.iter().map(|&v| (1u64 << (v + 1)) - 1).sum();
+    let expected: u64 = vs.iter().map(|&v| (1u64 << (v + 1)) - 1).sum();
     let n = roots.len() as u32;
     let seeds_buf = gpu.upload("seeds", &roots).unwrap();
     let seeds = [DeviceSeeds {
@@ -550,24 +604,29 @@ fn recorded_runs_finish_like_a_run_or_say_they_did_not() {
         buffer: &seeds_buf,
         count: n,
     }];
-    for kind in [StrategyKind::Megakernel, StrategyKind::Multipass] {
-        // One workgroup: a recorded megakernel's queues get one batch's worst case per
-        // workgroup on top of their size, which on a large GPU (the H200: ~4,000 workgroups)
-        // would make even the tiny run below big enough for the whole tree. (Two were not
-        // co-resident on a loaded lavapipe: slots abandoned after their bounded wait.)
-        let s = match kind {
-            StrategyKind::Megakernel => Scheduler::megakernel(
-                &gpu,
-                &program,
-                MegakernelConfig {
-                    initial_capacity: 64,
-                    workgroups: Workgroups::Fixed(1),
-                    ..Default::default()
-                },
-            )
-            .unwrap(),
-            _ => Scheduler::new(&gpu, &program, kind, 64).unwrap(),
-        };
+    // One workgroup: a recorded megakernel's queues get one batch's worst case per workgroup
+    // on top of their size, which on a large GPU (the H200: ~4,000 workgroups) would make even
+    // the tiny run below big enough for the whole tree. (Two were not co-resident on a loaded
+    // lavapipe: slots abandoned after their bounded wait.)
+    let megakernel = |item_layout| {
+        Scheduler::megakernel(
+            &gpu,
+            &program,
+            MegakernelConfig {
+                initial_capacity: 64,
+                workgroups: Workgroups::Fixed(1),
+                item_layout: Some(item_layout),
+                ..Default::default()
+            },
+        )
+        .unwrap()
+    };
+    for s in [
+        megakernel(ItemLayout::Interleaved),
+        megakernel(ItemLayout::Planar),
+        Scheduler::new(&gpu, &program, StrategyKind::Multipass, 64).unwrap(),
+    ] {
+        let kind = s.kind();
         let full = s.run(&gpu, &[Seed::new("split", &roots)], None).unwrap();
         assert_eq!(full.executed, [expected]);
         let size = RecordedSize::from_stats(&program, kind, &full, &[n], 1.0);

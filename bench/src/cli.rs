@@ -6,6 +6,7 @@ use crate::strategy::{GpuConfig, Policy};
 use crate::suite::Scale;
 use clap::error::ErrorKind;
 use clap::{CommandFactory, Parser, value_parser};
+use scheduler::ItemLayout;
 use scheduler::workloads::tree::{Fanout, TreeParams, TreePreset};
 use std::path::PathBuf;
 
@@ -127,10 +128,22 @@ pub struct Cli {
           help_heading = "Scheduler")]
     pub idle_backoff: u32,
 
+    /// How the megakernel's and multipass-host's queues hold items: `interleaved` (item after
+    /// item) or `planar` (word k of every item together: coalesced, faster for large one-thread
+    /// items on GPUs) [default: planar on a GPU for one-thread items of 16+ words, else
+    /// interleaved].
+    #[arg(long, value_parser = parse_item_layout, help_heading = "Scheduler")]
+    pub item_layout: Option<ItemLayout>,
+
     /// Queue slots at the start of a run [default: from the problem size].
     #[arg(long, value_name = "SLOTS", value_parser = value_parser!(u32).range(1..),
           help_heading = "Scheduler")]
     pub capacity: Option<u32>,
+}
+
+fn parse_item_layout(s: &str) -> Result<ItemLayout, String> {
+    ItemLayout::parse(s)
+        .ok_or_else(|| format!("unknown item layout `{s}` (known: interleaved, planar)"))
 }
 
 fn parse_preset(s: &str) -> Result<TreePreset, String> {
@@ -233,6 +246,7 @@ impl Cli {
             batch_steps: self.batch_steps,
             idle_backoff: self.idle_backoff,
             capacity: self.capacity,
+            item_layout: self.item_layout,
         }
     }
 }

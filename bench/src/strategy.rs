@@ -2,8 +2,8 @@
 //! per queue policy), the workload's CPU implementation (rayon), or a workload's own baseline.
 
 use scheduler::{
-    Gpu, MegakernelConfig, MultipassConfig, Program, QueuePolicy, RunError, Scheduler,
-    StrategyKind, Workgroups,
+    Gpu, HostMultipassConfig, ItemLayout, MegakernelConfig, MultipassConfig, Program, QueuePolicy,
+    RunError, Scheduler, StrategyKind, Workgroups,
 };
 
 /// The megakernel's queue policies, as the command line names them.
@@ -128,6 +128,8 @@ pub struct GpuConfig {
     pub batch_steps: u32,
     /// Longest pause of an idle megakernel workgroup (`MegakernelConfig::idle_backoff`).
     pub idle_backoff: u32,
+    /// How the queues hold items (`MegakernelConfig::item_layout`); `None`: the adapter's.
+    pub item_layout: Option<ItemLayout>,
     /// Queue slots at the start of a run; `None` lets the workload choose from its size.
     pub capacity: Option<u32>,
 }
@@ -138,6 +140,7 @@ impl Default for GpuConfig {
             workgroups: None,
             batch_steps: 1,
             idle_backoff: MegakernelConfig::default().idle_backoff,
+            item_layout: None,
             capacity: None,
         }
     }
@@ -167,6 +170,7 @@ pub fn compile(
                 policy: policy.queue_policy(),
                 batch_steps: config.batch_steps,
                 idle_backoff: config.idle_backoff,
+                item_layout: config.item_layout,
                 initial_capacity: capacity,
                 ..Default::default()
             },
@@ -176,6 +180,15 @@ pub fn compile(
             program,
             MultipassConfig {
                 initial_capacity: capacity,
+                ..Default::default()
+            },
+        ),
+        StrategyKind::MultipassHost => Scheduler::multipass_host(
+            gpu,
+            program,
+            HostMultipassConfig {
+                initial_capacity: capacity,
+                item_layout: config.item_layout,
                 ..Default::default()
             },
         ),

@@ -298,19 +298,7 @@ impl Gpu {
         layout: &wgpu::BindGroupLayout,
         buffers: &[&wgpu::Buffer],
     ) -> wgpu::BindGroup {
-        let entries: Vec<_> = buffers
-            .iter()
-            .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry {
-                binding: i as u32,
-                resource: b.as_entire_binding(),
-            })
-            .collect();
-        self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some(label),
-            layout,
-            entries: &entries,
-        })
+        bind_buffers(&self.device, label, layout, buffers)
     }
 
     /// Compiles WGSL, turning a validation error into a `RunError` that carries the message
@@ -365,4 +353,26 @@ pub(crate) fn log_pipeline_time(label: &str, entry: &str, start: std::time::Inst
         "pipeline `{label}::{entry}`: {:.1} ms",
         start.elapsed().as_secs_f64() * 1e3
     );
+}
+
+/// A bind group of `buffers`, whole, at bindings 0, 1, 2, … (see [`Gpu::bind_buffers`]).
+pub(crate) fn bind_buffers(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &[&wgpu::Buffer],
+) -> wgpu::BindGroup {
+    let entries: Vec<_> = buffers
+        .iter()
+        .enumerate()
+        .map(|(i, b)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: b.as_entire_binding(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
 }

@@ -4,6 +4,7 @@
 
 use crate::bindings::UserBindings;
 use crate::error::RunError;
+use crate::item_layout::{ItemLayout, planar_load_store_fns};
 use crate::probe::Part;
 use crate::procedure::Procedure;
 use crate::wgsl::{self, StructLayout};
@@ -196,20 +197,33 @@ impl Program {
     }
 
     /// `fn sched_execute(q, base, inv)`: loads the item at word `base` with `{prefix}_load_*`
-    /// (only for active invocations) and calls the body of procedure `q`.
-    pub(crate) fn execute_switch(&self, prefix: &str) -> String {
+    /// (only for active invocations) and calls the body of procedure `q`. With
+    /// [`ItemLayout::Planar`] it is `sched_execute(q, base, stride, inv)` (word `k` of the item
+    /// at `base + k × stride`).
+    pub(crate) fn execute_switch(&self, prefix: &str, items: ItemLayout) -> String {
+        let planar = items == ItemLayout::Planar;
         let mut s = String::new();
         let mut seen = Vec::new();
         for p in &self.procs {
             if !seen.contains(&p.layout.name) {
                 seen.push(p.layout.name.clone());
-                s += &wgsl::load_store_fns(&p.layout, prefix);
+                s += &match items {
+                    ItemLayout::Interleaved => wgsl::load_store_fns(&p.layout, prefix),
+                    ItemLayout::Planar => planar_load_store_fns(&p.layout, prefix),
+                };
             }
         }
-        s += "fn sched_execute(q: u32, base: u32, inv: Invocation) {\n    switch q {\n";
+        let (stride_param, stride) = if planar {
+            ("stride: u32, ", ", stride")
+        } else {
+            ("", "")
+        };
+        s += &format!(
+            "fn sched_execute(q: u32, base: u32, {stride_param}inv: Invocation) {{\n    switch q {{\n"
+        );
         for (i, p) in self.procs.iter().enumerate() {
             s += &format!(
-                "        case {i}u: {{ var it: {t}; if inv.live {{ it = {prefix}_load_{t}(base); }} {n}_execute(it, inv); }}\n",
+                "        case {i}u: {{ var it: {t}; if inv.live {{ it = {prefix}_load_{t}(base{stride}); }} {n}_execute(it, inv); }}\n",
                 t = p.layout.name,
                 n = p.proc.name
             );

@@ -2,6 +2,7 @@
 
 use crate::error::RunError;
 use crate::gpu::Gpu;
+use crate::item_layout::ItemLayout;
 use crate::megakernel::{Megakernel, MegakernelConfig};
 use crate::multipass::host::{HostMultipass, HostMultipassConfig};
 use crate::multipass::{Multipass, MultipassConfig};
@@ -144,6 +145,16 @@ impl Scheduler {
             Scheduler::Megakernel(m) => m.program(),
             Scheduler::Multipass(m) => m.program(),
             Scheduler::MultipassHost(m) => m.program(),
+        }
+    }
+
+    /// How its queues hold items: as configured, or as [`ItemLayout::for_program`] chose; the
+    /// device-driven multi-pass always interleaves them.
+    pub fn item_layout(&self) -> ItemLayout {
+        match self {
+            Scheduler::Megakernel(m) => m.item_layout(),
+            Scheduler::Multipass(_) => ItemLayout::Interleaved,
+            Scheduler::MultipassHost(m) => m.item_layout(),
         }
     }
 

@@ -220,15 +220,7 @@ pub(crate) fn moves_by_vec4(layout: &StructLayout) -> bool {
 /// of the large-payload tree moved several times faster: docs/results.md, session 18).
 pub(crate) fn load_store_fns(layout: &StructLayout, prefix: &str) -> String {
     let t = &layout.name;
-    let cast_in = |l: &Leaf, w: String| match l.kind {
-        ScalarKind::U32 => w,
-        ScalarKind::I32 => format!("bitcast<i32>({w})"),
-        ScalarKind::F32 => format!("bitcast<f32>({w})"),
-    };
-    let cast_out = |l: &Leaf| match l.kind {
-        ScalarKind::U32 => format!("v{}", l.path),
-        _ => format!("bitcast<u32>(v{})", l.path),
-    };
+    use crate::item_layout::{cast_in, cast_out};
     let mut s = format!("fn {prefix}_load_{t}(base: u32) -> {t} {{\n    var v: {t};\n");
     if moves_by_vec4(layout) {
         for g in 0..layout.words() / 4 {

@@ -9,33 +9,52 @@ use super::DeviceQueues;
 use super::layout::*;
 use crate::error::RunError;
 use crate::gpu::Gpu;
+use crate::item_layout::ItemLayout;
 use crate::program::Program;
 
 const SOURCE: &str = include_str!("../../../shaders/megakernel_compact.wgsl");
+/// Parameter words per queue (`CP_QUEUE_WORDS` in the shader).
+const CP_QUEUE_WORDS: usize = 10;
 
 /// Reads back each queue's reserved slots and keeps the published, unconsumed ones, in ticket
-/// order; one submission and one wait for all queues. An `EMPTY` flag below `Q_RESERVE`, or a
+/// order, as items back to back (whatever the queues' `items` layout); one submission and one
+/// wait for all queues. An `EMPTY` flag below `Q_RESERVE`, or a
 /// kept count other than `G_PENDING + G_ABANDONED`, is a protocol violation (`Device` error).
 pub(super) fn host_compact(
     gpu: &Gpu,
     program: &Program,
     d: &DeviceQueues,
     ctrl: &[u32],
+    items: ItemLayout,
 ) -> Result<Vec<Vec<u32>>, RunError> {
     let nq = program.queue_count();
-    let mut ranges = Vec::new();
+    // Per queue: its flags, then its slots' word ranges (one, or one per plane).
+    let (mut ranges, mut parts_of) = (Vec::new(), Vec::new());
     for qi in 0..nq {
-        let reserved = ctrl[q(qi, Q_RESERVE)] as u64;
-        let w = d.layout.words[qi] as u64;
-        ranges.push((&d.flags, d.layout.flag_base[qi] as u64, reserved));
-        ranges.push((&d.slots, d.layout.slot_base[qi] as u64, reserved * w));
+        let reserved = ctrl[q(qi, Q_RESERVE)];
+        ranges.push((&d.flags, d.layout.flag_base[qi] as u64, reserved as u64));
+        let parts = items.copy_ranges(&d.layout, &d.layout, qi, reserved);
+        parts_of.push(parts.len());
+        ranges.extend(
+            parts
+                .into_iter()
+                .map(|(from, _, words)| (&d.slots, from, words)),
+        );
     }
     let data = crate::readback::read_ranges(gpu, &ranges)?;
     let mut live = vec![Vec::new(); nq];
     let mut total_live = 0u64;
+    let mut at = 0;
     for qi in 0..nq {
-        let (flags, slots) = (&data[2 * qi], &data[2 * qi + 1]);
         let w = d.layout.words[qi] as usize;
+        let flags = &data[at];
+        let parts = &data[at + 1..at + 1 + parts_of[qi]];
+        at += 1 + parts_of[qi];
+        // Items back to back, whichever layout the slots have.
+        let slots: Vec<u32> = match items {
+            ItemLayout::Interleaved => parts.concat(),
+            ItemLayout::Planar => (0..flags.len() * w).map(|x| parts[x % w][x / w]).collect(),
+        };
         for (i, f) in flags.iter().enumerate() {
             match *f {
                 CONSUMED => {}
@@ -99,12 +118,14 @@ impl DeviceCompaction {
         old: &DeviceQueues,
         new: &DeviceQueues,
         reserved: &[u32],
+        items: ItemLayout,
     ) -> Result<CompactionPass, RunError> {
         let nq = reserved.len();
-        let mut cp = vec![0u32; 8 + 8 * nq];
+        let mut cp = vec![0u32; 8 + CP_QUEUE_WORDS * nq];
         cp[0] = g(nq, G_LOST) as u32;
         for (qi, &r) in reserved.iter().enumerate() {
-            cp[8 + 8 * qi..16 + 8 * qi].copy_from_slice(&[
+            let at = 8 + CP_QUEUE_WORDS * qi;
+            cp[at..at + CP_QUEUE_WORDS].copy_from_slice(&[
                 r,
                 old.layout.slot_base[qi],
                 old.layout.flag_base[qi],
@@ -113,6 +134,8 @@ impl DeviceCompaction {
                 new.layout.words[qi],
                 new.layout.capacity[qi],
                 q(qi, Q_KEPT) as u32,
+                old.layout.capacity[qi],
+                (items == ItemLayout::Planar) as u32,
             ]);
         }
         let params = gpu.storage_buffer("compaction params", cp.len() as u64)?;

@@ -17,6 +17,7 @@ use compact::{CompactionPass, DeviceCompaction};
 use crate::error::RunError;
 use crate::gpu::Gpu;
 use crate::growth::grow;
+use crate::item_layout::ItemLayout;
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
 use crate::queue_layout::{QueueLayout, RunStart};
@@ -88,6 +89,9 @@ pub struct MegakernelConfig {
     pub max_capacity: u32,
     /// Launches per run before it stops with [`RunError::NoProgress`] (default 10,000).
     pub max_launches: u32,
+    /// How queues and outboxes hold items; `None` (the default) picks
+    /// [`ItemLayout::for_program`].
+    pub item_layout: Option<ItemLayout>,
 }
 
 impl Default for MegakernelConfig {
@@ -102,6 +106,7 @@ impl Default for MegakernelConfig {
             initial_capacity: 1 << 16,
             max_capacity: 1 << 26,
             max_launches: 10_000,
+            item_layout: None,
         }
     }
 }
@@ -197,7 +202,11 @@ impl Megakernel {
             }
             outbox_stride = outbox_stride.max(off).next_multiple_of(4);
         }
-        let source = wgsl::source(program, gpu.coherent);
+        let items = config
+            .item_layout
+            .unwrap_or_else(|| ItemLayout::for_program(gpu, program));
+        config.item_layout = Some(items);
+        let source = wgsl::source(program, gpu.coherent, items);
         let entries = [
             storage_entry(0, false),
             storage_entry(1, false),
@@ -235,6 +244,11 @@ impl Megakernel {
     /// The program this megakernel runs.
     pub fn program(&self) -> &Program {
         &self.program
+    }
+
+    /// How its queues hold items (the configured layout, or the adapter's).
+    pub fn item_layout(&self) -> ItemLayout {
+        self.config.item_layout.unwrap_or_default()
     }
 
     /// Workgroups per launch, probing on first use (the probe launch needs the user's bind
@@ -372,11 +386,7 @@ impl Megakernel {
             let n = (items.len() / dq.layout.words[q] as usize) as u32;
             counts.push(n);
             if n > 0 {
-                gpu.queue.write_buffer(
-                    &dq.slots,
-                    dq.layout.slot_base[q] as u64 * 4,
-                    bytemuck::cast_slice(items),
-                );
+                (self.item_layout()).write_items(&gpu.queue, &dq.slots, &dq.layout, q, items);
                 let f = vec![SEED_STAMP; n as usize];
                 gpu.queue.write_buffer(
                     &dq.flags,
@@ -466,7 +476,10 @@ impl Megakernel {
                     live,
                 } => {
                     self.write_ctrl(gpu, &d.ctrl, live);
-                    Some(self.compaction.prepare(gpu, old, d, reserved)?)
+                    Some(
+                        self.compaction
+                            .prepare(gpu, old, d, reserved, self.item_layout())?,
+                    )
                 }
             };
             let mut enc = gpu.device.create_command_encoder(&Default::default());
@@ -590,7 +603,13 @@ impl Megakernel {
                 }
             } else {
                 stats.submits += 1;
-                Start::Upload(compact::host_compact(gpu, &self.program, d, &ctrl)?)
+                Start::Upload(compact::host_compact(
+                    gpu,
+                    &self.program,
+                    d,
+                    &ctrl,
+                    self.item_layout(),
+                )?)
             };
         }
         stats.queue_bytes = dq

@@ -8,6 +8,7 @@ use super::layout::*;
 use super::{DeviceQueues, Megakernel};
 use crate::error::RunError;
 use crate::gpu::Gpu;
+use crate::item_layout::{ItemLayout, PlanarScatter};
 use crate::program::Program;
 use crate::queue_layout::QueueLayout;
 use crate::recorded::{Outcome, RecordedSize};
@@ -20,6 +21,8 @@ pub(crate) struct Recorded {
     /// [`SEED_STAMP`] for the most seeds of one queue.
     stamps: wgpu::Buffer,
     workgroups: u32,
+    /// Moves device seeds into planar queues (`None` for interleaved ones: a buffer copy).
+    scatter: Option<PlanarScatter>,
 }
 
 impl Megakernel {
@@ -79,11 +82,16 @@ impl Megakernel {
             capacity,
             rounds: 0,
         };
+        let scatter = match self.item_layout() {
+            ItemLayout::Interleaved => None,
+            ItemLayout::Planar => Some(PlanarScatter::new(gpu, &dq.layout, seeded)?),
+        };
         let r = Recorded {
             dq,
             ctrl_start,
             stamps,
             workgroups,
+            scatter,
         };
         Ok((r, size))
     }
@@ -127,7 +135,10 @@ impl Recorded {
         m.kernels.check_user_group(user)?;
         let d = &self.dq;
         enc.clear_buffer(&d.flags, 0, None);
-        d.layout.encode_seed_copies(enc, seeds, &d.slots);
+        match &self.scatter {
+            Some(s) => s.record(enc, seeds, &d.slots),
+            None => d.layout.encode_seed_copies(enc, seeds, &d.slots),
+        }
         for &(q, _, n) in seeds.iter().filter(|s| s.2 > 0) {
             enc.copy_buffer_to_buffer(
                 &self.stamps,

@@ -2,12 +2,17 @@
 //! `@coherent` loads where the device has them, atomics otherwise), enqueue functions that write
 //! to the workgroup's outbox, and the loop in `shaders/megakernel.wgsl`.
 
+use crate::item_layout::{ItemLayout, planar_load_store_fns};
 use crate::program::Program;
 
 pub const TEMPLATE: &str = include_str!("../../../shaders/megakernel.wgsl");
 
-pub fn source(program: &Program, coherent: bool) -> String {
+/// The megakernel's WGSL for `program`, with `slots` read through `@coherent` loads where the
+/// device has them, and queues and outboxes holding items as `items` says.
+pub fn source(program: &Program, coherent: bool, items: ItemLayout) -> String {
+    let planar = items == ItemLayout::Planar;
     let mut s = program.tables_wgsl();
+    s += &format!("const ITEMS_PLANAR: bool = {planar};\n");
     s += &program.common_wgsl();
     if coherent {
         s += "@group(0) @binding(1) @coherent var<storage, read_write> slots: array<vec4<u32>>;\n";
@@ -22,21 +27,48 @@ pub fn source(program: &Program, coherent: bool) -> String {
                   for (var k = 0u; k < 4u; k++) { atomicStore(&slots[i + k], v[k]); }\n}\n";
     }
     s += &crate::wgsl::vec4_word_accessors("sched_ob", "outbox");
-    s += &program.execute_switch("sched_slot");
+    s += &program.execute_switch("sched_slot", items);
+    // Runs the item in slot `s` of queue `q`; outbox item `j` of part (q, t) and its stride.
+    let (slot_at, ob_at, ob_stride) = if planar {
+        (
+            "q_slot_base(q) + s, q_cap(q)",
+            "sched_outbox + ob_off(q, t) + j",
+            "ob_cap(q, t)",
+        )
+    } else {
+        (
+            "q_slot_base(q) + s * WORDS[q]",
+            "sched_outbox + ob_off(q, t) + j * WORDS[t]",
+            "1u",
+        )
+    };
+    s += &format!(
+        "fn mk_execute(q: u32, s: u32, inv: Invocation) {{ sched_execute(q, {slot_at}, inv); }}\n\
+         fn mk_outbox_item(q: u32, t: u32, j: u32) -> u32 {{ return {ob_at}; }}\n\
+         fn mk_outbox_stride(q: u32, t: u32) -> u32 {{ return {ob_stride}; }}\n"
+    );
     // The outbox only needs typed stores; loads of the same prefix are generated and unused.
     let mut seen = Vec::new();
     for p in &program.procs {
         if !seen.contains(&p.layout.name) {
             seen.push(p.layout.name.clone());
-            s += &crate::wgsl::load_store_fns(&p.layout, "sched_ob");
+            s += &match items {
+                ItemLayout::Interleaved => crate::wgsl::load_store_fns(&p.layout, "sched_ob"),
+                ItemLayout::Planar => planar_load_store_fns(&p.layout, "sched_ob"),
+            };
         }
     }
     for (t, p) in program.procs.iter().enumerate() {
         s += &format!(
             "fn enqueue_{name}(item: {ty}) {{\n    if !sched_active {{ return; }}\n    \
-             let at = sched_outbox_slot({t}u);\n    if at != 0xffffffffu {{ sched_ob_store_{ty}(at, item); }}\n}}\n",
+             let at = sched_outbox_slot({t}u);\n    if at != 0xffffffffu {{ sched_ob_store_{ty}(at{stride}, item); }}\n}}\n",
             name = p.proc.name,
-            ty = p.layout.name
+            ty = p.layout.name,
+            stride = if planar {
+                format!(", mk_outbox_stride(sched_proc, {t}u)")
+            } else {
+                String::new()
+            },
         );
     }
     s += TEMPLATE;

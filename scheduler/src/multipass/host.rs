@@ -11,6 +11,7 @@ use std::time::Instant;
 use crate::error::RunError;
 use crate::gpu::Gpu;
 use crate::growth::grow;
+use crate::item_layout::{ItemLayout, planar_load_store_fns};
 use crate::multipass::partial::{at_limit, needs_partial, partial_round};
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
@@ -41,6 +42,9 @@ pub struct HostMultipassConfig {
     pub max_capacity: u32,
     /// Rounds before the run gives up with [`RunError::NoProgress`] (default 100,000).
     pub max_rounds: u32,
+    /// How the round buffers hold items; `None` (the default) picks
+    /// [`ItemLayout::for_program`].
+    pub item_layout: Option<ItemLayout>,
 }
 
 impl Default for HostMultipassConfig {
@@ -49,6 +53,7 @@ impl Default for HostMultipassConfig {
             initial_capacity: 1 << 16,
             max_capacity: 1 << 26,
             max_rounds: 100_000,
+            item_layout: None,
         }
     }
 }
@@ -82,31 +87,45 @@ struct HostRounds {
     bind: [wgpu::BindGroup; 2],
 }
 
-/// The WGSL of the host-driven multi-pass: shared program code, append-style enqueue
-/// functions, one entry point per procedure (`mp_host_<name>`), then the template.
-pub(crate) fn source(program: &Program) -> String {
+/// The WGSL of the host-driven multi-pass: shared program code, `mp_execute` (runs item `i` of
+/// a queue's region), append-style enqueue functions, one entry point per procedure
+/// (`mp_host_<name>`), then the template.
+pub(crate) fn source(program: &Program, items: ItemLayout) -> String {
     let mut s = program.tables_wgsl();
     s += &program.common_wgsl();
     s += &crate::wgsl::vec4_word_accessors("mp_in", "items_in");
     s += &crate::wgsl::vec4_word_accessors("mp_out", "items_out");
-    s += &program.execute_switch("mp_in");
+    s += &program.execute_switch("mp_in", items);
     let mut seen = Vec::new();
     for p in &program.procs {
         if !seen.contains(&p.layout.name) {
             seen.push(p.layout.name.clone());
-            s += &crate::wgsl::load_store_fns(&p.layout, "mp_out");
+            s += &match items {
+                ItemLayout::Interleaved => crate::wgsl::load_store_fns(&p.layout, "mp_out"),
+                ItemLayout::Planar => planar_load_store_fns(&p.layout, "mp_out"),
+            };
         }
     }
+    // Where item `at` of queue `t` starts, and (planar) the stride between its words.
+    let item_at = |t: &str| match items {
+        ItemLayout::Interleaved => format!("q_base({t}) + at * WORDS[{t}]"),
+        ItemLayout::Planar => format!("q_base({t}) + at, q_cap({t})"),
+    };
+    s += &format!(
+        "fn mp_execute(t: u32, at: u32, inv: Invocation) {{ sched_execute(t, {}, inv); }}\n",
+        item_at("t")
+    );
     let args = "@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>, \
                 @builtin(num_workgroups) nwg: vec3<u32>";
     for (t, p) in program.procs.iter().enumerate() {
         s += &format!(
             "fn enqueue_{name}(item: {ty}) {{\n    if !sched_active {{ return; }}\n    \
              let at = sched_append_slot({t}u);\n    if at == 0xffffffffu {{ return; }}\n    \
-             mp_out_store_{ty}(q_base({t}u) + at * WORDS[{t}u], item);\n}}\n\
+             mp_out_store_{ty}({store_at}, item);\n}}\n\
              @compute @workgroup_size(256) fn mp_host_{name}({args}) {{ run_procedure({t}u, lid, wid.x, nwg.x); }}\n",
             name = p.proc.name,
-            ty = p.layout.name
+            ty = p.layout.name,
+            store_at = item_at(&format!("{t}u")),
         );
     }
     s += TEMPLATE;
@@ -119,14 +138,23 @@ impl HostMultipass {
         &self.program
     }
 
+    /// How its round buffers hold items (the configured layout, or the adapter's).
+    pub fn item_layout(&self) -> ItemLayout {
+        self.config.item_layout.unwrap_or_default()
+    }
+
     /// Compiles `program` for the host-driven multi-pass on `gpu`. Errors:
     /// [`RunError::Program`] for more than 16 procedures or WGSL that does not compile with the
     /// generated code.
     pub fn new(
         gpu: &Gpu,
         program: &Program,
-        config: HostMultipassConfig,
+        mut config: HostMultipassConfig,
     ) -> Result<HostMultipass, RunError> {
+        let items = config
+            .item_layout
+            .unwrap_or_else(|| ItemLayout::for_program(gpu, program));
+        config.item_layout = Some(items);
         if program.queue_count() > 16 {
             return Err(RunError::Program(
                 "the multi-pass strategy supports at most 16 procedures".into(),
@@ -143,7 +171,7 @@ impl HostMultipass {
             gpu,
             program,
             "multipass-host",
-            &source(program),
+            &source(program, items),
             &entries,
             &eps,
             None,
@@ -248,14 +276,9 @@ impl HostMultipass {
             _ => self.rounds_buffers(gpu, layout)?,
         };
         // Seeds: the inputs of the first round, at parity 0.
-        for (q, items) in live.iter().enumerate() {
-            if !items.is_empty() {
-                gpu.queue.write_buffer(
-                    &d.items[0],
-                    d.layout.slot_base[q] as u64 * 4,
-                    bytemuck::cast_slice(items),
-                );
-            }
+        let items = self.item_layout();
+        for (q, seed) in live.iter().enumerate() {
+            items.write_items(&gpu.queue, &d.items[0], &d.layout, q, seed);
         }
         gpu.queue
             .write_buffer(&d.counts[0], 0, bytemuck::cast_slice(&first_counts(&n)));
@@ -287,16 +310,13 @@ impl HostMultipass {
                 let new =
                     self.rounds_buffers(gpu, QueueLayout::new(&self.program, capacity.clone())?)?;
                 for (q, &k) in n.iter().enumerate() {
-                    let bytes = k as u64 * d.layout.words[q] as u64 * 4;
-                    if bytes > 0 {
-                        enc.copy_buffer_to_buffer(
-                            &d.items[par],
-                            d.layout.slot_base[q] as u64 * 4,
-                            &new.items[0],
-                            new.layout.slot_base[q] as u64 * 4,
-                            bytes,
-                        );
-                    }
+                    items.encode_copy(
+                        &mut enc,
+                        (&d.items[par], &d.layout),
+                        (&new.items[0], &new.layout),
+                        q,
+                        k,
+                    );
                 }
                 gpu.queue
                     .write_buffer(&new.counts[0], 0, bytemuck::cast_slice(&first_counts(&n)));
@@ -332,17 +352,13 @@ impl HostMultipass {
                     inputs[q] = run[q];
                     inputs[nq + H_SKIP + q] = keep;
                     carried[q] = keep;
-                    let bytes = keep as u64 * d.layout.words[q] as u64 * 4;
-                    let base = d.layout.slot_base[q] as u64 * 4;
-                    if bytes > 0 {
-                        enc.copy_buffer_to_buffer(
-                            &d.items[par],
-                            base,
-                            &d.items[1 - par],
-                            base,
-                            bytes,
-                        );
-                    }
+                    items.encode_copy(
+                        &mut enc,
+                        (&d.items[par], &d.layout),
+                        (&d.items[1 - par], &d.layout),
+                        q,
+                        keep,
+                    );
                 }
                 gpu.queue
                     .write_buffer(&d.counts[par], 0, bytemuck::cast_slice(&inputs));
