@@ -1160,3 +1160,31 @@ fn motion_blur_and_depth_of_field_from_the_command_line() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `--raster nearest` samples no time or lens: with `--spin` or `--dof` it is a usage error
+/// (exit 2) naming both flags, on every subcommand that renders, and no image is written.
+#[test]
+fn nearest_rasterization_with_motion_or_depth_of_field_is_a_usage_error() {
+    let dir = scratch("nearest-motion");
+    for (cmd, flag) in [
+        (
+            ["render", "-o", "x.png", "--cpu"].as_slice(),
+            ["--spin", "30"],
+        ),
+        (
+            ["render", "-o", "x.png", "--cpu"].as_slice(),
+            ["--dof", "2,100,420"],
+        ),
+        (["bench"].as_slice(), ["--spin", "30"]),
+    ] {
+        let mut args = cmd.to_vec();
+        args.extend(["--raster", "nearest", flag[0], flag[1]]);
+        let (code, _, err) = reyes_any(&dir, &args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(
+            err.contains("--raster nearest") && err.contains(flag[0]),
+            "{err}"
+        );
+    }
+    assert!(!dir.join("x.png").exists());
+}

@@ -114,6 +114,16 @@ pub fn run(cli: &Cli) -> Result<bool, String> {
     Ok(records.iter().all(|r| r.verified))
 }
 
+/// `x` with `digits` significant digits and no exponent (a CPU adapter's 0.000514 G items/s
+/// stays readable beside a GPU's 4.91).
+fn significant(x: f64, digits: i32) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let decimals = (digits - 1 - x.abs().log10().floor() as i32).max(0);
+    format!("{x:.*}", decimals as usize)
+}
+
 fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord]) {
     let Some((workload, cs)) = cells(records).into_iter().next() else {
         return;
@@ -142,10 +152,8 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
             c.ok(),
             fmt(c.gpu),
             fmt(c.wall),
-            c.gpu.map_or("n/a".into(), |g| format!(
-                "{:.2}",
-                c.items as f64 / g.0 / 1e6
-            )),
+            c.gpu
+                .map_or("n/a".into(), |g| significant(c.items as f64 / g.0 / 1e6, 3)),
             c.launches,
             c.rounds
         );
@@ -174,5 +182,16 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
                 );
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn rates_keep_three_significant_digits() {
+        assert_eq!(super::significant(4.9112, 3), "4.91");
+        assert_eq!(super::significant(0.000514, 3), "0.000514");
+        assert_eq!(super::significant(123.4, 3), "123");
+        assert_eq!(super::significant(0.0, 3), "0");
     }
 }

@@ -77,6 +77,36 @@ impl Command {
             Command::View(_) => "view",
         }
     }
+
+    /// The frame options of subcommands that render one.
+    fn render_args(&self) -> Option<&RenderArgs> {
+        match self {
+            Command::Render(c) => Some(&c.render),
+            Command::Measure(c) => Some(&c.render),
+            Command::Holes(c) => Some(&c.render),
+            Command::Bench(c) => Some(&c.render),
+            Command::View(c) => Some(&c.render),
+            Command::Sweep(_) | Command::Drift(_) => None,
+        }
+    }
+
+    /// Conflicts between options that clap's attributes cannot express, as usage errors (exit
+    /// 2, like clap's own): `--raster nearest` samples no motion or lens, so it cannot go with
+    /// `--spin` or `--dof`. (A scene file's own motion with `--raster nearest` is refused when
+    /// the scene is read, naming the flag.)
+    pub fn check_conflicts(&self) -> Result<(), String> {
+        if let Some(r) = self.render_args()
+            && r.raster == Raster::Nearest
+            && (r.spin.is_some() || r.dof.is_some())
+        {
+            let flag = if r.spin.is_some() { "--spin" } else { "--dof" };
+            return Err(format!(
+                "the argument '--raster nearest' cannot be used with '{flag}': motion blur and \
+                 depth of field need bounding-box rasterization (--raster bbox)"
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// The options of one rendered frame, shared by `render` and `measure`.

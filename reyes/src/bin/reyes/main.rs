@@ -301,6 +301,12 @@ fn times_text(runs: Option<&RunSummary>, gpu_ms: Option<f64>, last_wall_ms: f64)
 fn main() -> ExitCode {
     // Usage errors exit 2 naming the flag; --help and --version print to stdout and exit 0.
     let cli = Cli::parse();
+    if let Err(e) = cli.command.check_conflicts() {
+        use clap::CommandFactory;
+        Cli::command()
+            .error(clap::error::ErrorKind::ArgumentConflict, e)
+            .exit();
+    }
     reyes::driver_env::ensure_xdg_runtime_dir();
     reyes::logging::init();
     let name = cli.command.name();
