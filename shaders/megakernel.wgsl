@@ -76,6 +76,8 @@ var<workgroup> wg_emit_count: array<atomic<u32>, NQ>;
 var<workgroup> wg_emit_base: array<u32, NQ>;
 var<workgroup> wg_emit_n: array<u32, NQ>;
 var<workgroup> wg_abandoned: atomic<u32>;
+// Direct enqueue: the tickets this batch took, per target from ES_OFF[q * NQ + t].
+var<workgroup> wg_emit_slot: array<u32, EMIT_SLOTS>;
 
 var<private> sched_proc: u32;
 var<private> sched_active: bool;
@@ -108,6 +110,20 @@ fn sched_outbox_slot(t: u32) -> u32 {
         return 0xffffffffu;
     }
     return mk_outbox_item(sched_proc, t, j);
+}
+
+// Direct enqueue: a ticket of queue t for the j-th item this batch emits to t, listed for
+// publishing, or a raised error. The claim reserved the batch's worst case in t's budget, so the
+// ticket is below t's capacity.
+fn sched_direct_slot(t: u32) -> u32 {
+    let j = atomicAdd(&wg_emit_count[t], 1u);
+    if j >= sched_batch_n * EMITS[sched_proc * NQ + t] {
+        sched_raise(ERR_EMIT, sched_proc, t);
+        return 0xffffffffu;
+    }
+    let s = atomicAdd(&ctrl[t * QSTRIDE + Q_RESERVE], 1u);
+    wg_emit_slot[ES_OFF[sched_proc * NQ + t] + j] = s;
+    return s;
 }
 
 fn release_budget(q: u32, n: u32, upto: u32) {
@@ -279,9 +295,14 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
                 wg_emit_n[t] = k;
                 emitted += k;
                 if k > 0u {
-                    let base = atomicAdd(&ctrl[t * QSTRIDE + Q_RESERVE], k);
-                    wg_emit_base[t] = base;
-                    let waiting = base + k - min(atomicLoad(&ctrl[t * QSTRIDE + Q_HEAD]), base + k);
+                    // Direct enqueue took its tickets item by item; else take k now.
+                    var end = atomicLoad(&ctrl[t * QSTRIDE + Q_RESERVE]);
+                    if !DIRECT_ENQUEUE {
+                        let base = atomicAdd(&ctrl[t * QSTRIDE + Q_RESERVE], k);
+                        wg_emit_base[t] = base;
+                        end = base + k;
+                    }
+                    let waiting = end - min(atomicLoad(&ctrl[t * QSTRIDE + Q_HEAD]), end);
                     atomicMax(&ctrl[t * QSTRIDE + Q_PEAK], waiting);
                 }
                 // Unused promised room goes back.
@@ -300,7 +321,7 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         // 4. Copy the payloads into the reserved slots, coalesced: planar items a plane at a
         //    time; interleaved ones 16 bytes per thread where the item is a whole number of vec4s
         //    (queue regions and outbox parts are 16-byte aligned).
-        for (var t = 0u; t < NQ; t++) {
+        for (var t = 0u; t < NQ && !DIRECT_ENQUEUE; t++) {
             let k = wg_emit_n[t];
             let words = k * WORDS[t];
             let dst = q_slot_base(t) + wg_emit_base[t] * WORDS[t];
@@ -343,7 +364,9 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         // 5. Publish: flag new slots with the batch stamp, mark processed inputs consumed.
         for (var t = 0u; t < NQ; t++) {
             for (var j = lid; j < wg_emit_n[t]; j += 256u) {
-                atomicStore(&flags[q_flag_base(t) + wg_emit_base[t] + j], wg_stamp);
+                var s = wg_emit_base[t] + j;
+                if DIRECT_ENQUEUE { s = wg_emit_slot[ES_OFF[q * NQ + t] + j]; }
+                atomicStore(&flags[q_flag_base(t) + s], wg_stamp);
             }
         }
         for (var i = lid; i < n; i += 256u) {

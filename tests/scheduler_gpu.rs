@@ -83,6 +83,20 @@ fn stress_configs() -> Vec<(&'static str, MegakernelConfig)> {
             },
         ),
         (
+            // Direct enqueue, whatever the item size (by default only items of 16+ words), on
+            // one-step batches (the two-step ones above are too large for it: outbox), tiny
+            // queues and impatient waits.
+            "direct enqueue, tiny queues, short launches, impatient waits",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(3),
+                max_iterations: 24,
+                spin_limit: 1,
+                initial_capacity: 16,
+                direct_enqueue: Some(true),
+                ..base.clone()
+            },
+        ),
+        (
             // The same in planar items: live items move plane by plane on the device (growth)
             // and through the host.
             "planar items, tiny queues, short launches, impatient waits",
@@ -156,6 +170,18 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
                 )
             })
             .collect();
+        // Both ways of enqueueing are exercised: straight into the slots, and (batches too
+        // large for a ticket list in workgroup memory) through the outbox.
+        let direct: Vec<bool> = (schedulers.iter())
+            .filter_map(|(_, s)| match s {
+                Scheduler::Megakernel(m) => Some(m.direct_enqueue()),
+                _ => None,
+            })
+            .collect();
+        assert!(
+            direct.contains(&true) && direct.contains(&false),
+            "{direct:?}"
+        );
         schedulers.push((
             "multipass, tiny queues".into(),
             Scheduler::multipass(

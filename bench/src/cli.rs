@@ -135,10 +135,25 @@ pub struct Cli {
     #[arg(long, value_parser = parse_item_layout, help_heading = "Scheduler")]
     pub item_layout: Option<ItemLayout>,
 
+    /// The megakernel enqueues straight into the target queue's slots (`direct`, when a batch's
+    /// worst case fits a ticket list in workgroup memory) or through a per-workgroup outbox
+    /// copied out after each batch (`outbox`) [default: direct for items of 16+ words].
+    #[arg(long, value_enum, help_heading = "Scheduler")]
+    pub enqueue: Option<Enqueue>,
+
     /// Queue slots at the start of a run [default: from the problem size].
     #[arg(long, value_name = "SLOTS", value_parser = value_parser!(u32).range(1..),
           help_heading = "Scheduler")]
     pub capacity: Option<u32>,
+}
+
+/// `--enqueue`: how megakernel items reach their queue.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Enqueue {
+    /// Straight into the slots (a ticket per item).
+    Direct,
+    /// Through the workgroup's outbox.
+    Outbox,
 }
 
 fn parse_item_layout(s: &str) -> Result<ItemLayout, String> {
@@ -247,6 +262,7 @@ impl Cli {
             idle_backoff: self.idle_backoff,
             capacity: self.capacity,
             item_layout: self.item_layout,
+            direct_enqueue: self.enqueue.map(|e| e == Enqueue::Direct),
         }
     }
 }

@@ -128,8 +128,10 @@ pub struct GpuConfig {
     pub batch_steps: u32,
     /// Longest pause of an idle megakernel workgroup (`MegakernelConfig::idle_backoff`).
     pub idle_backoff: u32,
-    /// How the queues hold items (`MegakernelConfig::item_layout`); `None`: the adapter's.
+    /// How the queues hold items (`MegakernelConfig::item_layout`); `None`: `ItemLayout::for_program`.
     pub item_layout: Option<ItemLayout>,
+    /// `MegakernelConfig::direct_enqueue`; `None`: by item size.
+    pub direct_enqueue: Option<bool>,
     /// Queue slots at the start of a run; `None` lets the workload choose from its size.
     pub capacity: Option<u32>,
 }
@@ -141,6 +143,7 @@ impl Default for GpuConfig {
             batch_steps: 1,
             idle_backoff: MegakernelConfig::default().idle_backoff,
             item_layout: None,
+            direct_enqueue: None,
             capacity: None,
         }
     }
@@ -171,6 +174,7 @@ pub fn compile(
                 batch_steps: config.batch_steps,
                 idle_backoff: config.idle_backoff,
                 item_layout: config.item_layout,
+                direct_enqueue: config.direct_enqueue,
                 initial_capacity: capacity,
                 ..Default::default()
             },

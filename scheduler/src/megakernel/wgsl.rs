@@ -8,11 +8,32 @@ use crate::program::Program;
 pub const TEMPLATE: &str = include_str!("../../../shaders/megakernel.wgsl");
 
 /// The megakernel's WGSL for `program`, with `slots` read through `@coherent` loads where the
-/// device has them, and queues and outboxes holding items as `items` says.
-pub fn source(program: &Program, coherent: bool, items: ItemLayout) -> String {
+/// device has them, and queues and outboxes holding items as `items` says. `direct`: enqueue
+/// straight into the slots, with the longest ticket list of a batch and each (source, target)
+/// part's offset in it (`MegakernelConfig::direct_enqueue`).
+pub fn source(
+    program: &Program,
+    coherent: bool,
+    items: ItemLayout,
+    direct: Option<(u32, &[u32])>,
+) -> String {
     let planar = items == ItemLayout::Planar;
     let mut s = program.tables_wgsl();
     s += &format!("const ITEMS_PLANAR: bool = {planar};\n");
+    let (slots, offsets) = direct.unwrap_or((1, &[]));
+    let nq = program.queue_count();
+    let es: Vec<String> = (0..nq * nq)
+        .map(|i| format!("{}u", offsets.get(i).copied().unwrap_or(0)))
+        .collect();
+    s += &format!(
+        "const DIRECT_ENQUEUE: bool = {};\n\
+         const EMIT_SLOTS: u32 = {slots}u;\n\
+         // ES_OFF[q * NQ + t]: where target t's tickets start in a batch of q's ticket list\n\
+         const ES_OFF: array<u32, {n2}> = array<u32, {n2}>({});\n",
+        direct.is_some(),
+        es.join(", "),
+        n2 = nq * nq
+    );
     s += &program.common_wgsl();
     if coherent {
         s += "@group(0) @binding(1) @coherent var<storage, read_write> slots: array<vec4<u32>>;\n";
@@ -42,6 +63,12 @@ pub fn source(program: &Program, coherent: bool, items: ItemLayout) -> String {
             "1u",
         )
     };
+    // Where item `s` of queue `q`'s slots starts (and its stride), for direct enqueue.
+    let slot_store_at = if planar {
+        "q_slot_base(t) + s, q_cap(t)"
+    } else {
+        "q_slot_base(t) + s * WORDS[t]"
+    };
     s += &format!(
         "fn mk_execute(q: u32, s: u32, inv: Invocation) {{ sched_execute(q, {slot_at}, inv); }}\n\
          fn mk_outbox_item(q: u32, t: u32, j: u32) -> u32 {{ return {ob_at}; }}\n\
@@ -57,6 +84,19 @@ pub fn source(program: &Program, coherent: bool, items: ItemLayout) -> String {
                 ItemLayout::Planar => planar_load_store_fns(&p.layout, "sched_ob"),
             };
         }
+    }
+    if direct.is_some() {
+        // `sched_slot_store_*` come with the loads of `execute_switch`.
+        for (t, p) in program.procs.iter().enumerate() {
+            s += &format!(
+                "fn enqueue_{name}(item: {ty}) {{\n    if !sched_active {{ return; }}\n    \
+                 let s = sched_direct_slot({t}u);\n    if s != 0xffffffffu {{ let t = {t}u; sched_slot_store_{ty}({slot_store_at}, item); }}\n}}\n",
+                name = p.proc.name,
+                ty = p.layout.name,
+            );
+        }
+        s += TEMPLATE;
+        return s;
     }
     for (t, p) in program.procs.iter().enumerate() {
         s += &format!(
