@@ -262,7 +262,7 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
             let idx = first + slot;
             sched_active = idx < n && wg_ready[min(idx, MAX_BATCH - 1u)] != 0u;
             let base = q_slot_base(q) + (h + idx) * WORDS[q];
-            sched_execute(q, base, Invocation(lid % THREADS[q], slot, sched_active));
+            sched_execute(q, base, Invocation(lid % THREADS[q], slot, sched_active, THREADS[q]));
             // The next step may reuse the body's workgroup memory: all threads finish this one first.
             workgroupBarrier();
         }

@@ -78,7 +78,7 @@ fn run_procedure(q: u32, lid: u32, wid: u32, nwg: u32) {
         sched_proc = q;
         sched_slot = slot;
         sched_active = live;
-        sched_execute(q, base + idx * WORDS[q], Invocation(thread, slot, live));
+        sched_execute(q, base + idx * WORDS[q], Invocation(thread, slot, live, THREADS[q]));
         workgroupBarrier();
     }
 }
