@@ -280,7 +280,7 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         for (var first = 0u; first < n; first += per_step) {
             let idx = first + slot;
             sched_active = idx < n && wg_ready[min(idx, MAX_BATCH - 1u)] != 0u;
-            mk_execute(q, h + idx, Invocation(lid % THREADS[q], slot, sched_active));
+            mk_execute(q, h + idx, Invocation(lid % THREADS[q], slot, sched_active, THREADS[q]));
             // The next step may reuse the body's workgroup memory: all threads finish this one first.
             workgroupBarrier();
         }

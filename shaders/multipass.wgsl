@@ -223,7 +223,7 @@ fn run_procedure(q: u32, lid: u32, wid: u32, nwg: u32) {
         sched_item = idx - keep;
         sched_slot = slot;
         sched_active = live;
-        sched_execute(q, q_in_base(q) + idx * WORDS[q], Invocation(thread, slot, live));
+        sched_execute(q, q_in_base(q) + idx * WORDS[q], Invocation(thread, slot, live, THREADS[q]));
         workgroupBarrier();
     }
 }

@@ -79,7 +79,7 @@ fn run_procedure(q: u32, lid: u32, wid: u32, nwg: u32) {
         sched_proc = q;
         sched_slot = slot;
         sched_active = live;
-        mp_execute(q, skip + idx, Invocation(thread, slot, live));
+        mp_execute(q, skip + idx, Invocation(thread, slot, live, THREADS[q]));
         workgroupBarrier();
     }
 }

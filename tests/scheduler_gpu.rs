@@ -602,6 +602,48 @@ fn every_thread_that_calls_enqueue_adds_an_item_on_every_strategy() {
     }
 }
 
+/// Two procedures of 4 and 2 threads running one execute function (`Procedure::execute_of`):
+/// each runs its own items with its own threads (`inv.threads`), enqueues as the function says
+/// under its own declared emits, on every strategy; the megakernel has one call site for both.
+#[test]
+fn procedures_sharing_an_execute_function_each_run_their_own_items_on_every_strategy() {
+    let gpu = gpu();
+    let n = 50u32;
+    let item = ItemType::new("Word", "struct Word { v: u32 }");
+    // Thread t of item v marks seen[4 v + t]; a seeded item (v < n) also sends v + n to narrow.
+    let wide = Procedure::new("wide", item.clone(), 4)
+        .emits("narrow", 1)
+        .body(&format!(
+            "fn wide_execute(item: Word, inv: Invocation) {{\n\
+             if inv.live {{ atomicAdd(&seen[item.v * 4u + inv.thread], inv.threads); }}\n\
+             if inv.thread == 0u && item.v < {n}u {{ enqueue_narrow(Word(item.v + {n}u)); }}\n}}"
+        ));
+    let narrow = Procedure::new("narrow", item, 2)
+        .emits("narrow", 1)
+        .execute_of("wide");
+    let user = UserBindings::storage(
+        "@group(1) @binding(0) var<storage, read_write> seen: array<atomic<u32>>;",
+        &[(0, false)],
+    );
+    let program = Program::new(vec![wide, narrow], user).unwrap();
+    let seeds = [Seed::new("wide", &(0..n).collect::<Vec<u32>>())];
+    // CPU reference: wide's 4 threads add 4 each to their items' words, narrow's 2 threads 2.
+    let mut expected = vec![0u32; 8 * n as usize];
+    for v in 0..n as usize {
+        expected[4 * v..4 * v + 4].fill(4);
+        expected[4 * (v + n as usize)..4 * (v + n as usize) + 2].fill(2);
+    }
+    for kind in StrategyKind::ALL {
+        let seen = gpu.storage_buffer("seen", 8 * n as u64).unwrap();
+        let bind = program.user.bind_group(&gpu, &[&seen]).unwrap();
+        let s = Scheduler::new(&gpu, &program, kind, 64).unwrap();
+        let stats = s.run(&gpu, &seeds, Some(&bind)).unwrap();
+        assert_eq!(stats.executed, [n as u64, n as u64], "{kind:?}");
+        let words = gpu.read_words(&seen, 0, 8 * n as u64).unwrap();
+        assert_eq!(words, expected, "{kind:?}");
+    }
+}
+
 /// A run recorded without host waits ([`RecordedRun`]): sized from a full run of the same work,
 /// recorded twice into one encoder from seeds in a device buffer, each status says it finished
 /// with the CPU's count; sized to its seeds, its status says it did not (never a silent partial

@@ -50,8 +50,8 @@ pub fn program_for(features: SceneFeatures) -> Result<Program, RunError> {
         // With SCENE_UVT the points at shutter close follow the open ones (sample_uvt.wgsl).
         .shared("vec4<f32>", if features.uvt { 512 } else { 256 })
         .body(shaders::DICE_SHADE);
-    // dicesmall_execute is defined in dice_shade.wgsl and shares diceshade_shared.
-    let dicesmall = Procedure::new("dicesmall", item, 64).body("");
+    // DiceSmall runs diceshade_execute (dice_shade.wgsl) and shares diceshade_shared.
+    let dicesmall = Procedure::new("dicesmall", item, 64).execute_of("diceshade");
     let user = UserBindings {
         wgsl: [
             &features.wgsl(),

@@ -306,18 +306,42 @@ impl Gpu {
     pub fn shader(&self, label: &str, source: &str) -> Result<wgpu::ShaderModule, RunError> {
         let start = std::time::Instant::now();
         crate::wgsl::validate(label, source)?;
-        let module = self
-            .device
-            .create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some(label),
-                source: wgpu::ShaderSource::Wgsl(source.into()),
-            });
+        let desc = wgpu::ShaderModuleDescriptor {
+            label: Some(label),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        };
+        let module = if self.driver_bounds_loops() {
+            // SAFETY: wgpu requires that no loop of the shader runs forever without naga's
+            // bounding; the driver stops every loop itself (see `driver_bounds_loops`).
+            unsafe {
+                self.device.create_shader_module_trusted(
+                    desc,
+                    wgpu::ShaderRuntimeChecks {
+                        force_loop_bounding: false,
+                        ..wgpu::ShaderRuntimeChecks::checked()
+                    },
+                )
+            }
+        } else {
+            self.device.create_shader_module(desc)
+        };
         log::debug!(
             "shader module `{label}` ({} bytes of WGSL): {:.1} ms",
             source.len(),
             start.elapsed().as_secs_f64() * 1e3
         );
         Ok(module)
+    }
+
+    /// True when the driver bounds every loop itself, which makes naga's loop bounding
+    /// (`wgpu::ShaderRuntimeChecks::force_loop_bounding`, a 64-bit counter and a break added to
+    /// every loop) redundant, so [`Gpu::shader`] leaves it out: lavapipe (adapter name
+    /// `llvmpipe`, Vulkan), whose LLVM code generator (gallivm) stops any loop after 65,535
+    /// iterations. There naga's bounding makes lavapipe's SPIR-V to NIR step, on every run,
+    /// about 2.5 times slower (the Reyes megakernel's pipeline: 1.9 s against 0.6-0.8 s), for
+    /// frames no faster (docs/scheduler.md, "Start-up on lavapipe").
+    pub fn driver_bounds_loops(&self) -> bool {
+        self.info.backend == wgpu::Backend::Vulkan && self.info.name.contains("llvmpipe")
     }
 
     /// A compute pipeline of one entry point of a WGSL source, its layout derived from the

@@ -330,6 +330,9 @@ fn type_name(module: &naga::Module, ty: Handle<naga::Type>) -> String {
 /// functions in one body).
 fn check_execute_functions(probe: &Probe, module: &naga::Module) -> Result<(), RunError> {
     for (i, p) in probe.program.procs.iter().enumerate() {
+        if p.proc.execute_of.is_some() {
+            continue; // the other procedure's function, checked there (Program::new)
+        }
         let name = &p.proc.name;
         let item = &p.layout.name;
         let expected = format!("fn {name}_execute(item: {item}, inv: Invocation)");
@@ -424,7 +427,7 @@ fn check_enqueue_targets(probe: &Probe, module: &naga::Module) -> Result<(), Run
         .collect();
     let name_of = |h: Handle<naga::Function>| module.functions[h].name.clone().unwrap_or_default();
     for p in procs {
-        let Some(root) = function(module, &format!("{}_execute", p.proc.name)) else {
+        let Some(root) = function(module, &p.proc.execute_fn()) else {
             continue;
         };
         // Depth-first from the execute function, remembering how each function was reached.
@@ -577,6 +580,54 @@ mod tests {
         assert!(
             n.contains("`r`, a parameter of `sum`") && n.contains("line 3"),
             "{n}"
+        );
+    }
+
+    #[test]
+    fn a_procedure_may_run_another_s_execute_function_with_one_call_site_in_the_megakernel() {
+        let one = Procedure::new("one", word(), 4)
+            .body("fn one_execute(item: Word, inv: Invocation) { let t = inv.threads; }");
+        let two = Procedure::new("two", word(), 2).execute_of("one");
+        let p = Program::new(vec![one.clone(), sink(), two.clone()], UserBindings::none()).unwrap();
+        let src = crate::megakernel::wgsl::source(&p, false, crate::ItemLayout::Interleaved, None);
+        assert_eq!(src.matches("one_execute(it, inv)").count(), 1, "{src}");
+        assert!(src.contains("case 0u, 2u:"), "{src}");
+        // Unknown, chained or of another item type: refused, naming the procedure.
+        let m = error(
+            vec![
+                one.clone(),
+                Procedure::new("two", word(), 2).execute_of("on"),
+            ],
+            UserBindings::none(),
+        );
+        assert!(
+            m.contains("procedure `two`") && m.contains("unknown `on`"),
+            "{m}"
+        );
+        let three = Procedure::new("three", word(), 1).execute_of("two");
+        let m = error(vec![one.clone(), two, three], UserBindings::none());
+        assert!(
+            m.contains("procedure `three`") && m.contains("`two` itself"),
+            "{m}"
+        );
+        let other = ItemType::new("Pair", "struct Pair { a: u32, b: u32 }");
+        let m = error(
+            vec![one, Procedure::new("two", other, 2).execute_of("one")],
+            UserBindings::none(),
+        );
+        assert!(m.contains("takes `Word` items, not `Pair`"), "{m}");
+    }
+
+    #[test]
+    fn a_procedure_running_another_s_function_declares_what_it_enqueues() {
+        let one = Procedure::new("one", word(), 1)
+            .emits("sink", 1)
+            .body("fn one_execute(item: Word, inv: Invocation) { enqueue_sink(item); }");
+        let two = Procedure::new("two", word(), 1).execute_of("one");
+        let m = error(vec![one, sink(), two], UserBindings::none());
+        assert!(
+            m.contains("procedure `two` enqueues to `sink` (one_execute -> enqueue_sink)"),
+            "{m}"
         );
     }
 

@@ -61,8 +61,10 @@ pub struct SharedMemory {
 /// all `threads_per_item` threads of an item together, in workgroup-uniform control flow (so it
 /// may call `workgroupBarrier`), also for padding slots: `inv.live == false` there, the item is
 /// zeroed and enqueues are ignored; any other side effect must check `inv.live`.
-/// `Invocation { thread, slot, live }`: `thread` in `0..threads_per_item`, `slot` in
-/// `0..items_per_step` with `items_per_step = 256 / threads_per_item`.
+/// `Invocation { thread, slot, live, threads }`: `thread` in `0..threads_per_item`, `slot` in
+/// `0..items_per_step` with `items_per_step = 256 / threads_per_item`, `threads` the running
+/// procedure's `threads_per_item` (which tells apart procedures that share an execute function,
+/// [`Procedure::execute_of`]).
 ///
 /// **Emitting work.** `enqueue_<target>(item)` appends one item to `target`'s queue *for every
 /// call, by every thread*: in an item of several threads, a call made by each of them adds one
@@ -88,6 +90,9 @@ pub struct Procedure {
     pub max_emits: Vec<(String, u32)>,
     /// The WGSL body ([`Procedure::body`]).
     pub body: String,
+    /// The procedure whose execute function this one runs, if not its own
+    /// ([`Procedure::execute_of`]).
+    pub execute_of: Option<String>,
 }
 
 impl Procedure {
@@ -102,6 +107,7 @@ impl Procedure {
             shared: None,
             max_emits: Vec::new(),
             body: String::new(),
+            execute_of: None,
         }
     }
 
@@ -130,5 +136,25 @@ impl Procedure {
     pub fn body(mut self, wgsl: &str) -> Self {
         self.body = wgsl.into();
         self
+    }
+
+    /// Runs procedure `other`'s execute function, `<other>_execute`, instead of one of its own
+    /// (which it then need not define): `other` is declared in the same program, has the same
+    /// item type and runs its own function; `inv.threads` tells the two apart. The megakernel
+    /// calls a function shared so from one place for all its procedures, so that a compiler that
+    /// inlines every call (lavapipe, turning SPIR-V into NIR) compiles its code once, not once
+    /// per procedure. Checked by [`crate::Program::new`].
+    pub fn execute_of(mut self, other: &str) -> Self {
+        self.execute_of = Some(other.into());
+        self
+    }
+
+    /// The name of the WGSL function that runs its items: `<name>_execute`, or
+    /// `<other>_execute` with [`Procedure::execute_of`].
+    pub fn execute_fn(&self) -> String {
+        format!(
+            "{}_execute",
+            self.execute_of.as_deref().unwrap_or(&self.name)
+        )
     }
 }

@@ -54,7 +54,9 @@ impl Program {
     /// `__`, without duplicates; threads per item a power of two from 1 to 256; `emits` targets
     /// are procedures; item structs can travel in a queue (see [`ItemType`](crate::ItemType));
     /// item structs, user WGSL and bodies compile together with stub `enqueue_*` functions;
-    /// every `<name>_execute(item: <Item>, inv: Invocation)` exists; no procedure calls
+    /// every `<name>_execute(item: <Item>, inv: Invocation)` exists (but for a procedure that
+    /// runs another's, [`Procedure::execute_of`]: that one exists and has the same item type,
+    /// and itself runs its own); no procedure calls
     /// `enqueue_<t>` (directly or through helpers) for a target it did not declare with
     /// [`Procedure::emits`]; every `@group(1)` variable has a layout entry of the same binding
     /// and storage access.
@@ -101,6 +103,27 @@ impl Program {
                     ))
                 })?;
                 emits[ti] += max;
+            }
+            if let Some(other) = &p.execute_of {
+                let o = index(other).map(|o| &procedures[o]).ok_or_else(|| {
+                    RunError::Program(format!(
+                        "procedure `{}` runs the execute function of unknown `{other}`",
+                        p.name
+                    ))
+                })?;
+                if o.execute_of.is_some() {
+                    return Err(RunError::Program(format!(
+                        "procedure `{}` runs `{other}_execute`, but `{other}` itself runs \
+                         another's: name the procedure that runs its own",
+                        p.name
+                    )));
+                }
+                if o.item.name != p.item.name {
+                    return Err(RunError::Program(format!(
+                        "procedure `{}` runs `{other}_execute`, which takes `{}` items, not `{}`",
+                        p.name, o.item.name, p.item.name
+                    )));
+                }
             }
             let layout = wgsl::struct_layout(&p.item.wgsl, &p.item.name)?;
             if layout.words() == 0 {
@@ -166,7 +189,8 @@ impl Program {
             Part::Generated,
             "struct Invocation {\n    // thread within the item, 0..threads_per_item\n    thread: u32,\n    \
              // item slot within the workgroup step, 0..items_per_step\n    slot: u32,\n    \
-             // false for padding slots at the end of a batch\n    live: bool,\n}"
+             // false for padding slots at the end of a batch\n    live: bool,\n    \
+             // threads per item of the running procedure\n    threads: u32,\n}"
                 .to_string(),
         )];
         let mut seen = Vec::new();
@@ -221,12 +245,23 @@ impl Program {
         s += &format!(
             "fn sched_execute(q: u32, base: u32, {stride_param}inv: Invocation) {{\n    switch q {{\n"
         );
-        for (i, p) in self.procs.iter().enumerate() {
+        // One case, and one call, per execute function (Procedure::execute_of).
+        let mut done = Vec::new();
+        for p in &self.procs {
+            let f = p.proc.execute_fn();
+            if done.contains(&f) {
+                continue;
+            }
+            let qs: Vec<String> = (self.procs.iter().enumerate())
+                .filter(|(_, o)| o.proc.execute_fn() == f)
+                .map(|(i, _)| format!("{i}u"))
+                .collect();
             s += &format!(
-                "        case {i}u: {{ var it: {t}; if inv.live {{ it = {prefix}_load_{t}(base{stride}); }} {n}_execute(it, inv); }}\n",
+                "        case {qs}: {{ var it: {t}; if inv.live {{ it = {prefix}_load_{t}(base{stride}); }} {f}(it, inv); }}\n",
+                qs = qs.join(", "),
                 t = p.layout.name,
-                n = p.proc.name
             );
+            done.push(f);
         }
         s += "        default: {}\n    }\n}\n";
         s

@@ -24,9 +24,11 @@ fn micropolygon_cover(item: PatchItem, info: PatchInfo, i: u32, j: u32, nu: u32,
 // Two procedures dice: DiceShade with 256 threads per grid, and DiceSmall with 64 for grids of
 // at most 64 points (most grids of a finely split model), so that four small grids share a
 // workgroup instead of leaving three quarters of its threads idle. Both use diceshade_shared:
-// a workgroup step runs one procedure, and 4 x 64 = 256 points fit either way.
-fn diceshade_execute(item: PatchItem, inv: Invocation) { dice_grid(item, inv, 256u); }
-fn dicesmall_execute(item: PatchItem, inv: Invocation) { dice_grid(item, inv, 64u); }
+// a workgroup step runs one procedure, and 4 x 64 = 256 points fit either way. DiceSmall runs
+// this function too (Procedure::execute_of), told apart by inv.threads: the megakernel then
+// holds one copy of the dicing code, where a compiler that inlines every call (lavapipe) would
+// compile two (docs/scheduler.md, "Start-up on lavapipe").
+fn diceshade_execute(item: PatchItem, inv: Invocation) { dice_grid(item, inv, inv.threads); }
 
 fn dice_grid(item: PatchItem, inv: Invocation, threads: u32) {
     var cp = item.cp;

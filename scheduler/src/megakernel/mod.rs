@@ -227,9 +227,7 @@ impl Megakernel {
             emit_slots = emit_slots.max(es);
         }
         let largest = program.procs.iter().map(|p| p.words()).max().unwrap_or(0);
-        let wanted = config
-            .direct_enqueue
-            .unwrap_or(largest >= DIRECT_MIN_WORDS);
+        let wanted = config.direct_enqueue.unwrap_or(largest >= DIRECT_MIN_WORDS);
         let direct = wanted && emit_slots <= MAX_DIRECT_EMITS;
         if direct {
             // Items go straight to their slots: no outbox.
