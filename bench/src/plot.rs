@@ -214,6 +214,8 @@ mod tests {
             policy: None,
             size: format!("{items}"),
             params: String::new(),
+            item_layout: None,
+            enqueue: None,
             adapter: String::new(),
             run: 0,
             items,

@@ -19,6 +19,12 @@ pub struct RunRecord {
     pub size: String,
     /// The workload's parameters in its own words.
     pub params: String,
+    /// How the queues held items (`interleaved`, `planar`); absent for CPU runs.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub item_layout: Option<String>,
+    /// The megakernel's enqueue (`direct`, `outbox`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub enqueue: Option<String>,
     pub adapter: String,
     /// Index of the timed run (0-based; the untimed warm-up run is not recorded).
     pub run: u32,
@@ -89,6 +95,8 @@ impl RunRecord {
             peak_occupancy: s.peak_occupancy,
             queue_bytes: s.queue_bytes,
             workgroups: s.workgroups,
+            item_layout: (!s.item_layout.is_empty()).then(|| s.item_layout.clone()),
+            enqueue: (!s.enqueue.is_empty()).then(|| s.enqueue.clone()),
             ..Self::failed(k, String::new())
         }
     }
@@ -101,6 +109,8 @@ impl RunRecord {
             policy: k.strategy.policy().map(|p| p.name().to_string()),
             size: k.prepared.size.clone(),
             params: k.prepared.params.clone(),
+            item_layout: None,
+            enqueue: None,
             adapter: k.adapter.to_string(),
             run: k.run,
             items: 0,

@@ -136,7 +136,7 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
         "{:<16} {:>10} {:>8} {:>20} {:>20} {:>11} {:>8} {:>7}",
         "strategy",
         "items",
-        "ok",
+        "verified",
         "gpu ms (med ± MAD)",
         "wall ms (med ± MAD)",
         "G items/s",
@@ -152,12 +152,32 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
             c.ok(),
             fmt(c.gpu),
             fmt(c.wall),
+            // Per GPU ms; runs without GPU time (the CPU's) per wall ms.
             c.gpu
+                .or(c.wall)
                 .map_or("n/a".into(), |g| significant(c.items as f64 / g.0 / 1e6, 3)),
             c.launches,
             c.rounds
         );
     }
+    // What each scheduler strategy ran with (item layout, the megakernel's enqueue).
+    let mut queues: Vec<String> = Vec::new();
+    for r in records {
+        if let Some(l) = &r.item_layout {
+            let e = r
+                .enqueue
+                .as_ref()
+                .map_or(String::new(), |e| format!(", {e} enqueue"));
+            let line = format!("{}: {l} items{e}", r.strategy);
+            if !queues.contains(&line) {
+                queues.push(line);
+            }
+        }
+    }
+    if !queues.is_empty() {
+        println!("queues: {}", queues.join("; "));
+    }
+    println!("G items/s: items per GPU time; for runs without GPU time (cpu), per wall time");
     // GPU time against the first strategy's (the megakernel's when it ran), as before.
     let gpu_timed: Vec<_> = cs.iter().filter_map(|c| c.gpu.map(|g| (c, g.0))).collect();
     if let Some(((first, a), rest)) = gpu_timed.split_first() {

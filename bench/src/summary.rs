@@ -390,6 +390,8 @@ mod tests {
             policy: mk.then(|| "priority".into()),
             size: "roots=1".into(),
             params: "p".into(),
+            item_layout: None,
+            enqueue: None,
             adapter: "a".into(),
             run: 0,
             items: 1000,

@@ -5,6 +5,11 @@
 pub struct RunStats {
     /// The strategy's name ([`crate::StrategyKind::name`]).
     pub strategy: String,
+    /// How the queues held items ([`crate::ItemLayout::name`]: `interleaved` or `planar`).
+    pub item_layout: String,
+    /// Megakernel: how items reached their queue, `direct` or `outbox`
+    /// (`MegakernelConfig::direct_enqueue`); empty for the other strategies.
+    pub enqueue: String,
     /// Items executed, per procedure (program order).
     pub executed: Vec<u64>,
     /// Multi-pass: rounds that ran some work.

@@ -290,6 +290,14 @@ impl Megakernel {
         self.config.direct_enqueue == Some(true)
     }
 
+    fn enqueue_name(&self) -> &'static str {
+        if self.direct_enqueue() {
+            "direct"
+        } else {
+            "outbox"
+        }
+    }
+
     /// How its queues hold items (the configured layout, or the program's).
     pub fn item_layout(&self) -> ItemLayout {
         self.config.item_layout.unwrap_or_default()
@@ -477,6 +485,8 @@ impl Megakernel {
             .collect();
         let mut stats = RunStats {
             strategy: "megakernel".into(),
+            item_layout: self.item_layout().name().into(),
+            enqueue: self.enqueue_name().into(),
             executed: vec![0; nq],
             peak_occupancy: vec![0; nq],
             workgroups,

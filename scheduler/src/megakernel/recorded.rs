@@ -23,6 +23,8 @@ pub(crate) struct Recorded {
     workgroups: u32,
     /// Moves device seeds into planar queues (`None` for interleaved ones: a buffer copy).
     scatter: Option<PlanarScatter>,
+    item_layout: ItemLayout,
+    direct: bool,
 }
 
 impl Megakernel {
@@ -92,6 +94,8 @@ impl Megakernel {
             stamps,
             workgroups,
             scatter,
+            item_layout: self.item_layout(),
+            direct: self.direct_enqueue(),
         };
         Ok((r, size))
     }
@@ -205,6 +209,8 @@ impl Recorded {
         }
         let mut stats = RunStats {
             strategy: "megakernel".into(),
+            item_layout: self.item_layout.name().into(),
+            enqueue: if self.direct { "direct" } else { "outbox" }.into(),
             executed: (0..nq).map(|qi| ctrl[q(qi, Q_EXECUTED)] as u64).collect(),
             peak_occupancy: (0..nq).map(|qi| ctrl[q(qi, Q_PEAK)] as u64).collect(),
             batches: (0..nq).map(|qi| ctrl[q(qi, Q_BATCHES)] as u64).sum(),

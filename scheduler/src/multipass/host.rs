@@ -262,6 +262,7 @@ impl HostMultipass {
             .collect();
         let mut stats = RunStats {
             strategy: "multipass-host".into(),
+            item_layout: self.item_layout().name().into(),
             executed: vec![0; nq],
             peak_occupancy: vec![0; nq],
             ..Default::default()

@@ -363,6 +363,7 @@ impl Multipass {
         let mut rounds = rounds_per_submit;
         let mut stats = RunStats {
             strategy: "multipass".into(),
+            item_layout: crate::ItemLayout::Interleaved.name().into(),
             executed: vec![0; nq],
             peak_occupancy: vec![0; nq],
             ..Default::default()

@@ -126,6 +126,7 @@ impl Recorded {
         }
         Ok(Outcome::Done(RunStats {
             strategy: "multipass".into(),
+            item_layout: crate::ItemLayout::Interleaved.name().into(),
             executed: (0..nq).map(|q| ctrl[c(q, C_EXEC)] as u64).collect(),
             peak_occupancy: (0..nq).map(|q| ctrl[c(q, C_PEAK)] as u64).collect(),
             rounds: ctrl[g(nq, G_ROUNDS)] as u64,
