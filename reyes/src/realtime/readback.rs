@@ -73,8 +73,9 @@ pub(crate) fn map_for_read(maps: &[wgpu::Buffer]) -> Arc<AtomicUsize> {
 
 /// After a frame's submission finished: waits until every buffer of [`map_for_read`] is
 /// mapped. wgpu may run a map callback on a later poll than the one that saw the submission
-/// finish, so this polls once more, then waits for all submitted work (bounded), before
-/// reporting a frame that finished unmapped as [`RunError::Device`].
+/// finish, or on another thread that polled the same device first (and is still running the
+/// callbacks), so this polls once more, waits for all submitted work, then polls for up to 5 s
+/// (all bounded), before reporting a frame that finished unmapped as [`RunError::Device`].
 pub(crate) fn await_mapped(
     gpu: &Gpu,
     mapped: &AtomicUsize,
@@ -86,6 +87,13 @@ pub(crate) fn await_mapped(
     }
     if mapped.load(Ordering::Acquire) != n {
         gpu.wait_for(None, what)?;
+    }
+    // Another thread polling the same device (tests share one) may have taken the callbacks
+    // and be running them right now: give it a moment, bounded, before calling it an error.
+    let deadline = std::time::Instant::now() + gpu.timeout.min(std::time::Duration::from_secs(5));
+    while mapped.load(Ordering::Acquire) != n && std::time::Instant::now() < deadline {
+        let _ = gpu.device.poll(wgpu::PollType::Poll);
+        std::thread::sleep(std::time::Duration::from_millis(1));
     }
     if mapped.load(Ordering::Acquire) != n {
         return Err(RunError::Device(format!(
