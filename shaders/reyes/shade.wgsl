@@ -1,4 +1,4 @@
-// Shading of one grid point with RenderMan's standard surfaces (constant, matte, plastic) and
+// Shading of one grid point with RenderMan's standard surfaces (constant, matte, plastic, metal) and
 // lights (ambient, distant, point). Rust twin: reyes/src/stages/shade.rs.
 
 // `n` is the outside normal (unnormalised); `cs` the surface colour (the material's Color or the
@@ -31,6 +31,8 @@ fn shade(p: vec3<f32>, n: vec3<f32>, m: Material, cs: vec3<f32>) -> vec3<f32> {
     if m.kind == 0u { return cs; }
     var c = cs * (m.ka * amb + m.kd * diff);
     if m.kind == 2u { c += m.specular * m.ks * spec; }
+    // metal: no diffuse (Kd is 0), the highlight tinted by the surface colour.
+    if m.kind == 3u { c += cs * m.ks * spec; }
     return c;
 }
 

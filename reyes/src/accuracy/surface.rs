@@ -109,6 +109,7 @@ pub fn shade(p: DVec3, n: DVec3, m: &Material, lights: &[Light]) -> DVec3 {
         SurfaceKind::Plastic => {
             m.color * (m.ka * amb + m.kd * diff) + m.specular_color * m.ks * spec
         }
+        SurfaceKind::Metal => m.color * (m.ka * amb + m.ks * spec),
     }
 }
 

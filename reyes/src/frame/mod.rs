@@ -475,6 +475,7 @@ fn gpu_material(m: &crate::scene::Material) -> Material {
             SurfaceKind::Constant => 0,
             SurfaceKind::Matte => 1,
             SurfaceKind::Plastic => 2,
+            SurfaceKind::Metal => 3,
         },
         specular: f3(m.specular_color),
         ka: m.ka as f32,

@@ -192,6 +192,9 @@ pub enum SurfaceKind {
     Constant,
     Matte,
     Plastic,
+    /// RenderMan's `metal`: `Cs * (Ka ambient + Ks specular)`, no diffuse term, the highlight
+    /// tinted by the surface colour.
+    Metal,
 }
 
 /// A surface shader instance with its parameters plus the `Color`/`Opacity` attributes.
@@ -210,13 +213,14 @@ pub struct Material {
 }
 
 impl Material {
-    /// Parameter defaults of RenderMan's standard shaders (constant, matte, plastic); white
-    /// and opaque.
+    /// Parameter defaults of RenderMan's standard shaders (constant, matte, plastic, metal);
+    /// white and opaque.
     pub fn standard(kind: SurfaceKind) -> Material {
         let (ka, kd, ks) = match kind {
             SurfaceKind::Constant => (1.0, 0.0, 0.0),
             SurfaceKind::Matte => (1.0, 1.0, 0.0),
             SurfaceKind::Plastic => (1.0, 0.5, 0.5),
+            SurfaceKind::Metal => (1.0, 0.0, 1.0),
         };
         Material {
             kind,

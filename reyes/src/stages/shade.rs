@@ -1,4 +1,4 @@
-//! Twin of `shaders/reyes/shade.wgsl`: RenderMan's constant, matte and plastic surfaces.
+//! Twin of `shaders/reyes/shade.wgsl`: RenderMan's constant, matte, plastic and metal surfaces.
 
 use crate::frame::{GpuLight, Material};
 use glam::Vec3;
@@ -36,6 +36,10 @@ pub fn shade(p: Vec3, n: Vec3, m: &Material, cs: Vec3, lights: &[GpuLight]) -> V
     let mut c = cs * (m.ka * amb + m.kd * diff);
     if m.kind == 2 {
         c += Vec3::from(m.specular) * m.ks * spec;
+    }
+    // metal: no diffuse (Kd is 0), the highlight tinted by the surface colour.
+    if m.kind == 3 {
+        c += cs * m.ks * spec;
     }
     c
 }

@@ -14,6 +14,7 @@ impl Interp {
             "constant" => SurfaceKind::Constant,
             "matte" => SurfaceKind::Matte,
             "plastic" => SurfaceKind::Plastic,
+            "metal" => SurfaceKind::Metal,
             _ => {
                 let msg = format!(
                     "skipped unsupported surface shader \"{}\" (keeping the previous surface)",
@@ -26,10 +27,14 @@ impl Interp {
         let mut m = Material::standard(kind);
         for p in a.params()? {
             match (kind, p.name) {
-                (SurfaceKind::Matte | SurfaceKind::Plastic, "Ka") => m.ka = p.num(a)?,
+                (SurfaceKind::Matte | SurfaceKind::Plastic | SurfaceKind::Metal, "Ka") => {
+                    m.ka = p.num(a)?
+                }
                 (SurfaceKind::Matte | SurfaceKind::Plastic, "Kd") => m.kd = p.num(a)?,
-                (SurfaceKind::Plastic, "Ks") => m.ks = p.num(a)?,
-                (SurfaceKind::Plastic, "roughness") => m.roughness = p.num(a)?,
+                (SurfaceKind::Plastic | SurfaceKind::Metal, "Ks") => m.ks = p.num(a)?,
+                (SurfaceKind::Plastic | SurfaceKind::Metal, "roughness") => {
+                    m.roughness = p.num(a)?
+                }
                 (SurfaceKind::Plastic, "specularcolor") => m.specular_color = p.vec3(a)?,
                 (_, other) => self.ignored_param(req, other),
             }

@@ -110,3 +110,35 @@ fn sides() {
         "t.rib:2: `Sides`: sides must be 1 or 2, found 3"
     );
 }
+
+/// RenderMan's `metal` (Ka, Ks, roughness; no Kd): its parameters, its defaults (Ka 1, Ks 1,
+/// roughness 0.1, no diffuse), and a `Kd` it does not have ignored with a warning.
+#[test]
+fn metal_surface() {
+    let s = parse(&world(&format!(
+        "Surface \"metal\" \"Ka\" .5 \"Ks\" .7 \"roughness\" .05\n{QUAD}\nSurface \"metal\" \"Kd\" .9\n{QUAD}"
+    )));
+    let m: Vec<&Material> = s
+        .patches
+        .iter()
+        .map(|p| &s.materials[p.material as usize])
+        .collect();
+    assert_eq!(
+        *m[0],
+        Material {
+            ka: 0.5,
+            ks: 0.7,
+            roughness: 0.05,
+            ..Material::standard(SurfaceKind::Metal)
+        }
+    );
+    assert_eq!(
+        (m[1].kind, m[1].ka, m[1].kd, m[1].ks, m[1].roughness),
+        (SurfaceKind::Metal, 1.0, 0.0, 1.0, 0.1)
+    );
+    assert!(
+        s.warnings.iter().any(|w| w.contains("Kd")),
+        "{:?}",
+        s.warnings
+    );
+}
