@@ -15,6 +15,10 @@ impl Interp {
             "matte" => SurfaceKind::Matte,
             "plastic" => SurfaceKind::Plastic,
             "metal" => SurfaceKind::Metal,
+            // RenderMan's textured variants: without a texture (`texturename` "", the default)
+            // they are exactly metal and plastic; a texture is ignored with a warning.
+            "shinymetal" => SurfaceKind::Metal,
+            "paintedplastic" => SurfaceKind::Plastic,
             _ => {
                 let msg = format!(
                     "skipped unsupported surface shader \"{}\" (keeping the previous surface)",

@@ -142,3 +142,27 @@ fn metal_surface() {
         s.warnings
     );
 }
+
+/// `shinymetal` and `paintedplastic` without their texture are metal and plastic; their texture
+/// parameters are ignored with a warning naming them.
+#[test]
+fn textured_standard_surfaces_without_textures() {
+    let s = parse(&world(&format!(
+        "Surface \"shinymetal\" \"Ks\" .6 \"Kr\" 1 \"texturename\" \"env.tx\"\n{QUAD}\n\
+         Surface \"paintedplastic\" \"Kd\" .8 \"texturename\" \"grid.tx\"\n{QUAD}"
+    )));
+    let m: Vec<&Material> = s
+        .patches
+        .iter()
+        .map(|p| &s.materials[p.material as usize])
+        .collect();
+    assert_eq!((m[0].kind, m[0].ks), (SurfaceKind::Metal, 0.6));
+    assert_eq!((m[1].kind, m[1].kd), (SurfaceKind::Plastic, 0.8));
+    for p in ["Kr", "texturename"] {
+        assert!(
+            s.warnings.iter().any(|w| w.contains(p)),
+            "{p}: {:?}",
+            s.warnings
+        );
+    }
+}
