@@ -1,6 +1,7 @@
 //! Generates the megakernel's WGSL: the program's shared code, queue word accessors (plain
 //! `@coherent` loads where the device has them, atomics otherwise), enqueue functions that write
-//! to the workgroup's outbox, and the loop in `shaders/megakernel.wgsl`.
+//! to the workgroup's outbox or (direct enqueue) straight into the slots, and the loop in
+//! `shaders/megakernel.wgsl`.
 
 use crate::item_layout::{ItemLayout, planar_load_store_fns};
 use crate::program::Program;
@@ -49,34 +50,30 @@ pub fn source(
     }
     s += &crate::wgsl::vec4_word_accessors("sched_ob", "outbox");
     s += &program.execute_switch("sched_slot", items);
-    // Runs the item in slot `s` of queue `q`; outbox item `j` of part (q, t) and its stride.
-    let (slot_at, ob_at, ob_stride) = if planar {
-        (
-            "q_slot_base(q) + s, q_cap(q)",
-            "sched_outbox + ob_off(q, t) + j",
-            "ob_cap(q, t)",
-        )
-    } else {
-        (
-            "q_slot_base(q) + s * WORDS[q]",
-            "sched_outbox + ob_off(q, t) + j * WORDS[t]",
-            "1u",
-        )
+    // Where item `s` of queue `q`'s slots starts (planar: and its stride).
+    let slot_at = |q: &str| {
+        if planar {
+            format!("q_slot_base({q}) + s, q_cap({q})")
+        } else {
+            format!("q_slot_base({q}) + s * WORDS[{q}]")
+        }
     };
-    // Where item `s` of queue `q`'s slots starts (and its stride), for direct enqueue.
-    let slot_store_at = if planar {
-        "q_slot_base(t) + s, q_cap(t)"
+    // Outbox item `j` of part (q, t) and its stride.
+    let (ob_at, ob_stride) = if planar {
+        ("sched_outbox + ob_off(q, t) + j", "ob_cap(q, t)")
     } else {
-        "q_slot_base(t) + s * WORDS[t]"
+        ("sched_outbox + ob_off(q, t) + j * WORDS[t]", "1u")
     };
     s += &format!(
-        "fn mk_execute(q: u32, s: u32, inv: Invocation) {{ sched_execute(q, {slot_at}, inv); }}\n\
+        "fn mk_execute(q: u32, s: u32, inv: Invocation) {{ sched_execute(q, {}, inv); }}\n\
          fn mk_outbox_item(q: u32, t: u32, j: u32) -> u32 {{ return {ob_at}; }}\n\
-         fn mk_outbox_stride(q: u32, t: u32) -> u32 {{ return {ob_stride}; }}\n"
+         fn mk_outbox_stride(q: u32, t: u32) -> u32 {{ return {ob_stride}; }}\n",
+        slot_at("q")
     );
-    // The outbox only needs typed stores; loads of the same prefix are generated and unused.
+    // Typed outbox stores, only where items go through the outbox (direct enqueue stores with
+    // the `sched_slot_store_*` that come with `execute_switch`'s loads).
     let mut seen = Vec::new();
-    for p in &program.procs {
+    for p in program.procs.iter().filter(|_| direct.is_none()) {
         if !seen.contains(&p.layout.name) {
             seen.push(p.layout.name.clone());
             s += &match items {
@@ -85,30 +82,26 @@ pub fn source(
             };
         }
     }
-    if direct.is_some() {
-        // `sched_slot_store_*` come with the loads of `execute_switch`.
-        for (t, p) in program.procs.iter().enumerate() {
-            s += &format!(
-                "fn enqueue_{name}(item: {ty}) {{\n    if !sched_active {{ return; }}\n    \
-                 let s = sched_direct_slot({t}u);\n    if s != 0xffffffffu {{ let t = {t}u; sched_slot_store_{ty}({slot_store_at}, item); }}\n}}\n",
-                name = p.proc.name,
-                ty = p.layout.name,
-            );
-        }
-        s += TEMPLATE;
-        return s;
-    }
     for (t, p) in program.procs.iter().enumerate() {
-        s += &format!(
-            "fn enqueue_{name}(item: {ty}) {{\n    if !sched_active {{ return; }}\n    \
-             let at = sched_outbox_slot({t}u);\n    if at != 0xffffffffu {{ sched_ob_store_{ty}(at{stride}, item); }}\n}}\n",
-            name = p.proc.name,
-            ty = p.layout.name,
-            stride = if planar {
+        let ty = &p.layout.name;
+        let store = if direct.is_some() {
+            let at = slot_at(&format!("{t}u"));
+            format!(
+                "let s = sched_direct_slot({t}u);\n    if s != 0xffffffffu {{ sched_slot_store_{ty}({at}, item); }}"
+            )
+        } else {
+            let stride = if planar {
                 format!(", mk_outbox_stride(sched_proc, {t}u)")
             } else {
                 String::new()
-            },
+            };
+            format!(
+                "let at = sched_outbox_slot({t}u);\n    if at != 0xffffffffu {{ sched_ob_store_{ty}(at{stride}, item); }}"
+            )
+        };
+        s += &format!(
+            "fn enqueue_{name}(item: {ty}) {{\n    if !sched_active {{ return; }}\n    {store}\n}}\n",
+            name = p.proc.name,
         );
     }
     s += TEMPLATE;

@@ -11,11 +11,7 @@ fn materials() {
          Surface \"wood\"\n{QUAD}\nSurface \"constant\"\n{QUAD}\nSurface \"matte\" \"Kd\" .7\n{QUAD}\n\
          Surface \"plastic\" \"Ks\" .8 \"roughness\" .2 \"specularcolor\" [1 1 0]\n{QUAD}"
     )));
-    let m: Vec<&Material> = s
-        .patches
-        .iter()
-        .map(|p| &s.materials[p.material as usize])
-        .collect();
+    let m = patch_materials(&s);
     assert_eq!(
         *m[0],
         Material::standard(SurfaceKind::Matte),
@@ -118,11 +114,7 @@ fn metal_surface() {
     let s = parse(&world(&format!(
         "Surface \"metal\" \"Ka\" .5 \"Ks\" .7 \"roughness\" .05\n{QUAD}\nSurface \"metal\" \"Kd\" .9\n{QUAD}"
     )));
-    let m: Vec<&Material> = s
-        .patches
-        .iter()
-        .map(|p| &s.materials[p.material as usize])
-        .collect();
+    let m = patch_materials(&s);
     assert_eq!(
         *m[0],
         Material {
@@ -151,11 +143,7 @@ fn textured_standard_surfaces_without_textures() {
         "Surface \"shinymetal\" \"Ks\" .6 \"Kr\" 1 \"texturename\" \"env.tx\"\n{QUAD}\n\
          Surface \"paintedplastic\" \"Kd\" .8 \"texturename\" \"grid.tx\"\n{QUAD}"
     )));
-    let m: Vec<&Material> = s
-        .patches
-        .iter()
-        .map(|p| &s.materials[p.material as usize])
-        .collect();
+    let m = patch_materials(&s);
     assert_eq!((m[0].kind, m[0].ks), (SurfaceKind::Metal, 0.6));
     assert_eq!((m[1].kind, m[1].kd), (SurfaceKind::Plastic, 0.8));
     for p in ["Kr", "texturename"] {
@@ -165,4 +153,12 @@ fn textured_standard_surfaces_without_textures() {
             s.warnings
         );
     }
+}
+
+/// Each patch's material, in patch order.
+fn patch_materials(s: &crate::scene::Scene) -> Vec<&Material> {
+    s.patches
+        .iter()
+        .map(|p| &s.materials[p.material as usize])
+        .collect()
 }
