@@ -2,10 +2,11 @@
 //! f64 reference, `reyes measure` and `reyes sweep` end to end. Runs on lavapipe in CI; the
 //! adapter comes from the environment and a missing one fails loudly.
 
-use reyes::accuracy::exact_image::render_reference;
-use reyes::accuracy::geometry::geometry;
-use reyes::accuracy::image_error::image_error;
-use reyes::accuracy::measure::pinhole_count;
+use reyes::progress::NoProgress;
+use reyes_accuracy::exact_image::render_reference;
+use reyes_accuracy::geometry::geometry;
+use reyes_accuracy::image_error::image_error;
+use reyes_accuracy::measure::pinhole_count;
 use reyes::frame::{FrameData, RenderOptions};
 use reyes::scene::{self, Scene};
 use reyes::stages::C_MICROPOLYGONS;
@@ -17,7 +18,7 @@ use std::process::Command;
 mod common;
 use common::{gpu, renderer, small};
 
-const BLOB: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/closed_blob.rib");
+const BLOB: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/closed_blob.rib");
 
 fn blob() -> Scene {
     scene::load(Path::new(BLOB)).unwrap()
@@ -31,7 +32,7 @@ fn blob() -> Scene {
 fn gpu_frame_against_the_exact_reference() {
     let s = blob();
     let (w, h) = (64, 48);
-    let reference = render_reference(&s, w, h, 8);
+    let reference = render_reference(&s, w, h, 8, &NoProgress);
     let mut psnr = Vec::new();
     for spp in [(1, 1), (4, 4)] {
         let o = RenderOptions {
@@ -64,7 +65,7 @@ fn gpu_frame_against_the_exact_reference() {
 fn a_hole_in_the_render_is_counted() {
     let s = blob();
     let (w, h) = (64, 48);
-    let reference = render_reference(&s, w, h, 4);
+    let reference = render_reference(&s, w, h, 4, &NoProgress);
     let data = FrameData::new(&s, &small(w, h)).unwrap();
     let mut img = renderer(StrategyKind::Megakernel)
         .render(gpu(), &data)
@@ -130,12 +131,12 @@ fn measure_prints_one_json_object_and_the_blob_has_no_pinholes() {
     assert!(num("wall_ms") > 0.0);
     assert!(v["gpu_ms"].is_null() || num("gpu_ms") > 0.0);
     // The typed report reads it back whole: no key more or less than MeasureReport's.
-    let typed: reyes::accuracy::measure::MeasureReport = serde_json::from_value(v.clone()).unwrap();
+    let typed: reyes_accuracy::measure::MeasureReport = serde_json::from_value(v.clone()).unwrap();
     assert_eq!(serde_json::to_value(&typed).unwrap(), v);
     assert_eq!(typed.runs, 1);
     // Every key is documented in docs/reyes.md's table.
     let docs =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/reyes.md")).unwrap();
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/reyes.md")).unwrap();
     for key in v.as_object().unwrap().keys() {
         assert!(
             docs.contains(&format!("`{key}`")) || docs.contains(&format!("`{key}.")),

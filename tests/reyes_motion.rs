@@ -7,6 +7,7 @@ use reyes::cpu_render::render_cpu;
 use reyes::frame::{FrameData, RenderOptions, Sampling};
 use reyes::image::FrameImage;
 use reyes::orbit::orbit_scene;
+use reyes::progress::NoProgress;
 use reyes::realtime::{Pixels, RealtimeRenderer};
 use reyes::scene::{self, Scene};
 use scheduler::StrategyKind;
@@ -257,7 +258,7 @@ fn the_pipelined_renderer_blurs_like_render() {
     };
     let mut r =
         RealtimeRenderer::new(gpu(), &s, &o, StrategyKind::Multipass, Pixels::Float).unwrap();
-    let frames = r.render(gpu(), &[0.0, 40f64.to_radians()]).unwrap();
+    let frames = r.render(gpu(), &[0.0, 40f64.to_radians()], &NoProgress).unwrap();
     for (f, deg) in frames.iter().zip([0.0, 40.0]) {
         let host = FrameData::new(&orbit_scene(&s, f64::to_radians(deg)), &o).unwrap();
         let reference = renderer(StrategyKind::Multipass)

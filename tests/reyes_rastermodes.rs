@@ -4,7 +4,7 @@
 //! twin follows. Runs on lavapipe; the adapter comes from the environment and a missing one
 //! fails loudly.
 
-use reyes::accuracy::holes::{Holes, holes};
+use reyes_accuracy::holes::{Holes, holes};
 use reyes::cpu_render::render_cpu;
 use reyes::frame::{FrameData, RasterMode, RenderOptions};
 use reyes::image::FrameImage;

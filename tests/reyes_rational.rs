@@ -251,7 +251,7 @@ fn f32_rational_splits_drift_less_than_a_tenth_of_a_pixel() {
         ..Default::default()
     };
     let data = FrameData::new(&s, &o).unwrap();
-    let t = reyes::accuracy::drift::tree_drift(&s, &data);
+    let t = reyes_accuracy::drift::tree_drift(&s, &data);
     eprintln!(
         "rational sphere at 1920x1080: {} grids, max depth {}, drift {:.2e} px",
         t.grids,

@@ -6,6 +6,7 @@
 use reyes::frame::{FrameData, RenderOptions};
 use reyes::image::FrameImage;
 use reyes::orbit::orbit_scene;
+use reyes::progress::NoProgress;
 use reyes::realtime::{Pixels, RealtimeFrame, RealtimeRenderer};
 use reyes::scene;
 use scheduler::{RecordedSize, StrategyKind};
@@ -56,7 +57,7 @@ fn a_turntable_frame_is_render_of_the_scene_turned_on_the_host() {
     let o = small(W, H);
     for kind in [StrategyKind::Multipass, StrategyKind::Megakernel] {
         let mut r = realtime(kind, &o);
-        let frames = r.render(gpu(), &[0.0, 40f64.to_radians()]).unwrap();
+        let frames = r.render(gpu(), &[0.0, 40f64.to_radians()], &NoProgress).unwrap();
         assert_eq!(
             image(&frames[0]),
             &host_turned(kind, 0.0, &o),
@@ -97,10 +98,10 @@ fn pipelined_frames_each_equal_their_single_frame_render() {
     for kind in [StrategyKind::Multipass, StrategyKind::Megakernel] {
         let mut r = realtime(kind, &o);
         assert_eq!(r.not_pipelined(), None);
-        let frames = r.render(gpu(), &angles).unwrap();
+        let frames = r.render(gpu(), &angles, &NoProgress).unwrap();
         assert_eq!(frames.len(), angles.len());
         for (f, &a) in frames.iter().zip(&angles) {
-            let one = r.render(gpu(), &[a]).unwrap();
+            let one = r.render(gpu(), &[a], &NoProgress).unwrap();
             assert_eq!(image(f), image(&one[0]), "{kind:?} at {a} rad");
             assert_eq!(f.counters, one[0].counters, "{kind:?} at {a} rad");
             assert!(f.wall_ms > 0.0);
@@ -111,7 +112,7 @@ fn pipelined_frames_each_equal_their_single_frame_render() {
         // 8-bit output converted on the GPU: FrameImage::rgba8 of the same frame within one
         // step (the GPU's pow may round the other way at a step).
         r.set_pixels(gpu(), Pixels::Rgba8).unwrap();
-        let f = r.render(gpu(), &angles[1..2]).unwrap();
+        let f = r.render(gpu(), &angles[1..2], &NoProgress).unwrap();
         let host = image(&frames[1]).rgba8();
         let got = f[0].rgba8.as_ref().unwrap();
         assert_eq!(got.len(), host.len());
@@ -133,7 +134,7 @@ fn an_overflowing_frame_is_rendered_again_not_shown_wrong() {
         let mut r = realtime(kind, &o);
         let grown = r.size().unwrap().clone();
         // Items per queue of this frame: what a megakernel's queues must hold.
-        let need = r.render(gpu(), &[0.0]).unwrap()[0].run.executed.clone();
+        let need = r.render(gpu(), &[0.0], &NoProgress).unwrap()[0].run.executed.clone();
         let tiny = RecordedSize {
             capacity: vec![1; grown.capacity.len()],
             rounds: 1,
@@ -149,7 +150,7 @@ fn an_overflowing_frame_is_rendered_again_not_shown_wrong() {
         if gpu().info.device_type == scheduler::wgpu::DeviceType::Cpu {
             assert!(too_small, "{kind:?}: {small:?} holds the frame ({need:?})");
         }
-        let frames = r.render(gpu(), &[0.0, 0.0, 0.0, 0.0]).unwrap();
+        let frames = r.render(gpu(), &[0.0, 0.0, 0.0, 0.0], &NoProgress).unwrap();
         for (i, f) in frames.iter().enumerate() {
             assert_eq!(image(f), &reference, "{kind:?} frame {i}");
         }
@@ -178,7 +179,7 @@ fn an_overflowing_frame_is_rendered_again_not_shown_wrong() {
     };
     let mut r = realtime(StrategyKind::Multipass, &budget);
     assert!(r.not_pipelined().unwrap().contains("buckets"));
-    for f in r.render(gpu(), &[0.0, 0.0]).unwrap() {
+    for f in r.render(gpu(), &[0.0, 0.0], &NoProgress).unwrap() {
         assert!(f.rerendered.is_some());
         assert_eq!(image(&f), &reference);
     }
@@ -192,7 +193,7 @@ fn an_empty_scene_gives_empty_pipelined_frames() {
     for kind in [StrategyKind::Multipass, StrategyKind::Megakernel] {
         let mut r = RealtimeRenderer::new(gpu(), &scene::Scene::default(), &o, kind, Pixels::Float)
             .unwrap();
-        for f in r.render(gpu(), &[0.0, 1.0, 2.0]).unwrap() {
+        for f in r.render(gpu(), &[0.0, 1.0, 2.0], &NoProgress).unwrap() {
             assert_eq!(f.rerendered, None, "{kind:?}");
             assert_eq!(image(&f).covered_pixels(), 0, "{kind:?}");
         }

@@ -52,7 +52,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     cli.check();
     reyes::driver_env::ensure_xdg_runtime_dir();
-    reyes::logging::init();
+    reyes_cli::logging::init();
     let result = if cli.suite {
         run_suite(&cli)
     } else {

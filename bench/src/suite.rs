@@ -126,8 +126,8 @@ pub fn run_suite(gpu: &Gpu, o: &SuiteOptions) -> Result<bool, String> {
         .iter()
         .map(|w| w.sizes().len() * w.strategies().len())
         .sum::<usize>();
-    // On a terminal: a bar over (workload, size, strategy) steps (`reyes::progress`).
-    let bar = reyes::progress::bar(total as u64, "");
+    // On a terminal: a bar over (workload, size, strategy) steps (`reyes_cli::progress`).
+    let bar = reyes_cli::progress::bar(total as u64, "");
     let mut jsonl = PendingFile::new(&o.out, "runs.jsonl")?;
     let mut records = Vec::new();
     for w in &mut workloads {
@@ -160,7 +160,7 @@ pub fn run_suite(gpu: &Gpu, o: &SuiteOptions) -> Result<bool, String> {
                     let mut line = serde_json::to_string(&r).expect("records serialise");
                     line.push('\n');
                     jsonl.write(line.as_bytes())?;
-                    // The logger writes above the bar (`reyes::logging`).
+                    // The logger writes above the bar (`reyes_cli::logging`).
                     if let Some(e) = r.error.as_ref().filter(|_| !r.verified) {
                         log::error!(
                             "{} {} {} run {}: {e}",

@@ -5,6 +5,7 @@
 use crate::buckets;
 use crate::frame::{Frame, FrameData, PatchItem, SceneFeatures};
 use crate::image::FrameImage;
+use crate::progress::Progress;
 use crate::shaders;
 use crate::stages::{C_MAX_DEPTH, COUNTERS};
 use scheduler::timing::PassTimer;
@@ -389,23 +390,14 @@ impl GpuRenderer {
     }
 
     /// Renders one frame (it compiles pipelines and sizes the queues), raises the GPU's clocks
-    /// for [`WARM_UP`], renders one more frame, then `runs` frames back to back, timing each.
+    /// for [`WARM_UP`], renders one more frame, then `runs` frames back to back, timing each;
+    /// `progress` advances by one after each timed frame.
     pub fn timed_frames(
         &self,
         gpu: &Gpu,
         data: &FrameData,
         runs: u32,
-    ) -> Result<TimedFrames, RunError> {
-        self.timed_frames_with(gpu, data, runs, &indicatif::ProgressBar::hidden())
-    }
-
-    /// [`GpuRenderer::timed_frames`], advancing `progress` by one after each timed frame.
-    pub fn timed_frames_with(
-        &self,
-        gpu: &Gpu,
-        data: &FrameData,
-        runs: u32,
-        progress: &indicatif::ProgressBar,
+        progress: &dyn Progress,
     ) -> Result<TimedFrames, RunError> {
         self.render(gpu, data)?;
         scheduler::clocks::raise_clocks(gpu, WARM_UP)?;
@@ -415,7 +407,7 @@ impl GpuRenderer {
             last = self.render(gpu, data)?;
             gpu_ms.push(last.run.gpu_ms.zip(last.resolve_gpu_ms).map(|(a, b)| a + b));
             wall_ms.push(last.wall_ms);
-            progress.inc(1);
+            progress.advance(1);
         }
         Ok(TimedFrames {
             last,

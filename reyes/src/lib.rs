@@ -2,7 +2,6 @@
 //! bounded, split, diced, shaded and sampled on the GPU by either scheduling strategy, with a
 //! CPU twin of every stage as the reference.
 
-pub mod accuracy;
 pub mod buckets;
 pub mod camera;
 pub mod cpu_render;
@@ -10,7 +9,6 @@ pub mod driver_env;
 pub mod frame;
 pub mod gpu_render;
 pub mod image;
-pub mod logging;
 pub mod orbit;
 pub mod output;
 pub mod present;

@@ -97,7 +97,7 @@ pub const UVT_BBOX: u32 = 3;
 /// Steinberger, "Reyes Rendering on the GPU", section 3.3; docs/reyes.md, "Motion blur and
 /// depth of field"). Each pixel keeps its `PixelSamples` sub-samples; each sub-sample gets one
 /// (lens u, lens v, time) triple, which the algorithms assign differently.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Sampling {
     /// Simple UVT: the same S triples in every pixel (S = samples per pixel); each
     /// micropolygon is moved to each triple and rasterized into that triple's sub-sample.
@@ -110,7 +110,6 @@ pub enum Sampling {
     Interleave,
     /// Bounding box: one pass over the micropolygon's bound grown by its motion and circle of
     /// confusion; each pixel's triples come from a 64 x 64 pixel table repeated over the image.
-    #[value(name = "bbox")]
     BoundingBox,
 }
 

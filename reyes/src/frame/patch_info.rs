@@ -97,7 +97,7 @@ pub const DISPLACE_BUMPS: u32 = 0;
 pub const DISPLACE_MAP: u32 = 1;
 
 /// Which normal displaced grid points move along (`--displacement-normals`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum DisplacementNormals {
     /// The surface normal from the patch's analytic derivatives (Sattler et al.'s eq. 1):
     /// one direction per point of the original patch, whatever grid computes it, so grids

@@ -41,6 +41,7 @@ use crate::frame::{FrameData, PatchItem, RenderOptions};
 use crate::gpu_render::{GpuRenderer, dispatch_2d, resolve_params};
 use crate::image::FrameImage;
 use crate::orbit;
+use crate::progress::Progress;
 use crate::scene::Scene;
 use crate::shaders;
 use crate::stages::COUNTERS;
@@ -472,44 +473,30 @@ impl RealtimeRenderer {
     }
 
     /// Renders one frame per turntable angle (radians; [`orbit::orbit_transform`] about the
-    /// scene's centre), pipelined, and returns them in order. Errors: as
-    /// [`RealtimeRenderer::render_transforms`].
-    pub fn render(&mut self, gpu: &Gpu, angles: &[f64]) -> Result<Vec<RealtimeFrame>, RunError> {
-        self.render_with(gpu, angles, &indicatif::ProgressBar::hidden())
-    }
-
-    /// [`RealtimeRenderer::render`], advancing `progress` by one as each frame is finished.
-    pub fn render_with(
+    /// scene's centre), pipelined, and returns them in order; `progress` advances by one as
+    /// each frame is finished. Errors: as [`RealtimeRenderer::render_transforms`].
+    pub fn render(
         &mut self,
         gpu: &Gpu,
         angles: &[f64],
-        progress: &indicatif::ProgressBar,
+        progress: &dyn Progress,
     ) -> Result<Vec<RealtimeFrame>, RunError> {
         let transforms: Vec<DMat4> = (angles.iter())
             .map(|&a| orbit::orbit_transform(self.centre, a))
             .collect();
-        self.render_transforms_with(gpu, &transforms, progress)
+        self.render_transforms(gpu, &transforms, progress)
     }
 
     /// Renders one frame per camera-space transform of the scene's control points (an affine
     /// f64 matrix, applied on the GPU in f32; e.g. [`crate::camera::ViewCamera::transform`]),
-    /// pipelined, and returns them in order. Errors: a device error or timeout, an emit beyond
-    /// a procedure's declaration, and those of a frame rendered again (e.g. a queue overflow of
-    /// one patch in the smallest bucket).
+    /// pipelined, and returns them in order; `progress` advances by one per finished frame.
+    /// Errors: a device error or timeout, an emit beyond a procedure's declaration, and those
+    /// of a frame rendered again (e.g. a queue overflow of one patch in the smallest bucket).
     pub fn render_transforms(
         &mut self,
         gpu: &Gpu,
         transforms: &[DMat4],
-    ) -> Result<Vec<RealtimeFrame>, RunError> {
-        self.render_transforms_with(gpu, transforms, &indicatif::ProgressBar::hidden())
-    }
-
-    /// [`RealtimeRenderer::render_transforms`], advancing `progress` by one per finished frame.
-    pub fn render_transforms_with(
-        &mut self,
-        gpu: &Gpu,
-        transforms: &[DMat4],
-        progress: &indicatif::ProgressBar,
+        progress: &dyn Progress,
     ) -> Result<Vec<RealtimeFrame>, RunError> {
         let mut out = Vec::with_capacity(transforms.len());
         let mut flight: VecDeque<InFlight> = VecDeque::new();
@@ -521,12 +508,12 @@ impl RealtimeRenderer {
             if flight.len() == IN_FLIGHT {
                 let f = flight.pop_front().unwrap();
                 out.push(self.finish(gpu, f, &mut last)?);
-                progress.inc(1);
+                progress.advance(1);
             }
         }
         while let Some(f) = flight.pop_front() {
             out.push(self.finish(gpu, f, &mut last)?);
-            progress.inc(1);
+            progress.advance(1);
         }
         Ok(out)
     }

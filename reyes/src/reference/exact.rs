@@ -27,6 +27,7 @@
 //! curve with weights w z > 0) stays in the hull of its projected control points. Polynomial
 //! patches (w = 1) give the same numbers as Euclidean nets.
 
+use rayon::prelude::*;
 use super::homogeneous::{HomNet, euclidean, homogeneous, split_curve, split_u, split_v};
 use super::polygon::{bounds, clip_z, covers, curve_deviation, cut_at_z};
 use crate::scene::Scene;
@@ -212,37 +213,32 @@ fn coverage_with(
         rows: (0, height as usize * n),
     };
     let proj = Proj::new(scene, width, height);
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |t| t.get())
-        .min(scene.patches.len().max(1));
-    let bits = std::thread::scope(|s| {
-        let workers: Vec<_> = (0..threads)
-            .map(|t| {
-                s.spawn(move || {
-                    let mut bits = vec![0u64; (grid.sw * grid.sh).div_ceil(64)];
-                    let mut r =
-                        Raster::new(proj, grid, size_px, flat_px, |_: &Leaf, [kx, ky], _| {
-                            let k = ky * grid.sw + kx;
-                            bits[k / 64] |= 1 << (k % 64);
-                        });
-                    for (i, p) in scene.patches.iter().enumerate().skip(t).step_by(threads) {
-                        r.patch(i, &homogeneous(p));
-                    }
-                    bits
+    // Each of rayon's threads rasterizes its share of the patches into its own bit set; the
+    // sets are OR-ed together (at most one share per thread, so as many sets as threads).
+    let words = (grid.sw * grid.sh).div_ceil(64);
+    let share = scene.patches.len().div_ceil(rayon::current_num_threads()).max(1);
+    let bits = (scene.patches.par_iter().enumerate())
+        .with_min_len(share)
+        .fold(
+            || vec![0u64; words],
+            |mut bits, (i, p)| {
+                Raster::new(proj, grid, size_px, flat_px, |_: &Leaf, [kx, ky], _| {
+                    let k = ky * grid.sw + kx;
+                    bits[k / 64] |= 1 << (k % 64);
                 })
-            })
-            .collect();
-        let mut all = vec![0u64; (grid.sw * grid.sh).div_ceil(64)];
-        for w in workers {
-            for (a, b) in all
-                .iter_mut()
-                .zip(w.join().expect("coverage worker panicked"))
-            {
-                *a |= b;
-            }
-        }
-        all
-    });
+                .patch(i, &homogeneous(p));
+                bits
+            },
+        )
+        .reduce(
+            || vec![0u64; words],
+            |mut all, b| {
+                for (a, b) in all.iter_mut().zip(b) {
+                    *a |= b;
+                }
+                all
+            },
+        );
     let frac = (0..height as usize)
         .flat_map(|y| (0..width as usize).map(move |x| (x, y)))
         .map(|(x, y)| {

@@ -129,7 +129,7 @@ pub fn item_weights(
     (info.flags & PATCH_RATIONAL != 0).then(|| rational_weights(primvars, info.weights, item.uv))
 }
 
-pub(crate) fn project(f: &crate::frame::Frame, p: Vec3) -> [f32; 2] {
+pub fn project(f: &crate::frame::Frame, p: Vec3) -> [f32; 2] {
     [
         0.5 * f.width as f32 + f.focal * p.x / p.z,
         0.5 * f.height as f32 - f.focal * p.y / p.z,
@@ -143,7 +143,7 @@ pub use scheduler::hash::lowbias32 as reyes_hash;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::accuracy::drift::split_half_f64;
+    use reyes_accuracy::drift::split_half_f64;
     use glam::DVec4;
 
     /// Blossoming a patch's weights at an item's range gives the sub-patch's weights: those

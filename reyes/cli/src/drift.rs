@@ -1,9 +1,9 @@
 //! `reyes drift [SCENE] [--width N --height N] [--paths N] [--seed N] [--json]`: how far the
 //! GPU's f32 splits drift from exact f64 subdivision, per split depth, in pixels (see
-//! `reyes::accuracy::drift`), and how deep the scene really splits (CPU pipeline).
+//! `reyes_accuracy::drift`), and how deep the scene really splits (CPU pipeline).
 
 use crate::cli::DriftCmd;
-use reyes::accuracy::drift::{self, PathOptions};
+use reyes_accuracy::drift::{self, PathOptions};
 use reyes::cpu_render::render_cpu;
 use reyes::frame::{FrameData, RenderOptions};
 use reyes::scene;

@@ -1,13 +1,13 @@
 //! `reyes holes [SCENE] [render options] [--reference exact|bbox] [--ref-samples N] [--json]`:
 //! renders a frame on the GPU in the `--raster` mode asked for and counts its holes
-//! (`reyes::accuracy::holes`) against a reference coverage: the exact f64 surfaces, or a
+//! (`reyes_accuracy::holes`) against a reference coverage: the exact f64 surfaces, or a
 //! bounding-box render of the same frame (for surfaces the exact reference does not know, such
 //! as displaced ones). Prints a table (header and one row) or a JSON object (docs/reyes.md, *Rasterization
 //! modes*).
 
 use crate::cli::{HOLES_COLUMNS, HoleReference, HolesCmd};
 use crate::measure::load_scene;
-use reyes::accuracy::holes::{Holes, coverage_of, holes};
+use reyes_accuracy::holes::{Holes, coverage_of, holes};
 use reyes::frame::{FrameData, RasterMode, RenderOptions};
 use reyes::gpu_render::{GpuRenderer, required_features};
 use reyes::stages;

@@ -119,7 +119,7 @@ impl Figure<'_> {
             self.draw(&root)?
         };
         let img = image::RgbImage::from_raw(w, h, buf).ok_or("plot buffer size")?;
-        Ok((crate::output::png(&img)?, positions))
+        Ok((reyes::output::png(&img)?, positions))
     }
 
     /// The figure as SVG.
@@ -135,13 +135,13 @@ impl Figure<'_> {
     /// Writes the PNG to `path` (atomically).
     pub fn write_png(&self, path: &Path) -> Result<(), String> {
         let (png, _) = self.png().map_err(|e| format!("{}: {e}", path.display()))?;
-        crate::output::write_atomic(path, &png)
+        reyes::output::write_atomic(path, &png)
     }
 
     /// Writes the SVG to `path` (atomically).
     pub fn write_svg(&self, path: &Path) -> Result<(), String> {
         let svg = self.svg().map_err(|e| format!("{}: {e}", path.display()))?;
-        crate::output::write_atomic(path, svg.as_bytes())
+        reyes::output::write_atomic(path, svg.as_bytes())
     }
 
     fn draw<DB: DrawingBackend>(

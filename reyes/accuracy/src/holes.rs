@@ -4,8 +4,8 @@
 //! where those are not the surface drawn (a displaced scene), a bounding-box render of the same
 //! frame ([`coverage_of`]).
 
-use crate::image::FrameImage;
-use crate::reference::Coverage;
+use reyes::image::FrameImage;
+use reyes::reference::Coverage;
 use serde::{Deserialize, Serialize};
 
 /// A render's holes against a reference coverage.
@@ -29,7 +29,7 @@ pub struct Holes {
 /// `reference`'s interior. Panics when the two differ in size.
 pub fn holes(image: &FrameImage, reference: &Coverage, samples_per_pixel: u32) -> Holes {
     let alpha: Vec<f32> = image.rgba.iter().map(|p| p[3]).collect();
-    let hole_px = crate::reference::pinholes(&alpha, reference);
+    let hole_px = reyes::reference::pinholes(&alpha, reference);
     let interior = reference.interior();
     let spp = samples_per_pixel as f64;
     let (mut interior_px, mut hole_samples) = (0usize, 0u64);

@@ -15,6 +15,7 @@
 //! rendered again first), so a wrong frame is never shown; every wait is bounded (the GPU's
 //! timeout; a scripted run that shows no frame within it fails).
 
+use reyes::progress::NoProgress;
 use crate::cli::ViewCmd;
 use reyes::camera::ViewCamera;
 use reyes::frame::{FrameData, MAX_PIXEL_SAMPLES, RenderOptions};
@@ -231,7 +232,7 @@ impl Viewer {
         }
         let r = st.renderer.as_mut().expect("made above");
         let transform = self.camera.transform(r.centre());
-        let frame = (r.render_transforms(&st.gpu, &[transform]))
+        let frame = (r.render_transforms(&st.gpu, &[transform], &NoProgress))
             .map_err(|e| e.to_string())?
             .pop()
             .expect("one frame per transform");

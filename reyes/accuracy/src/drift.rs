@@ -19,13 +19,13 @@
 //! - `grid`: the screen position DiceShade computes (f32 `eval_patch`, f32 projection) on the
 //!   same grid, against the exact one: split drift plus the dicer's own rounding.
 
-use crate::frame::{Frame, FrameData, PatchItem};
-use crate::reference::homogeneous::{HomNet, euclidean_net, eval_net, homogeneous};
-use crate::scene::Scene;
-use crate::stages::bound::{Decision, bound};
-use crate::stages::dice_shade::eval_surface;
-use crate::stages::split::split_half;
-use crate::stages::{self, Weights, cp_h, item_weights};
+use reyes::frame::{Frame, FrameData, PatchItem};
+use reyes::reference::homogeneous::{HomNet, euclidean_net, eval_net, homogeneous};
+use reyes::scene::Scene;
+use reyes::stages::bound::{Decision, bound};
+use reyes::stages::dice_shade::eval_surface;
+use reyes::stages::split::split_half;
+use reyes::stages::{self, Weights, cp_h, item_weights};
 use glam::{DVec2, DVec3, DVec4};
 use serde_json::{Value, json};
 
@@ -457,9 +457,9 @@ pub fn table(rows: &[DepthRow]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cpu_render::render_cpu;
-    use crate::frame::RenderOptions;
-    use crate::scene::{self, builtin_teapot};
+    use reyes::cpu_render::render_cpu;
+    use reyes::frame::RenderOptions;
+    use reyes::scene::{self, builtin_teapot};
 
     /// The split depth real scenes reach is measured at this size (the question).
     const HD: (u32, u32) = (1920, 1080);
@@ -482,7 +482,7 @@ mod tests {
         let cam = Projector::new(&s, &data.frame);
         for p in s.patches.iter().flat_map(|p| p.cp) {
             let a = cam.pixel(p).unwrap();
-            let b = crate::reference::project(&s, 320, 240, p).unwrap();
+            let b = reyes::reference::project(&s, 320, 240, p).unwrap();
             assert!(a.distance(b) < 1e-9, "{a} vs {b}");
         }
     }
@@ -505,7 +505,7 @@ mod tests {
                 }
                 for (a, b) in [(0.0, 0.0), (0.3, 0.7), (1.0, 0.5)] {
                     let sub = eval_net(&cp, false, a, b).0;
-                    let orig = crate::scene::eval_bezier(
+                    let orig = reyes::scene::eval_bezier(
                         &p.cp,
                         uv[0] + a * (uv[1] - uv[0]),
                         uv[2] + b * (uv[3] - uv[2]),
@@ -602,7 +602,7 @@ mod tests {
 
     #[test]
     fn drift_stays_under_a_tenth_of_a_pixel_at_real_depths_killeroo() {
-        let path = crate::shared_data_dir().join("rib/killeroo.rib");
+        let path = reyes::shared_data_dir().join("rib/killeroo.rib");
         if !path.is_file() {
             eprintln!("skipped: {} is missing", path.display());
             return;

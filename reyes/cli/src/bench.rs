@@ -2,10 +2,11 @@
 //! [--strategy NAME] [render options]`: frames of a (turning) scene by the persistent pipelined
 //! renderer (`reyes::realtime`): per-frame wall and GPU ms (median, p95) and frames per second,
 //! as a table or one JSON object ([`BenchReport`], keys in docs/reyes.md). On a terminal a
-//! progress bar counts the frames (`reyes::progress`). With `--peer raster`, the raster peer
+//! progress bar counts the frames (`reyes_cli::progress`). With `--peer raster`, the raster peer
 //! (`reyes::raster_peer`) timed the same way on the same frames, and its image against the
 //! Reyes image of the first and last timed frame ([`PeerReport`]).
 
+use reyes::progress::NoProgress;
 use crate::cli::{BenchCmd, Peer};
 use reyes::gpu_render::{WARM_UP, required_features};
 use reyes::raster_peer::{PeerFrame, RasterPeer};
@@ -172,15 +173,15 @@ pub fn main(a: BenchCmd) -> Result<(), String> {
     let timed: Vec<f64> = (0..a.frames).map(angle).collect();
     let warm = (0..a.warmup).map(|i| angle(i % a.frames));
     let all: Vec<f64> = warm.chain(timed.iter().copied()).collect();
-    let bar = reyes::progress::bar(all.len() as u64, "frames (warm-up and timed)");
-    let mut frames = r.render_with(&gpu, &all, &bar).map_err(|e| e.to_string())?;
+    let bar = reyes_cli::progress::bar(all.len() as u64, "frames (warm-up and timed)");
+    let mut frames = r.render(&gpu, &all, &|n| bar.inc(n)).map_err(|e| e.to_string())?;
     bar.finish_and_clear();
     frames.drain(..a.warmup as usize);
     if let Some(out) = &a.out {
         r.set_pixels(&gpu, Pixels::Rgba8)
             .map_err(|e| e.to_string())?;
         let last = r
-            .render(&gpu, &timed[timed.len() - 1..])
+            .render(&gpu, &timed[timed.len() - 1..], &NoProgress)
             .map_err(|e| e.to_string())?;
         let (w, h, _) = r.frame_size();
         let img = image::RgbaImage::from_raw(w, h, last[0].rgba8.clone().unwrap_or_default())
@@ -228,7 +229,7 @@ fn raster_peer(
     }
     r.set_pixels(gpu, Pixels::Float)?;
     p.set_pixels(gpu, Pixels::Float)?;
-    let reyes = r.render(gpu, &check)?;
+    let reyes = r.render(gpu, &check, &NoProgress)?;
     let peer = p.render(gpu, &check)?;
     let difference = (reyes.iter().zip(&peer).zip(&check))
         .map(|((a, b), angle)| {

@@ -94,14 +94,14 @@ fn run(a: RenderCmd) -> Result<(), String> {
     let per_frame = if gpu.is_some() { a.runs.max(1) } else { 1 };
     let steps = jobs.len() as u64 * per_frame as u64;
     let bar = if steps > 1 {
-        reyes::progress::bar(steps, "")
+        reyes_cli::progress::bar(steps, "")
     } else {
         indicatif::ProgressBar::hidden()
     };
     for ((i, outputs), data) in jobs.iter().zip(&data) {
         let number = seq.frames[*i].number;
         if seq.frames.len() > 1 {
-            reyes::progress::note(format!("frame {number}:"));
+            reyes_cli::progress::note(format!("frame {number}:"));
             bar.set_message(format!("frame {number}"));
         } else {
             bar.set_message("timed frames");
@@ -164,7 +164,7 @@ fn render_frame(
             log::warn!("{w}");
         }
         r.image.write_png(&out.image)?;
-        reyes::progress::note(format!(
+        reyes_cli::progress::note(format!(
             "wrote {} ({}x{}, CPU reference, {:.2} s)",
             out.image.display(),
             r.image.width,
@@ -177,11 +177,11 @@ fn render_frame(
     // (GpuRenderer::timed_frames).
     let (frame, times) = if a.runs > 1 {
         let t = renderer
-            .timed_frames_with(gpu, data, a.runs, progress)
+            .timed_frames(gpu, data, a.runs, &|n| progress.inc(n))
             .map_err(|e| e.to_string())?;
         for (i, (g, w)) in t.gpu_ms.iter().zip(&t.wall_ms).enumerate() {
             let g = g.map_or("n/a".into(), |g| format!("{g:.3}"));
-            reyes::progress::note(format!("run {i}: GPU {g} ms, wall {w:.2} ms"));
+            reyes_cli::progress::note(format!("run {i}: GPU {g} ms, wall {w:.2} ms"));
         }
         let times = t
             .gpu_ms
@@ -227,7 +227,7 @@ fn render_frame(
         let text = serde_json::to_string_pretty(&stats).unwrap();
         reyes::output::write_atomic(p, (text + "\n").as_bytes())?;
     }
-    reyes::progress::note(format!(
+    reyes_cli::progress::note(format!(
         "wrote {} ({}x{}, {}{}: {} grids, {} micropolygons, {})",
         out.image.display(),
         data.frame.width,
@@ -263,8 +263,8 @@ fn compare_to(
             image.height
         ));
     }
-    let e = reyes::accuracy::image_error::image_error(reference, image);
-    reyes::progress::note(format!(
+    let e = reyes_accuracy::image_error::image_error(reference, image);
+    reyes_cli::progress::note(format!(
         "image error against {}: PSNR {:.2} dB, FLIP mean {:.4}",
         path.display(),
         e.psnr_db,
@@ -308,7 +308,7 @@ fn main() -> ExitCode {
             .exit();
     }
     reyes::driver_env::ensure_xdg_runtime_dir();
-    reyes::logging::init();
+    reyes_cli::logging::init();
     let name = cli.command.name();
     let result = match cli.command {
         Command::Render(a) => run(a),

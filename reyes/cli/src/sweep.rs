@@ -10,16 +10,16 @@
 //! image would be measured on its own).
 //!
 //! On a terminal a progress bar counts the settings (one step per scene, dicing, samples and
-//! strategy) and another the rows of each scene's reference render (`reyes::progress`).
+//! strategy) and another the rows of each scene's reference render (`reyes_cli::progress`).
 
 use crate::cli::SweepCmd;
 use crate::measure::{load_scene, timed_frames};
-use reyes::accuracy::exact_image::render_reference_with;
-use reyes::accuracy::geometry::{GeometryStats, geometry};
-use reyes::accuracy::image_error::{ImageError, composite_srgb8, srgb8_errors};
-use reyes::accuracy::measure::pinhole_count;
-use reyes::accuracy::pareto::pareto_front;
-use reyes::accuracy::plot::{Figure, Panel, Point, Shape, Style};
+use reyes_accuracy::exact_image::render_reference;
+use reyes_accuracy::geometry::{GeometryStats, geometry};
+use reyes_accuracy::image_error::{ImageError, composite_srgb8, srgb8_errors};
+use reyes_accuracy::measure::pinhole_count;
+use reyes_accuracy::pareto::pareto_front;
+use reyes_accuracy::plot::{Figure, Panel, Point, Shape, Style};
 use reyes::frame::{FrameData, RenderOptions};
 use reyes::gpu_render::{GpuRenderer, required_features};
 use reyes::image::FrameImage;
@@ -128,7 +128,7 @@ pub fn main(a: SweepCmd) -> Result<(), String> {
     let defaults = RenderOptions::default();
     // Settings per scene; a scene whose own sample count is not in --samples adds its own.
     let per_samples = (c.dicings.len() * c.strategies.len()) as u64;
-    let settings = reyes::progress::bar(
+    let settings = reyes_cli::progress::bar(
         c.scenes.len() as u64 * c.samples.len() as u64 * per_samples,
         "settings",
     );
@@ -141,12 +141,12 @@ pub fn main(a: SweepCmd) -> Result<(), String> {
         };
         let (w, h) = (c.width, c.height);
         settings.set_message(format!("settings ({short})"));
-        let ref_rows = reyes::progress::bar(h as u64, &format!("{short}: reference pixel rows"));
-        let reference = render_reference_with(&scene, w, h, c.ref_samples, &ref_rows);
+        let ref_rows = reyes_cli::progress::bar(h as u64, &format!("{short}: reference pixel rows"));
+        let reference = render_reference(&scene, w, h, c.ref_samples, &|n| ref_rows.inc(n));
         ref_rows.finish_and_clear();
         let mut images: Vec<Vec<u8>> = Vec::new();
         let first_row = rows.len();
-        reyes::progress::note(format!(
+        reyes_cli::progress::note(format!(
             "{short}: reference {w}x{h}, {n}x{n} samples/pixel, {:.1} s",
             reference.cpu_ms / 1e3,
             n = c.ref_samples
@@ -212,7 +212,7 @@ pub fn main(a: SweepCmd) -> Result<(), String> {
                         front_geom: false,
                         front_flip: false,
                     };
-                    reyes::progress::note(format!(
+                    reyes_cli::progress::note(format!(
                         "{short} {} {} {}x{}: {:.3} ms, geom max {:.3} px, pinholes {}, {} workgroups",
                         row.strategy,
                         dicing.label(),
@@ -233,7 +233,7 @@ pub fn main(a: SweepCmd) -> Result<(), String> {
         for (row, image) in &mut rows[first_row..] {
             row.img = errors[*image];
         }
-        reyes::progress::note(format!(
+        reyes_cli::progress::note(format!(
             "{short}: image metrics of {} distinct images done",
             images.len()
         ));

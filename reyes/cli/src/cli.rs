@@ -5,8 +5,8 @@
 //! exit 1.
 
 use clap::{Args, Parser, Subcommand, ValueEnum, value_parser};
-use reyes::accuracy::drift::PathOptions;
-use reyes::accuracy::exact_image::DEFAULT_SAMPLES_PER_AXIS;
+use reyes_accuracy::drift::PathOptions;
+use reyes_accuracy::exact_image::DEFAULT_SAMPLES_PER_AXIS;
 use reyes::frame::{DisplacementNormals, RasterMode, RenderOptions, Sampling};
 use reyes::scene::{DepthOfField, FrameRanges, Scene};
 use scheduler::StrategyKind;
@@ -150,8 +150,8 @@ pub struct RenderArgs {
 
     /// The normal displaced patches move along: exact (from the patch's derivatives) or
     /// approximate (the grid's finite differences, which leave holes; for comparisons only).
-    #[arg(long, value_enum, value_name = "NORMALS", default_value_t = DisplacementNormals::Exact)]
-    pub displacement_normals: DisplacementNormals,
+    #[arg(long, value_enum, value_name = "NORMALS", default_value_t = Normals::Exact)]
+    pub displacement_normals: Normals,
 
     /// Micropolygon rasterization: bbox (every sub-sample under its screen bound, tested
     /// against its two triangles) or nearest (only the sub-sample nearest its centre, the
@@ -170,8 +170,8 @@ pub struct RenderArgs {
     /// times as many, permuted per tile; noise instead) or bbox (Bounding box: one pass over
     /// the micropolygon's bound grown by its motion and blur, per-pixel samples from a
     /// repeated 64x64 table). Scenes without motion or depth of field ignore it.
-    #[arg(long, value_name = "ALGORITHM", value_enum, default_value_t = Sampling::Simple)]
-    pub sampling: Sampling,
+    #[arg(long, value_name = "ALGORITHM", value_enum, default_value_t = SamplingArg::Simple)]
+    pub sampling: SamplingArg,
 
     /// Interleave UVT's tile side K in pixels: 2, 3 or 4.
     #[arg(long, value_name = "K", default_value_t = RenderOptions::default().il_tile,
@@ -227,9 +227,9 @@ impl RenderArgs {
             max_depth: self.max_depth,
             memory_budget: self.memory_budget,
             crack_dilation: !self.no_crack_dilation,
-            displacement_normals: self.displacement_normals,
+            displacement_normals: self.displacement_normals.into(),
             raster: self.raster.mode(),
-            sampling: self.sampling,
+            sampling: self.sampling.into(),
             il_tile: self.il_tile,
             il_perms: self.il_perms,
             ..RenderOptions::default()
@@ -515,6 +515,55 @@ impl Raster {
         match self {
             Raster::Bbox => RasterMode::BoundingBox,
             Raster::Nearest => RasterMode::NearestSample,
+        }
+    }
+}
+
+/// `--displacement-normals`: [`DisplacementNormals`] on the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Normals {
+    /// The surface normal from the patch's analytic derivatives (Sattler et al.'s eq. 1):
+    /// one direction per point of the original patch, whatever grid computes it, so grids
+    /// that share an edge move it alike.
+    Exact,
+    /// The normal of the grid's own finite differences (central inside, one-sided at its
+    /// border): neighbouring grids of other rates move a shared edge differently, which
+    /// opens holes. For comparison only.
+    Approximate,
+}
+
+impl From<Normals> for DisplacementNormals {
+    fn from(n: Normals) -> DisplacementNormals {
+        match n {
+            Normals::Exact => DisplacementNormals::Exact,
+            Normals::Approximate => DisplacementNormals::Approximate,
+        }
+    }
+}
+
+/// `--sampling`: [`Sampling`] on the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum SamplingArg {
+    /// Simple UVT: the same S triples in every pixel (S = samples per pixel); each
+    /// micropolygon is moved to each triple and rasterized into that triple's sub-sample.
+    /// Ghost images when S is small.
+    Simple,
+    /// Interleave UVT: K x K pixel tiles share K^2 S triples, each sub-sample of the tile one of
+    /// them, assigned by one of P permutations chosen per tile (the paper's eq. 2-3). Noise
+    /// instead of ghosts.
+    Interleave,
+    /// Bounding box: one pass over the micropolygon's bound grown by its motion and circle of
+    /// confusion; each pixel's triples come from a 64 x 64 pixel table repeated over the image.
+    #[value(name = "bbox")]
+    BoundingBox,
+}
+
+impl From<SamplingArg> for Sampling {
+    fn from(s: SamplingArg) -> Sampling {
+        match s {
+            SamplingArg::Simple => Sampling::Simple,
+            SamplingArg::Interleave => Sampling::Interleave,
+            SamplingArg::BoundingBox => Sampling::BoundingBox,
         }
     }
 }

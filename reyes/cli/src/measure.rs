@@ -3,13 +3,14 @@
 //! `--runs N` timed ones, median reported) and measures the frame
 //! against the exact surfaces (`reyes::accuracy`): geometric error and size of the
 //! micropolygons, PSNR and FLIP against an f64 reference render, pinholes. The reference
-//! render shows a progress bar on a terminal (`reyes::progress`).
+//! render shows a progress bar on a terminal (`reyes_cli::progress`).
 
+use reyes::progress::NoProgress;
 use crate::cli::MeasureCmd;
-use reyes::accuracy::exact_image::{ReferenceImage, render_reference_with};
-use reyes::accuracy::geometry::geometry;
-use reyes::accuracy::image_error::image_error;
-use reyes::accuracy::measure::{Measurement, MetricsCpuMs, pinhole_count};
+use reyes_accuracy::exact_image::{ReferenceImage, render_reference};
+use reyes_accuracy::geometry::geometry;
+use reyes_accuracy::image_error::image_error;
+use reyes_accuracy::measure::{Measurement, MetricsCpuMs, pinhole_count};
 use reyes::frame::FrameData;
 use reyes::gpu_render::{GpuFrame, GpuRenderer, required_features};
 use reyes::scene::{self, Scene};
@@ -41,7 +42,7 @@ pub fn timed_frames(
     runs: u32,
 ) -> Result<(GpuFrame, Vec<Option<f64>>, Vec<f64>), String> {
     let t = renderer
-        .timed_frames(gpu, data, runs)
+        .timed_frames(gpu, data, runs, &NoProgress)
         .map_err(|e| e.to_string())?;
     Ok((t.last, t.gpu_ms, t.wall_ms))
 }
@@ -70,8 +71,8 @@ pub fn main(a: MeasureCmd) -> Result<(), String> {
         frame.image.write_png(p)?;
     }
     let (w, h) = (data.frame.width, data.frame.height);
-    let rows = reyes::progress::bar(h as u64, "reference render: pixel rows");
-    let reference: ReferenceImage = render_reference_with(&scene, w, h, ref_samples, &rows);
+    let rows = reyes_cli::progress::bar(h as u64, "reference render: pixel rows");
+    let reference: ReferenceImage = render_reference(&scene, w, h, ref_samples, &|n| rows.inc(n));
     rows.finish_and_clear();
     if let Some(p) = &reference_png {
         reference.image.write_png(p)?;

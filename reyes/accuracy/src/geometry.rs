@@ -17,11 +17,11 @@
 
 use super::parallel::in_chunks;
 use super::surface::eval;
-use crate::cpu_render::diced_items;
-use crate::frame::{FrameData, PatchItem};
-use crate::reference::project;
-use crate::scene::Scene;
-use crate::stages::dice_shade::dice;
+use reyes::cpu_render::diced_items;
+use reyes::frame::{FrameData, PatchItem};
+use reyes::reference::project;
+use reyes::scene::Scene;
+use reyes::stages::dice_shade::dice;
 use glam::DVec2;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -55,9 +55,9 @@ pub fn geometry(scene: &Scene, data: &FrameData) -> GeometryStats {
     // the metric measures projected micropolygons, which they do not have.
     let items: Vec<PatchItem> = diced_items(data)
         .into_iter()
-        .filter(|i| i.rates & crate::stages::NEAR_CLIP_GRID == 0)
+        .filter(|i| i.rates & reyes::stages::NEAR_CLIP_GRID == 0)
         .collect();
-    let threads = std::thread::available_parallelism().map_or(1, |t| t.get());
+    let threads = rayon::current_num_threads();
     let parts = in_chunks(items.len(), items.len().div_ceil(threads * 16), |range| {
         let mut part = Part::default();
         for item in &items[range] {
@@ -153,8 +153,8 @@ fn measure_item(scene: &Scene, data: &FrameData, item: &PatchItem, part: &mut Pa
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::frame::RenderOptions;
-    use crate::scene::builtin_teapot;
+    use reyes::frame::RenderOptions;
+    use reyes::scene::builtin_teapot;
 
     fn stats(mp_size: f32, bound_px: Option<f32>) -> GeometryStats {
         let o = RenderOptions {

@@ -6,8 +6,8 @@
 //! the LDR variant, through the `nv-flip` crate) at its default 67 pixels per degree, the
 //! mean of its per-pixel error map in [0, 1].
 
-use crate::image::FrameImage;
-use crate::stages::shade::srgb_encode;
+use reyes::image::FrameImage;
+use reyes::stages::shade::srgb_encode;
 
 /// RGB bytes of `img` composited over black, 8-bit sRGB.
 pub fn composite_srgb8(img: &FrameImage) -> Vec<u8> {

@@ -4,9 +4,9 @@
 use super::exact_image::ReferenceImage;
 use super::geometry::GeometryStats;
 use super::image_error::ImageError;
-use crate::image::FrameImage;
-use crate::reference::pinholes;
-use crate::stats::FrameStats;
+use reyes::image::FrameImage;
+use reyes::reference::pinholes;
+use reyes::stats::FrameStats;
 use serde::{Deserialize, Serialize};
 
 /// Pixels that the exact surfaces cover completely, together with their eight neighbours
@@ -93,7 +93,7 @@ pub struct Settings {
     /// Fixed-bound dicing's bound (px); null for adaptive dicing.
     pub bound_px: Option<f64>,
     /// Micropolygon rasterization, `bbox` or `nearest` (as in `FrameStats`).
-    #[serde(default = "crate::stats::default_raster")]
+    #[serde(default = "reyes::stats::default_raster")]
     pub raster: String,
 }
 

@@ -21,11 +21,11 @@
 
 use super::parallel::in_chunks;
 use super::surface::{back_facing, eval, scene_lights, shade};
-use crate::image::FrameImage;
-use crate::reference::exact::{Coverage, Leaf, for_each_covered_sample};
-use crate::scene::Scene;
+use reyes::image::FrameImage;
+use reyes::reference::exact::{Coverage, Leaf, for_each_covered_sample};
+use reyes::scene::Scene;
 use glam::{DVec2, DVec3};
-use indicatif::ProgressBar;
+use reyes::progress::Progress;
 
 /// Samples per pixel axis of the reference unless told otherwise (64 per pixel).
 pub const DEFAULT_SAMPLES_PER_AXIS: u32 = 8;
@@ -67,37 +67,21 @@ const NO_HIT: Hit = Hit {
 };
 
 /// Renders the reference of `scene` at `width` x `height` with `samples_per_axis`^2 samples
-/// per pixel, on all cores (bands of rows handed out one at a time).
+/// per pixel, on all cores (bands of rows handed out one at a time); `progress` advances by
+/// each band's pixel rows as it is done (`height` in all).
 pub fn render_reference(
     scene: &Scene,
     width: u32,
     height: u32,
     samples_per_axis: u32,
-) -> ReferenceImage {
-    render_reference_with(
-        scene,
-        width,
-        height,
-        samples_per_axis,
-        &ProgressBar::hidden(),
-    )
-}
-
-/// [`render_reference`], advancing `progress` by each band's pixel rows as it is done (the
-/// caller sets its length: `height` rows).
-pub fn render_reference_with(
-    scene: &Scene,
-    width: u32,
-    height: u32,
-    samples_per_axis: u32,
-    progress: &ProgressBar,
+    progress: &dyn Progress,
 ) -> ReferenceImage {
     let start = std::time::Instant::now();
     let (w, h, n) = (width as usize, height as usize, samples_per_axis as usize);
     let lights = scene_lights(scene);
     let bands = in_chunks(h, BAND_ROWS, |rows| {
         let b = band(scene, &lights, width, height, n, rows.start, rows.end);
-        progress.inc(rows.len() as u64);
+        progress.advance(rows.len() as u64);
         b
     });
     let mut rgba = vec![[0f32; 4]; w * h];
@@ -132,7 +116,7 @@ pub fn render_reference_with(
 /// Pixel rows `y0..y1`: (y0, pixels, depths, unconverged samples, covered samples).
 fn band(
     scene: &Scene,
-    lights: &[crate::scene::Light],
+    lights: &[reyes::scene::Light],
     width: u32,
     height: u32,
     n: usize,
@@ -290,13 +274,14 @@ fn locate(scene: &Scene, cam: &Camera, leaf: &Leaf, s: DVec2) -> Option<Hit> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::reference::{closed::blob_patches, coverage, project};
-    use crate::scene::builtin_teapot;
+    use reyes::reference::{closed::blob_patches, coverage, project};
+    use reyes::progress::NoProgress;
+    use reyes::scene::builtin_teapot;
 
     fn blob() -> Scene {
-        crate::scene::load(std::path::Path::new(concat!(
+        reyes::scene::load(std::path::Path::new(concat!(
             env!("CARGO_MANIFEST_DIR"),
-            "/scenes/closed_blob.rib"
+            "/../scenes/closed_blob.rib"
         )))
         .unwrap()
     }
@@ -306,9 +291,12 @@ mod tests {
     #[test]
     fn coverage_matches_the_exact_reference() {
         for s in [builtin_teapot(), blob()] {
-            let rows = ProgressBar::hidden();
-            let r = render_reference_with(&s, 48, 36, 4, &rows);
-            assert_eq!(rows.position(), 36);
+            let rows = std::sync::atomic::AtomicU64::new(0);
+            let count = |n| {
+                rows.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
+            };
+            let r = render_reference(&s, 48, 36, 4, &count);
+            assert_eq!(rows.into_inner(), 36);
             let c = coverage(&s, 48, 36, 4);
             assert_eq!(r.coverage, c);
             assert!(r.covered_samples > 1000);
@@ -329,7 +317,7 @@ mod tests {
         let s = blob();
         let (w, h) = (40, 30);
         // One sample per pixel, at its centre: the pixel is that sample's shading.
-        let r = render_reference(&s, w, h, 1);
+        let r = render_reference(&s, w, h, 1, &NoProgress);
         // Centre pixel: nearer than the blob's centre (z = 6).
         let c = (h / 2 * w + w / 2) as usize;
         assert!(r.image.depth[c] < 6.0 - 0.5, "{}", r.image.depth[c]);

@@ -5,8 +5,8 @@
 //! `FrameData`, so it shares no arithmetic with the GPU path or its f32 twins: the metrics in
 //! this module's siblings compare the renderer against it.
 
-use crate::reference::homogeneous::eval_patch;
-use crate::scene::{Light, Material, Patch, Scene, SurfaceKind};
+use reyes::reference::homogeneous::eval_patch;
+use reyes::scene::{Light, Material, Patch, Scene, SurfaceKind};
 use glam::DVec3;
 
 /// An exact surface point of a patch.
@@ -116,7 +116,7 @@ pub fn shade(p: DVec3, n: DVec3, m: &Material, lights: &[Light]) -> DVec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{PatchSource, builtin_teapot};
+    use reyes::scene::{PatchSource, builtin_teapot};
 
     fn patch(cp: [DVec3; 16]) -> Patch {
         Patch {
@@ -204,7 +204,7 @@ mod tests {
     #[test]
     fn shading_matches_the_f32_twin() {
         let s = builtin_teapot();
-        let data = crate::frame::FrameData::new(&s, &Default::default()).unwrap();
+        let data = reyes::frame::FrameData::new(&s, &Default::default()).unwrap();
         let lights = scene_lights(&s);
         assert_eq!(lights.len(), data.lights.len());
         let m32 = &data.materials[0];
@@ -214,7 +214,7 @@ mod tests {
             for (u, v) in [(0.25, 0.25), (0.5, 0.75), (0.8, 0.4)] {
                 let e = eval(p, u, v);
                 let c = shade(e.p, e.n, m, &lights);
-                let c32 = crate::stages::shade::shade(
+                let c32 = reyes::stages::shade::shade(
                     e.p.as_vec3(),
                     e.n.as_vec3(),
                     m32,
@@ -230,7 +230,7 @@ mod tests {
             lights: Vec::new(),
             ..s.clone()
         };
-        let d = crate::frame::FrameData::new(&dark, &Default::default()).unwrap();
+        let d = reyes::frame::FrameData::new(&dark, &Default::default()).unwrap();
         let Light::Distant { color, dir } = scene_lights(&dark)[0] else {
             panic!("not distant")
         };

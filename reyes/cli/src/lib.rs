@@ -1,0 +1,7 @@
+//! What the project's command-line tools (`reyes`, `schedbench`) share and a library user does
+//! not need: progress bars on a terminal ([`progress`]) and the logger that writes above them
+//! ([`logging`]). The `reyes` command itself is this package's binary (`src/main.rs`).
+#![warn(missing_docs)]
+
+pub mod logging;
+pub mod progress;
