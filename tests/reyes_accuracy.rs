@@ -2,14 +2,14 @@
 //! f64 reference, `reyes measure` and `reyes sweep` end to end. Runs on lavapipe in CI; the
 //! adapter comes from the environment and a missing one fails loudly.
 
+use reyes::frame::{FrameData, RenderOptions};
 use reyes::progress::NoProgress;
+use reyes::scene::{self, Scene};
+use reyes::stages::C_MICROPOLYGONS;
 use reyes_accuracy::exact_image::render_reference;
 use reyes_accuracy::geometry::geometry;
 use reyes_accuracy::image_error::image_error;
 use reyes_accuracy::measure::pinhole_count;
-use reyes::frame::{FrameData, RenderOptions};
-use reyes::scene::{self, Scene};
-use reyes::stages::C_MICROPOLYGONS;
 use scheduler::StrategyKind;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -135,8 +135,8 @@ fn measure_prints_one_json_object_and_the_blob_has_no_pinholes() {
     assert_eq!(serde_json::to_value(&typed).unwrap(), v);
     assert_eq!(typed.runs, 1);
     // Every key is documented in docs/reyes.md's table.
-    let docs =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/reyes.md")).unwrap();
+    let docs = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/reyes.md"))
+        .unwrap();
     for key in v.as_object().unwrap().keys() {
         assert!(
             docs.contains(&format!("`{key}`")) || docs.contains(&format!("`{key}.")),

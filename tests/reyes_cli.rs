@@ -847,8 +847,8 @@ fn stats_and_exr_hold_the_rendered_frame() {
     assert!(typed.micropolygons > 100 && typed.grids_diced > 0);
     assert_eq!(typed.runs.as_ref().unwrap().count, 2);
     assert_eq!(v["executed"]["bound"], typed.bounds);
-    let docs =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/reyes.md")).unwrap();
+    let docs = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/reyes.md"))
+        .unwrap();
     for key in v.as_object().unwrap().keys() {
         assert!(
             docs.contains(&format!("`{key}`")) || docs.contains(&format!("`{key}.")),
@@ -1125,8 +1125,8 @@ fn motion_blur_and_depth_of_field_from_the_command_line() {
     let e = s.image_error.expect("image error statistics");
     assert!(e.psnr_db.is_finite() && e.psnr_db > 10.0, "{e:?}");
     assert!(e.flip_mean > 0.0 && e.flip_mean < 0.5, "{e:?}");
-    let docs =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/reyes.md")).unwrap();
+    let docs = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/reyes.md"))
+        .unwrap();
     for key in ["uvt", "image_error"] {
         assert!(
             docs.contains(&format!("`{key}`")),

@@ -258,7 +258,9 @@ fn the_pipelined_renderer_blurs_like_render() {
     };
     let mut r =
         RealtimeRenderer::new(gpu(), &s, &o, StrategyKind::Multipass, Pixels::Float).unwrap();
-    let frames = r.render(gpu(), &[0.0, 40f64.to_radians()], &NoProgress).unwrap();
+    let frames = r
+        .render(gpu(), &[0.0, 40f64.to_radians()], &NoProgress)
+        .unwrap();
     for (f, deg) in frames.iter().zip([0.0, 40.0]) {
         let host = FrameData::new(&orbit_scene(&s, f64::to_radians(deg)), &o).unwrap();
         let reference = renderer(StrategyKind::Multipass)

@@ -4,12 +4,12 @@
 //! twin follows. Runs on lavapipe; the adapter comes from the environment and a missing one
 //! fails loudly.
 
-use reyes_accuracy::holes::{Holes, holes};
 use reyes::cpu_render::render_cpu;
 use reyes::frame::{FrameData, RasterMode, RenderOptions};
 use reyes::image::FrameImage;
 use reyes::scene::{self, Scene};
 use reyes::stages;
+use reyes_accuracy::holes::{Holes, holes};
 use scheduler::StrategyKind;
 
 mod common;

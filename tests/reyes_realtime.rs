@@ -57,7 +57,9 @@ fn a_turntable_frame_is_render_of_the_scene_turned_on_the_host() {
     let o = small(W, H);
     for kind in [StrategyKind::Multipass, StrategyKind::Megakernel] {
         let mut r = realtime(kind, &o);
-        let frames = r.render(gpu(), &[0.0, 40f64.to_radians()], &NoProgress).unwrap();
+        let frames = r
+            .render(gpu(), &[0.0, 40f64.to_radians()], &NoProgress)
+            .unwrap();
         assert_eq!(
             image(&frames[0]),
             &host_turned(kind, 0.0, &o),
@@ -134,7 +136,10 @@ fn an_overflowing_frame_is_rendered_again_not_shown_wrong() {
         let mut r = realtime(kind, &o);
         let grown = r.size().unwrap().clone();
         // Items per queue of this frame: what a megakernel's queues must hold.
-        let need = r.render(gpu(), &[0.0], &NoProgress).unwrap()[0].run.executed.clone();
+        let need = r.render(gpu(), &[0.0], &NoProgress).unwrap()[0]
+            .run
+            .executed
+            .clone();
         let tiny = RecordedSize {
             capacity: vec![1; grown.capacity.len()],
             rounds: 1,

@@ -19,6 +19,7 @@
 //! - `grid`: the screen position DiceShade computes (f32 `eval_patch`, f32 projection) on the
 //!   same grid, against the exact one: split drift plus the dicer's own rounding.
 
+use glam::{DVec2, DVec3, DVec4};
 use reyes::frame::{Frame, FrameData, PatchItem};
 use reyes::reference::homogeneous::{HomNet, euclidean_net, eval_net, homogeneous};
 use reyes::scene::Scene;
@@ -26,7 +27,6 @@ use reyes::stages::bound::{Decision, bound};
 use reyes::stages::dice_shade::eval_surface;
 use reyes::stages::split::split_half;
 use reyes::stages::{self, Weights, cp_h, item_weights};
-use glam::{DVec2, DVec3, DVec4};
 use serde_json::{Value, json};
 
 /// Deepest split level measured: the renderer's default `max_depth`.

@@ -21,11 +21,11 @@
 
 use super::parallel::in_chunks;
 use super::surface::{back_facing, eval, scene_lights, shade};
+use glam::{DVec2, DVec3};
 use reyes::image::FrameImage;
+use reyes::progress::Progress;
 use reyes::reference::exact::{Coverage, Leaf, for_each_covered_sample};
 use reyes::scene::Scene;
-use glam::{DVec2, DVec3};
-use reyes::progress::Progress;
 
 /// Samples per pixel axis of the reference unless told otherwise (64 per pixel).
 pub const DEFAULT_SAMPLES_PER_AXIS: u32 = 8;
@@ -274,8 +274,8 @@ fn locate(scene: &Scene, cam: &Camera, leaf: &Leaf, s: DVec2) -> Option<Hit> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use reyes::reference::{closed::blob_patches, coverage, project};
     use reyes::progress::NoProgress;
+    use reyes::reference::{closed::blob_patches, coverage, project};
     use reyes::scene::builtin_teapot;
 
     fn blob() -> Scene {

@@ -17,12 +17,12 @@
 
 use super::parallel::in_chunks;
 use super::surface::eval;
+use glam::DVec2;
 use reyes::cpu_render::diced_items;
 use reyes::frame::{FrameData, PatchItem};
 use reyes::reference::project;
 use reyes::scene::Scene;
 use reyes::stages::dice_shade::dice;
-use glam::DVec2;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct GeometryStats {

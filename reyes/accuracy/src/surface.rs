@@ -5,9 +5,9 @@
 //! `FrameData`, so it shares no arithmetic with the GPU path or its f32 twins: the metrics in
 //! this module's siblings compare the renderer against it.
 
+use glam::DVec3;
 use reyes::reference::homogeneous::eval_patch;
 use reyes::scene::{Light, Material, Patch, Scene, SurfaceKind};
-use glam::DVec3;
 
 /// An exact surface point of a patch.
 #[derive(Clone, Copy, Debug, PartialEq)]

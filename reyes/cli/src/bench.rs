@@ -6,9 +6,9 @@
 //! (`reyes::raster_peer`) timed the same way on the same frames, and its image against the
 //! Reyes image of the first and last timed frame ([`PeerReport`]).
 
-use reyes::progress::NoProgress;
 use crate::cli::{BenchCmd, Peer};
 use reyes::gpu_render::{WARM_UP, required_features};
+use reyes::progress::NoProgress;
 use reyes::raster_peer::{PeerFrame, RasterPeer};
 use reyes::realtime::{Pixels, RealtimeFrame, RealtimeRenderer};
 use reyes::stages::C_MICROPOLYGONS;
@@ -174,7 +174,9 @@ pub fn main(a: BenchCmd) -> Result<(), String> {
     let warm = (0..a.warmup).map(|i| angle(i % a.frames));
     let all: Vec<f64> = warm.chain(timed.iter().copied()).collect();
     let bar = reyes_cli::progress::bar(all.len() as u64, "frames (warm-up and timed)");
-    let mut frames = r.render(&gpu, &all, &|n| bar.inc(n)).map_err(|e| e.to_string())?;
+    let mut frames = r
+        .render(&gpu, &all, &|n| bar.inc(n))
+        .map_err(|e| e.to_string())?;
     bar.finish_and_clear();
     frames.drain(..a.warmup as usize);
     if let Some(out) = &a.out {

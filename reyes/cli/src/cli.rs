@@ -5,10 +5,10 @@
 //! exit 1.
 
 use clap::{Args, Parser, Subcommand, ValueEnum, value_parser};
-use reyes_accuracy::drift::PathOptions;
-use reyes_accuracy::exact_image::DEFAULT_SAMPLES_PER_AXIS;
 use reyes::frame::{DisplacementNormals, RasterMode, RenderOptions, Sampling};
 use reyes::scene::{DepthOfField, FrameRanges, Scene};
+use reyes_accuracy::drift::PathOptions;
+use reyes_accuracy::exact_image::DEFAULT_SAMPLES_PER_AXIS;
 use scheduler::StrategyKind;
 use std::path::PathBuf;
 

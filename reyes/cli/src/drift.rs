@@ -3,10 +3,10 @@
 //! `reyes_accuracy::drift`), and how deep the scene really splits (CPU pipeline).
 
 use crate::cli::DriftCmd;
-use reyes_accuracy::drift::{self, PathOptions};
 use reyes::cpu_render::render_cpu;
 use reyes::frame::{FrameData, RenderOptions};
 use reyes::scene;
+use reyes_accuracy::drift::{self, PathOptions};
 
 /// Runs the subcommand.
 pub fn main(a: DriftCmd) -> Result<(), String> {

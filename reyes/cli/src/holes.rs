@@ -7,10 +7,10 @@
 
 use crate::cli::{HOLES_COLUMNS, HoleReference, HolesCmd};
 use crate::measure::load_scene;
-use reyes_accuracy::holes::{Holes, coverage_of, holes};
 use reyes::frame::{FrameData, RasterMode, RenderOptions};
 use reyes::gpu_render::{GpuRenderer, required_features};
 use reyes::stages;
+use reyes_accuracy::holes::{Holes, coverage_of, holes};
 use scheduler::Gpu;
 use serde::Serialize;
 

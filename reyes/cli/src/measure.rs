@@ -5,16 +5,16 @@
 //! micropolygons, PSNR and FLIP against an f64 reference render, pinholes. The reference
 //! render shows a progress bar on a terminal (`reyes_cli::progress`).
 
-use reyes::progress::NoProgress;
 use crate::cli::MeasureCmd;
+use reyes::frame::FrameData;
+use reyes::gpu_render::{GpuFrame, GpuRenderer, required_features};
+use reyes::progress::NoProgress;
+use reyes::scene::{self, Scene};
+use reyes::stats::frame_stats;
 use reyes_accuracy::exact_image::{ReferenceImage, render_reference};
 use reyes_accuracy::geometry::geometry;
 use reyes_accuracy::image_error::image_error;
 use reyes_accuracy::measure::{Measurement, MetricsCpuMs, pinhole_count};
-use reyes::frame::FrameData;
-use reyes::gpu_render::{GpuFrame, GpuRenderer, required_features};
-use reyes::scene::{self, Scene};
-use reyes::stats::frame_stats;
 use scheduler::Gpu;
 use std::path::Path;
 

@@ -14,16 +14,16 @@
 
 use crate::cli::SweepCmd;
 use crate::measure::{load_scene, timed_frames};
+use reyes::frame::{FrameData, RenderOptions};
+use reyes::gpu_render::{GpuRenderer, required_features};
+use reyes::image::FrameImage;
+use reyes::stages::C_MICROPOLYGONS;
 use reyes_accuracy::exact_image::render_reference;
 use reyes_accuracy::geometry::{GeometryStats, geometry};
 use reyes_accuracy::image_error::{ImageError, composite_srgb8, srgb8_errors};
 use reyes_accuracy::measure::pinhole_count;
 use reyes_accuracy::pareto::pareto_front;
 use reyes_accuracy::plot::{Figure, Panel, Point, Shape, Style};
-use reyes::frame::{FrameData, RenderOptions};
-use reyes::gpu_render::{GpuRenderer, required_features};
-use reyes::image::FrameImage;
-use reyes::stages::C_MICROPOLYGONS;
 use scheduler::stats::median_and_mad;
 use scheduler::{Gpu, StrategyKind};
 use std::fmt::Write as _;
@@ -141,7 +141,8 @@ pub fn main(a: SweepCmd) -> Result<(), String> {
         };
         let (w, h) = (c.width, c.height);
         settings.set_message(format!("settings ({short})"));
-        let ref_rows = reyes_cli::progress::bar(h as u64, &format!("{short}: reference pixel rows"));
+        let ref_rows =
+            reyes_cli::progress::bar(h as u64, &format!("{short}: reference pixel rows"));
         let reference = render_reference(&scene, w, h, c.ref_samples, &|n| ref_rows.inc(n));
         ref_rows.finish_and_clear();
         let mut images: Vec<Vec<u8>> = Vec::new();

@@ -15,12 +15,12 @@
 //! rendered again first), so a wrong frame is never shown; every wait is bounded (the GPU's
 //! timeout; a scripted run that shows no frame within it fails).
 
-use reyes::progress::NoProgress;
 use crate::cli::ViewCmd;
 use reyes::camera::ViewCamera;
 use reyes::frame::{FrameData, MAX_PIXEL_SAMPLES, RenderOptions};
 use reyes::gpu_render::required_features;
 use reyes::present::Presenter;
+use reyes::progress::NoProgress;
 use reyes::realtime::{Pixels, RealtimeFrame, RealtimeRenderer};
 use reyes::scene::Scene;
 use reyes::stages::C_MICROPOLYGONS;

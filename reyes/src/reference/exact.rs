@@ -27,11 +27,11 @@
 //! curve with weights w z > 0) stays in the hull of its projected control points. Polynomial
 //! patches (w = 1) give the same numbers as Euclidean nets.
 
-use rayon::prelude::*;
 use super::homogeneous::{HomNet, euclidean, homogeneous, split_curve, split_u, split_v};
 use super::polygon::{bounds, clip_z, covers, curve_deviation, cut_at_z};
 use crate::scene::Scene;
 use glam::{DVec2, DVec3, DVec4};
+use rayon::prelude::*;
 use std::ops::RangeInclusive;
 
 /// A leaf cell's projected control net must fit in a box this big (pixels).
@@ -216,7 +216,11 @@ fn coverage_with(
     // Each of rayon's threads rasterizes its share of the patches into its own bit set; the
     // sets are OR-ed together (at most one share per thread, so as many sets as threads).
     let words = (grid.sw * grid.sh).div_ceil(64);
-    let share = scene.patches.len().div_ceil(rayon::current_num_threads()).max(1);
+    let share = scene
+        .patches
+        .len()
+        .div_ceil(rayon::current_num_threads())
+        .max(1);
     let bits = (scene.patches.par_iter().enumerate())
         .with_min_len(share)
         .fold(

@@ -143,8 +143,8 @@ pub use scheduler::hash::lowbias32 as reyes_hash;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use reyes_accuracy::drift::split_half_f64;
     use glam::DVec4;
+    use reyes_accuracy::drift::split_half_f64;
 
     /// Blossoming a patch's weights at an item's range gives the sub-patch's weights: those
     /// f64 de Casteljau halving gives, to f32 rounding, down random paths of 20 splits. A root
