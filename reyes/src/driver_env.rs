@@ -9,6 +9,10 @@
 /// (mode 0700) under the temporary folder, `reyes-runtime-<uid>`, is made if needed and set.
 /// Call first in `main`, before any other thread exists (setting a variable is not
 /// thread-safe). Does nothing off Unix; failures leave the variable as it was.
+#[allow(
+    unsafe_code,
+    reason = "std::env::set_var, called first in main while the process has one thread"
+)]
 pub fn ensure_xdg_runtime_dir() {
     #[cfg(unix)]
     {
