@@ -308,22 +308,34 @@ mod tests {
 
     #[test]
     fn planar_is_chosen_for_large_one_thread_items_on_gpus_only() {
-        use crate::workloads::tree::TreeParams;
-        let tree = |payload_words| {
-            TreeParams {
-                payload_words,
-                ..TreeParams::binary_benchmark()
-            }
-            .program()
-            .unwrap()
+        // A node procedure and a leaf procedure of one thread per item each, as in a split
+        // tree, on items of `words` words.
+        let one_thread = |words: u32| {
+            let item =
+                crate::ItemType::new("Node", &format!("struct Node {{ w: array<u32, {words}> }}"));
+            let node = crate::Procedure::new("node", item.clone(), 1)
+                .emits("leaf", 2)
+                .body("fn node_execute(item: Node, inv: Invocation) { enqueue_leaf(item); }");
+            let leaf = crate::Procedure::new("leaf", item, 1)
+                .body("fn leaf_execute(item: Node, inv: Invocation) {}");
+            crate::Program::new(vec![node, leaf], crate::UserBindings::none()).unwrap()
         };
         // 64-word and 16-word items: planar on a GPU, interleaved on a CPU adapter.
-        assert_eq!(ItemLayout::choose(false, &tree(62)), ItemLayout::Planar);
-        assert_eq!(ItemLayout::choose(false, &tree(14)), ItemLayout::Planar);
-        assert_eq!(ItemLayout::choose(true, &tree(62)), ItemLayout::Interleaved);
+        assert_eq!(
+            ItemLayout::choose(false, &one_thread(64)),
+            ItemLayout::Planar
+        );
+        assert_eq!(
+            ItemLayout::choose(false, &one_thread(16)),
+            ItemLayout::Planar
+        );
+        assert_eq!(
+            ItemLayout::choose(true, &one_thread(64)),
+            ItemLayout::Interleaved
+        );
         // 15-word items, and items read by several threads each.
         assert_eq!(
-            ItemLayout::choose(false, &tree(13)),
+            ItemLayout::choose(false, &one_thread(15)),
             ItemLayout::Interleaved
         );
         let wide = crate::ItemType::new("Wide", "struct Wide { w: array<u32, 32> }");

@@ -35,7 +35,6 @@ pub mod stats;
 pub mod strategy;
 pub mod timing;
 pub mod wgsl;
-pub mod workloads;
 
 /// The bytemuck this crate is built against: `#[derive(Pod, Zeroable)]` host twins of item
 /// structs go through it ([`Seed::new`], [`Gpu::upload`]).

@@ -4,15 +4,15 @@
 //! result), and leaves fold an order-independent checksum. Inner nodes run `branch`, childless
 //! nodes run `leaf`. A CPU reference gives exact item counts and the checksum.
 
-use crate::bindings::UserBindings;
-use crate::error::RunError;
-use crate::gpu::Gpu;
-use crate::hash::{lowbias32 as hash, lowbias32_wgsl};
-use crate::procedure::{ItemType, Procedure};
-use crate::program::{Program, Seed};
-use crate::stats::RunStats;
-use crate::strategy::Scheduler;
 use rayon::prelude::*;
+use scheduler::bindings::UserBindings;
+use scheduler::error::RunError;
+use scheduler::gpu::Gpu;
+use scheduler::hash::{lowbias32 as hash, lowbias32_wgsl};
+use scheduler::procedure::{ItemType, Procedure};
+use scheduler::program::{Program, Seed};
+use scheduler::stats::RunStats;
+use scheduler::strategy::Scheduler;
 
 /// How many children an inner node has.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -373,8 +373,8 @@ impl TreeParams {
                 TREE_WGSL
             ),
             layout: vec![
-                crate::bindings::storage_entry(0, false),
-                crate::bindings::storage_entry(1, true),
+                scheduler::storage_entry(0, false),
+                scheduler::storage_entry(1, true),
             ],
         };
         let branch = Procedure::new("branch", item.clone(), 1)
@@ -410,7 +410,7 @@ impl TreeParams {
     }
 }
 
-// `tree_hash` is `crate::hash::lowbias32_wgsl`, the twin of the CPU reference's hash.
+// `tree_hash` is `scheduler::hash::lowbias32_wgsl`, the twin of the CPU reference's hash.
 const TREE_WGSL: &str = r#"
 fn tree_children(id: u32, depth: u32) -> u32 {
     if depth >= tree_cfg[0] { return 0u; }

@@ -29,13 +29,13 @@
 //! entirely inside a rectangle with a uniform border); the preset views are ones where it does in
 //! both arithmetics, checked against the brute-force image.
 
-use crate::bindings::UserBindings;
-use crate::error::RunError;
-use crate::gpu::Gpu;
-use crate::procedure::{ItemType, Procedure};
-use crate::program::{Program, Seed};
-use crate::stats::RunStats;
-use crate::strategy::Scheduler;
+use scheduler::bindings::UserBindings;
+use scheduler::error::RunError;
+use scheduler::gpu::Gpu;
+use scheduler::procedure::{ItemType, Procedure};
+use scheduler::program::{Program, Seed};
+use scheduler::stats::RunStats;
+use scheduler::strategy::Scheduler;
 
 mod cpu;
 pub use cpu::dwell;
@@ -365,9 +365,9 @@ impl MandelParams {
                  const MS_T: u32 = {MS_THREADS}u;\n{MS_WGSL}"
             ),
             layout: vec![
-                crate::bindings::storage_entry(0, false),
-                crate::bindings::storage_entry(1, true),
-                crate::bindings::storage_entry(2, false),
+                scheduler::storage_entry(0, false),
+                scheduler::storage_entry(1, true),
+                scheduler::storage_entry(2, false),
             ],
         };
         let rect = Procedure::new("ms_rect", item.clone(), MS_THREADS)
@@ -576,7 +576,7 @@ impl MandelRun {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::wgsl::struct_layout;
+    use scheduler::wgsl::struct_layout;
 
     fn small(w: u32, h: u32) -> MandelParams {
         MandelParams {
