@@ -220,7 +220,6 @@ pub(crate) fn moves_by_vec4(layout: &StructLayout) -> bool {
 /// of the large-payload tree moved several times faster: docs/results.md, session 18).
 pub(crate) fn load_store_fns(layout: &StructLayout, prefix: &str) -> String {
     let t = &layout.name;
-    use crate::item_layout::{cast_in, cast_out};
     let mut s = format!("fn {prefix}_load_{t}(base: u32) -> {t} {{\n    var v: {t};\n");
     if moves_by_vec4(layout) {
         for g in 0..layout.words() / 4 {
@@ -262,6 +261,23 @@ pub(crate) fn load_store_fns(layout: &StructLayout, prefix: &str) -> String {
     }
     s += "}\n";
     s
+}
+
+/// The WGSL that turns stored word `w` into the scalar of leaf `l`.
+pub(crate) fn cast_in(l: &Leaf, w: String) -> String {
+    match l.kind {
+        ScalarKind::U32 => w,
+        ScalarKind::I32 => format!("bitcast<i32>({w})"),
+        ScalarKind::F32 => format!("bitcast<f32>({w})"),
+    }
+}
+
+/// The WGSL that turns leaf `l` of a value `v` into the word stored.
+pub(crate) fn cast_out(l: &Leaf) -> String {
+    match l.kind {
+        ScalarKind::U32 => format!("v{}", l.path),
+        _ => format!("bitcast<u32>(v{})", l.path),
+    }
 }
 
 /// WGSL accessors `{prefix}_load_word`, `{prefix}_store_word`, `{prefix}_load_vec4` and

@@ -5,7 +5,7 @@
 
 mod compact;
 pub(crate) mod layout;
-pub(crate) mod recorded;
+pub(crate) mod record;
 pub(crate) mod wgsl;
 
 use std::time::Instant;

@@ -7,7 +7,7 @@
 pub mod host;
 pub(crate) mod layout;
 pub mod partial;
-pub(crate) mod recorded;
+pub(crate) mod record;
 pub(crate) mod wgsl;
 
 use std::time::Instant;
