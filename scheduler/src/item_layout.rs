@@ -43,7 +43,7 @@ impl ItemLayout {
     pub const PLANAR_MIN_WORDS: u32 = 16;
 
     /// The faster layout for `program` on `gpu`, as measured on the H200 (docs/results.md,
-    /// session 19): planar when every procedure runs one thread per item and the largest item
+    /// "Planar (structure-of-arrays) queues"): planar when every procedure runs one thread per item and the largest item
     /// has at least [`Self::PLANAR_MIN_WORDS`] words (the tree of 64-word items: host-driven
     /// multi-pass 1.10 -> 0.76 ms, megakernel 1.30 -> 1.17; of 16-word items 0.53 -> 0.49),
     /// interleaved otherwise: for 3-word items planar was up to 10% slower (the megakernel

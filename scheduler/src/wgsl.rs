@@ -217,7 +217,8 @@ pub(crate) fn moves_by_vec4(layout: &StructLayout) -> bool {
 /// Why vectors: a one-thread item is read and written by its own thread, so a warp touches 32
 /// items at a stride of the item size. Word by word, each of those accesses is its own memory
 /// transaction; 16 bytes at a time there are a quarter as many (on the H200 the 256-byte items
-/// of the large-payload tree moved several times faster: docs/results.md, session 18).
+/// of the large-payload tree moved several times faster: docs/results.md, "Large items: how they
+/// are copied").
 pub(crate) fn load_store_fns(layout: &StructLayout, prefix: &str) -> String {
     let t = &layout.name;
     let mut s = format!("fn {prefix}_load_{t}(base: u32) -> {t} {{\n    var v: {t};\n");

@@ -85,7 +85,9 @@ impl TreePreset {
         Self::ALL.into_iter().find(|p| p.name() == s)
     }
 
-    /// The tree the preset names (the benchmark sizes of issue 10's table).
+    /// The tree the preset names: the benchmark's trees, sized as those of the reference
+    /// figures for Whippletree and a plain CUDA multi-pass that docs/results.md sets the
+    /// strategies beside.
     pub fn params(self) -> TreeParams {
         let binary = TreeParams::binary_benchmark();
         match self {
@@ -422,8 +424,8 @@ fn tree_children(id: u32, depth: u32) -> u32 {
 // The bodies as written: loops over the payload. `TreeParams::program` unrolls them (`unrolled`)
 // for the program's payload size, as a CUDA compiler unrolls loops of constant trip count; the
 // Vulkan driver keeps such a loop, and with it the payload in local memory instead of
-// registers (1.6x the GPU time of the large-payload tree on the H200: docs/results.md,
-// session 18). Both copy the item into a `var` first: indexing the `item` parameter (a value)
+// registers (1.6x the GPU time of the large-payload tree on the H200: docs/results.md, "Large
+// items: how they are copied"). Both copy the item into a `var` first: indexing the `item` parameter (a value)
 // with a run-time index makes naga's SPIR-V copy the whole array to a temporary at every access
 // (`Program::new` warns of it; docs/scheduler.md, "Writing fast procedures").
 const BRANCH_WGSL: &str = r#"
