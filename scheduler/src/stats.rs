@@ -85,6 +85,10 @@ impl RunStats {
 
 /// What a recorded run's status copy says ([`crate::RecordedRun::outcome`]).
 #[derive(Debug, Clone, PartialEq)]
+#[allow(
+    clippy::large_enum_variant,
+    reason = "one per record, read once; callers match `Done(stats)` without a box"
+)]
 pub enum Outcome {
     /// The run finished: every item was executed. `launches` and `rounds` are those recorded;
     /// `submits` is 0 (the run cost no host round trip of its own), `gpu_ms` and `wall_ms` are

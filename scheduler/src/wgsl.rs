@@ -86,15 +86,7 @@ pub fn struct_layout(source: &str, name: &str) -> Result<StructLayout, RunError>
         return Err(RunError::Program(format!("`{name}` is not a struct")));
     };
     let mut leaves = Vec::new();
-    flatten(
-        &module,
-        &layouter,
-        handle,
-        String::new(),
-        0,
-        &mut leaves,
-        name,
-    )?;
+    flatten(&module, handle, String::new(), 0, &mut leaves, name)?;
     Ok(StructLayout {
         name: name.to_string(),
         size: layouter[handle].size,
@@ -108,7 +100,6 @@ pub fn struct_layout(source: &str, name: &str) -> Result<StructLayout, RunError>
 
 fn flatten(
     module: &naga::Module,
-    layouter: &naga::proc::Layouter,
     ty: naga::Handle<naga::Type>,
     path: String,
     byte: u32,
@@ -170,7 +161,6 @@ fn flatten(
             for i in 0..n.get() {
                 flatten(
                     module,
-                    layouter,
                     *base,
                     format!("{path}[{i}]"),
                     byte + i * stride,
@@ -184,7 +174,6 @@ fn flatten(
                 let name = m.name.clone().unwrap_or_default();
                 flatten(
                     module,
-                    layouter,
                     m.ty,
                     format!("{path}.{name}"),
                     byte + m.offset,

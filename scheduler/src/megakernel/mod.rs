@@ -167,7 +167,7 @@ enum Start {
     /// Copied on the device from the previous launch's buffers, whose first `reserved[q]`
     /// tickets hold `live[q]` published, unconsumed items per queue.
     Compact {
-        old: DeviceQueues,
+        old: Box<DeviceQueues>,
         reserved: Vec<u32>,
         live: Vec<u32>,
     },
@@ -653,7 +653,7 @@ impl Megakernel {
             start = if grew {
                 // New buffers; the live items move there on the device, in the next launch's pass.
                 Start::Compact {
-                    old: dq.take().expect("buffers of the launch"),
+                    old: Box::new(dq.take().expect("buffers of the launch")),
                     reserved,
                     live,
                 }

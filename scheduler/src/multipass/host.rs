@@ -83,7 +83,7 @@ struct HostRounds {
     layout: QueueLayout,
     counts: [wgpu::Buffer; 2],
     items: [wgpu::Buffer; 2],
-    /// bind[p]: reads counts[p] and items[p], appends to counts[1 - p] and items[1 - p].
+    /// `bind[p]`: reads `counts[p]` and `items[p]`, appends to `counts[1 - p]` and `items[1 - p]`.
     bind: [wgpu::BindGroup; 2],
 }
 

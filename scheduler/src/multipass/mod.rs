@@ -72,7 +72,7 @@ struct DeviceRounds {
     items: [wgpu::Buffer; 2],
     indirect: wgpu::Buffer,
     plan_bind: wgpu::BindGroup,
-    /// bind[parity]: round r reads items[r % 2] and writes items[(r + 1) % 2].
+    /// `bind[parity]`: round r reads `items[r % 2]` and writes `items[(r + 1) % 2]`.
     bind: [wgpu::BindGroup; 2],
 }
 

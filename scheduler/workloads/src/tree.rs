@@ -287,7 +287,7 @@ impl TreeParams {
 
     /// [`TreeParams::reference`] on every core (rayon): the same [`TreeResult`], the CPU floor a
     /// GPU result must beat. The top of the tree is expanded breadth-first on the calling
-    /// thread until there are [`SUBTREES_PER_THREAD`] subtrees per rayon thread (or the tree
+    /// thread until there are `SUBTREES_PER_THREAD` subtrees per rayon thread (or the tree
     /// ends); rayon then walks the subtrees depth-first, each with a flat stack of payload
     /// words, so no node allocates. Children's order differs from the reference's, which
     /// cannot change the result: every fold is commutative.
