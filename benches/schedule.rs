@@ -3,8 +3,8 @@
 //! SCHED_BENCH_FULL=1 selects the 2,097,088-item benchmark tree (for real GPUs).
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use scheduler::workloads::tree::{Fanout, TreeParams, TreeRun};
 use scheduler::*;
+use workloads::tree::{Fanout, TreeParams, TreeRun};
 
 fn trees() -> Vec<(&'static str, TreeParams)> {
     if std::env::var_os("SCHED_BENCH_FULL").is_some() {

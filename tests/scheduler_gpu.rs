@@ -1,8 +1,8 @@
 //! GPU tests of the scheduler on whatever adapter the environment names (lavapipe in CI).
 //! No adapter is a failure, never a skip.
 
-use scheduler::workloads::tree::{Fanout, TreeParams, TreeRun};
 use scheduler::*;
+use workloads::tree::{Fanout, TreeParams, TreeRun};
 
 fn gpu() -> Gpu {
     Gpu::from_env().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"))

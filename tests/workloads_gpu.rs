@@ -2,10 +2,10 @@
 //! (lavapipe in CI), every strategy, exact equality with the CPU references. No adapter is a
 //! failure, never a skip. Sizes are small: the whole file runs in well under a minute on lavapipe.
 
-use scheduler::workloads::bfs::{BfsParams, BfsRun, UNREACHED};
-use scheduler::workloads::frontier_bfs::FrontierBfs;
-use scheduler::workloads::mandelbrot::{self, MandelParams, MandelRun};
 use scheduler::*;
+use workloads::bfs::{BfsParams, BfsRun, UNREACHED};
+use workloads::frontier_bfs::FrontierBfs;
+use workloads::mandelbrot::{self, MandelParams, MandelRun};
 
 fn gpu() -> Gpu {
     Gpu::from_env().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"))

@@ -1,15 +1,15 @@
-//! Breadth-first search (`scheduler::workloads::bfs`) as a suite workload: Graph500 R-MAT graphs
+//! Breadth-first search (`workloads::bfs`) as a suite workload: Graph500 R-MAT graphs
 //! by scale, the scheduler's strategies against the hand-written level-synchronous frontier
-//! BFS (`scheduler::workloads::frontier_bfs`), every run's levels equal to the CPU BFS's. Runs
+//! BFS (`workloads::frontier_bfs`), every run's levels equal to the CPU BFS's. Runs
 //! record the Graph500 traversed edges, so the report gives GTEPS.
 
 use crate::strategy::GpuConfig;
 use crate::suite::Scale;
 use crate::workload::{ProblemWorkload, ScheduledProblem};
-use scheduler::workloads::bfs::{BfsParams, BfsRun, UNREACHED, bfs_levels_rayon};
-use scheduler::workloads::frontier_bfs::FrontierBfs;
 use scheduler::{Gpu, Program, RunError, RunStats, Scheduler};
 use std::cell::OnceCell;
+use workloads::bfs::{BfsParams, BfsRun, UNREACHED, bfs_levels_rayon};
+use workloads::frontier_bfs::FrontierBfs;
 
 /// The seed of every suite graph (the source is drawn from it too).
 pub const SEED: u64 = 1;

@@ -5,18 +5,18 @@ use crate::strategy::GpuConfig;
 use crate::suite::Scale;
 use crate::tree::preset_workload;
 use crate::workload::Workload;
-use scheduler::workloads::tree::TreePreset::*;
+use workloads::tree::TreePreset::*;
 
 /// `--workload` names.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum WorkloadName {
-    /// The synthetic split tree (`scheduler::workloads::tree`); the suite runs every preset.
+    /// The synthetic split tree (`workloads::tree`); the suite runs every preset.
     Tree,
     /// Reyes frames: the built-in teapot and Killeroo (`reyes::gpu_render`).
     Reyes,
-    /// Escape-time Mandelbrot with per-tile refinement (`scheduler::workloads::mandelbrot`).
+    /// Escape-time Mandelbrot with per-tile refinement (`workloads::mandelbrot`).
     Mandelbrot,
-    /// Breadth-first search (`scheduler::workloads::bfs`), with a frontier baseline.
+    /// Breadth-first search (`workloads::bfs`), with a frontier baseline.
     Bfs,
 }
 
@@ -78,7 +78,7 @@ impl WorkloadName {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use scheduler::workloads::tree::TreePreset;
+    use workloads::tree::TreePreset;
 
     #[test]
     fn the_suite_runs_every_tree_preset_once() {

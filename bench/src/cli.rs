@@ -7,8 +7,8 @@ use crate::suite::Scale;
 use clap::error::ErrorKind;
 use clap::{CommandFactory, Parser, value_parser};
 use scheduler::ItemLayout;
-use scheduler::workloads::tree::{Fanout, TreeParams, TreePreset};
 use std::path::PathBuf;
+use workloads::tree::{Fanout, TreeParams, TreePreset};
 
 const EXAMPLES: &str = "Examples:
   schedbench --workload tree --strategy all --runs 10

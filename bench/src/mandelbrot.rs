@@ -1,4 +1,4 @@
-//! Adaptive Mandelbrot (`scheduler::workloads::mandelbrot`, Mariani-Silver) as a suite
+//! Adaptive Mandelbrot (`workloads::mandelbrot`, Mariani-Silver) as a suite
 //! workload: the whole set at square sizes. Each size is put in the device's `fma` arithmetic
 //! when prepared ([`ScheduledProblem::for_device`]), so its brute-force reference is the image
 //! this device must produce exactly.
@@ -6,8 +6,8 @@
 use crate::strategy::GpuConfig;
 use crate::suite::Scale;
 use crate::workload::{ProblemWorkload, ScheduledProblem};
-use scheduler::workloads::mandelbrot::{MandelParams, MandelResult, MandelRun};
 use scheduler::{Gpu, Program, RunError, RunStats, Scheduler};
+use workloads::mandelbrot::{MandelParams, MandelResult, MandelRun};
 
 /// Iterations of the small sizes: lavapipe cuts a megakernel invocation's loops at 65,535 turns
 /// in all (docs/scheduler.md, section 4), so its dwell loops stay short.

@@ -1,11 +1,11 @@
-//! The split tree (`scheduler::workloads::tree`) as a suite workload: one workload per preset,
+//! The split tree (`workloads::tree`) as a suite workload: one workload per preset,
 //! its sizes by number of roots.
 
 use crate::strategy::GpuConfig;
 use crate::suite::Scale;
 use crate::workload::{ProblemWorkload, ScheduledProblem};
-use scheduler::workloads::tree::{Fanout, TreeParams, TreePreset, TreeResult, TreeRun};
 use scheduler::{Gpu, Program, RunError, RunStats, Scheduler};
+use workloads::tree::{Fanout, TreeParams, TreePreset, TreeResult, TreeRun};
 
 impl ScheduledProblem for TreeParams {
     type Output = TreeResult;

@@ -1,6 +1,6 @@
 //! The suite's view of a workload: problem sizes, the strategies it runs under, and one
 //! verified, timed run at a time. [`ScheduledProblem`] adapts any workload in the shape of
-//! `scheduler::workloads::tree` (parameters with a CPU reference and a rayon twin, a GPU run of
+//! `workloads::tree` (parameters with a CPU reference and a rayon twin, a GPU run of
 //! one program) in a few lines; Reyes implements [`Workload`] itself (`crate::reyes`).
 
 use crate::strategy::{GpuConfig, Strategy, compile};
@@ -59,7 +59,7 @@ pub trait Workload {
     fn run(&mut self, gpu: &Gpu, strategy: &Strategy) -> Result<Measurement, String>;
 }
 
-/// A workload in the shape of `scheduler::workloads::tree`, adapted by [`ProblemWorkload`]:
+/// A workload in the shape of `workloads::tree`, adapted by [`ProblemWorkload`]:
 /// `Self` is one problem size (the workload's parameters).
 pub trait ScheduledProblem: Clone {
     /// What a run computes; GPU and CPU results must be equal.

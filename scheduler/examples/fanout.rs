@@ -9,6 +9,7 @@
 //!
 //! It needs no dependency but `scheduler`: wgpu and bytemuck come re-exported.
 
+use std::fmt;
 use std::process::ExitCode;
 
 use scheduler::bytemuck::{Pod, Zeroable};
@@ -105,14 +106,65 @@ fn reference() -> Expected {
     e
 }
 
+/// Why the example failed.
+#[derive(Debug)]
+enum FanoutError {
+    /// Setting up: the device, the program, a user buffer or a read-back.
+    Run(RunError),
+    /// Compiling or running the program for one strategy.
+    Strategy(StrategyKind, RunError),
+    /// The host twin [`Node`] has another size than the WGSL struct (its WGSL size, bytes).
+    NodeSize(u32),
+    /// A strategy's result differs from the CPU reference.
+    Mismatch {
+        strategy: StrategyKind,
+        got: Expected,
+        expected: Expected,
+    },
+}
+
+impl fmt::Display for FanoutError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            FanoutError::Run(e) => write!(f, "{e}"),
+            FanoutError::Strategy(kind, e) => write!(f, "{kind:?}: {e}"),
+            FanoutError::NodeSize(size) => write!(f, "Node: WGSL size {size} != host size"),
+            FanoutError::Mismatch {
+                strategy,
+                got,
+                expected,
+            } => write!(
+                f,
+                "{}: GPU {got:?} differs from the CPU reference {expected:?}",
+                strategy.name()
+            ),
+        }
+    }
+}
+
+impl std::error::Error for FanoutError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            FanoutError::Run(e) | FanoutError::Strategy(_, e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+impl From<RunError> for FanoutError {
+    fn from(e: RunError) -> Self {
+        FanoutError::Run(e)
+    }
+}
+
 /// Runs the tree on every strategy and checks each against the CPU reference; prints the
 /// results and statistics when `print`.
-fn run(print: bool) -> Result<(), String> {
-    let gpu = Gpu::from_env().map_err(|e| e.to_string())?;
-    let program = program().map_err(|e| e.to_string())?;
-    let layout = scheduler::wgsl::struct_layout(NODE_WGSL, "Node").map_err(|e| e.to_string())?;
+fn run(print: bool) -> Result<(), FanoutError> {
+    let gpu = Gpu::from_env()?;
+    let program = program()?;
+    let layout = scheduler::wgsl::struct_layout(NODE_WGSL, "Node")?;
     if layout.size as usize != size_of::<Node>() {
-        return Err(format!("Node: WGSL size {} != host size", layout.size));
+        return Err(FanoutError::NodeSize(layout.size));
     }
     let expected = reference();
     let roots: Vec<Node> = (0..ROOTS).map(|id| Node { id, depth: 0 }).collect();
@@ -127,22 +179,13 @@ fn run(print: bool) -> Result<(), String> {
     }
     for kind in StrategyKind::ALL {
         // Fresh user buffers per run: the counters start at zero.
-        let out = gpu
-            .storage_buffer("fanout out", 2)
-            .map_err(|e| e.to_string())?;
-        let cfg = gpu
-            .upload("fanout cfg", &[DEPTH])
-            .map_err(|e| e.to_string())?;
-        let bind = program
-            .user
-            .bind_group(&gpu, &[&out, &cfg])
-            .map_err(|e| e.to_string())?;
-        let scheduler =
-            Scheduler::new(&gpu, &program, kind, 1024).map_err(|e| format!("{kind:?}: {e}"))?;
-        let stats = scheduler
-            .run(&gpu, &seeds, Some(&bind))
-            .map_err(|e| format!("{kind:?}: {e}"))?;
-        let words = gpu.read_words(&out, 0, 2).map_err(|e| e.to_string())?;
+        let out = gpu.storage_buffer("fanout out", 2)?;
+        let cfg = gpu.upload("fanout cfg", &[DEPTH])?;
+        let bind = program.user.bind_group(&gpu, &[&out, &cfg])?;
+        let strategy = |e| FanoutError::Strategy(kind, e);
+        let scheduler = Scheduler::new(&gpu, &program, kind, 1024).map_err(strategy)?;
+        let stats = scheduler.run(&gpu, &seeds, Some(&bind)).map_err(strategy)?;
+        let words = gpu.read_words(&out, 0, 2)?;
         let got = Expected {
             executed: stats.executed.clone(),
             leaves: words[0],
@@ -168,10 +211,11 @@ fn run(print: bool) -> Result<(), String> {
             );
         }
         if got != expected {
-            return Err(format!(
-                "{}: GPU {got:?} differs from the CPU reference {expected:?}",
-                kind.name()
-            ));
+            return Err(FanoutError::Mismatch {
+                strategy: kind,
+                got,
+                expected,
+            });
         }
     }
     if print {

@@ -5,8 +5,10 @@
 //! size; interleaved touches one sector per thread per access, but moves an item whose size is
 //! a whole number of `vec4`s 16 bytes at a time (docs/scheduler.md, "Item layout").
 
+use crate::gpu::Gpu;
+use crate::program::Program;
 use crate::queue_layout::QueueLayout;
-use crate::wgsl::{Leaf, ScalarKind, StructLayout};
+use crate::wgsl::{StructLayout, cast_in, cast_out, load_store_fns};
 
 /// Where word `k` of item `i` of a queue region lives (in u32 words from the region's start,
 /// `capacity` slots).
@@ -41,7 +43,7 @@ impl ItemLayout {
     pub const PLANAR_MIN_WORDS: u32 = 16;
 
     /// The faster layout for `program` on `gpu`, as measured on the H200 (docs/results.md,
-    /// session 19): planar when every procedure runs one thread per item and the largest item
+    /// "Planar (structure-of-arrays) queues"): planar when every procedure runs one thread per item and the largest item
     /// has at least [`Self::PLANAR_MIN_WORDS`] words (the tree of 64-word items: host-driven
     /// multi-pass 1.10 -> 0.76 ms, megakernel 1.30 -> 1.17; of 16-word items 0.53 -> 0.49),
     /// interleaved otherwise: for 3-word items planar was up to 10% slower (the megakernel
@@ -49,12 +51,12 @@ impl ItemLayout {
     /// every thread of the item, 5-10% slower (a vec4 load serves all the item's threads at
     /// once). Interleaved on CPU adapters such as lavapipe, whose caches favour an item's words
     /// together (planar was 3x slower there on the 64-word tree).
-    pub fn for_program(gpu: &crate::Gpu, program: &crate::Program) -> ItemLayout {
+    pub fn for_program(gpu: &Gpu, program: &Program) -> ItemLayout {
         Self::choose(gpu.info.device_type == wgpu::DeviceType::Cpu, program)
     }
 
     /// [`ItemLayout::for_program`] on a CPU adapter (`cpu`) or a GPU.
-    fn choose(cpu: bool, program: &crate::Program) -> ItemLayout {
+    fn choose(cpu: bool, program: &Program) -> ItemLayout {
         let one_thread = program.procs.iter().all(|p| p.proc.threads_per_item == 1);
         let largest = program.procs.iter().map(|p| p.words()).max().unwrap_or(0);
         if !cpu && one_thread && largest >= Self::PLANAR_MIN_WORDS {
@@ -62,6 +64,54 @@ impl ItemLayout {
         } else {
             ItemLayout::Interleaved
         }
+    }
+
+    /// `fn sched_execute(q, base, inv)` for `program`'s queues laid out this way: loads the
+    /// item at word `base` with `{prefix}_load_*` (only for active invocations) and calls the
+    /// body of procedure `q`. With [`ItemLayout::Planar`] it is `sched_execute(q, base, stride,
+    /// inv)` (word `k` of the item at `base + k × stride`).
+    pub(crate) fn execute_switch(self, program: &Program, prefix: &str) -> String {
+        let items = self;
+        let planar = items == ItemLayout::Planar;
+        let mut s = String::new();
+        let mut seen = Vec::new();
+        for p in &program.procs {
+            if !seen.contains(&p.layout.name) {
+                seen.push(p.layout.name.clone());
+                s += &match items {
+                    ItemLayout::Interleaved => load_store_fns(&p.layout, prefix),
+                    ItemLayout::Planar => planar_load_store_fns(&p.layout, prefix),
+                };
+            }
+        }
+        let (stride_param, stride) = if planar {
+            ("stride: u32, ", ", stride")
+        } else {
+            ("", "")
+        };
+        s += &format!(
+            "fn sched_execute(q: u32, base: u32, {stride_param}inv: Invocation) {{\n    switch q {{\n"
+        );
+        // One case, and one call, per execute function (Procedure::execute_of).
+        let mut done = Vec::new();
+        for p in &program.procs {
+            let f = p.proc.execute_fn();
+            if done.contains(&f) {
+                continue;
+            }
+            let qs: Vec<String> = (program.procs.iter().enumerate())
+                .filter(|(_, o)| o.proc.execute_fn() == f)
+                .map(|(i, _)| format!("{i}u"))
+                .collect();
+            s += &format!(
+                "        case {qs}: {{ var it: {t}; if inv.live {{ it = {prefix}_load_{t}(base{stride}); }} {f}(it, inv); }}\n",
+                qs = qs.join(", "),
+                t = p.layout.name,
+            );
+            done.push(f);
+        }
+        s += "        default: {}\n    }\n}\n";
+        s
     }
 
     /// Word ranges `(from_word, to_word, words)` that copy items `0..n` of queue `q` from a
@@ -157,7 +207,7 @@ impl PlanarScatter {
     /// For queues of `layout` seeded with `seeded[q]` items each. Errors: pipeline or buffer
     /// creation ([`crate::RunError::Device`]).
     pub fn new(
-        gpu: &crate::Gpu,
+        gpu: &Gpu,
         layout: &QueueLayout,
         seeded: &[u32],
     ) -> Result<PlanarScatter, crate::RunError> {
@@ -248,23 +298,6 @@ pub(crate) fn planar_load_store_fns(layout: &StructLayout, prefix: &str) -> Stri
     s
 }
 
-/// The WGSL that turns stored word `w` into the scalar of leaf `l`.
-pub(crate) fn cast_in(l: &Leaf, w: String) -> String {
-    match l.kind {
-        ScalarKind::U32 => w,
-        ScalarKind::I32 => format!("bitcast<i32>({w})"),
-        ScalarKind::F32 => format!("bitcast<f32>({w})"),
-    }
-}
-
-/// The WGSL that turns leaf `l` of a value `v` into the word stored.
-pub(crate) fn cast_out(l: &Leaf) -> String {
-    match l.kind {
-        ScalarKind::U32 => format!("v{}", l.path),
-        _ => format!("bitcast<u32>(v{})", l.path),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -308,22 +341,34 @@ mod tests {
 
     #[test]
     fn planar_is_chosen_for_large_one_thread_items_on_gpus_only() {
-        use crate::workloads::tree::TreeParams;
-        let tree = |payload_words| {
-            TreeParams {
-                payload_words,
-                ..TreeParams::binary_benchmark()
-            }
-            .program()
-            .unwrap()
+        // A node procedure and a leaf procedure of one thread per item each, as in a split
+        // tree, on items of `words` words.
+        let one_thread = |words: u32| {
+            let item =
+                crate::ItemType::new("Node", &format!("struct Node {{ w: array<u32, {words}> }}"));
+            let node = crate::Procedure::new("node", item.clone(), 1)
+                .emits("leaf", 2)
+                .body("fn node_execute(item: Node, inv: Invocation) { enqueue_leaf(item); }");
+            let leaf = crate::Procedure::new("leaf", item, 1)
+                .body("fn leaf_execute(item: Node, inv: Invocation) {}");
+            crate::Program::new(vec![node, leaf], crate::UserBindings::none()).unwrap()
         };
         // 64-word and 16-word items: planar on a GPU, interleaved on a CPU adapter.
-        assert_eq!(ItemLayout::choose(false, &tree(62)), ItemLayout::Planar);
-        assert_eq!(ItemLayout::choose(false, &tree(14)), ItemLayout::Planar);
-        assert_eq!(ItemLayout::choose(true, &tree(62)), ItemLayout::Interleaved);
+        assert_eq!(
+            ItemLayout::choose(false, &one_thread(64)),
+            ItemLayout::Planar
+        );
+        assert_eq!(
+            ItemLayout::choose(false, &one_thread(16)),
+            ItemLayout::Planar
+        );
+        assert_eq!(
+            ItemLayout::choose(true, &one_thread(64)),
+            ItemLayout::Interleaved
+        );
         // 15-word items, and items read by several threads each.
         assert_eq!(
-            ItemLayout::choose(false, &tree(13)),
+            ItemLayout::choose(false, &one_thread(15)),
             ItemLayout::Interleaved
         );
         let wide = crate::ItemType::new("Wide", "struct Wide { w: array<u32, 32> }");

@@ -25,17 +25,15 @@ pub mod item_layout;
 pub mod megakernel;
 pub mod multipass;
 mod pipeline;
-mod probe;
 pub mod procedure;
 pub mod program;
 mod queue_layout;
 mod readback;
-pub mod recorded;
+pub mod recorded_run;
 pub mod stats;
 pub mod strategy;
 pub mod timing;
 pub mod wgsl;
-pub mod workloads;
 
 /// The bytemuck this crate is built against: `#[derive(Pod, Zeroable)]` host twins of item
 /// structs go through it ([`Seed::new`], [`Gpu::upload`]).
@@ -53,6 +51,6 @@ pub use multipass::host::{HostMultipass, HostMultipassConfig};
 pub use multipass::{Multipass, MultipassConfig};
 pub use procedure::{ItemType, Procedure};
 pub use program::{Program, Seed};
-pub use recorded::{DeviceSeeds, Outcome, RecordedRun, RecordedSize};
-pub use stats::RunStats;
+pub use recorded_run::{DeviceSeeds, RecordedRun, RecordedSize};
+pub use stats::{Outcome, RunStats};
 pub use strategy::{Scheduler, StrategyKind};

@@ -122,6 +122,22 @@ impl QueueLayout {
         let seeded: Vec<u32> = (0..program.queue_count())
             .map(|q| (live[q].len() / program.procs[q].words() as usize) as u32)
             .collect();
+        Self::check_seeds(program, &seeded, &max_cap)?;
+        Ok(RunStart {
+            live,
+            seeded,
+            max_cap,
+        })
+    }
+
+    /// Seeds of `seeded[q]` items per queue against each queue's most slots `max_cap[q]`: the
+    /// seeds of one queue that exceed its limit are a [`RunError::QueueOverflow`] naming the
+    /// first such queue, as in a run.
+    pub(crate) fn check_seeds(
+        program: &Program,
+        seeded: &[u32],
+        max_cap: &[u32],
+    ) -> Result<(), RunError> {
         if let Some(q) = (0..seeded.len()).find(|&q| seeded[q] > max_cap[q]) {
             return Err(RunError::QueueOverflow {
                 queue: program.procs[q].proc.name.clone(),
@@ -129,11 +145,7 @@ impl QueueLayout {
                 needed_more_than: seeded[q] as u64,
             });
         }
-        Ok(RunStart {
-            live,
-            seeded,
-            max_cap,
-        })
+        Ok(())
     }
 
     /// Per-queue seed items (words back to back), validated against the program.

@@ -1,4 +1,5 @@
-//! What a run reports, whatever the strategy.
+//! What a run reports, whatever the strategy: [`RunStats`], and for a run recorded without host
+//! waits, its [`Outcome`].
 
 /// Statistics of one run. Counters that do not apply to a strategy are zero.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -80,6 +81,23 @@ impl RunStats {
         self.gpu_ms = self.gpu_ms.zip(o.gpu_ms).map(|(a, b)| a + b);
         self.wall_ms += o.wall_ms;
     }
+}
+
+/// What a recorded run's status copy says ([`crate::RecordedRun::outcome`]).
+#[derive(Debug, Clone, PartialEq)]
+#[allow(
+    clippy::large_enum_variant,
+    reason = "one per record, read once; callers match `Done(stats)` without a box"
+)]
+pub enum Outcome {
+    /// The run finished: every item was executed. `launches` and `rounds` are those recorded;
+    /// `submits` is 0 (the run cost no host round trip of its own), `gpu_ms` and `wall_ms` are
+    /// the caller's to measure.
+    Done(RunStats),
+    /// The run stopped with work left, why in words (a queue name and its capacity, or the
+    /// bound that ended it); the user results are partial: run the work again with
+    /// [`crate::Scheduler::run`].
+    Incomplete(String),
 }
 
 /// Median and median absolute deviation (the spread measure robust to the odd slow run) of

@@ -86,15 +86,7 @@ pub fn struct_layout(source: &str, name: &str) -> Result<StructLayout, RunError>
         return Err(RunError::Program(format!("`{name}` is not a struct")));
     };
     let mut leaves = Vec::new();
-    flatten(
-        &module,
-        &layouter,
-        handle,
-        String::new(),
-        0,
-        &mut leaves,
-        name,
-    )?;
+    flatten(&module, handle, String::new(), 0, &mut leaves, name)?;
     Ok(StructLayout {
         name: name.to_string(),
         size: layouter[handle].size,
@@ -108,7 +100,6 @@ pub fn struct_layout(source: &str, name: &str) -> Result<StructLayout, RunError>
 
 fn flatten(
     module: &naga::Module,
-    layouter: &naga::proc::Layouter,
     ty: naga::Handle<naga::Type>,
     path: String,
     byte: u32,
@@ -170,7 +161,6 @@ fn flatten(
             for i in 0..n.get() {
                 flatten(
                     module,
-                    layouter,
                     *base,
                     format!("{path}[{i}]"),
                     byte + i * stride,
@@ -184,7 +174,6 @@ fn flatten(
                 let name = m.name.clone().unwrap_or_default();
                 flatten(
                     module,
-                    layouter,
                     m.ty,
                     format!("{path}.{name}"),
                     byte + m.offset,
@@ -217,10 +206,10 @@ pub(crate) fn moves_by_vec4(layout: &StructLayout) -> bool {
 /// Why vectors: a one-thread item is read and written by its own thread, so a warp touches 32
 /// items at a stride of the item size. Word by word, each of those accesses is its own memory
 /// transaction; 16 bytes at a time there are a quarter as many (on the H200 the 256-byte items
-/// of the large-payload tree moved several times faster: docs/results.md, session 18).
+/// of the large-payload tree moved several times faster: docs/results.md, "Large items: how they
+/// are copied").
 pub(crate) fn load_store_fns(layout: &StructLayout, prefix: &str) -> String {
     let t = &layout.name;
-    use crate::item_layout::{cast_in, cast_out};
     let mut s = format!("fn {prefix}_load_{t}(base: u32) -> {t} {{\n    var v: {t};\n");
     if moves_by_vec4(layout) {
         for g in 0..layout.words() / 4 {
@@ -262,6 +251,23 @@ pub(crate) fn load_store_fns(layout: &StructLayout, prefix: &str) -> String {
     }
     s += "}\n";
     s
+}
+
+/// The WGSL that turns stored word `w` into the scalar of leaf `l`.
+pub(crate) fn cast_in(l: &Leaf, w: String) -> String {
+    match l.kind {
+        ScalarKind::U32 => w,
+        ScalarKind::I32 => format!("bitcast<i32>({w})"),
+        ScalarKind::F32 => format!("bitcast<f32>({w})"),
+    }
+}
+
+/// The WGSL that turns leaf `l` of a value `v` into the word stored.
+pub(crate) fn cast_out(l: &Leaf) -> String {
+    match l.kind {
+        ScalarKind::U32 => format!("v{}", l.path),
+        _ => format!("bitcast<u32>(v{})", l.path),
+    }
 }
 
 /// WGSL accessors `{prefix}_load_word`, `{prefix}_store_word`, `{prefix}_load_vec4` and

@@ -101,7 +101,7 @@ mod tests {
             assert_eq!(wgsl_const(src, name), Some(host), "{name}");
         }
         // Words the compaction kernel writes are unused by the megakernel and inside ctrl.
-        assert!(Q_KEPT > Q_DEMAND && Q_KEPT < QSTRIDE);
-        assert!(G_LOST > G_ITER_EXITS && G_LOST < GLOBAL_WORDS);
+        const { assert!(Q_KEPT > Q_DEMAND && Q_KEPT < QSTRIDE) };
+        const { assert!(G_LOST > G_ITER_EXITS && G_LOST < GLOBAL_WORDS) };
     }
 }

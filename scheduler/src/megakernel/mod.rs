@@ -5,7 +5,7 @@
 
 mod compact;
 pub(crate) mod layout;
-pub(crate) mod recorded;
+pub(crate) mod record;
 pub(crate) mod wgsl;
 
 use std::time::Instant;
@@ -79,7 +79,8 @@ pub struct MegakernelConfig {
     /// one multiply-add (about 4 clocks each); the pause doubles per idle turn up to this and
     /// ends at the first claimed batch. Idle workgroups polling without a pause crowd the L2
     /// lines of the queue counters that every claim needs: on the H200, 64 made the deep tree
-    /// 25% faster and no tree slower (docs/results.md, session 18). 0 polls without a pause
+    /// 25% faster and no tree slower (docs/results.md, "A megakernel turn's latency, and idle
+    /// workgroups pausing"). 0 polls without a pause
     /// (and is what lavapipe gets: its loop limiter counts the pause's trips).
     pub idle_backoff: u32,
     /// Slots per queue at the start of a run (at least twice the seeds).
@@ -97,7 +98,8 @@ pub struct MegakernelConfig {
     /// out after the batch: saves a write and a read of every item, costs an atomic per item
     /// instead of one per batch. Only where a batch's worst-case emits fit
     /// [`MAX_DIRECT_EMITS`]. `None` (the default): where the largest item has
-    /// [`DIRECT_MIN_WORDS`] words or more. Measured on the H200 (docs/results.md, session 19):
+    /// [`DIRECT_MIN_WORDS`] words or more. Measured on the H200 (docs/results.md, "Direct
+    /// enqueue in the megakernel"):
     /// 64-word items 1.17 -> 0.80 ms, Reyes frames 1-4% faster; 3-word items 6-25% slower.
     pub direct_enqueue: Option<bool>,
 }
@@ -165,7 +167,7 @@ enum Start {
     /// Copied on the device from the previous launch's buffers, whose first `reserved[q]`
     /// tickets hold `live[q]` published, unconsumed items per queue.
     Compact {
-        old: DeviceQueues,
+        old: Box<DeviceQueues>,
         reserved: Vec<u32>,
         live: Vec<u32>,
     },
@@ -651,7 +653,7 @@ impl Megakernel {
             start = if grew {
                 // New buffers; the live items move there on the device, in the next launch's pass.
                 Start::Compact {
-                    old: dq.take().expect("buffers of the launch"),
+                    old: Box::new(dq.take().expect("buffers of the launch")),
                     reserved,
                     live,
                 }

@@ -49,7 +49,7 @@ pub fn source(
                   for (var k = 0u; k < 4u; k++) { atomicStore(&slots[i + k], v[k]); }\n}\n";
     }
     s += &crate::wgsl::vec4_word_accessors("sched_ob", "outbox");
-    s += &program.execute_switch("sched_slot", items);
+    s += &items.execute_switch(program, "sched_slot");
     // Where item `s` of queue `q`'s slots starts (planar: and its stride).
     let slot_at = |q: &str| {
         if planar {
@@ -71,7 +71,7 @@ pub fn source(
         slot_at("q")
     );
     // Typed outbox stores, only where items go through the outbox (direct enqueue stores with
-    // the `sched_slot_store_*` that come with `execute_switch`'s loads).
+    // the `sched_slot_store_*` that come with `ItemLayout::execute_switch`'s loads).
     let mut seen = Vec::new();
     for p in program.procs.iter().filter(|_| direct.is_none()) {
         if !seen.contains(&p.layout.name) {
@@ -106,4 +106,23 @@ pub fn source(
     }
     s += TEMPLATE;
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::{ItemLayout, ItemType, Procedure, Program, UserBindings};
+
+    #[test]
+    fn procedures_sharing_an_execute_function_share_one_call_site() {
+        let word = ItemType::new("Word", "struct Word { v: u32 }");
+        let one = Procedure::new("one", word.clone(), 4)
+            .body("fn one_execute(item: Word, inv: Invocation) { let t = inv.threads; }");
+        let sink = Procedure::new("sink", word.clone(), 1)
+            .body("fn sink_execute(item: Word, inv: Invocation) {}");
+        let two = Procedure::new("two", word, 2).execute_of("one");
+        let p = Program::new(vec![one, sink, two], UserBindings::none()).unwrap();
+        let src = super::source(&p, false, ItemLayout::Interleaved, None);
+        assert_eq!(src.matches("one_execute(it, inv)").count(), 1, "{src}");
+        assert!(src.contains("case 0u, 2u:"), "{src}");
+    }
 }

@@ -83,7 +83,7 @@ struct HostRounds {
     layout: QueueLayout,
     counts: [wgpu::Buffer; 2],
     items: [wgpu::Buffer; 2],
-    /// bind[p]: reads counts[p] and items[p], appends to counts[1 - p] and items[1 - p].
+    /// `bind[p]`: reads `counts[p]` and `items[p]`, appends to `counts[1 - p]` and `items[1 - p]`.
     bind: [wgpu::BindGroup; 2],
 }
 
@@ -95,7 +95,7 @@ pub(crate) fn source(program: &Program, items: ItemLayout) -> String {
     s += &program.common_wgsl();
     s += &crate::wgsl::vec4_word_accessors("mp_in", "items_in");
     s += &crate::wgsl::vec4_word_accessors("mp_out", "items_out");
-    s += &program.execute_switch("mp_in", items);
+    s += &items.execute_switch(program, "mp_in");
     let mut seen = Vec::new();
     for p in &program.procs {
         if !seen.contains(&p.layout.name) {

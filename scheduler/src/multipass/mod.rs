@@ -7,7 +7,7 @@
 pub mod host;
 pub(crate) mod layout;
 pub mod partial;
-pub(crate) mod recorded;
+pub(crate) mod record;
 pub(crate) mod wgsl;
 
 use std::time::Instant;
@@ -72,7 +72,7 @@ struct DeviceRounds {
     items: [wgpu::Buffer; 2],
     indirect: wgpu::Buffer,
     plan_bind: wgpu::BindGroup,
-    /// bind[parity]: round r reads items[r % 2] and writes items[(r + 1) % 2].
+    /// `bind[parity]`: round r reads `items[r % 2]` and writes `items[(r + 1) % 2]`.
     bind: [wgpu::BindGroup; 2],
 }
 

@@ -28,7 +28,7 @@ pub fn source(program: &Program) -> String {
     s += &crate::wgsl::vec4_word_accessors("mp_in", "items_in");
     s += &crate::wgsl::vec4_word_accessors("mp_out", "items_out");
     s += &crate::wgsl::vec4_word_accessors("mp_emit", "emit");
-    s += &program.execute_switch("mp_in", crate::ItemLayout::Interleaved);
+    s += &crate::ItemLayout::Interleaved.execute_switch(program, "mp_in");
     let mut seen = Vec::new();
     for p in &program.procs {
         if !seen.contains(&p.layout.name) {

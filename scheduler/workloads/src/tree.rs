@@ -4,15 +4,15 @@
 //! result), and leaves fold an order-independent checksum. Inner nodes run `branch`, childless
 //! nodes run `leaf`. A CPU reference gives exact item counts and the checksum.
 
-use crate::bindings::UserBindings;
-use crate::error::RunError;
-use crate::gpu::Gpu;
-use crate::hash::{lowbias32 as hash, lowbias32_wgsl};
-use crate::procedure::{ItemType, Procedure};
-use crate::program::{Program, Seed};
-use crate::stats::RunStats;
-use crate::strategy::Scheduler;
 use rayon::prelude::*;
+use scheduler::bindings::UserBindings;
+use scheduler::error::RunError;
+use scheduler::gpu::Gpu;
+use scheduler::hash::{lowbias32 as hash, lowbias32_wgsl};
+use scheduler::procedure::{ItemType, Procedure};
+use scheduler::program::{Program, Seed};
+use scheduler::stats::RunStats;
+use scheduler::strategy::Scheduler;
 
 /// How many children an inner node has.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -85,7 +85,9 @@ impl TreePreset {
         Self::ALL.into_iter().find(|p| p.name() == s)
     }
 
-    /// The tree the preset names (the benchmark sizes of issue 10's table).
+    /// The tree the preset names: the benchmark's trees, sized as those of the reference
+    /// figures for Whippletree and a plain CUDA multi-pass that docs/results.md sets the
+    /// strategies beside.
     pub fn params(self) -> TreeParams {
         let binary = TreeParams::binary_benchmark();
         match self {
@@ -285,7 +287,7 @@ impl TreeParams {
 
     /// [`TreeParams::reference`] on every core (rayon): the same [`TreeResult`], the CPU floor a
     /// GPU result must beat. The top of the tree is expanded breadth-first on the calling
-    /// thread until there are [`SUBTREES_PER_THREAD`] subtrees per rayon thread (or the tree
+    /// thread until there are `SUBTREES_PER_THREAD` subtrees per rayon thread (or the tree
     /// ends); rayon then walks the subtrees depth-first, each with a flat stack of payload
     /// words, so no node allocates. Children's order differs from the reference's, which
     /// cannot change the result: every fold is commutative.
@@ -373,8 +375,8 @@ impl TreeParams {
                 TREE_WGSL
             ),
             layout: vec![
-                crate::bindings::storage_entry(0, false),
-                crate::bindings::storage_entry(1, true),
+                scheduler::storage_entry(0, false),
+                scheduler::storage_entry(1, true),
             ],
         };
         let branch = Procedure::new("branch", item.clone(), 1)
@@ -410,7 +412,7 @@ impl TreeParams {
     }
 }
 
-// `tree_hash` is `crate::hash::lowbias32_wgsl`, the twin of the CPU reference's hash.
+// `tree_hash` is `scheduler::hash::lowbias32_wgsl`, the twin of the CPU reference's hash.
 const TREE_WGSL: &str = r#"
 fn tree_children(id: u32, depth: u32) -> u32 {
     if depth >= tree_cfg[0] { return 0u; }
@@ -422,8 +424,8 @@ fn tree_children(id: u32, depth: u32) -> u32 {
 // The bodies as written: loops over the payload. `TreeParams::program` unrolls them (`unrolled`)
 // for the program's payload size, as a CUDA compiler unrolls loops of constant trip count; the
 // Vulkan driver keeps such a loop, and with it the payload in local memory instead of
-// registers (1.6x the GPU time of the large-payload tree on the H200: docs/results.md,
-// session 18). Both copy the item into a `var` first: indexing the `item` parameter (a value)
+// registers (1.6x the GPU time of the large-payload tree on the H200: docs/results.md, "Large
+// items: how they are copied"). Both copy the item into a `var` first: indexing the `item` parameter (a value)
 // with a run-time index makes naga's SPIR-V copy the whole array to a temporary at every access
 // (`Program::new` warns of it; docs/scheduler.md, "Writing fast procedures").
 const BRANCH_WGSL: &str = r#"

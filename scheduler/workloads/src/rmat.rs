@@ -11,7 +11,7 @@
 
 use rayon::prelude::*;
 
-use crate::error::RunError;
+use scheduler::error::RunError;
 
 /// Generator parameters. `d = 1 - a - b - c`.
 #[derive(Debug, Clone, Copy, PartialEq)]

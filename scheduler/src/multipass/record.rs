@@ -1,4 +1,4 @@
-//! The device-driven multi-pass's [`crate::recorded::RecordedRun`]: a fixed number of rounds
+//! The device-driven multi-pass's part of a [`crate::RecordedRun`]: a fixed number of rounds
 //! on queues of fixed capacity, seeded on the device, in one pass. A round that would not fit
 //! is refused on the device as in a run (inputs intact, every later round refused too), and an
 //! empty round costs only its plan and empty indirect dispatches.
@@ -9,10 +9,10 @@ use crate::error::RunError;
 use crate::gpu::Gpu;
 use crate::program::Program;
 use crate::queue_layout::QueueLayout;
-use crate::recorded::{Outcome, RecordedSize};
-use crate::stats::RunStats;
+use crate::stats::{Outcome, RunStats};
 
-pub(crate) struct Recorded {
+/// The rounds' queues and start state, recorded again for every record of the run.
+pub(crate) struct RecordedRounds {
     d: super::DeviceRounds,
     /// mp_ctrl at the start: the seed counts as the first round's inputs, all else 0.
     ctrl_start: wgpu::Buffer,
@@ -20,15 +20,17 @@ pub(crate) struct Recorded {
 }
 
 impl Multipass {
-    /// Queues of `size` (lowered to each queue's limit under the device and `max_queue_bytes`,
-    /// raised to its seeds) and `size.rounds` (at least 1) rounds per record.
-    pub(crate) fn recorded(
+    /// Queues of `wanted[q]` slots each (lowered to each queue's limit under the device and
+    /// `max_queue_bytes`, raised to its seeds) and `rounds` (at least 1) rounds per record;
+    /// with the capacities allocated.
+    pub(crate) fn recorded_rounds(
         &self,
         gpu: &Gpu,
         seeded: &[u32],
-        size: &RecordedSize,
+        wanted: &[u32],
+        rounds: u32,
         max_queue_bytes: Option<u64>,
-    ) -> Result<(Recorded, RecordedSize), RunError> {
+    ) -> Result<(RecordedRounds, Vec<u32>), RunError> {
         let max_cap = QueueLayout::within_budget(
             &self.program,
             QueueLayout::capacity_limits(
@@ -39,9 +41,9 @@ impl Multipass {
             max_queue_bytes,
             3,
         );
-        crate::megakernel::recorded::check_seeds(&self.program, seeded, &max_cap)?;
+        QueueLayout::check_seeds(&self.program, seeded, &max_cap)?;
         let capacity: Vec<u32> = (0..seeded.len())
-            .map(|q| size.capacity[q].min(max_cap[q]).max(seeded[q]).max(1))
+            .map(|q| wanted[q].min(max_cap[q]).max(seeded[q]).max(1))
             .collect();
         // No partial rounds: a recorded run has a fixed round count, so a round that does not
         // fit halts and the run reports itself incomplete (the caller re-renders that frame).
@@ -56,25 +58,30 @@ impl Multipass {
             ctrl[c(q, C_NEXT)] = n;
         }
         let ctrl_start = gpu.upload("mp_ctrl at start", &ctrl)?;
-        let rounds = size.rounds.max(1);
-        let size = RecordedSize { capacity, rounds };
+        let rounds = rounds.max(1);
         Ok((
-            Recorded {
+            RecordedRounds {
                 d,
                 ctrl_start,
                 rounds,
             },
-            size,
+            capacity,
         ))
     }
 }
 
-impl Recorded {
+impl RecordedRounds {
+    /// Rounds encoded per record.
+    pub fn rounds(&self) -> u32 {
+        self.rounds
+    }
+
+    /// Words of the run's control block, which each record copies to the caller's status.
     pub fn status_words(&self) -> u64 {
         self.d.ctrl.size() / 4
     }
 
-    /// See [`crate::recorded::RecordedRun::record`]; seeds are `(queue, buffer, count)`.
+    /// See [`crate::RecordedRun::record`]; seeds are `(queue, buffer, count)`.
     pub fn record(
         &self,
         m: &Multipass,
@@ -94,11 +101,12 @@ impl Recorded {
     }
 
     /// Done when no round was refused and the last left no inputs; an emit beyond a
-    /// declaration is an error.
+    /// declaration is an error. `capacity`: the slots per queue
+    /// [`Multipass::recorded_rounds`] allocated.
     pub fn outcome(
         &self,
         program: &Program,
-        size: &RecordedSize,
+        capacity: &[u32],
         ctrl: &[u32],
     ) -> Result<Outcome, RunError> {
         let nq = program.queue_count();
@@ -114,7 +122,7 @@ impl Recorded {
         if error == ERR_OVERFLOW {
             return Ok(Outcome::Incomplete(format!(
                 "a round refused: queue `{}` may receive {b} items, more than its {} slots",
-                program.procs[a].proc.name, size.capacity[a]
+                program.procs[a].proc.name, capacity[a]
             )));
         }
         let left: u64 = (0..nq).map(|q| ctrl[c(q, C_NEXT)] as u64).sum();

@@ -4,10 +4,26 @@
 
 use crate::bindings::UserBindings;
 use crate::error::RunError;
-use crate::item_layout::{ItemLayout, planar_load_store_fns};
-use crate::probe::Part;
 use crate::procedure::Procedure;
 use crate::wgsl::{self, StructLayout};
+
+mod validation;
+
+/// Where a piece of the program's shared WGSL came from ([`Program::common_parts`]), so that
+/// an error in it can name what the user wrote.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Part {
+    /// Written by the scheduler (`Invocation`; the enqueue stubs of validation).
+    Generated,
+    /// An item struct's declaration, by struct name.
+    Item(String),
+    /// The workgroup array `.shared(...)` declares for procedure `i`.
+    Shared(usize),
+    /// [`crate::UserBindings::wgsl`].
+    User,
+    /// The body of procedure `i`.
+    Body(usize),
+}
 
 /// Workgroup size of every scheduler kernel; threads per item divide it.
 pub const WORKGROUP_SIZE: u32 = 256;
@@ -147,7 +163,7 @@ impl Program {
         // Compile the shared part once on its own, so that an error names the procedure and a
         // line of its body, not a line of a strategy's generated shader; then check what naga
         // parsed: every `<name>_execute`, enqueue targets against `.emits`, user bindings.
-        program.notes = crate::probe::check(&program)?;
+        program.notes = validation::check(&program)?;
         for n in &program.notes {
             log::warn!("{n}");
         }
@@ -218,53 +234,6 @@ impl Program {
             parts.push((Part::Body(i), p.proc.body.clone()));
         }
         parts
-    }
-
-    /// `fn sched_execute(q, base, inv)`: loads the item at word `base` with `{prefix}_load_*`
-    /// (only for active invocations) and calls the body of procedure `q`. With
-    /// [`ItemLayout::Planar`] it is `sched_execute(q, base, stride, inv)` (word `k` of the item
-    /// at `base + k × stride`).
-    pub(crate) fn execute_switch(&self, prefix: &str, items: ItemLayout) -> String {
-        let planar = items == ItemLayout::Planar;
-        let mut s = String::new();
-        let mut seen = Vec::new();
-        for p in &self.procs {
-            if !seen.contains(&p.layout.name) {
-                seen.push(p.layout.name.clone());
-                s += &match items {
-                    ItemLayout::Interleaved => wgsl::load_store_fns(&p.layout, prefix),
-                    ItemLayout::Planar => planar_load_store_fns(&p.layout, prefix),
-                };
-            }
-        }
-        let (stride_param, stride) = if planar {
-            ("stride: u32, ", ", stride")
-        } else {
-            ("", "")
-        };
-        s += &format!(
-            "fn sched_execute(q: u32, base: u32, {stride_param}inv: Invocation) {{\n    switch q {{\n"
-        );
-        // One case, and one call, per execute function (Procedure::execute_of).
-        let mut done = Vec::new();
-        for p in &self.procs {
-            let f = p.proc.execute_fn();
-            if done.contains(&f) {
-                continue;
-            }
-            let qs: Vec<String> = (self.procs.iter().enumerate())
-                .filter(|(_, o)| o.proc.execute_fn() == f)
-                .map(|(i, _)| format!("{i}u"))
-                .collect();
-            s += &format!(
-                "        case {qs}: {{ var it: {t}; if inv.live {{ it = {prefix}_load_{t}(base{stride}); }} {f}(it, inv); }}\n",
-                qs = qs.join(", "),
-                t = p.layout.name,
-            );
-            done.push(f);
-        }
-        s += "        default: {}\n    }\n}\n";
-        s
     }
 
     /// Constant tables: queue count, threads per item, item words, emit table.

@@ -1,9 +1,9 @@
-//! The validation probe of [`Program::new`]: the program's shared WGSL (item structs, user
+//! The validation of [`Program::new`]: the program's shared WGSL (item structs, user
 //! WGSL, bodies) compiled on its own with stub `enqueue_*` functions, so that an error is
 //! reported where the user wrote it (a procedure's body and a line of that body) rather than
 //! at a line of a strategy's generated shader. A bracket a part leaves unclosed (naga then
 //! stumbles at the next part) is reported in the part that opened it. After naga has parsed and
-//! validated the probe, its module is checked for what naga cannot know:
+//! validated that source, its module is checked for what naga cannot know:
 //! - every procedure has `fn <name>_execute(item: <Item>, inv: Invocation)` with no result;
 //! - a procedure's execute function, and every function it calls, directly or not, calls
 //!   `enqueue_<t>` only for targets `t` the procedure declared with `.emits(t, n)`, `n > 0`
@@ -13,51 +13,36 @@
 
 use naga::{Block, Handle, Span, Statement};
 
+use super::{Part, Program};
 use crate::error::RunError;
-use crate::program::Program;
 
-/// Where a piece of the probe's WGSL came from.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) enum Part {
-    /// Written by the scheduler (`Invocation`, enqueue stubs).
-    Generated,
-    /// An item struct's declaration, by struct name.
-    Item(String),
-    /// The workgroup array `.shared(...)` declares for procedure `i`.
-    Shared(usize),
-    /// [`crate::UserBindings::wgsl`].
-    User,
-    /// The body of procedure `i`.
-    Body(usize),
-}
-
-/// The probe's source, and the byte range of each part in it.
-struct Probe<'a> {
+/// The shared WGSL with enqueue stubs, and the byte range of each part in it.
+struct SharedSource<'a> {
     program: &'a Program,
     text: String,
     parts: Vec<(Part, usize, usize)>,
 }
 
-impl<'a> Probe<'a> {
-    fn new(program: &'a Program) -> Probe<'a> {
-        let mut probe = Probe {
+impl<'a> SharedSource<'a> {
+    fn new(program: &'a Program) -> SharedSource<'a> {
+        let mut shared = SharedSource {
             program,
             text: String::new(),
             parts: Vec::new(),
         };
         for (part, text) in program.common_parts() {
-            probe.push(part, &text);
+            shared.push(part, &text);
         }
         let stubs: String = program
             .procs
             .iter()
             .map(|p| format!("fn enqueue_{}(item: {}) {{}}\n", p.proc.name, p.layout.name))
             .collect();
-        probe.push(
+        shared.push(
             Part::Generated,
-            &format!("{stubs}@compute @workgroup_size(1) fn sched_probe() {{}}"),
+            &format!("{stubs}@compute @workgroup_size(1) fn sched_validation() {{}}"),
         );
-        probe
+        shared
     }
 
     fn push(&mut self, part: Part, text: &str) {
@@ -224,13 +209,13 @@ impl<'a> Probe<'a> {
 /// Every error is a [`RunError::Program`] naming the procedure, part and line it is about.
 /// Returns performance notes ([`Program::notes`](crate::Program::notes)).
 pub(crate) fn check(program: &Program) -> Result<Vec<String>, RunError> {
-    let probe = Probe::new(program);
-    let module = naga::front::wgsl::parse_str(&probe.text).map_err(|e| {
+    let shared = SharedSource::new(program);
+    let module = naga::front::wgsl::parse_str(&shared.text).map_err(|e| {
         let spans: Vec<(Span, String)> = e.labels().map(|(s, l)| (s, l.to_string())).collect();
         let notes: Vec<String> = e.notes().map(str::to_string).collect();
-        let report = probe.report(e.message(), &spans, &notes, false);
+        let report = shared.report(e.message(), &spans, &notes, false);
         // An unclosed bracket makes naga report the next part's first line: name the part.
-        RunError::Program(match probe.unbalanced() {
+        RunError::Program(match shared.unbalanced() {
             Some(at) => format!("{at}\nnaga's error, which follows from it: {report}"),
             None => report,
         })
@@ -250,12 +235,12 @@ pub(crate) fn check(program: &Program) -> Result<Vec<String>, RunError> {
         }
         let message = chain.pop().unwrap_or_default();
         let spans: Vec<(Span, String)> = e.spans().cloned().collect();
-        RunError::Program(probe.report(&message, &spans, &chain, true))
+        RunError::Program(shared.report(&message, &spans, &chain, true))
     })?;
-    check_execute_functions(&probe, &module)?;
-    check_enqueue_targets(&probe, &module)?;
-    check_user_bindings(&probe, &module)?;
-    Ok(dynamic_item_indexing(&probe, &module, &info))
+    check_execute_functions(&shared, &module)?;
+    check_enqueue_targets(&shared, &module)?;
+    check_user_bindings(&shared, &module)?;
+    Ok(dynamic_item_indexing(&shared, &module, &info))
 }
 
 /// Notes for each run-time index into an array or matrix reached from a parameter (a value)
@@ -263,13 +248,13 @@ pub(crate) fn check(program: &Program) -> Result<Vec<String>, RunError> {
 /// helper's), without a `var` in between: naga's SPIR-V backend spills the indexed value to a
 /// temporary at every such access (`spill_to_internal_variable` in naga's `back/spv`).
 fn dynamic_item_indexing(
-    probe: &Probe,
+    shared: &SharedSource,
     module: &naga::Module,
     info: &naga::valid::ModuleInfo,
 ) -> Vec<String> {
     let mut notes = Vec::new();
     for (h, f) in module.functions.iter() {
-        if probe.is_generated(module.functions.get_span(h)) {
+        if shared.is_generated(module.functions.get_span(h)) {
             continue;
         }
         for (e, expr) in f.expressions.iter() {
@@ -295,7 +280,7 @@ fn dynamic_item_indexing(
             }
             let fname = f.name.as_deref().unwrap_or("?");
             let param = f.arguments[arg as usize].name.as_deref().unwrap_or("?");
-            let at = probe
+            let at = shared
                 .locate(f.expressions.get_span(e))
                 .map(|(at, ..)| format!("{at}: "))
                 .unwrap_or_default();
@@ -328,8 +313,8 @@ fn type_name(module: &naga::Module, ty: Handle<naga::Type>) -> String {
 /// Every procedure `p` has `fn <p>_execute(item: <Item>, inv: Invocation)` without a result.
 /// It may be defined in any body or in the user WGSL (Reyes defines two procedures' execute
 /// functions in one body).
-fn check_execute_functions(probe: &Probe, module: &naga::Module) -> Result<(), RunError> {
-    for (i, p) in probe.program.procs.iter().enumerate() {
+fn check_execute_functions(shared: &SharedSource, module: &naga::Module) -> Result<(), RunError> {
+    for (i, p) in shared.program.procs.iter().enumerate() {
         if p.proc.execute_of.is_some() {
             continue; // the other procedure's function, checked there (Program::new)
         }
@@ -344,7 +329,7 @@ fn check_execute_functions(probe: &Probe, module: &naga::Module) -> Result<(), R
                 .filter(|(h, _)| {
                     let span = module.functions.get_span(*h);
                     span.to_range()
-                        .and_then(|r| probe.part_at(r.start))
+                        .and_then(|r| shared.part_at(r.start))
                         .is_some_and(|(part, _)| *part == Part::Body(i))
                 })
                 .filter_map(|(_, f)| f.name.clone())
@@ -365,7 +350,7 @@ fn check_execute_functions(probe: &Probe, module: &naga::Module) -> Result<(), R
             .map(|a| type_name(module, a.ty))
             .collect();
         if types != [item.as_str(), "Invocation"] || f.result.is_some() {
-            let at = probe
+            let at = shared
                 .locate(module.functions.get_span(h))
                 .map(|(at, ..)| format!(" ({at})"))
                 .unwrap_or_default();
@@ -418,9 +403,9 @@ fn call_graph(module: &naga::Module) -> Vec<Vec<Handle<naga::Function>>> {
 }
 
 /// Every `enqueue_<t>` reachable from `<p>_execute` in the call graph is a target `p` declared.
-fn check_enqueue_targets(probe: &Probe, module: &naga::Module) -> Result<(), RunError> {
+fn check_enqueue_targets(shared: &SharedSource, module: &naga::Module) -> Result<(), RunError> {
     let calls = call_graph(module);
-    let procs = &probe.program.procs;
+    let procs = &shared.program.procs;
     let enqueue: Vec<Option<Handle<naga::Function>>> = procs
         .iter()
         .map(|t| function(module, &format!("enqueue_{}", t.proc.name)))
@@ -471,14 +456,14 @@ fn check_enqueue_targets(probe: &Probe, module: &naga::Module) -> Result<(), Run
 }
 
 /// `@group(1)` variables match the user layout entries; no other group but the scheduler's.
-fn check_user_bindings(probe: &Probe, module: &naga::Module) -> Result<(), RunError> {
-    let layout = &probe.program.user.layout;
+fn check_user_bindings(shared: &SharedSource, module: &naga::Module) -> Result<(), RunError> {
+    let layout = &shared.program.user.layout;
     for (h, var) in module.global_variables.iter() {
         let Some(binding) = &var.binding else {
             continue;
         };
         let name = var.name.as_deref().unwrap_or("?");
-        let at = probe
+        let at = shared
             .locate(module.global_variables.get_span(h))
             .map(|(at, ..)| format!(" ({at})"))
             .unwrap_or_default();
@@ -584,14 +569,11 @@ mod tests {
     }
 
     #[test]
-    fn a_procedure_may_run_another_s_execute_function_with_one_call_site_in_the_megakernel() {
+    fn a_procedure_may_run_the_execute_function_of_a_known_one_of_its_item_type_only() {
         let one = Procedure::new("one", word(), 4)
             .body("fn one_execute(item: Word, inv: Invocation) { let t = inv.threads; }");
         let two = Procedure::new("two", word(), 2).execute_of("one");
-        let p = Program::new(vec![one.clone(), sink(), two.clone()], UserBindings::none()).unwrap();
-        let src = crate::megakernel::wgsl::source(&p, false, crate::ItemLayout::Interleaved, None);
-        assert_eq!(src.matches("one_execute(it, inv)").count(), 1, "{src}");
-        assert!(src.contains("case 0u, 2u:"), "{src}");
+        Program::new(vec![one.clone(), sink(), two.clone()], UserBindings::none()).unwrap();
         // Unknown, chained or of another item type: refused, naming the procedure.
         let m = error(
             vec![

@@ -1,4 +1,4 @@
-//! Breadth-first search on R-MAT graphs ([`super::rmat`]) through the scheduler: the Graph500
+//! Breadth-first search on R-MAT graphs ([`crate::rmat`]) through the scheduler: the Graph500
 //! kernel 2 problem (levels instead of a parent tree), solved by label-correcting relaxation.
 //!
 //! `level[v]` (u32, `u32::MAX` = unreached) starts at 0 for the source. Two procedures,
@@ -18,21 +18,21 @@
 //!
 //! Baselines: [`bfs_levels`] (sequential queue, the reference), [`bfs_levels_rayon`]
 //! (level-synchronous, parallel over the frontier), and the plain-wgpu level-synchronous
-//! frontier BFS in [`super::frontier_bfs`].
+//! frontier BFS in [`crate::frontier_bfs`].
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU32, Ordering};
 
 use rayon::prelude::*;
 
-use super::rmat::{self, Csr, RmatParams};
-use crate::bindings::UserBindings;
-use crate::error::RunError;
-use crate::gpu::Gpu;
-use crate::procedure::{ItemType, Procedure};
-use crate::program::{Program, Seed};
-use crate::stats::RunStats;
-use crate::strategy::Scheduler;
+use crate::rmat::{self, Csr, RmatParams};
+use scheduler::bindings::UserBindings;
+use scheduler::error::RunError;
+use scheduler::gpu::Gpu;
+use scheduler::procedure::{ItemType, Procedure};
+use scheduler::program::{Program, Seed};
+use scheduler::stats::RunStats;
+use scheduler::strategy::Scheduler;
 
 /// Level of a vertex the search did not reach.
 pub const UNREACHED: u32 = u32::MAX;
@@ -189,9 +189,9 @@ impl BfsParams {
                  const BFS_SPLIT: u32 = {split}u;\n{RELAX_WGSL}"
             ),
             layout: vec![
-                crate::bindings::storage_entry(0, true),
-                crate::bindings::storage_entry(1, true),
-                crate::bindings::storage_entry(2, false),
+                scheduler::storage_entry(0, true),
+                scheduler::storage_entry(1, true),
+                scheduler::storage_entry(2, false),
             ],
         };
         let vertex = Procedure::new("bfs_vertex", ItemType::new("BfsVertex", VERTEX_WGSL), t)
@@ -387,7 +387,7 @@ impl BfsRun {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::wgsl::struct_layout;
+    use scheduler::wgsl::struct_layout;
 
     /// 0-1-2-3 path, 1-4 and 4-3 shortcut, 5-6 a separate component, 7 isolated.
     fn hand_made() -> Csr {

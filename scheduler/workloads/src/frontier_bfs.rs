@@ -17,10 +17,10 @@
 
 use std::time::Instant;
 
-use super::bfs::{BfsParams, initial_levels, upload_graph, write_words};
-use crate::error::RunError;
-use crate::gpu::Gpu;
-use crate::timing::PassTimer;
+use crate::bfs::{BfsParams, initial_levels, upload_graph, write_words};
+use scheduler::error::RunError;
+use scheduler::gpu::Gpu;
+use scheduler::timing::PassTimer;
 
 /// What a frontier BFS run did.
 #[derive(Debug, Clone, Default, PartialEq)]

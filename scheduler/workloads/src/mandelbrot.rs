@@ -22,20 +22,20 @@
 //! either side. But WGSL's (and Vulkan's `GLSL.std.450 Fma`) precision is only "inherited from a
 //! multiply and an add": a device may or may not fuse it. NVIDIA fuses; Mesa 22.3's lavapipe
 //! splits it into a rounded multiply and an add (measured: the unfused twin reproduces its images
-//! bit for bit). So [`fma_is_fused`] probes the device with inputs on which the two differ, and
+//! bit for bit). So [`fma_is_fused`] tests the device with inputs on which the two differ, and
 //! [`MandelParams::fused_fma`] tells the CPU twin which to compute (`f32::mul_add`, or `a * b + c`,
 //! which Rust never contracts); [`MandelParams::for_gpu`] sets it. Images are then compared
 //! exactly. Mariani-Silver itself is exact only where the border property holds (no detail
 //! entirely inside a rectangle with a uniform border); the preset views are ones where it does in
 //! both arithmetics, checked against the brute-force image.
 
-use crate::bindings::UserBindings;
-use crate::error::RunError;
-use crate::gpu::Gpu;
-use crate::procedure::{ItemType, Procedure};
-use crate::program::{Program, Seed};
-use crate::stats::RunStats;
-use crate::strategy::Scheduler;
+use scheduler::bindings::UserBindings;
+use scheduler::error::RunError;
+use scheduler::gpu::Gpu;
+use scheduler::procedure::{ItemType, Procedure};
+use scheduler::program::{Program, Seed};
+use scheduler::stats::RunStats;
+use scheduler::strategy::Scheduler;
 
 mod cpu;
 pub use cpu::dwell;
@@ -201,16 +201,17 @@ impl PartialEq<MandelImage> for MandelResult {
 /// `2^-11` unfused (the product's last bit is a tie that rounds to even). The inputs come from a
 /// buffer so that no compiler can fold them. Any other answer is a [`RunError::Device`].
 pub fn fma_is_fused(gpu: &Gpu) -> Result<bool, RunError> {
-    const PROBE: &str = "@group(0) @binding(0) var<storage, read_write> io: array<f32, 4>;\n\
+    const FMA_TEST: &str = "@group(0) @binding(0) var<storage, read_write> io: array<f32, 4>;\n\
         @compute @workgroup_size(1) fn main() { io[3] = fma(io[0], io[1], io[2]); }";
     let a = 1.0 + 2f32.powi(-12);
     let (fused, unfused) = (2f32.powi(-11) + 2f32.powi(-24), 2f32.powi(-11));
     debug_assert_eq!(a.mul_add(a, -1.0), fused);
     debug_assert_eq!(a * a - 1.0, unfused);
+    // Labels and the error message keep their wording ("fma probe"): error texts stay as they were.
     let io = gpu.storage_buffer("fma probe", 4)?;
     gpu.queue
         .write_buffer(&io, 0, bytemuck::cast_slice(&[a, a, -1.0, 0.0]));
-    let pipe = gpu.compute_pipeline("fma probe", PROBE, "main")?;
+    let pipe = gpu.compute_pipeline("fma probe", FMA_TEST, "main")?;
     let bind = gpu.bind_buffers("fma probe", &pipe.get_bind_group_layout(0), &[&io]);
     let mut enc = gpu.device.create_command_encoder(&Default::default());
     {
@@ -365,9 +366,9 @@ impl MandelParams {
                  const MS_T: u32 = {MS_THREADS}u;\n{MS_WGSL}"
             ),
             layout: vec![
-                crate::bindings::storage_entry(0, false),
-                crate::bindings::storage_entry(1, true),
-                crate::bindings::storage_entry(2, false),
+                scheduler::storage_entry(0, false),
+                scheduler::storage_entry(1, true),
+                scheduler::storage_entry(2, false),
             ],
         };
         let rect = Procedure::new("ms_rect", item.clone(), MS_THREADS)
@@ -576,7 +577,7 @@ impl MandelRun {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::wgsl::struct_layout;
+    use scheduler::wgsl::struct_layout;
 
     fn small(w: u32, h: u32) -> MandelParams {
         MandelParams {

@@ -1,4 +1,4 @@
-//! The megakernel's [`crate::recorded::RecordedRun`]: one launch on queues of fixed capacity,
+//! The megakernel's part of a [`crate::RecordedRun`]: one launch on queues of fixed capacity,
 //! seeded on the device. The launch's start state is what [`Megakernel::upload`] writes for the
 //! same seed counts (flags cleared, the seeds' slots stamped [`SEED_STAMP`], ctrl from
 //! [`Megakernel::write_ctrl`]), kept in two small buffers and copied in each record, so a record
@@ -11,10 +11,10 @@ use crate::gpu::Gpu;
 use crate::item_layout::{ItemLayout, PlanarScatter};
 use crate::program::Program;
 use crate::queue_layout::QueueLayout;
-use crate::recorded::{Outcome, RecordedSize};
-use crate::stats::RunStats;
+use crate::stats::{Outcome, RunStats};
 
-pub(crate) struct Recorded {
+/// One launch's queues and start state, recorded again for every record of the run.
+pub(crate) struct RecordedLaunch {
     dq: DeviceQueues,
     /// ctrl at the start of a launch with the recorded seed counts.
     ctrl_start: wgpu::Buffer,
@@ -28,16 +28,18 @@ pub(crate) struct Recorded {
 }
 
 impl Megakernel {
-    /// Queues of `size` (lowered to each queue's limit under the device and `max_queue_bytes`,
-    /// raised to its seeds) for launches seeded with `seeded` items per queue.
-    pub(crate) fn recorded(
+    /// Queues of `wanted[q]` slots each, plus room for the worst case of one batch per
+    /// workgroup (lowered to each queue's limit under the device and `max_queue_bytes`, raised
+    /// to its seeds), for launches seeded with `seeded` items per queue; with the capacities
+    /// allocated.
+    pub(crate) fn recorded_launch(
         &self,
         gpu: &Gpu,
         seeded: &[u32],
-        size: &RecordedSize,
+        wanted: &[u32],
         user: Option<&wgpu::BindGroup>,
         max_queue_bytes: Option<u64>,
-    ) -> Result<(Recorded, RecordedSize), RunError> {
+    ) -> Result<(RecordedLaunch, Vec<u32>), RunError> {
         self.kernels.check_user_group(user)?;
         let workgroups = self.workgroups(gpu, user)?;
         let max_cap = QueueLayout::within_budget(
@@ -50,10 +52,10 @@ impl Megakernel {
             max_queue_bytes,
             1,
         );
-        check_seeds(&self.program, seeded, &max_cap)?;
+        QueueLayout::check_seeds(&self.program, seeded, &max_cap)?;
         // A batch is claimed only when the worst case of its output fits beside every ticket
         // taken and every promise of the running batches (Q_BUDGET): on top of the tickets
-        // `size` asks for, each queue keeps room for one batch's worst case per workgroup.
+        // `wanted` asks for, each queue keeps room for one batch's worst case per workgroup.
         let nq = seeded.len();
         let slack: Vec<u64> = (0..nq)
             .map(|t| {
@@ -70,7 +72,7 @@ impl Megakernel {
             .collect();
         let capacity: Vec<u32> = (0..nq)
             .map(|q| {
-                let want = (size.capacity[q] as u64 + slack[q]).min(u32::MAX as u64) as u32;
+                let want = (wanted[q] as u64 + slack[q]).min(u32::MAX as u64) as u32;
                 want.min(max_cap[q]).max(seeded[q]).max(1)
             })
             .collect();
@@ -80,15 +82,11 @@ impl Megakernel {
         self.write_ctrl(gpu, &ctrl_start, seeded);
         let most = seeded.iter().copied().max().unwrap_or(0) as usize;
         let stamps = gpu.upload("seed stamps", &vec![SEED_STAMP; most])?;
-        let size = RecordedSize {
-            capacity,
-            rounds: 0,
-        };
         let scatter = match self.item_layout() {
             ItemLayout::Interleaved => None,
             ItemLayout::Planar => Some(PlanarScatter::new(gpu, &dq.layout, seeded)?),
         };
-        let r = Recorded {
+        let r = RecordedLaunch {
             dq,
             ctrl_start,
             stamps,
@@ -97,7 +95,7 @@ impl Megakernel {
             item_layout: self.item_layout(),
             direct: self.direct_enqueue(),
         };
-        Ok((r, size))
+        Ok((r, capacity))
     }
 
     fn params_for(&self, capacity: &[u32]) -> Result<Vec<u32>, RunError> {
@@ -105,28 +103,13 @@ impl Megakernel {
     }
 }
 
-/// The seeds of one queue that exceed its limit are an overflow, as in a run.
-pub(crate) fn check_seeds(
-    program: &Program,
-    seeded: &[u32],
-    max_cap: &[u32],
-) -> Result<(), RunError> {
-    if let Some(q) = (0..seeded.len()).find(|&q| seeded[q] > max_cap[q]) {
-        return Err(RunError::QueueOverflow {
-            queue: program.procs[q].proc.name.clone(),
-            capacity: max_cap[q] as u64,
-            needed_more_than: seeded[q] as u64,
-        });
-    }
-    Ok(())
-}
-
-impl Recorded {
+impl RecordedLaunch {
+    /// Words of the run's control block, which each record copies to the caller's status.
     pub fn status_words(&self) -> u64 {
         self.dq.ctrl.size() / 4
     }
 
-    /// See [`crate::recorded::RecordedRun::record`]; seeds are `(queue, buffer, count)`.
+    /// See [`crate::RecordedRun::record`]; seeds are `(queue, buffer, count)`.
     pub fn record(
         &self,
         m: &Megakernel,
@@ -170,10 +153,11 @@ impl Recorded {
     }
 
     /// Done when nothing is pending or abandoned; an emit beyond a declaration is an error.
+    /// `capacity`: the slots per queue [`Megakernel::recorded_launch`] allocated.
     pub fn outcome(
         &self,
         program: &Program,
-        size: &RecordedSize,
+        capacity: &[u32],
         ctrl: &[u32],
     ) -> Result<Outcome, RunError> {
         let nq = program.queue_count();
@@ -192,7 +176,7 @@ impl Recorded {
                 .map(|qi| {
                     format!(
                         "queue `{}` out of room at {} slots",
-                        program.procs[qi].proc.name, size.capacity[qi]
+                        program.procs[qi].proc.name, capacity[qi]
                     )
                 })
                 .collect();

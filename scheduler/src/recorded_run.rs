@@ -21,9 +21,11 @@
 
 use crate::error::RunError;
 use crate::gpu::Gpu;
+use crate::megakernel::record::RecordedLaunch;
+use crate::multipass::record::RecordedRounds;
 use crate::program::Program;
-use crate::stats::RunStats;
-use crate::strategy::Scheduler;
+use crate::stats::{Outcome, RunStats};
+use crate::strategy::{Scheduler, StrategyKind};
 
 /// Seeds of one procedure already on the device: `count` items back to back from byte 0 of
 /// `buffer` (which needs `COPY_SRC` usage), in the procedure's item layout.
@@ -34,19 +36,6 @@ pub struct DeviceSeeds<'a> {
     pub buffer: &'a wgpu::Buffer,
     /// Items to seed; the same for every record of one [`RecordedRun`].
     pub count: u32,
-}
-
-/// What a recorded run's status copy says.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Outcome {
-    /// The run finished: every item was executed. `launches` and `rounds` are those recorded;
-    /// `submits` is 0 (the run cost no host round trip of its own), `gpu_ms` and `wall_ms` are
-    /// the caller's to measure.
-    Done(RunStats),
-    /// The run stopped with work left, why in words (a queue name and its capacity, or the
-    /// bound that ended it); the user results are partial: run the work again with
-    /// [`Scheduler::run`].
-    Incomplete(String),
 }
 
 /// Fixed sizes of a [`RecordedRun`]: queue slots per procedure (program order) and, for the
@@ -73,7 +62,7 @@ impl RecordedSize {
     /// [`RecordedRun::new`] lowers capacities to the device's and the budget's limits.
     pub fn from_stats(
         program: &Program,
-        kind: crate::StrategyKind,
+        kind: StrategyKind,
         stats: &RunStats,
         seeds: &[u32],
         headroom: f64,
@@ -84,7 +73,7 @@ impl RecordedSize {
         let capacity = (0..nq)
             .map(|t| {
                 let need = match kind {
-                    crate::StrategyKind::Megakernel => at(&stats.executed, t),
+                    StrategyKind::Megakernel => at(&stats.executed, t),
                     _ => (0..nq)
                         .map(|p| at(&stats.peak_occupancy, p) * program.procs[p].emits[t] as f64)
                         .sum::<f64>()
@@ -99,7 +88,7 @@ impl RecordedSize {
         // Rounds follow the split depth, which varies little between similar runs, and each
         // empty round still costs a plan and its empty indirect dispatches: no headroom factor.
         let rounds = match kind {
-            crate::StrategyKind::Megakernel => 0,
+            StrategyKind::Megakernel => 0,
             _ => (stats.rounds.min(u32::MAX as u64 - 2) as u32) + 2,
         };
         RecordedSize { capacity, rounds }
@@ -127,9 +116,10 @@ pub struct RecordedRun {
     pub(crate) seeded: Vec<u32>,
 }
 
+/// The strategy's part of a recorded run.
 pub(crate) enum Inner {
-    Megakernel(crate::megakernel::recorded::Recorded),
-    Multipass(crate::multipass::recorded::Recorded),
+    Megakernel(RecordedLaunch),
+    Multipass(RecordedRounds),
 }
 
 impl RecordedRun {
@@ -166,12 +156,22 @@ impl RecordedRun {
         }
         let (inner, size) = match scheduler {
             Scheduler::Megakernel(m) => {
-                let (r, s) = m.recorded(gpu, &seeded, size, user, max_queue_bytes)?;
-                (Inner::Megakernel(r), s)
+                let (r, capacity) =
+                    m.recorded_launch(gpu, &seeded, &size.capacity, user, max_queue_bytes)?;
+                let size = RecordedSize {
+                    capacity,
+                    rounds: 0,
+                };
+                (Inner::Megakernel(r), size)
             }
             Scheduler::Multipass(m) => {
-                let (r, s) = m.recorded(gpu, &seeded, size, max_queue_bytes)?;
-                (Inner::Multipass(r), s)
+                let (r, capacity) =
+                    m.recorded_rounds(gpu, &seeded, &size.capacity, size.rounds, max_queue_bytes)?;
+                let size = RecordedSize {
+                    capacity,
+                    rounds: r.rounds(),
+                };
+                (Inner::Multipass(r), size)
             }
             Scheduler::MultipassHost(_) => {
                 return Err(RunError::Program(
@@ -257,8 +257,8 @@ impl RecordedRun {
             )));
         }
         match &self.inner {
-            Inner::Megakernel(r) => r.outcome(program, &self.size, status),
-            Inner::Multipass(r) => r.outcome(program, &self.size, status),
+            Inner::Megakernel(r) => r.outcome(program, &self.size.capacity, status),
+            Inner::Multipass(r) => r.outcome(program, &self.size.capacity, status),
         }
     }
 }
