@@ -29,8 +29,10 @@ device_setup() {
         else
             echo "device-setup: no Vulkan loader: installing libvulkan1 (apt-get)" >&2
             local sudo=; [ "$(id -u)" = 0 ] || sudo=sudo
-            $sudo apt-get update -qq && DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq \
-                libvulkan1 libegl1 libglvnd0 libopengl0 libgl1 libglx0 libgles2 >/dev/null || return 1
+            $sudo apt-get update -qq \
+                && DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq libvulkan1 libegl1 \
+                    libglvnd0 libopengl0 libgl1 libglx0 libgles2 >/dev/null \
+                || return 1
         fi
     fi
     if [ -z "${VK_DRIVER_FILES:-}${VK_ICD_FILENAMES:-}" ] \

@@ -73,8 +73,8 @@ pub struct Cli {
     #[arg(long, value_name = "DIR")]
     pub data: Option<PathBuf>,
 
-    /// A scene of frames, bench, peer and raster-modes (repeatable): `teapot` (built in), a name of the
-    /// shared data's `rib/` (`killeroo`, `uteapot`), a path in the shared data
+    /// A scene of frames, bench, peer and raster-modes (repeatable): `teapot` (built in), a
+    /// name of the shared data's `rib/` (`killeroo`, `uteapot`), a path in the shared data
     /// (`field/airplane.rib`) or a file [default: the suite's scenes].
     #[arg(long = "scene", value_name = "SCENE")]
     pub scenes: Vec<String>,
