@@ -959,7 +959,7 @@ fn bad_image_sizes_are_clear_errors_not_panics() {
             height: Some(h),
             ..Default::default()
         };
-        let e = FrameData::new(&s, &o).unwrap_err();
+        let e = FrameData::new(&s, &o).unwrap_err().to_string();
         assert!(e.contains(&format!("image size {w}x{h}")), "{e}");
     }
     // Within the side limit but beyond any wgpu binding (4 GiB): refused up front, on the GPU
@@ -969,7 +969,7 @@ fn bad_image_sizes_are_clear_errors_not_panics() {
         height: Some(16384),
         ..Default::default()
     };
-    let e = FrameData::new(&s, &o).unwrap_err();
+    let e = FrameData::new(&s, &o).unwrap_err().to_string();
     assert!(e.contains("bytes of RGBA"), "{e}");
     // Within that bound but beyond this adapter's binding limit: the renderer refuses with
     // the buffer's name (16384x8191 pixels of 2x2 samples: 4 GiB - 512 KiB of samples).
@@ -996,7 +996,7 @@ fn bad_image_sizes_are_clear_errors_not_panics() {
         pixel_samples: Some((16, 16)),
         ..o
     };
-    let e = FrameData::new(&s, &o).unwrap_err();
+    let e = FrameData::new(&s, &o).unwrap_err().to_string();
     assert!(e.contains("sub-samples"), "{e}");
 }
 

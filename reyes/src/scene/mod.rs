@@ -21,9 +21,10 @@ mod spin;
 mod teapot;
 
 use glam::{DMat4, DVec3};
-use std::fmt;
+
 use std::path::Path;
 
+pub use crate::error::SceneError;
 pub use basis::Basis;
 pub use bpt::parse_bpt;
 pub use displacement::{
@@ -251,36 +252,6 @@ pub enum Light {
         pos: DVec3,
     },
 }
-
-/// An input error, located at a file and line (line 0: the file as a whole).
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct SceneError {
-    pub file: String,
-    pub line: u32,
-    pub message: String,
-}
-
-impl SceneError {
-    pub fn new(file: &str, line: u32, message: impl Into<String>) -> SceneError {
-        SceneError {
-            file: file.to_string(),
-            line,
-            message: message.into(),
-        }
-    }
-}
-
-impl fmt::Display for SceneError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        // Line 0: the error is about the whole file (it cannot be read), not a line of it.
-        match self.line {
-            0 => write!(f, "{}: {}", self.file, self.message),
-            line => write!(f, "{}:{line}: {}", self.file, self.message),
-        }
-    }
-}
-
-impl std::error::Error for SceneError {}
 
 /// The input formats `load` understands.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
