@@ -295,11 +295,9 @@ impl SceneFeatures {
     }
 }
 
-/// Largest image side accepted (the sample buffer must also fit the adapter; checked there).
-pub const MAX_IMAGE_SIDE: u32 = 16384;
-
-/// Most samples per pixel in x and in y (RenderMan's `PixelSamples`).
-pub const MAX_PIXEL_SAMPLES: u32 = 16;
+// The limits a scene's `Format` and `PixelSamples` are read within; the frame holds the
+// options to them too.
+pub use crate::scene::{MAX_IMAGE_SIDE, MAX_PIXEL_SAMPLES};
 
 /// Smallest micropolygon edge accepted, in pixels: 256 micropolygons per pixel. Below it the
 /// work per patch grows without bound (each halving of the size quadruples the grids) while

@@ -39,6 +39,12 @@ pub use sequence::{Display, FrameRanges, FrameSequence, SceneFrame};
 pub use spin::spin;
 pub use teapot::{builtin_teapot, teapot_object_patches};
 
+/// Largest image side accepted (the sample buffer must also fit the adapter; checked there).
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+
+/// Most samples per pixel in x and in y (RenderMan's `PixelSamples`).
+pub const MAX_PIXEL_SAMPLES: u32 = 16;
+
 /// RenderMan's `RI_EPSILON`, the default near clipping distance.
 pub const RI_EPSILON: f64 = 1.0e-10;
 /// RenderMan's `RI_INFINITY` (as in `ri.h`), the default far clipping distance. Finite on
@@ -259,6 +265,17 @@ pub enum InputFormat {
     Rib,
     Newell,
     Bpt,
+}
+
+/// Centre of the axis-aligned bounding box of every control point, camera space; the origin
+/// for a scene without patches.
+pub fn scene_centre(scene: &Scene) -> DVec3 {
+    let mut pts = scene.patches.iter().flat_map(|p| p.cp.iter().copied());
+    let Some(first) = pts.next() else {
+        return DVec3::ZERO;
+    };
+    let (lo, hi) = pts.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p)));
+    (lo + hi) / 2.0
 }
 
 /// Loads a scene of one image from a file: the first frame that can be rendered of

@@ -6,7 +6,7 @@ use crate::Error;
 use glam::{DMat4, DVec3};
 
 /// Spins every patch of `scene` by `degrees` over the shutter about the world's z axis
-/// through the centre of the scene's bound ([`crate::orbit::scene_centre`]): the patches stay where
+/// through the centre of the scene's bound ([`super::scene_centre`]): the patches stay where
 /// they are at shutter open and are turned by `degrees` at shutter close (composed with any
 /// motion they already have). Points move linearly between the two (as the renderer moves
 /// every point: docs/reyes.md). Errors: [`Error::NonFiniteSpin`], and
@@ -24,7 +24,7 @@ pub fn spin(scene: &mut Scene, degrees: f64) -> Result<(), Error> {
         .transform_vector3(DVec3::Z)
         .try_normalize()
         .ok_or(Error::DegenerateSpinAxis)?;
-    let c = crate::orbit::scene_centre(scene);
+    let c = super::scene_centre(scene);
     let turn = DMat4::from_translation(c)
         * DMat4::from_axis_angle(axis, degrees.to_radians())
         * DMat4::from_translation(-c);
@@ -46,7 +46,7 @@ mod tests {
     #[test]
     fn spin_turns_about_world_z_through_the_centre() {
         let mut s = crate::scene::builtin_teapot();
-        let c = crate::orbit::scene_centre(&s);
+        let c = super::super::scene_centre(&s);
         spin(&mut s, 90.0).unwrap();
         let m = s.patches[0].motion.as_deref().unwrap();
         assert!((m.transform_point3(c) - c).length() < 1e-9);
