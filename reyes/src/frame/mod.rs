@@ -165,9 +165,11 @@ pub struct Tile {
     pub h: u32,
 }
 
+/// A material as the GPU stages read it (`Material` in common.wgsl): the f32 form of a
+/// [`crate::scene::Material`].
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
-pub struct Material {
+pub struct GpuMaterial {
     pub color: [f32; 3],
     /// 0 constant, 1 matte, 2 plastic
     pub kind: u32,
@@ -194,7 +196,7 @@ pub struct GpuLight {
 #[derive(Clone, Debug)]
 pub struct FrameData {
     pub frame: Frame,
-    pub materials: Vec<Material>,
+    pub materials: Vec<GpuMaterial>,
     pub lights: Vec<GpuLight>,
     pub patch_info: Vec<PatchInfo>,
     /// The colour fields of the patches that have primitive variables, referenced by
@@ -472,8 +474,8 @@ fn f3(v: glam::DVec3) -> [f32; 3] {
     [v.x as f32, v.y as f32, v.z as f32]
 }
 
-fn gpu_material(m: &crate::scene::Material) -> Material {
-    Material {
+fn gpu_material(m: &crate::scene::Material) -> GpuMaterial {
+    GpuMaterial {
         color: f3(m.color),
         kind: match m.kind {
             SurfaceKind::Constant => 0,
@@ -660,13 +662,13 @@ mod tests {
         );
         check(
             "Material",
-            size_of::<Material>(),
+            size_of::<GpuMaterial>(),
             &[
-                ("kind", offset_of!(Material, kind)),
-                ("specular", offset_of!(Material, specular)),
-                ("ka", offset_of!(Material, ka)),
-                ("roughness", offset_of!(Material, roughness)),
-                ("opacity", offset_of!(Material, opacity)),
+                ("kind", offset_of!(GpuMaterial, kind)),
+                ("specular", offset_of!(GpuMaterial, specular)),
+                ("ka", offset_of!(GpuMaterial, ka)),
+                ("roughness", offset_of!(GpuMaterial, roughness)),
+                ("opacity", offset_of!(GpuMaterial, opacity)),
             ],
         );
         check(
