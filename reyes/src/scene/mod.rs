@@ -399,8 +399,8 @@ mod tests {
         let p = crate::shared_data_dir().join(rel);
         assert!(
             p.is_file(),
-            "test data {} is missing (set REYES_SHARED_DATA, or keep the shared data directory \
-             next to the repository or at /work/shared/data)",
+            "test data {} is missing (set REYES_SHARED_DATA to the shared data directory, or \
+             keep it next to the repository as shared/data)",
             p.display()
         );
         p
