@@ -1,4 +1,4 @@
-//! Accuracy metrics on the GPU (issue 5, speed against error): the GPU frame against the exact
+//! Accuracy metrics on the GPU (speed against error): the GPU frame against the exact
 //! f64 reference, `reyes measure` and `reyes sweep` end to end. Runs on lavapipe in CI; the
 //! adapter comes from the environment and a missing one fails loudly.
 

@@ -15,7 +15,7 @@ use reyes::scene::{self, Scene};
 use scheduler::StrategyKind;
 
 mod common;
-use common::{compare, gpu, renderer};
+use common::{CPU_TWIN_OVER, compare, gpu, renderer};
 
 /// Renders `data` with every strategy (asserting identical images and counters) and the CPU
 /// twin (asserting the usual agreement); returns the GPU image.
@@ -34,11 +34,9 @@ fn render_everywhere(data: &FrameData) -> FrameImage {
     }
     let image = first.unwrap().image;
     let cpu = render_cpu(data);
-    // The usual tolerance of the CPU twin (f32 in the same order of operations; GPU sin and
-    // fused multiply-adds differ by ulps, which move a few edge samples).
     let (max, over) = compare(&image, &cpu.image);
     assert!(
-        over < 0.002,
+        over < CPU_TWIN_OVER,
         "CPU twin: {:.3}% of pixels differ by more than 2/255 (max {max})",
         over * 100.0
     );

@@ -10,7 +10,7 @@ use scheduler::StrategyKind;
 use std::path::Path;
 
 mod common;
-use common::{compare, coverage_disagreement, gpu, renderer, small};
+use common::{CPU_TWIN_OVER, compare, coverage_disagreement, gpu, renderer, small};
 
 fn data_dir() -> std::path::PathBuf {
     reyes::shared_data_dir()
@@ -53,7 +53,7 @@ fn gpu_image_matches_the_cpu_pipeline_and_strategies_agree_exactly() {
     );
     let (max, over) = compare(&mk.image, &cpu.image);
     assert!(
-        over < 0.002,
+        over < CPU_TWIN_OVER,
         "{:.3}% of pixels differ by more than 2/255 (max {max})",
         over * 100.0
     );
@@ -79,7 +79,7 @@ fn paper_mode_fixed_bound_and_pixel_samples_match_the_cpu_pipeline() {
     assert_eq!(mk.run.executed.as_slice(), cpu.executed.as_slice());
     let (max, over) = compare(&mk.image, &cpu.image);
     assert!(
-        over < 0.002,
+        over < CPU_TWIN_OVER,
         "{:.3}% of pixels differ by more than 2/255 (max {max})",
         over * 100.0
     );
@@ -103,7 +103,7 @@ fn megakernel_like_cpu(s: &Scene) -> (reyes::gpu_render::GpuFrame, reyes::cpu_re
         .unwrap();
     let (max, over) = compare(&mk.image, &cpu.image);
     assert!(
-        over < 0.002,
+        over < CPU_TWIN_OVER,
         "{:.3}% of pixels differ by more than 2/255 (max {max})",
         over * 100.0
     );
@@ -358,7 +358,11 @@ fn one_sided_patches_facing_away_are_culled_in_bound_like_the_cpu_pipeline() {
     assert_eq!(g.counters, cpu.counters);
     assert_eq!(g.run.executed.as_slice(), cpu.executed.as_slice());
     let (max, over) = compare(&g.image, &cpu.image);
-    assert!(over < 0.002, "{:.3}% differ (max {max})", over * 100.0);
+    assert!(
+        over < CPU_TWIN_OVER,
+        "{:.3}% differ (max {max})",
+        over * 100.0
+    );
 }
 
 #[test]

@@ -13,7 +13,7 @@ use reyes::scene::{self, Scene};
 use scheduler::StrategyKind;
 
 mod common;
-use common::{compare, gpu, renderer};
+use common::{CPU_TWIN_OVER_MOTION, compare, gpu, renderer};
 
 const ALL: [Sampling; 3] = [
     Sampling::Simple,
@@ -153,9 +153,8 @@ fn depth_of_field_keeps_the_focal_plane_sharp() {
 }
 
 /// Megakernel and multipass give the same bits (render_gpu), and the CPU twin the same image
-/// within the usual twin tolerance (f32 in the same order of operations; the GPU's sin, cos
-/// and fused multiply-adds differ by ulps, which can move a sample across an edge): at most
-/// 1% of pixels differ by more than 2/255, for motion and depth of field together.
+/// within the twin tolerance for motion and depth of field together
+/// ([`common::CPU_TWIN_OVER_MOTION`]).
 #[test]
 fn the_cpu_twin_agrees() {
     let s = quads(&format!("{SHUTTER}\n{DOF}"), MOVE);
@@ -163,7 +162,7 @@ fn the_cpu_twin_agrees() {
         let d = FrameData::new(&s, &options(sampling, 2)).unwrap();
         let (max, over) = compare(&render_gpu(&d), &render_cpu(&d).image);
         assert!(
-            over <= 0.01,
+            over <= CPU_TWIN_OVER_MOTION,
             "{sampling:?}: {:.2}% over 2/255 (max {max})",
             over * 100.0
         );

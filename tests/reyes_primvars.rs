@@ -15,7 +15,7 @@ use reyes::stages;
 use scheduler::StrategyKind;
 
 mod common;
-use common::{compare, gpu, renderer};
+use common::{CPU_TWIN_OVER, compare, gpu, renderer};
 
 /// Renders `data` with every strategy (asserting identical images and counters) and the CPU
 /// twin (asserting the usual agreement); returns the GPU image.
@@ -42,7 +42,7 @@ fn render_counted(data: &FrameData) -> (FrameImage, [u64; stages::COUNTERS]) {
     let cpu = render_cpu(data);
     let (max, over) = compare(&image, &cpu.image);
     assert!(
-        over < 0.002,
+        over < CPU_TWIN_OVER,
         "CPU twin: {:.3}% of pixels differ by more than 2/255 (max {max})",
         over * 100.0
     );

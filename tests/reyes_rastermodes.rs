@@ -13,7 +13,7 @@ use reyes_accuracy::holes::{Holes, holes};
 use scheduler::StrategyKind;
 
 mod common;
-use common::{compare, gpu, renderer, small};
+use common::{CPU_TWIN_OVER, compare, gpu, renderer, small};
 
 const MODES: [RasterMode; 2] = [RasterMode::BoundingBox, RasterMode::NearestSample];
 
@@ -114,7 +114,7 @@ fn each_mode_draws_one_image_on_every_strategy_and_the_cpu_twin_follows() {
         );
         let (max, over) = compare(&mp.image, &cpu.image);
         assert!(
-            over < 0.002,
+            over < CPU_TWIN_OVER,
             "{raster:?}: {:.3}% of pixels differ from the CPU twin by more than 2/255 (max {max})",
             over * 100.0
         );

@@ -157,7 +157,7 @@ impl Workload for ReyesWorkload {
 
     fn prepare(&mut self, _gpu: &Gpu, i: usize) -> Result<Prepared, String> {
         let size = self.sizes[i];
-        let data = FrameData::new(&self.scene, &self.options(size))?;
+        let data = FrameData::new(&self.scene, &self.options(size)).map_err(|e| e.to_string())?;
         let cpu = render_cpu(&data);
         let f = &data.frame;
         let prepared = Prepared {

@@ -2,6 +2,7 @@
 //! depth (PFM, one channel) and OpenEXR (linear f32 R, G, B, A and Z in one file). Files are written to a temporary name and renamed, so a failed
 //! write never leaves a half-written image under the requested name.
 
+use crate::Error;
 use crate::stages::shade::srgb_encode;
 use std::path::Path;
 
@@ -93,19 +94,19 @@ impl FrameImage {
         self.rgba.iter().filter(|p| p[3] > 0.0).count()
     }
 
-    pub fn write_png(&self, path: &Path) -> Result<(), String> {
+    pub fn write_png(&self, path: &Path) -> Result<(), Error> {
         let img = image::RgbaImage::from_raw(self.width, self.height, self.rgba8())
-            .ok_or("image buffer size mismatch")?;
+            .ok_or(Error::BufferSizeMismatch)?;
         crate::output::write_atomic(path, &crate::output::png(&img)?)
     }
 
     /// Linear RGB as PFM (bottom row first, little-endian).
-    pub fn write_pfm(&self, path: &Path) -> Result<(), String> {
+    pub fn write_pfm(&self, path: &Path) -> Result<(), Error> {
         self.pfm(path, 3, |p, c| self.rgba[p][c])
     }
 
     /// Camera-space depth as a one-channel PFM; background pixels hold +inf.
-    pub fn write_depth(&self, path: &Path) -> Result<(), String> {
+    pub fn write_depth(&self, path: &Path) -> Result<(), Error> {
         self.pfm(path, 1, |p, _| self.file_depth(p))
     }
 
@@ -123,7 +124,7 @@ impl FrameImage {
     /// defines it and compositing tools expect (`R = rgba[0] * rgba[3]`, exactly in f32); Z is
     /// the camera-space depth of the nearest sample, +inf where the background shows. Rows
     /// top to bottom. Written with the `exr` crate.
-    pub fn exr(&self) -> Result<Vec<u8>, String> {
+    pub fn exr(&self) -> Result<Vec<u8>, crate::Error> {
         use exr::prelude::*;
         let n = self.rgba.len();
         let premultiplied =
@@ -151,24 +152,31 @@ impl FrameImage {
         Image::from_layer(layer)
             .write()
             .to_buffered(&mut out)
-            .map_err(|e| format!("OpenEXR: {e}"))?;
+            .map_err(crate::Error::EncodeExr)?;
         Ok(out.into_inner())
     }
 
     /// Reads an OpenEXR image as [`FrameImage::exr`] writes it: channels R, G, B
     /// (premultiplied), A and optionally Z, in f32 or f16, first layer. Errors name the file.
-    pub fn read_exr(path: &Path) -> Result<FrameImage, String> {
+    pub fn read_exr(path: &Path) -> Result<FrameImage, crate::Error> {
         use exr::prelude::*;
-        let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
-        let image = read_all_flat_layers_from_file(path).map_err(|e| err(&e))?;
-        let layer = (image.layer_data.first()).ok_or_else(|| err(&"no image layer"))?;
+        let missing = |what: String| crate::Error::ImageContent {
+            path: path.to_path_buf(),
+            what,
+        };
+        let image =
+            read_all_flat_layers_from_file(path).map_err(|source| crate::Error::ReadExr {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        let layer = (image.layer_data.first()).ok_or_else(|| missing("no image layer".into()))?;
         let (w, h) = (layer.size.width(), layer.size.height());
         let channel = |name: &str| {
             (layer.channel_data.list.iter())
                 .find(|c| c.name.eq(name))
                 .map(|c| c.sample_data.values_as_f32().collect::<Vec<f32>>())
         };
-        let need = |name: &str| channel(name).ok_or_else(|| err(&format!("no {name} channel")));
+        let need = |name: &str| channel(name).ok_or_else(|| missing(format!("no {name} channel")));
         let (r, g, b, a) = (need("R")?, need("G")?, need("B")?, need("A")?);
         let z = channel("Z").unwrap_or_else(|| vec![f32::INFINITY; w * h]);
         let rgba = (0..w * h)
@@ -190,7 +198,7 @@ impl FrameImage {
     }
 
     /// [`FrameImage::exr`] written to `path` (atomically).
-    pub fn write_exr(&self, path: &Path) -> Result<(), String> {
+    pub fn write_exr(&self, path: &Path) -> Result<(), Error> {
         crate::output::write_atomic(path, &self.exr()?)
     }
 
@@ -199,7 +207,7 @@ impl FrameImage {
         path: &Path,
         channels: usize,
         value: impl Fn(usize, usize) -> f32,
-    ) -> Result<(), String> {
+    ) -> Result<(), Error> {
         let header = format!(
             "{}\n{} {}\n-1.0\n",
             if channels == 3 { "PF" } else { "Pf" },

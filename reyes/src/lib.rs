@@ -6,6 +6,7 @@ pub mod buckets;
 pub mod camera;
 pub mod cpu_render;
 pub mod driver_env;
+pub mod error;
 pub mod frame;
 pub mod gpu_render;
 pub mod image;
@@ -22,16 +23,15 @@ pub mod stages;
 pub mod stats;
 pub mod warnings;
 
-/// Where the shared test scenes are (they may not be copied into the repository):
-/// `REYES_SHARED_DATA`, else `shared/data` next to the repository, else `/work/shared/data`.
+pub use error::Error;
+
+/// Where the shared test scenes are (they may not be copied into the repository): the folder
+/// named by the environment variable `REYES_SHARED_DATA`, else `shared/data` beside the
+/// repository (a sibling of its top folder). When the scenes are elsewhere, set
+/// `REYES_SHARED_DATA`; a missing folder shows as the scene file's "cannot read file" error.
 pub fn shared_data_dir() -> std::path::PathBuf {
-    if let Some(d) = std::env::var_os("REYES_SHARED_DATA") {
-        return d.into();
-    }
-    let beside = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data");
-    if beside.is_dir() {
-        beside
-    } else {
-        "/work/shared/data".into()
+    match std::env::var_os("REYES_SHARED_DATA") {
+        Some(d) => d.into(),
+        None => std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data"),
     }
 }

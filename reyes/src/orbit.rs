@@ -13,16 +13,9 @@
 use crate::scene::Scene;
 use glam::{DMat4, DVec3};
 
-/// Centre of the axis-aligned bounding box of every control point, camera space; the origin
-/// for a scene without patches.
-pub fn scene_centre(scene: &Scene) -> DVec3 {
-    let mut pts = scene.patches.iter().flat_map(|p| p.cp.iter().copied());
-    let Some(first) = pts.next() else {
-        return DVec3::ZERO;
-    };
-    let (lo, hi) = pts.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p)));
-    (lo + hi) / 2.0
-}
+/// The scene's centre, which the orbits turn about (defined with the scene, which spins
+/// about it too).
+pub use crate::scene::scene_centre;
 
 /// The turn by `angle` radians about the y axis through `centre`, in f64.
 pub fn orbit_transform(centre: DVec3, angle: f64) -> DMat4 {

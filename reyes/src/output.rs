@@ -3,16 +3,20 @@
 //! target at the end. A failure leaves nothing behind, a reader never sees half a file, and two
 //! runs writing the same name do not collide (each has its own temporary file).
 
+use crate::Error;
 use std::io::Write;
 use std::path::Path;
 
-/// Writes `bytes` to `path` atomically. Errors name the path: a missing or read-only folder, a
-/// full disk.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    let err = |e: std::io::Error| format!("{}: {e}", path.display());
-    let name = path
-        .file_name()
-        .ok_or_else(|| format!("{}: not a file name", path.display()))?;
+/// Writes `bytes` to `path` atomically. Errors name the path: [`Error::Write`] (a missing or
+/// read-only folder, a full disk), [`Error::NotAFileName`].
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
+    let err = |source: std::io::Error| Error::Write {
+        path: path.to_path_buf(),
+        source,
+    };
+    let name = path.file_name().ok_or_else(|| Error::NotAFileName {
+        path: path.to_path_buf(),
+    })?;
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -46,16 +50,15 @@ pub fn new_file_permissions() -> std::fs::Permissions {
     }
 }
 
-/// An image encoded as PNG, for [`write_atomic`].
-pub fn png<P, C>(img: &image::ImageBuffer<P, C>) -> Result<Vec<u8>, String>
+/// An image encoded as PNG, for [`write_atomic`]. Errors: [`Error::Encode`].
+pub fn png<P, C>(img: &image::ImageBuffer<P, C>) -> Result<Vec<u8>, Error>
 where
     P: image::PixelWithColorType,
     [P::Subpixel]: image::EncodableLayout,
     C: std::ops::Deref<Target = [P::Subpixel]>,
 {
     let mut out = std::io::Cursor::new(Vec::new());
-    img.write_to(&mut out, image::ImageFormat::Png)
-        .map_err(|e| e.to_string())?;
+    img.write_to(&mut out, image::ImageFormat::Png)?;
     Ok(out.into_inner())
 }
 
@@ -71,7 +74,7 @@ mod tests {
         write_atomic(&p, b"two").unwrap();
         assert_eq!(std::fs::read(&p).unwrap(), b"two");
         let missing = dir.path().join("no/such/folder/b.txt");
-        let e = write_atomic(&missing, b"x").unwrap_err();
+        let e = write_atomic(&missing, b"x").unwrap_err().to_string();
         assert!(e.contains("no/such/folder/b.txt"), "{e}");
         let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
         assert_eq!(left.len(), 1, "only a.txt: no temporary file left");

@@ -11,6 +11,27 @@ use reyes::image::FrameImage;
 use scheduler::{Gpu, StrategyKind};
 use std::sync::OnceLock;
 
+/// Share of pixels that may differ by more than 2/255 ([`FrameImage::compare`]'s `over`)
+/// between a GPU frame and its CPU twin. The twin does the GPU's f32 operations in the same
+/// order, so decisions and counts agree exactly (tests assert those with `==`); a pixel may
+/// still differ where the GPU rounds `pow`, `sqrt`, `normalize` or `sin` by a few ulps or fuses
+/// a multiply-add, which moves a packed 10-bit colour by one step or a sample lying exactly on
+/// an edge to its other side.
+pub const CPU_TWIN_OVER: f64 = 0.002;
+
+/// [`CPU_TWIN_OVER`] for scenes made to stress f32 (the hard cases: coordinates far from the
+/// origin, patches through the near plane, grids of sliver micropolygons) and for rational
+/// patches (a homogeneous division per point): many more samples lie within an ulp of an edge.
+pub const CPU_TWIN_OVER_HARD: f64 = 0.005;
+
+/// [`CPU_TWIN_OVER`] with motion blur and depth of field: every sample's point is moved over
+/// the shutter and its lens position mapped to the disc (`sin`, `cos`), so the ulps that can
+/// move a sample across an edge come at every sample rather than once per grid point.
+pub const CPU_TWIN_OVER_MOTION: f64 = 0.01;
+
+/// The one device of the test binary, shared by every test (pipelines compile once), from the
+/// adapter the environment names (`WGPU_ADAPTER_NAME`, `WGPU_BACKEND`) with the features the
+/// renderer needs; none is a panic, never a skip.
 pub fn gpu() -> &'static Gpu {
     static GPU: OnceLock<Gpu> = OnceLock::new();
     GPU.get_or_init(|| {

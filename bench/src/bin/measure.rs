@@ -192,7 +192,7 @@ fn measure(cli: &Cli) -> Result<bool, String> {
         builds.push((Build::Base, base.clone()));
     }
     builds.push((Build::New, new_dir));
-    let data = cli.data.clone().unwrap_or_else(plan::shared_data_dir);
+    let data = cli.data.clone().unwrap_or_else(reyes::shared_data_dir);
     let scratch = tempfile::tempdir().map_err(|e| format!("creating a scratch folder: {e}"))?;
     let temporary_work;
     let work = match &cli.out {

@@ -69,7 +69,7 @@ pub struct Cli {
     pub adapter: Option<String>,
 
     /// The shared scene folder (`rib/killeroo.rib`, `field/...`) [default: REYES_SHARED_DATA,
-    /// else `shared/data` beside the repository, else /work/shared/data].
+    /// else `shared/data` beside the repository].
     #[arg(long, value_name = "DIR")]
     pub data: Option<PathBuf>,
 

@@ -622,21 +622,6 @@ impl Planner<'_, '_> {
     }
 }
 
-/// The shared scene folder: `REYES_SHARED_DATA`, else `shared/data` beside the repository
-/// (this crate's folder's grandparent), else /work/shared/data; the rule of the tests and
-/// `reyes`.
-pub fn shared_data_dir() -> PathBuf {
-    if let Some(d) = std::env::var_os("REYES_SHARED_DATA") {
-        return d.into();
-    }
-    let beside = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data");
-    if beside.is_dir() {
-        beside
-    } else {
-        "/work/shared/data".into()
-    }
-}
-
 /// A scene's name in the table: `teapot`, `killeroo`, a file's stem.
 fn scene_label(name: &str) -> String {
     Path::new(name)

@@ -11,7 +11,7 @@ use plotters::coord::ranged1d::{KeyPointHint, NoDefaultFormatting, Ranged, Value
 use plotters::prelude::*;
 use plotters::style::{FontStyle, register_font};
 use std::ops::Range;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Once;
 
 /// Marker shapes (one per pixel-sample setting in the sweep).
@@ -78,8 +78,30 @@ fn rgb(c: [u8; 3]) -> RGBColor {
     RGBColor(c[0], c[1], c[2])
 }
 
-fn err(e: impl std::fmt::Display) -> String {
-    format!("plot: {e}")
+/// Why a figure could not be drawn or written.
+#[derive(Debug, thiserror::Error)]
+pub enum PlotError {
+    /// The plotting backend failed; its error as text (its type depends on the backend).
+    #[error("plot: {0}")]
+    Draw(String),
+    /// The drawn bitmap does not have the figure's width x height pixels.
+    #[error("plot buffer size")]
+    BufferSize,
+    /// The figure could not be encoded as PNG or its file written.
+    #[error(transparent)]
+    Output(#[from] reyes::Error),
+    /// A figure for the file `path` that could not be drawn or encoded.
+    #[error("{}: {source}", path.display())]
+    For {
+        /// The file the figure was for.
+        path: PathBuf,
+        /// What went wrong.
+        source: Box<PlotError>,
+    },
+}
+
+fn err(e: impl std::fmt::Display) -> PlotError {
+    PlotError::Draw(e.to_string())
 }
 
 fn register_fonts() {
@@ -111,19 +133,19 @@ impl Figure<'_> {
 
     /// The figure as PNG bytes, and each panel's drawn points' pixel positions (in the order
     /// of their points, `None` for points left out).
-    pub fn png(&self) -> Result<(Vec<u8>, Vec<Vec<Option<(i32, i32)>>>), String> {
+    pub fn png(&self) -> Result<(Vec<u8>, Vec<Vec<Option<(i32, i32)>>>), PlotError> {
         let (w, h) = self.size();
         let mut buf = vec![0u8; (w * h * 3) as usize];
         let positions = {
             let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
             self.draw(&root)?
         };
-        let img = image::RgbImage::from_raw(w, h, buf).ok_or("plot buffer size")?;
+        let img = image::RgbImage::from_raw(w, h, buf).ok_or(PlotError::BufferSize)?;
         Ok((reyes::output::png(&img)?, positions))
     }
 
     /// The figure as SVG.
-    pub fn svg(&self) -> Result<String, String> {
+    pub fn svg(&self) -> Result<String, PlotError> {
         let mut text = String::new();
         {
             let root = SVGBackend::with_string(&mut text, self.size()).into_drawing_area();
@@ -133,21 +155,27 @@ impl Figure<'_> {
     }
 
     /// Writes the PNG to `path` (atomically).
-    pub fn write_png(&self, path: &Path) -> Result<(), String> {
-        let (png, _) = self.png().map_err(|e| format!("{}: {e}", path.display()))?;
-        reyes::output::write_atomic(path, &png)
+    pub fn write_png(&self, path: &Path) -> Result<(), PlotError> {
+        let (png, _) = self.png().map_err(|e| PlotError::For {
+            path: path.to_path_buf(),
+            source: Box::new(e),
+        })?;
+        Ok(reyes::output::write_atomic(path, &png)?)
     }
 
     /// Writes the SVG to `path` (atomically).
-    pub fn write_svg(&self, path: &Path) -> Result<(), String> {
-        let svg = self.svg().map_err(|e| format!("{}: {e}", path.display()))?;
-        reyes::output::write_atomic(path, svg.as_bytes())
+    pub fn write_svg(&self, path: &Path) -> Result<(), PlotError> {
+        let svg = self.svg().map_err(|e| PlotError::For {
+            path: path.to_path_buf(),
+            source: Box::new(e),
+        })?;
+        Ok(reyes::output::write_atomic(path, svg.as_bytes())?)
     }
 
     fn draw<DB: DrawingBackend>(
         &self,
         root: &DrawingArea<DB, Shift>,
-    ) -> Result<Vec<Vec<Option<(i32, i32)>>>, String> {
+    ) -> Result<Vec<Vec<Option<(i32, i32)>>>, PlotError> {
         register_fonts();
         root.fill(&WHITE).map_err(err)?;
         let (header, rest) = root.split_vertically(HEADER);
@@ -274,7 +302,7 @@ fn marker<DB: DrawingBackend, CT: CoordTranslate>(
     area: &DrawingArea<DB, CT>,
     at: CT::From,
     s: &Style,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let r = 5;
     let colour = rgb(s.colour);
     let result = match (s.shape, s.hollow) {
@@ -314,7 +342,7 @@ fn drawable(q: &Point) -> bool {
 fn panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     p: &Panel,
-) -> Result<Vec<Option<(i32, i32)>>, String> {
+) -> Result<Vec<Option<(i32, i32)>>, PlotError> {
     let x_axis = log_axis(p.points.iter().map(|q| q.x));
     let xs = x_axis.range.clone();
     let y_axis = log_axis(

@@ -188,7 +188,8 @@ pub fn main(a: BenchCmd) -> Result<(), String> {
         let (w, h, _) = r.frame_size();
         let img = image::RgbaImage::from_raw(w, h, last[0].rgba8.clone().unwrap_or_default())
             .ok_or("image buffer size mismatch")?;
-        reyes::output::write_atomic(out, &reyes::output::png(&img)?)?;
+        reyes::output::write_atomic(out, &reyes::output::png(&img).map_err(|e| e.to_string())?)
+            .map_err(|e| e.to_string())?;
         eprintln!("wrote {}", out.display());
     }
     let peer = match a.peer {

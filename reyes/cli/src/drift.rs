@@ -29,7 +29,7 @@ pub fn main(a: DriftCmd) -> Result<(), String> {
         height: Some(height),
         ..Default::default()
     };
-    let data = FrameData::new(&scene, &options)?;
+    let data = FrameData::new(&scene, &options).map_err(|e| e.to_string())?;
     // The depth the CPU pipeline reaches, and the same split tree walked with exact twins.
     let cpu = render_cpu(&data);
     let cpu_depth = cpu.counters[reyes::stages::C_MAX_DEPTH];

@@ -40,7 +40,7 @@ pub fn main(a: HolesCmd) -> Result<(), String> {
         log::warn!("{w}");
     }
     let options = a.render.options();
-    let data = FrameData::new(&scene, &options)?;
+    let data = FrameData::new(&scene, &options).map_err(|e| e.to_string())?;
     let gpu = Gpu::from_env_requiring(required_features()).map_err(|e| e.to_string())?;
     let renderer =
         GpuRenderer::for_features(&gpu, a.render.strategy_for(&gpu), false, data.features())
@@ -58,7 +58,8 @@ pub fn main(a: HolesCmd) -> Result<(), String> {
                     raster: RasterMode::BoundingBox,
                     ..options.clone()
                 },
-            )?;
+            )
+            .map_err(|e| e.to_string())?;
             let g = renderer.render(&gpu, &bbox).map_err(|e| e.to_string())?;
             coverage_of(&g.image)
         }

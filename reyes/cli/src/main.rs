@@ -76,7 +76,8 @@ fn run(a: RenderCmd) -> Result<(), String> {
     let data = jobs
         .iter()
         .map(|(i, _)| FrameData::new(&seq.frames[*i].scene, &options))
-        .collect::<Result<Vec<_>, _>>()?;
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| e.to_string())?;
     let gpu = match (a.cpu, jobs.is_empty()) {
         (false, false) => {
             // One program for every frame: compiled for what they need together.
@@ -163,7 +164,7 @@ fn render_frame(
         for w in reyes::warnings::frame_warnings(data, &r.counters) {
             log::warn!("{w}");
         }
-        r.image.write_png(&out.image)?;
+        r.image.write_png(&out.image).map_err(|e| e.to_string())?;
         reyes_cli::progress::note(format!(
             "wrote {} ({}x{}, CPU reference, {:.2} s)",
             out.image.display(),
@@ -213,19 +214,22 @@ fn render_frame(
     if let Some(reference) = reference {
         stats.image_error = Some(compare_to(reference, &frame.image)?);
     }
-    frame.image.write_png(&out.image)?;
+    frame
+        .image
+        .write_png(&out.image)
+        .map_err(|e| e.to_string())?;
     if let Some(p) = &out.float {
-        frame.image.write_pfm(p)?;
+        frame.image.write_pfm(p).map_err(|e| e.to_string())?;
     }
     if let Some(p) = &out.depth {
-        frame.image.write_depth(p)?;
+        frame.image.write_depth(p).map_err(|e| e.to_string())?;
     }
     if let Some(p) = &out.exr {
-        frame.image.write_exr(p)?;
+        frame.image.write_exr(p).map_err(|e| e.to_string())?;
     }
     if let Some(p) = &out.stats {
         let text = serde_json::to_string_pretty(&stats).unwrap();
-        reyes::output::write_atomic(p, (text + "\n").as_bytes())?;
+        reyes::output::write_atomic(p, (text + "\n").as_bytes()).map_err(|e| e.to_string())?;
     }
     reyes_cli::progress::note(format!(
         "wrote {} ({}x{}, {}{}: {} grids, {} micropolygons, {})",

@@ -55,7 +55,7 @@ pub fn main(a: MeasureCmd) -> Result<(), String> {
     for w in &scene.warnings {
         log::warn!("{w}");
     }
-    let data = FrameData::new(&scene, &a.render.options())?;
+    let data = FrameData::new(&scene, &a.render.options()).map_err(|e| e.to_string())?;
     let gpu = Gpu::from_env_requiring(required_features()).map_err(|e| e.to_string())?;
     let renderer =
         GpuRenderer::for_features(&gpu, a.render.strategy_for(&gpu), false, data.features())
@@ -68,14 +68,14 @@ pub fn main(a: MeasureCmd) -> Result<(), String> {
     }
     stats.wall_ms = scheduler::stats::median_and_mad(&wall_ms).0;
     if let Some(p) = &a.out {
-        frame.image.write_png(p)?;
+        frame.image.write_png(p).map_err(|e| e.to_string())?;
     }
     let (w, h) = (data.frame.width, data.frame.height);
     let rows = reyes_cli::progress::bar(h as u64, "reference render: pixel rows");
     let reference: ReferenceImage = render_reference(&scene, w, h, ref_samples, &|n| rows.inc(n));
     rows.finish_and_clear();
     if let Some(p) = &reference_png {
-        reference.image.write_png(p)?;
+        reference.image.write_png(p).map_err(|e| e.to_string())?;
     }
     let t = std::time::Instant::now();
     let geom = geometry(&scene, &data);

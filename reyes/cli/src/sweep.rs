@@ -173,9 +173,12 @@ pub fn main(a: SweepCmd) -> Result<(), String> {
                 },
                 ..RenderOptions::default()
             };
-            let geom = geometry(&scene, &FrameData::new(&scene, &options((1, 1)))?);
+            let geom = geometry(
+                &scene,
+                &FrameData::new(&scene, &options((1, 1))).map_err(|e| e.to_string())?,
+            );
             for &spp in &sample_set {
-                let data = FrameData::new(&scene, &options(spp))?;
+                let data = FrameData::new(&scene, &options(spp)).map_err(|e| e.to_string())?;
                 // This setting's distinct images (the strategies' are normally identical).
                 let mut seen: Vec<(FrameImage, usize, usize)> = Vec::new();
                 for (kind, renderer) in &renderers {
@@ -259,7 +262,7 @@ pub fn main(a: SweepCmd) -> Result<(), String> {
 }
 
 fn write(path: &Path, text: &str) -> Result<(), String> {
-    reyes::output::write_atomic(path, text.as_bytes())
+    reyes::output::write_atomic(path, text.as_bytes()).map_err(|e| e.to_string())
 }
 
 /// Pareto fronts per scene: cost against geometric error and against FLIP.
@@ -488,6 +491,10 @@ fn plots(dir: &Path, rows: &[Row], c: &Config, adapter: &str) -> Result<(), Stri
         columns: 2,
         legend: &legend,
     };
-    figure.write_png(&dir.join("sweep.png"))?;
-    figure.write_svg(&dir.join("sweep.svg"))
+    figure
+        .write_png(&dir.join("sweep.png"))
+        .map_err(|e| e.to_string())?;
+    figure
+        .write_svg(&dir.join("sweep.svg"))
+        .map_err(|e| e.to_string())
 }

@@ -50,7 +50,9 @@ pub fn main(a: ViewCmd) -> Result<(), String> {
     // The scene's own size and samples, unless the flags say otherwise; a bad option fails
     // here, before a window opens.
     let options = a.render.options();
-    let first = FrameData::new(&scene, &options)?.frame;
+    let first = FrameData::new(&scene, &options)
+        .map_err(|e| e.to_string())?
+        .frame;
     let event_loop = EventLoop::new().map_err(|e| {
         format!(
             "cannot open a window: {e} (no display? set DISPLAY, or run it under Xvfb: \
@@ -321,7 +323,8 @@ impl Viewer {
             .map_err(|e| e.to_string())?;
         let img = image::RgbaImage::from_raw(f.width, f.height, bytes)
             .ok_or("image buffer size mismatch")?;
-        reyes::output::write_atomic(path, &reyes::output::png(&img)?)?;
+        reyes::output::write_atomic(path, &reyes::output::png(&img).map_err(|e| e.to_string())?)
+            .map_err(|e| e.to_string())?;
         eprintln!("wrote {}", path.display());
         Ok(())
     }

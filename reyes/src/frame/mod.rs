@@ -2,6 +2,7 @@
 //! `shaders/reyes/common.wgsl` (`#[repr(C)]` bytemuck types, layouts checked against naga's
 //! reflection in the tests), and their construction from a [`Scene`] and [`RenderOptions`].
 
+use crate::Error;
 use crate::scene::{Light, Patch, Scene, SurfaceKind};
 use bytemuck::{Pod, Zeroable};
 
@@ -164,9 +165,11 @@ pub struct Tile {
     pub h: u32,
 }
 
+/// A material as the GPU stages read it (`Material` in common.wgsl): the f32 form of a
+/// [`crate::scene::Material`].
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
-pub struct Material {
+pub struct GpuMaterial {
     pub color: [f32; 3],
     /// 0 constant, 1 matte, 2 plastic
     pub kind: u32,
@@ -193,7 +196,7 @@ pub struct GpuLight {
 #[derive(Clone, Debug)]
 pub struct FrameData {
     pub frame: Frame,
-    pub materials: Vec<Material>,
+    pub materials: Vec<GpuMaterial>,
     pub lights: Vec<GpuLight>,
     pub patch_info: Vec<PatchInfo>,
     /// The colour fields of the patches that have primitive variables, referenced by
@@ -294,11 +297,9 @@ impl SceneFeatures {
     }
 }
 
-/// Largest image side accepted (the sample buffer must also fit the adapter; checked there).
-pub const MAX_IMAGE_SIDE: u32 = 16384;
-
-/// Most samples per pixel in x and in y (RenderMan's `PixelSamples`).
-pub const MAX_PIXEL_SAMPLES: u32 = 16;
+// The limits a scene's `Format` and `PixelSamples` are read within; the frame holds the
+// options to them too.
+pub use crate::scene::{MAX_IMAGE_SIDE, MAX_PIXEL_SAMPLES};
 
 /// Smallest micropolygon edge accepted, in pixels: 256 micropolygons per pixel. Below it the
 /// work per patch grows without bound (each halving of the size quadruples the grids) while
@@ -318,13 +319,15 @@ pub fn image_bytes(width: u32, height: u32) -> u64 {
 }
 
 /// Checks the options both render paths share that do not depend on the scene: the
-/// micropolygon size and the screen bound. Errors say which option and why.
-pub fn check_quality(o: &RenderOptions) -> Result<(), String> {
+/// micropolygon size and the screen bound. Errors ([`Error::InvalidOptions`]) say which option
+/// and why.
+pub fn check_quality(o: &RenderOptions) -> Result<(), Error> {
+    let invalid = |message: String| Err(Error::InvalidOptions(message));
     if !(1..=15).contains(&o.grid_max) {
-        return Err(format!("grid_max {} must be 1..=15", o.grid_max));
+        return invalid(format!("grid_max {} must be 1..=15", o.grid_max));
     }
     if !(o.mp_size.is_finite() && o.mp_size >= MIN_MP_SIZE) {
-        return Err(format!(
+        return invalid(format!(
             "micropolygon size {:?} px is not supported: it must be at least {MIN_MP_SIZE} px \
              (256 micropolygons per pixel) and finite",
             o.mp_size
@@ -334,16 +337,16 @@ pub fn check_quality(o: &RenderOptions) -> Result<(), String> {
     if let Some(b) = o.bound_px
         && !(b.is_finite() && b >= min_bound)
     {
-        return Err(format!(
+        return invalid(format!(
             "screen bound {b:?} px is not supported: it must be at least {min_bound} px (grids \
              of 15x15 micropolygons of at least {MIN_MP_SIZE} px) and finite"
         ));
     }
     if !(2..=4).contains(&o.il_tile) {
-        return Err(format!("interleave tile {} must be 2, 3 or 4", o.il_tile));
+        return invalid(format!("interleave tile {} must be 2, 3 or 4", o.il_tile));
     }
     if !(1..=1024).contains(&o.il_perms) {
-        return Err(format!(
+        return invalid(format!(
             "interleave permutations {} must be 1..=1024",
             o.il_perms
         ));
@@ -352,45 +355,49 @@ pub fn check_quality(o: &RenderOptions) -> Result<(), String> {
 }
 
 impl FrameData {
-    pub fn new(scene: &Scene, o: &RenderOptions) -> Result<FrameData, String> {
+    /// The frame of `scene` under the options `o`: the uniforms, materials, lights and the
+    /// per-patch tables. Errors: options out of range ([`Error::InvalidOptions`]), a frame
+    /// whose buffers exceed a device binding ([`Error::FrameTooLarge`]), per-patch tables over
+    /// a binding ([`Error::TablesTooLarge`]).
+    pub fn new(scene: &Scene, o: &RenderOptions) -> Result<FrameData, Error> {
         let width = o.width.unwrap_or(scene.width);
         let height = o.height.unwrap_or(scene.height);
         if width == 0 || height == 0 || width > MAX_IMAGE_SIDE || height > MAX_IMAGE_SIDE {
-            return Err(format!(
+            return Err(Error::InvalidOptions(format!(
                 "image size {width}x{height} is not supported: each side must be 1..={MAX_IMAGE_SIDE}"
-            ));
+            )));
         }
         let (sx, sy) = o.pixel_samples.unwrap_or(scene.pixel_samples);
         let spp = 1..=MAX_PIXEL_SAMPLES;
         if !spp.contains(&sx) || !spp.contains(&sy) {
-            return Err(format!(
+            return Err(Error::InvalidOptions(format!(
                 "pixel samples {sx}x{sy}: each must be 1..={MAX_PIXEL_SAMPLES}"
-            ));
+            )));
         }
         // Sample indices are 32-bit in the shaders and in the CPU pipeline.
         let subsamples = width as u64 * height as u64 * (sx * sy) as u64;
         if subsamples > u32::MAX as u64 {
-            return Err(format!(
+            return Err(Error::FrameTooLarge(format!(
                 "image size {width}x{height} with {sx}x{sy} pixel samples needs {subsamples} \
                  sub-samples, more than a 32-bit sample index reaches ({})",
                 u32::MAX
-            ));
+            )));
         }
         let limit = MAX_FRAME_BUFFER_BYTES;
         let image = image_bytes(width, height);
         if image > limit {
-            return Err(format!(
+            return Err(Error::FrameTooLarge(format!(
                 "image size {width}x{height} needs {image} bytes of RGBA, more than the {limit} \
                  bytes (4 GiB) a frame buffer may hold"
-            ));
+            )));
         }
         let samples = subsamples * 8;
         if samples > limit && o.memory_budget.is_none() {
-            return Err(format!(
+            return Err(Error::FrameTooLarge(format!(
                 "image size {width}x{height} with {sx}x{sy} pixel samples needs {samples} bytes \
                  of samples, more than the {limit} bytes (4 GiB) a frame buffer may hold: give \
                  --memory-budget to render it in buckets"
-            ));
+            )));
         }
         check_quality(o)?;
         let fov = scene.camera.fov_deg.to_radians();
@@ -439,10 +446,10 @@ impl FrameData {
         }
         if moving || frame.coc_scale > 0.0 {
             if o.raster == RasterMode::NearestSample {
-                return Err(
+                return Err(Error::InvalidOptions(
                     "motion blur and depth of field need bounding-box rasterization (--raster bbox)"
                         .to_string(),
-                );
+                ));
             }
             frame.uvt = o.sampling.gpu_code();
         }
@@ -467,8 +474,8 @@ fn f3(v: glam::DVec3) -> [f32; 3] {
     [v.x as f32, v.y as f32, v.z as f32]
 }
 
-fn gpu_material(m: &crate::scene::Material) -> Material {
-    Material {
+fn gpu_material(m: &crate::scene::Material) -> GpuMaterial {
+    GpuMaterial {
         color: f3(m.color),
         kind: match m.kind {
             SurfaceKind::Constant => 0,
@@ -511,7 +518,7 @@ fn patch_info(
     p: &Patch,
     table: &mut Vec<[f32; 4]>,
     maps: &mut Vec<(*const crate::scene::DisplacementMap, u32)>,
-) -> Result<PatchInfo, String> {
+) -> Result<PatchInfo, Error> {
     let mut field = |f: Option<&crate::scene::ColorField>| f.map_or(Ok(0), |f| field_ref(table, f));
     let vars = p.primvars.as_deref();
     let cs = field(vars.and_then(|v| v.cs.as_ref()))?;
@@ -549,15 +556,15 @@ fn patch_info(
 }
 
 /// Appends the 16 weights of homogeneous points `h` to the table as 4 entries (row v = l in
-/// entry l) and returns the first entry's index ([`PatchInfo::weights`]). Errors when the
-/// table would outgrow what a GPU binding holds.
-fn weights_ref(table: &mut Vec<[f32; 4]>, h: &[[f32; 4]; 16]) -> Result<u32, String> {
+/// entry l) and returns the first entry's index ([`PatchInfo::weights`]). Errors
+/// ([`Error::TablesTooLarge`]) when the table would outgrow what a GPU binding holds.
+fn weights_ref(table: &mut Vec<[f32; 4]>, h: &[[f32; 4]; 16]) -> Result<u32, Error> {
     let at = table.len() as u64;
     if (at + 4) * 16 > MAX_FRAME_BUFFER_BYTES {
-        return Err(format!(
-            "the patches' weights and primitive variables need more than the \
-             {MAX_FRAME_BUFFER_BYTES} bytes a GPU table may hold"
-        ));
+        return Err(Error::TablesTooLarge {
+            what: "weights and primitive variables",
+            limit: MAX_FRAME_BUFFER_BYTES,
+        });
     }
     table.extend((0..4).map(|l| std::array::from_fn(|u| h[4 * l + u][3])));
     Ok(at as u32)
@@ -655,13 +662,13 @@ mod tests {
         );
         check(
             "Material",
-            size_of::<Material>(),
+            size_of::<GpuMaterial>(),
             &[
-                ("kind", offset_of!(Material, kind)),
-                ("specular", offset_of!(Material, specular)),
-                ("ka", offset_of!(Material, ka)),
-                ("roughness", offset_of!(Material, roughness)),
-                ("opacity", offset_of!(Material, opacity)),
+                ("kind", offset_of!(GpuMaterial, kind)),
+                ("specular", offset_of!(GpuMaterial, specular)),
+                ("ka", offset_of!(GpuMaterial, ka)),
+                ("roughness", offset_of!(GpuMaterial, roughness)),
+                ("opacity", offset_of!(GpuMaterial, opacity)),
             ],
         );
         check(
@@ -767,6 +774,7 @@ mod tests {
             assert!(
                 FrameData::new(&scene, &o)
                     .unwrap_err()
+                    .to_string()
                     .contains("image size")
             );
         }
@@ -780,7 +788,9 @@ mod tests {
         let with = |f: &dyn Fn(&mut RenderOptions)| {
             let mut o = RenderOptions::default();
             f(&mut o);
-            FrameData::new(&scene, &o).map(|_| ())
+            FrameData::new(&scene, &o)
+                .map(|_| ())
+                .map_err(|e| e.to_string())
         };
         let e = with(&|o| (o.width, o.height) = (Some(16384), Some(16384))).unwrap_err();
         assert!(e.contains("needs 4294967296 bytes of RGBA"), "{e}");

@@ -35,14 +35,15 @@ pub struct PatchInfo {
 pub const PATCH_MOVING: u32 = 16;
 
 /// Appends the affine part of the camera-space motion `m` (shutter open to close) to the table
-/// as 3 rows `[m_r0, m_r1, m_r2, t_r]` and returns the first entry's index.
-pub fn motion_ref(table: &mut Vec<[f32; 4]>, m: &glam::DMat4) -> Result<u32, String> {
+/// as 3 rows `[m_r0, m_r1, m_r2, t_r]` and returns the first entry's index. Errors
+/// ([`Error::TablesTooLarge`]) when the table would outgrow what a GPU binding holds.
+pub fn motion_ref(table: &mut Vec<[f32; 4]>, m: &glam::DMat4) -> Result<u32, Error> {
     let at = table.len() as u64;
     if (at + 3) * 16 > MAX_FRAME_BUFFER_BYTES {
-        return Err(format!(
-            "the patches' motion and primitive variables need more than the \
-             {MAX_FRAME_BUFFER_BYTES} bytes a GPU table may hold"
-        ));
+        return Err(Error::TablesTooLarge {
+            what: "motion and primitive variables",
+            limit: MAX_FRAME_BUFFER_BYTES,
+        });
     }
     table.extend((0..3).map(|r| std::array::from_fn(|c| m.col(c)[r] as f32)));
     Ok(at as u32)
@@ -57,11 +58,11 @@ pub const FIELD_BEZIER: u32 = 3;
 
 /// Appends `field` to the primitive-variable table (one `[r, g, b, 0]` entry per value, in
 /// f32) and returns its reference: the entry index shifted left by 2, or-ed with its shape.
-/// Errors when the table would outgrow what a GPU binding holds.
+/// Errors ([`Error::TablesTooLarge`]) when the table would outgrow what a GPU binding holds.
 pub fn field_ref(
     table: &mut Vec<[f32; 4]>,
     field: &crate::scene::ColorField,
-) -> Result<u32, String> {
+) -> Result<u32, Error> {
     use crate::scene::ColorField;
     let shape = match field {
         ColorField::Flat(_) => FIELD_FLAT,
@@ -71,9 +72,10 @@ pub fn field_ref(
     let at = table.len() as u64;
     let end = at + field.values().len() as u64;
     if end * 16 > MAX_FRAME_BUFFER_BYTES || at >= 1 << 30 {
-        return Err(format!(
-            "the patches' primitive variables need more than the {MAX_FRAME_BUFFER_BYTES} bytes a GPU table may hold"
-        ));
+        return Err(Error::TablesTooLarge {
+            what: "primitive variables",
+            limit: MAX_FRAME_BUFFER_BYTES,
+        });
     }
     table.extend(field.values().iter().map(|c| {
         let c = f3(*c);
@@ -114,19 +116,18 @@ pub enum DisplacementNormals {
 /// ([`PatchInfo::displacement`]): entry `at` = (amount, bound, kind, map entry or bumps
 /// frequency) with the last two as `u32` bits. A map's block (shared by every patch that uses the map; `maps`
 /// remembers where each went) is one entry (width, height as `u32` bits, 0, 0), then its
-/// texels 4 to an entry, row-major from the top row.
+/// texels 4 to an entry, row-major from the top row. Errors ([`Error::TablesTooLarge`]) when
+/// the table would outgrow what a GPU binding holds.
 pub fn displacement_ref(
     table: &mut Vec<[f32; 4]>,
     maps: &mut Vec<(*const crate::scene::DisplacementMap, u32)>,
     d: &crate::scene::Displacement,
-) -> Result<u32, String> {
+) -> Result<u32, Error> {
     use crate::scene::DisplacementPattern;
     let too_big = |end: u64| {
-        (end * 16 > MAX_FRAME_BUFFER_BYTES).then(|| {
-            format!(
-                "the patches' displacements and primitive variables need more than the \
-                 {MAX_FRAME_BUFFER_BYTES} bytes a GPU table may hold"
-            )
+        (end * 16 > MAX_FRAME_BUFFER_BYTES).then_some(Error::TablesTooLarge {
+            what: "displacements and primitive variables",
+            limit: MAX_FRAME_BUFFER_BYTES,
         })
     };
     let (kind, map_at) = match &d.pattern {

@@ -208,7 +208,7 @@ impl RasterPeer {
         options: &RenderOptions,
         pixels: Pixels,
     ) -> Result<RasterPeer, RunError> {
-        let base = FrameData::new(scene, options).map_err(RunError::Program)?;
+        let base = FrameData::new(scene, options).map_err(|e| RunError::Program(e.to_string()))?;
         if scene.patches.len() > MAX_PATCHES {
             return Err(RunError::Program(format!(
                 "the raster peer draws at most {MAX_PATCHES} patches; the scene has {}",

@@ -255,7 +255,7 @@ impl RealtimeRenderer {
         strategy: StrategyKind,
         pixels: Pixels,
     ) -> Result<RealtimeRenderer, RunError> {
-        let base = FrameData::new(scene, options).map_err(RunError::Program)?;
+        let base = FrameData::new(scene, options).map_err(|e| RunError::Program(e.to_string()))?;
         let renderer = GpuRenderer::for_features(gpu, strategy, false, base.features())?;
         let f = base.frame;
         let n = scene.patches.len() as u32;

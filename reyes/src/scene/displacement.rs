@@ -3,6 +3,7 @@
 //! `amount * pattern(u, v)`, (u, v) the parameters of the original patch (docs/reyes.md,
 //! "Displacement").
 
+use crate::Error;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -37,16 +38,21 @@ pub struct DisplacementMap {
 
 impl DisplacementMap {
     /// Reads a PNG (8 or 16 bit, any channels) or OpenEXR image through the `image` crate and
-    /// keeps its luminance (for EXR, clamped to [0, 1]). Errors name the file.
-    pub fn load(path: &Path) -> Result<DisplacementMap, String> {
-        let img = image::open(path)
-            .map_err(|e| format!("cannot read the displacement map {}: {e}", path.display()))?;
+    /// keeps its luminance (for EXR, clamped to [0, 1]). Errors name the file:
+    /// [`Error::DisplacementMapUnreadable`], [`Error::DisplacementMapSize`].
+    pub fn load(path: &Path) -> Result<DisplacementMap, Error> {
+        let img = image::open(path).map_err(|source| Error::DisplacementMapUnreadable {
+            path: path.to_path_buf(),
+            source,
+        })?;
         let (width, height) = (img.width(), img.height());
         if width == 0 || height == 0 || width > MAX_MAP_SIDE || height > MAX_MAP_SIDE {
-            return Err(format!(
-                "the displacement map {} is {width}x{height}: each side must be 1..={MAX_MAP_SIDE}",
-                path.display()
-            ));
+            return Err(Error::DisplacementMapSize {
+                path: path.to_path_buf(),
+                width,
+                height,
+                max_side: MAX_MAP_SIDE,
+            });
         }
         let luma = img.to_luma32f();
         let texels = luma

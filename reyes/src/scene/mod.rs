@@ -21,9 +21,10 @@ mod spin;
 mod teapot;
 
 use glam::{DMat4, DVec3};
-use std::fmt;
+
 use std::path::Path;
 
+pub use crate::error::SceneError;
 pub use basis::Basis;
 pub use bpt::parse_bpt;
 pub use displacement::{
@@ -37,6 +38,12 @@ pub use rib::{load_rib, open_rib, parse_rib, parse_rib_frames};
 pub use sequence::{Display, FrameRanges, FrameSequence, SceneFrame};
 pub use spin::spin;
 pub use teapot::{builtin_teapot, teapot_object_patches};
+
+/// Largest image side accepted (the sample buffer must also fit the adapter; checked there).
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+
+/// Most samples per pixel in x and in y (RenderMan's `PixelSamples`).
+pub const MAX_PIXEL_SAMPLES: u32 = 16;
 
 /// RenderMan's `RI_EPSILON`, the default near clipping distance.
 pub const RI_EPSILON: f64 = 1.0e-10;
@@ -252,42 +259,23 @@ pub enum Light {
     },
 }
 
-/// An input error, located at a file and line (line 0: the file as a whole).
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct SceneError {
-    pub file: String,
-    pub line: u32,
-    pub message: String,
-}
-
-impl SceneError {
-    pub fn new(file: &str, line: u32, message: impl Into<String>) -> SceneError {
-        SceneError {
-            file: file.to_string(),
-            line,
-            message: message.into(),
-        }
-    }
-}
-
-impl fmt::Display for SceneError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        // Line 0: the error is about the whole file (it cannot be read), not a line of it.
-        match self.line {
-            0 => write!(f, "{}: {}", self.file, self.message),
-            line => write!(f, "{}:{line}: {}", self.file, self.message),
-        }
-    }
-}
-
-impl std::error::Error for SceneError {}
-
 /// The input formats `load` understands.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum InputFormat {
     Rib,
     Newell,
     Bpt,
+}
+
+/// Centre of the axis-aligned bounding box of every control point, camera space; the origin
+/// for a scene without patches.
+pub fn scene_centre(scene: &Scene) -> DVec3 {
+    let mut pts = scene.patches.iter().flat_map(|p| p.cp.iter().copied());
+    let Some(first) = pts.next() else {
+        return DVec3::ZERO;
+    };
+    let (lo, hi) = pts.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p)));
+    (lo + hi) / 2.0
 }
 
 /// Loads a scene of one image from a file: the first frame that can be rendered of
@@ -411,8 +399,8 @@ mod tests {
         let p = crate::shared_data_dir().join(rel);
         assert!(
             p.is_file(),
-            "test data {} is missing (set REYES_SHARED_DATA, or keep the shared data directory \
-             next to the repository or at /work/shared/data)",
+            "test data {} is missing (set REYES_SHARED_DATA to the shared data directory, or \
+             keep it next to the repository as shared/data)",
             p.display()
         );
         p

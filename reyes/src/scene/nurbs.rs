@@ -11,6 +11,7 @@
 //! points `(w x, w y, w z, w)`, which is what makes it exact for rational surfaces.
 
 use super::rational::elevate_to_cubic;
+use crate::Error;
 use glam::DVec4;
 
 /// The lowest order supported (bilinear spans).
@@ -51,35 +52,41 @@ fn spans(
     order: usize,
     knots: &[f64],
     (min, max): (f64, f64),
-) -> Result<Vec<Span>, String> {
+) -> Result<Vec<Span>, Error> {
     if !(MIN_ORDER..=MAX_ORDER).contains(&order) {
-        return Err(format!(
+        return Err(Error::InvalidSurface(format!(
             "{dir} order {order} is not supported (orders {MIN_ORDER} to {MAX_ORDER}: \
              linear to cubic)"
-        ));
+        )));
     }
     if n < order {
-        return Err(format!("n{dir} = {n} is less than the order {order}"));
+        return Err(Error::InvalidSurface(format!(
+            "n{dir} = {n} is less than the order {order}"
+        )));
     }
     if knots.len() != n + order {
-        return Err(format!(
+        return Err(Error::InvalidSurface(format!(
             "{dir} knot vector has {} values, expected n{dir} + order = {}",
             knots.len(),
             n + order
-        ));
+        )));
     }
     if let Some(k) = knots.iter().position(|k| !k.is_finite()) {
-        return Err(format!("{dir} knot {k} is not finite"));
+        return Err(Error::InvalidSurface(format!(
+            "{dir} knot {k} is not finite"
+        )));
     }
     if knots.windows(2).any(|w| w[1] < w[0]) {
-        return Err(format!("{dir} knot vector is decreasing somewhere"));
+        return Err(Error::InvalidSurface(format!(
+            "{dir} knot vector is decreasing somewhere"
+        )));
     }
     let (lo, hi) = (knots[order - 1], knots[n]);
     if !(min.is_finite() && max.is_finite() && lo <= min && min < max && max <= hi) {
-        return Err(format!(
+        return Err(Error::InvalidSurface(format!(
             "{dir} range [{min}, {max}] is not within the knot range [{lo}, {hi}] \
              (need {dir}min < {dir}max)"
-        ));
+        )));
     }
     let mut out = Vec::new();
     for i in order - 1..n {
@@ -118,7 +125,7 @@ fn span_to_bezier(knots: &[f64], pts: [DVec4; 4], p: usize, s: Span) -> [DVec4; 
 }
 
 /// Number of Bezier patches the surface will produce (nonempty u spans x v spans).
-pub fn span_count(s: &NuSurface) -> Result<usize, String> {
+pub fn span_count(s: &NuSurface) -> Result<usize, Error> {
     Ok(spans('u', s.nu, s.uorder, s.uknot, s.urange)?.len()
         * spans('v', s.nv, s.vorder, s.vknot, s.vrange)?.len())
 }
@@ -128,7 +135,7 @@ pub type SpanRange = (usize, f64, f64);
 
 /// For each patch [`to_bezier`] makes, in its order: its u and v span (what primitive
 /// variables of class uniform and varying are looked up by).
-pub fn patch_spans(s: &NuSurface) -> Result<Vec<[SpanRange; 2]>, String> {
+pub fn patch_spans(s: &NuSurface) -> Result<Vec<[SpanRange; 2]>, Error> {
     let us = spans('u', s.nu, s.uorder, s.uknot, s.urange)?;
     let vs = spans('v', s.nv, s.vorder, s.vknot, s.vrange)?;
     Ok((vs.iter())
@@ -139,15 +146,15 @@ pub fn patch_spans(s: &NuSurface) -> Result<Vec<[SpanRange; 2]>, String> {
 /// Converts the surface to homogeneous bicubic Bezier patches (cp[4*v + u]), ordered v-span
 /// major, u-span minor. Errors (orders, knots, ranges, the point count) are messages without
 /// a location; the caller adds it.
-pub fn to_bezier(s: &NuSurface) -> Result<Vec<[DVec4; 16]>, String> {
+pub fn to_bezier(s: &NuSurface) -> Result<Vec<[DVec4; 16]>, Error> {
     let us = spans('u', s.nu, s.uorder, s.uknot, s.urange)?;
     let vs = spans('v', s.nv, s.vorder, s.vknot, s.vrange)?;
     if s.points.len() != s.nu * s.nv {
-        return Err(format!(
+        return Err(Error::InvalidSurface(format!(
             "has {} control points, expected nu * nv = {}",
             s.points.len(),
             s.nu * s.nv
-        ));
+        )));
     }
     let (pu, pv) = (s.uorder - 1, s.vorder - 1);
     // Pass 1 (u): every row of control points becomes 4 Bezier points per u span.
@@ -427,6 +434,7 @@ mod tests {
                 points,
             })
             .map(|p| p.len())
+            .map_err(|e| e.to_string())
         };
         assert_eq!(err(4, &vk, (0.0, 1.0), &pts), Ok(1));
         let short = [0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];

@@ -3,6 +3,7 @@
 //! Every loader returns a [`FrameSequence`]; single-image formats give a one-frame sequence.
 
 use super::Scene;
+use crate::Error;
 
 /// A frame's `Display name type mode` (RenderMan Interface Specification 3.2, §4.1.6).
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -98,12 +99,15 @@ impl FrameSequence {
 pub struct FrameRanges(Vec<(u32, u32)>);
 
 impl FrameRanges {
-    /// Parses `N`, `A-B` and comma-separated lists of them. Errors name the bad part.
-    pub fn parse(spec: &str) -> Result<FrameRanges, String> {
+    /// Parses `N`, `A-B` and comma-separated lists of them. Errors
+    /// ([`Error::InvalidFrameRanges`]) name the bad part.
+    pub fn parse(spec: &str) -> Result<FrameRanges, Error> {
         let num = |s: &str| {
-            s.trim()
-                .parse::<u32>()
-                .map_err(|_| format!("--frames: `{s}` is not a frame number (in `{spec}`)"))
+            s.trim().parse::<u32>().map_err(|_| {
+                Error::InvalidFrameRanges(format!(
+                    "--frames: `{s}` is not a frame number (in `{spec}`)"
+                ))
+            })
         };
         let mut out = Vec::new();
         for part in spec.split(',') {
@@ -115,9 +119,9 @@ impl FrameRanges {
                 }
             };
             if a > b {
-                return Err(format!(
+                return Err(Error::InvalidFrameRanges(format!(
                     "--frames: the range `{part}` is empty (its start is after its end)"
-                ));
+                )));
             }
             out.push((a, b));
         }
@@ -143,11 +147,13 @@ mod tests {
         assert!(
             FrameRanges::parse("3-2")
                 .unwrap_err()
+                .to_string()
                 .contains("`3-2` is empty")
         );
         assert!(
             FrameRanges::parse("1,x")
                 .unwrap_err()
+                .to_string()
                 .contains("`x` is not a frame number")
         );
         assert!(FrameRanges::parse("").is_err());

@@ -2,16 +2,18 @@
 //! what a `MotionBegin` rotation around the whole world block would do.
 
 use super::Scene;
+use crate::Error;
 use glam::{DMat4, DVec3};
 
 /// Spins every patch of `scene` by `degrees` over the shutter about the world's z axis
-/// through the centre of the scene's bound ([`crate::orbit::scene_centre`]): the patches stay where
+/// through the centre of the scene's bound ([`super::scene_centre`]): the patches stay where
 /// they are at shutter open and are turned by `degrees` at shutter close (composed with any
 /// motion they already have). Points move linearly between the two (as the renderer moves
-/// every point: docs/reyes.md). Errors when the world's z axis is degenerate in camera space.
-pub fn spin(scene: &mut Scene, degrees: f64) -> Result<(), String> {
+/// every point: docs/reyes.md). Errors: [`Error::NonFiniteSpin`], and
+/// [`Error::DegenerateSpinAxis`] when the world's z axis is degenerate in camera space.
+pub fn spin(scene: &mut Scene, degrees: f64) -> Result<(), Error> {
     if !degrees.is_finite() {
-        return Err(format!("spin {degrees} degrees: must be finite"));
+        return Err(Error::NonFiniteSpin { degrees });
     }
     if degrees == 0.0 {
         return Ok(());
@@ -21,8 +23,8 @@ pub fn spin(scene: &mut Scene, degrees: f64) -> Result<(), String> {
         .world_to_camera
         .transform_vector3(DVec3::Z)
         .try_normalize()
-        .ok_or("the world's z axis is degenerate in camera space: cannot spin about it")?;
-    let c = crate::orbit::scene_centre(scene);
+        .ok_or(Error::DegenerateSpinAxis)?;
+    let c = super::scene_centre(scene);
     let turn = DMat4::from_translation(c)
         * DMat4::from_axis_angle(axis, degrees.to_radians())
         * DMat4::from_translation(-c);
@@ -44,7 +46,7 @@ mod tests {
     #[test]
     fn spin_turns_about_world_z_through_the_centre() {
         let mut s = crate::scene::builtin_teapot();
-        let c = crate::orbit::scene_centre(&s);
+        let c = super::super::scene_centre(&s);
         spin(&mut s, 90.0).unwrap();
         let m = s.patches[0].motion.as_deref().unwrap();
         assert!((m.transform_point3(c) - c).length() < 1e-9);

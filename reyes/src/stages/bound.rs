@@ -4,9 +4,11 @@
 //! the test on their homogeneous net, and get a rational crack bound; the arguments are
 //! beside the WGSL.
 
-use super::{ControlNet, Weights, cp_h, cp_point, item_weights, project, to_euclidean};
-use crate::frame::{Frame, PatchInfo, PatchItem};
-use glam::{Vec2, Vec4};
+use super::{
+    ControlNet, Weights, coc, cp_h, cp_point, item_weights, moved_point, project, to_euclidean,
+};
+use crate::frame::{Frame, PATCH_MOVING, PatchInfo, PatchItem};
+use glam::{Vec2, Vec3, Vec4};
 
 /// See `MAX_DILATE_PX` and `CULL_MARGIN_PX` in common.wgsl: bucketed renders stay exact.
 pub const MAX_DILATE_PX: f32 = 2.0;
@@ -73,8 +75,8 @@ pub fn bound(item: &PatchItem, f: &Frame, info: &PatchInfo, primvars: &[[f32; 4]
     zmax += r;
     // Motion blur or depth of field: culling uses the bound over the shutter and the lens
     // (`uvt_bound` in bound.wgsl); splitting and dicing the patch at shutter open.
-    let uvt = (f.uvt != crate::frame::UVT_OFF)
-        .then(|| super::sample_uvt::uvt_bound(f, cp, info, primvars, r, (zmin, zmax)));
+    let uvt =
+        (f.uvt != crate::frame::UVT_OFF).then(|| uvt_bound(f, cp, info, primvars, r, (zmin, zmax)));
     let moving = uvt.is_some() && info.flags & crate::frame::PATCH_MOVING != 0;
     let (uzmin, uzmax) = uvt.map_or((zmin, zmax), |u| u.2);
     if uzmax < f.near || uzmin > f.far {
@@ -343,6 +345,54 @@ pub fn curve_c2_rational(p: [Vec4; 4]) -> f32 {
         .abs()
         .max((w.y - 2.0 * w.z + w.w).abs());
     (6.0 * (wmax * d2 + dw2 * d1 + ddw * r) + 18.0 * dw1 / wmin * (wmax * d1 + dw1 * r)) / wmin
+}
+
+/// `uvt_bound` in bound.wgsl: the screen bound (lo, hi) of the patch at shutter close (huge
+/// when a point there reaches the near plane; empty when it does not move), its depth range
+/// over the shutter, and the largest circle of confusion `c` over that range; the caller
+/// grows the shutter-open bound by `c` and takes the union. `cp`: Euclidean points; `r`: the
+/// displacement radius; (zmin, zmax): depths at shutter open.
+pub fn uvt_bound(
+    f: &Frame,
+    cp: &ControlNet,
+    info: &PatchInfo,
+    table: &[[f32; 4]],
+    r: f32,
+    (zmin, zmax): (f32, f32),
+) -> (Vec2, Vec2, (f32, f32), f32) {
+    let (mut lo, mut hi) = (Vec2::splat(3.0e38), Vec2::splat(-3.0e38));
+    let (mut z0, mut z1) = (zmin, zmax);
+    if info.flags & PATCH_MOVING != 0 {
+        let m = |k: usize| {
+            let e = table[(info.motion as usize) + k];
+            Vec3::new(e[0], e[1], e[2])
+        };
+        let r1 = r * (m(0).dot(m(0)) + m(1).dot(m(1)) + m(2).dot(m(2))).sqrt();
+        let (mut g, mut near) = (0f32, false);
+        for k in 0..16 {
+            let q = moved_point(table, info.motion, cp_point(cp, k));
+            z0 = z0.min(q.z - r1);
+            z1 = z1.max(q.z + r1);
+            if q.z - r1 < f.near {
+                near = true;
+                continue;
+            }
+            let s = Vec2::from(project(f, q));
+            lo = lo.min(s);
+            hi = hi.max(s);
+            if r1 > 0.0 {
+                g = g.max(q.length() / (q.z * (q.z - r1)));
+            }
+        }
+        lo -= Vec2::splat(f.focal * r1 * g);
+        hi += Vec2::splat(f.focal * r1 * g);
+        if near {
+            (lo, hi) = (Vec2::splat(-3.0e38), Vec2::splat(3.0e38));
+        }
+    }
+    let zn = z0.max(f.near);
+    let c = coc(f, zn).abs().max(coc(f, z1.max(zn)).abs());
+    (lo - Vec2::splat(c), hi + Vec2::splat(c), (z0, z1), c)
 }
 
 #[cfg(test)]

@@ -393,7 +393,7 @@ pub fn dice_shade(item: &PatchItem, data: &FrameData, samples: &mut [u64]) -> (u
         (points.iter())
             .map(|&p| {
                 let p1 = if info.flags & crate::frame::PATCH_MOVING != 0 {
-                    super::sample_uvt::moved_point(&data.primvars, info.motion, p)
+                    super::moved_point(&data.primvars, info.motion, p)
                 } else {
                     p
                 };

@@ -140,6 +140,21 @@ pub fn project(f: &crate::frame::Frame, p: Vec3) -> [f32; 2] {
 /// `shaders/reyes/common.wgsl`).
 pub use scheduler::hash::lowbias32 as reyes_hash;
 
+/// `moved_point` in common.wgsl: `p` at shutter close under the motion at `at` in the table.
+pub fn moved_point(table: &[[f32; 4]], at: u32, p: Vec3) -> Vec3 {
+    let r = |k: usize| table[at as usize + k];
+    let row = |k: usize| {
+        let m = r(k);
+        m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3]
+    };
+    Vec3::new(row(0), row(1), row(2))
+}
+
+/// `coc` in common.wgsl: the signed circle of confusion in pixels of depth z.
+pub fn coc(f: &crate::frame::Frame, z: f32) -> f32 {
+    f.coc_scale * (f.inv_focus - 1.0 / z)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

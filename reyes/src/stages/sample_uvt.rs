@@ -1,13 +1,13 @@
 //! Twin of `shaders/reyes/sample_uvt.wgsl`: sampling in time and on the lens (motion blur and
 //! depth of field) by Simple UVT, Interleave UVT or the bounding-box algorithm
-//! ([`crate::frame::Sampling`]), and Bound's bound over the shutter and the lens.
+//! ([`crate::frame::Sampling`]).
 
-use super::reyes_hash;
 use super::sample::{
     Cover, Triangle, covers, micropolygon_color, sample_id, sample_position, triangle_depth,
     triangle_setup, write_sample,
 };
-use crate::frame::{Frame, PATCH_MOVING, PatchInfo, UVT_INTERLEAVE, UVT_SIMPLE};
+use super::{coc, reyes_hash};
+use crate::frame::{Frame, UVT_INTERLEAVE, UVT_SIMPLE};
 use glam::{Vec2, Vec3};
 
 /// `UVT_SALT` and `PERM_SALT` in sample_uvt.wgsl.
@@ -15,21 +15,6 @@ pub const UVT_SALT: u32 = 0x9e3779b9;
 pub const PERM_SALT: u32 = 0x632be5ab;
 /// `UVT_TABLE`: the side of the repeated table of per-pixel samples (bounding box).
 pub const UVT_TABLE: u32 = 64;
-
-/// `moved_point` in common.wgsl: `p` at shutter close under the motion at `at` in the table.
-pub fn moved_point(table: &[[f32; 4]], at: u32, p: Vec3) -> Vec3 {
-    let r = |k: usize| table[at as usize + k];
-    let row = |k: usize| {
-        let m = r(k);
-        m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3]
-    };
-    Vec3::new(row(0), row(1), row(2))
-}
-
-/// `coc` in common.wgsl: the signed circle of confusion in pixels of depth z.
-pub fn coc(f: &Frame, z: f32) -> f32 {
-    f.coc_scale * (f.inv_focus - 1.0 / z)
-}
 
 /// `concentric_disc`: Shirley & Chiu's area-preserving map of the unit square to the disc.
 pub fn concentric_disc(s: Vec2) -> Vec2 {
@@ -248,54 +233,6 @@ pub fn sample_micropolygon_uvt(
         }
     }
     true
-}
-
-/// `uvt_bound` in bound.wgsl: the screen bound (lo, hi) of the patch at shutter close (huge
-/// when a point there reaches the near plane; empty when it does not move), its depth range
-/// over the shutter, and the largest circle of confusion `c` over that range; the caller
-/// grows the shutter-open bound by `c` and takes the union. `cp`: Euclidean points; `r`: the
-/// displacement radius; (zmin, zmax): depths at shutter open.
-pub fn uvt_bound(
-    f: &Frame,
-    cp: &super::ControlNet,
-    info: &PatchInfo,
-    table: &[[f32; 4]],
-    r: f32,
-    (zmin, zmax): (f32, f32),
-) -> (Vec2, Vec2, (f32, f32), f32) {
-    let (mut lo, mut hi) = (Vec2::splat(3.0e38), Vec2::splat(-3.0e38));
-    let (mut z0, mut z1) = (zmin, zmax);
-    if info.flags & PATCH_MOVING != 0 {
-        let m = |k: usize| {
-            let e = table[(info.motion as usize) + k];
-            Vec3::new(e[0], e[1], e[2])
-        };
-        let r1 = r * (m(0).dot(m(0)) + m(1).dot(m(1)) + m(2).dot(m(2))).sqrt();
-        let (mut g, mut near) = (0f32, false);
-        for k in 0..16 {
-            let q = moved_point(table, info.motion, super::cp_point(cp, k));
-            z0 = z0.min(q.z - r1);
-            z1 = z1.max(q.z + r1);
-            if q.z - r1 < f.near {
-                near = true;
-                continue;
-            }
-            let s = Vec2::from(super::project(f, q));
-            lo = lo.min(s);
-            hi = hi.max(s);
-            if r1 > 0.0 {
-                g = g.max(q.length() / (q.z * (q.z - r1)));
-            }
-        }
-        lo -= Vec2::splat(f.focal * r1 * g);
-        hi += Vec2::splat(f.focal * r1 * g);
-        if near {
-            (lo, hi) = (Vec2::splat(-3.0e38), Vec2::splat(3.0e38));
-        }
-    }
-    let zn = z0.max(f.near);
-    let c = coc(f, zn).abs().max(coc(f, z1.max(zn)).abs());
-    (lo - Vec2::splat(c), hi + Vec2::splat(c), (z0, z1), c)
 }
 
 #[cfg(test)]

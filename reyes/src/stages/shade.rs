@@ -1,12 +1,12 @@
 //! Twin of `shaders/reyes/shade.wgsl`: RenderMan's constant, matte, plastic and metal surfaces.
 
-use crate::frame::{GpuLight, Material};
+use crate::frame::{GpuLight, GpuMaterial};
 use glam::Vec3;
 
 /// `n` is the outside normal (unnormalised); `cs` the surface colour (the material's `Color`
 /// or the patch's `"Cs"`), which the standard shaders multiply into ambient and diffuse light.
 /// Returns linear RGB.
-pub fn shade(p: Vec3, n: Vec3, m: &Material, cs: Vec3, lights: &[GpuLight]) -> Vec3 {
+pub fn shade(p: Vec3, n: Vec3, m: &GpuMaterial, cs: Vec3, lights: &[GpuLight]) -> Vec3 {
     let i = p.normalize();
     let nn = n.normalize();
     let nf = if nn.dot(i) > 0.0 { -nn } else { nn };

@@ -21,6 +21,7 @@
 //! [`QuadricPatch::v`] give the RenderMan parameter range it covers.
 
 use super::rational::{arc, elevate_to_cubic, quarter_turns};
+use crate::Error;
 use glam::{DVec3, DVec4};
 
 /// A quadric with its RIB arguments; angles in degrees, as RIB gives them.
@@ -137,7 +138,7 @@ impl Quadric {
     }
 
     /// The profile Q(v) in pieces, in order of v.
-    fn profile(self) -> Result<Vec<ProfilePiece>, String> {
+    fn profile(self) -> Result<Vec<ProfilePiece>, Error> {
         Ok(match self {
             Quadric::Sphere {
                 radius, zmin, zmax, ..
@@ -173,15 +174,15 @@ impl Quadric {
                 rmax, zmin, zmax, ..
             } => {
                 if zmax == 0.0 {
-                    return Err(
+                    return Err(Error::InvalidSurface(
                         "zmax is 0: the paraboloid r = rmax sqrt(z / zmax) is undefined".into(),
-                    );
+                    ));
                 }
                 if zmin / zmax < 0.0 {
-                    return Err(format!(
+                    return Err(Error::InvalidSurface(format!(
                         "zmin {zmin} and zmax {zmax} lie on opposite sides of 0: \
                          r = rmax sqrt(z / zmax) is undefined between them"
-                    ));
+                    )));
                 }
                 // z = zmax (r / rmax)^2 is a parabola in r: with r linear in the curve
                 // parameter, a polynomial quadratic whose middle point has r halfway and
@@ -204,7 +205,7 @@ impl Quadric {
     /// profile on the z axis, ...) gives no patches. Errors: a paraboloid with zmax = 0 or z
     /// range crossing 0 (the message has no location; the caller adds it). Arguments are
     /// finite (the RIB reader checks).
-    pub fn to_bezier(self) -> Result<Vec<QuadricPatch>, String> {
+    pub fn to_bezier(self) -> Result<Vec<QuadricPatch>, Error> {
         let sweep = full_turn_at_most(self.thetamax());
         let profile = self.profile()?;
         let euclid = |h: &DVec4| h.truncate() / h.w;

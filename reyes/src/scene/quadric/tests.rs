@@ -274,9 +274,12 @@ fn paraboloids() {
     check(p(0.5, 0.2, 0.7, 270.0), 3);
     check(p(1.0, -2.0, -0.5, 360.0), 4);
     check(p(2.0, 1.0, 0.25, -90.0), 1);
-    let e = p(1.0, 0.0, 0.0, 360.0).to_bezier().unwrap_err();
+    let e = p(1.0, 0.0, 0.0, 360.0).to_bezier().unwrap_err().to_string();
     assert!(e.contains("zmax is 0"), "{e}");
-    let e = p(1.0, -1.0, 1.0, 360.0).to_bezier().unwrap_err();
+    let e = p(1.0, -1.0, 1.0, 360.0)
+        .to_bezier()
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("opposite sides of 0"), "{e}");
 }
 

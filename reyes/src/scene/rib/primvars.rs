@@ -13,6 +13,7 @@
 use super::lexer::shown;
 use super::state::Interp;
 use super::syntax::{Args, Param, Request};
+use crate::Error;
 use crate::scene::basis::{Basis, block_to_bezier};
 use crate::scene::nurbs::{self, NuSurface};
 use crate::scene::rational::from_homogeneous;
@@ -57,7 +58,7 @@ const TYPES: &[&str] = &[
 ];
 
 /// Parses a declaration (`[class] type[n]`; the class defaults to uniform, as the spec says).
-pub(super) fn parse_decl(text: &str) -> Result<Decl, String> {
+pub(super) fn parse_decl(text: &str) -> Result<Decl, Error> {
     let mut words = text.split_whitespace().peekable();
     let class = match words.peek().copied() {
         Some("constant") => Some(Class::Constant),
@@ -78,12 +79,17 @@ pub(super) fn parse_decl(text: &str) -> Result<Decl, String> {
                 .strip_suffix(']')
                 .and_then(|n| n.parse::<usize>().ok())
                 .filter(|n| (1..=1 << 16).contains(n))
-                .ok_or_else(|| format!("bad array length in \"{}\"", shown(text)))?;
+                .ok_or_else(|| {
+                    Error::InvalidDeclaration(format!("bad array length in \"{}\"", shown(text)))
+                })?;
             (ty, n)
         }
     };
     if !TYPES.contains(&ty) {
-        return Err(format!("no type in declaration \"{}\"", shown(text)));
+        return Err(Error::InvalidDeclaration(format!(
+            "no type in declaration \"{}\"",
+            shown(text)
+        )));
     }
     Ok(Decl {
         class: class.unwrap_or(Class::Uniform),
@@ -307,7 +313,7 @@ impl ColorVar {
         &self,
         surf: &NuSurface,
         order: (usize, usize),
-    ) -> Result<Vec<ColorField>, String> {
+    ) -> Result<Vec<ColorField>, Error> {
         let v = &self.values;
         if self.class == Class::Vertex {
             let weighted: Vec<DVec4> = (v.iter().zip(surf.points))

@@ -10,7 +10,7 @@ use super::patches::basis_arg;
 use super::quadrics::QUADRICS;
 use super::state::{Block, Interp};
 use super::syntax::{Args, Request};
-use crate::frame::{MAX_IMAGE_SIDE, MAX_PIXEL_SAMPLES};
+use crate::scene::{MAX_IMAGE_SIDE, MAX_PIXEL_SAMPLES};
 use crate::scene::{RI_EPSILON, SceneError};
 use glam::{DMat4, DVec3};
 

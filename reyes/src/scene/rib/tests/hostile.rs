@@ -72,7 +72,7 @@ fn range_checks_name_the_file_and_line() {
         ),
         "{e}"
     );
-    let side = crate::frame::MAX_IMAGE_SIDE;
+    let side = crate::scene::MAX_IMAGE_SIDE;
     assert_eq!(
         err(&format!("\nFormat {} 10 1\n{}", side + 1, world(""))),
         format!(
