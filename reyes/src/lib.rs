@@ -7,6 +7,7 @@ pub mod camera;
 pub mod cpu_render;
 pub mod driver_env;
 pub mod frame;
+pub mod gpu;
 pub mod gpu_render;
 pub mod image;
 pub mod orbit;

@@ -8,7 +8,7 @@
 use crate::cli::{HOLES_COLUMNS, HoleReference, HolesCmd};
 use crate::measure::load_scene;
 use reyes::frame::{FrameData, RasterMode, RenderOptions};
-use reyes::gpu_render::{GpuRenderer, required_features};
+use reyes::gpu_render::{GpuRenderer, RendererConfig, required_features};
 use reyes::stages;
 use reyes_accuracy::holes::{Holes, coverage_of, holes};
 use scheduler::Gpu;
@@ -42,9 +42,8 @@ pub fn main(a: HolesCmd) -> Result<(), String> {
     let options = a.render.options();
     let data = FrameData::new(&scene, &options)?;
     let gpu = Gpu::from_env_requiring(required_features()).map_err(|e| e.to_string())?;
-    let renderer =
-        GpuRenderer::for_features(&gpu, a.render.strategy_for(&gpu), false, data.features())
-            .map_err(|e| e.to_string())?;
+    let config = RendererConfig::new(a.render.strategy_for(&gpu)).features(data.features());
+    let renderer = GpuRenderer::new(&gpu, config).map_err(|e| e.to_string())?;
     let frame = renderer.render(&gpu, &data).map_err(|e| e.to_string())?;
     let f = &data.frame;
     let reference = match a.reference {

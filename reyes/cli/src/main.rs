@@ -14,7 +14,7 @@ mod view;
 use clap::Parser;
 use cli::{Cli, Command, RenderCmd};
 use reyes::frame::{FrameData, SceneFeatures};
-use reyes::gpu_render::{GpuRenderer, required_features};
+use reyes::gpu_render::{GpuRenderer, RendererConfig, required_features};
 use reyes::image::FrameImage;
 use reyes::scene::{self, FrameSequence, Scene};
 use reyes::stats::{RunSummary, frame_stats};
@@ -132,8 +132,10 @@ fn gpu_renderer(
             "--stage-times: the megakernel's stages share one launch; only multipass times them apart"
         );
     }
-    let renderer = GpuRenderer::for_features(&gpu, strategy, a.stage_times, features)
-        .map_err(|e| e.to_string())?;
+    let config = RendererConfig::new(strategy)
+        .stage_timing(a.stage_times)
+        .features(features);
+    let renderer = GpuRenderer::new(&gpu, config).map_err(|e| e.to_string())?;
     Ok((gpu, renderer))
 }
 

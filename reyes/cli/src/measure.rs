@@ -7,7 +7,7 @@
 
 use crate::cli::MeasureCmd;
 use reyes::frame::FrameData;
-use reyes::gpu_render::{GpuFrame, GpuRenderer, required_features};
+use reyes::gpu_render::{GpuFrame, GpuRenderer, RendererConfig, required_features};
 use reyes::progress::NoProgress;
 use reyes::scene::{self, Scene};
 use reyes::stats::frame_stats;
@@ -57,9 +57,8 @@ pub fn main(a: MeasureCmd) -> Result<(), String> {
     }
     let data = FrameData::new(&scene, &a.render.options())?;
     let gpu = Gpu::from_env_requiring(required_features()).map_err(|e| e.to_string())?;
-    let renderer =
-        GpuRenderer::for_features(&gpu, a.render.strategy_for(&gpu), false, data.features())
-            .map_err(|e| e.to_string())?;
+    let config = RendererConfig::new(a.render.strategy_for(&gpu)).features(data.features());
+    let renderer = GpuRenderer::new(&gpu, config).map_err(|e| e.to_string())?;
     let (frame, gpu_ms, wall_ms) = timed_frames(&gpu, &renderer, &data, a.runs)?;
     let mut stats = frame_stats(&data, &frame, &gpu.adapter_name(), &scene.warnings);
     let gpu_ms: Vec<f64> = gpu_ms.into_iter().flatten().collect();
