@@ -2,16 +2,16 @@
 //! under a moving camera: the turntable of [`crate::orbit`] (`reyes bench`), or any camera-space
 //! transform per frame, as the viewer's orbit, pan and dolly ([`crate::camera`], `reyes view`).
 //!
-//! [`GpuRenderer::render`] makes everything per frame: uploads, a run that reads counters back
-//! between launches, and a read-back of the f32 image. Here, instead:
-//! - the scene is uploaded once: each patch's homogeneous control points (`x w, y w, z w, w`) in
-//!   a table, the materials, lights and patch flags; a frame writes only an 80-byte [`Orbit`]
-//!   (its camera transform);
+//! [`GpuRenderer::render`] makes its root items on the host, runs with counters read back
+//! between launches, and reads back the f32 image. Here, instead:
+//! - the scene is uploaded once ([`SceneBuffers::with_patches`]): each patch's homogeneous
+//!   control points (`x w, y w, z w, w`) in a table, the materials, lights and patch flags; a
+//!   frame writes only an 80-byte [`Orbit`] (its camera transform);
 //! - the root items are made on the GPU (`roots.wgsl`: the transform, then the same root item
 //!   as [`crate::frame::FrameData::new`] makes on the host), every frame rebuilt from the
 //!   patches; nothing is cached between frames but buffers and pipelines;
-//! - every buffer is allocated once ([`RealtimeRenderer::new`]) and reused: samples, counters,
-//!   image, the queues of a [`RecordedRun`] (the scheduler's run of fixed sizes, recorded
+//! - every buffer is allocated once ([`RealtimeRenderer::new`]) and reused: the
+//!   [`FrameTarget`] (samples, counters, image), the queues of a [`RecordedRun`] (the scheduler's run of fixed sizes, recorded
 //!   without host waits);
 //! - frames are pipelined: frame i+1 is recorded and submitted while the GPU runs frame i (at
 //!   most [`IN_FLIGHT`] submitted and unfinished); each frame's status (the scheduler's control
@@ -23,8 +23,8 @@
 //!
 //! A frame whose fixed sizes did not suffice (a queue out of room, a megakernel launch at its
 //! loop bound, multi-pass out of rounds) is found a frame late from its status and rendered again
-//! by [`GpuRenderer::render`] from the same root items (read back from the GPU), which grows its
-//! queues, splits batches and cuts buckets as needed: the frame comes out right and says that it
+//! by the offline renderer's core (that of [`GpuRenderer::render`], on this renderer's scene
+//! tables and target) from the same root items (read back from the GPU), which grows its queues, splits batches and cuts buckets as needed: the frame comes out right and says that it
 //! was rendered again ([`RealtimeFrame::rerendered`]); the fixed sizes then grow to what that
 //! render needed. A wrong frame is never returned.
 //!
