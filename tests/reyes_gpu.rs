@@ -3,6 +3,7 @@
 
 use reyes::cpu_render::render_cpu;
 use reyes::frame::{FrameData, RenderOptions};
+use reyes::gpu_render::RendererConfig;
 use reyes::image::FrameImage;
 use reyes::scene::{self, Scene};
 use reyes::stages;
@@ -413,9 +414,8 @@ fn a_renderer_compiled_for_the_scenes_features_draws_the_same_image() {
     let data = FrameData::new(&scene, &small(96, 72)).unwrap();
     assert_eq!(data.features(), SceneFeatures::default());
     for kind in [StrategyKind::Megakernel, StrategyKind::Multipass] {
-        let plain =
-            reyes::gpu_render::GpuRenderer::for_features(gpu(), kind, false, data.features())
-                .unwrap();
+        let config = RendererConfig::new(kind).features(data.features());
+        let plain = reyes::gpu_render::GpuRenderer::new(gpu(), config).unwrap();
         let a = plain.render(gpu(), &data).unwrap();
         let b = renderer(kind).render(gpu(), &data).unwrap();
         assert!(a.image == b.image, "{kind:?}: images differ");
@@ -447,13 +447,8 @@ fn planar_and_interleaved_queues_draw_the_same_image() {
     let scene = scene::builtin_teapot();
     let data = FrameData::new(&scene, &small(96, 72)).unwrap();
     let features = data.features();
-    let interleaved = reyes::gpu_render::GpuRenderer::for_features(
-        gpu(),
-        StrategyKind::Megakernel,
-        false,
-        features,
-    )
-    .unwrap();
+    let config = RendererConfig::new(StrategyKind::Megakernel).features(features);
+    let interleaved = reyes::gpu_render::GpuRenderer::new(gpu(), config).unwrap();
     assert_eq!(interleaved.scheduler.item_layout(), ItemLayout::Interleaved);
     let program = reyes::gpu_render::program_for(features).unwrap();
     let s = Scheduler::megakernel(
@@ -466,8 +461,10 @@ fn planar_and_interleaved_queues_draw_the_same_image() {
         },
     )
     .unwrap();
-    let planar =
-        reyes::gpu_render::GpuRenderer::from_scheduler(gpu(), program, s, features).unwrap();
+    let config = RendererConfig::new(StrategyKind::Megakernel)
+        .features(features)
+        .scheduler(s);
+    let planar = reyes::gpu_render::GpuRenderer::new(gpu(), config).unwrap();
     let (a, b) = (
         interleaved.render(gpu(), &data).unwrap(),
         planar.render(gpu(), &data).unwrap(),

@@ -13,7 +13,7 @@ use scheduler::{RecordedSize, StrategyKind};
 
 mod common;
 use common::{gpu, small};
-use reyes::gpu_render::GpuRenderer;
+use reyes::gpu_render::{GpuRenderer, RendererConfig};
 use std::sync::OnceLock;
 
 const W: u32 = 96;
@@ -37,8 +37,8 @@ fn host_turned(kind: StrategyKind, deg: f64, o: &RenderOptions) -> FrameImage {
     } else {
         &MP
     };
-    let r = cell
-        .get_or_init(|| GpuRenderer::for_features(gpu(), kind, false, data.features()).unwrap());
+    let config = RendererConfig::new(kind).features(data.features());
+    let r = cell.get_or_init(|| GpuRenderer::new(gpu(), config).unwrap());
     r.render(gpu(), &data).unwrap().image
 }
 
@@ -152,7 +152,7 @@ fn an_overflowing_frame_is_rendered_again_not_shown_wrong() {
         let small = r.size().unwrap().clone();
         let too_small = kind == StrategyKind::Multipass
             || (small.capacity.iter().zip(&need)).any(|(&s, &n)| (s as u64) < n);
-        if gpu().info.device_type == scheduler::wgpu::DeviceType::Cpu {
+        if gpu().is_cpu_adapter() {
             assert!(too_small, "{kind:?}: {small:?} holds the frame ({need:?})");
         }
         let frames = r.render(gpu(), &[0.0, 0.0, 0.0, 0.0], &NoProgress).unwrap();

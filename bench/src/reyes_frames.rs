@@ -14,7 +14,7 @@ use crate::suite::Scale;
 use crate::workload::{Measurement, Prepared, Workload, ms_since};
 use reyes::cpu_render::{CpuRender, render_cpu};
 use reyes::frame::{FrameData, RenderOptions};
-use reyes::gpu_render::{GpuRenderer, INITIAL_CAPACITY, program_for};
+use reyes::gpu_render::{GpuRenderer, INITIAL_CAPACITY, RendererConfig, program_for};
 use reyes::image::FrameImage;
 use reyes::scene::{self, Scene};
 use reyes::stages::C_MICROPOLYGONS;
@@ -209,8 +209,10 @@ impl Workload for ReyesWorkload {
                     let capacity = self.config.capacity.unwrap_or(INITIAL_CAPACITY);
                     let scheduler = compile(gpu, &program, strategy, &self.config, capacity)
                         .map_err(|e| e.to_string())?;
-                    let r = GpuRenderer::from_scheduler(gpu, program, scheduler, features)
-                        .map_err(|e| e.to_string())?;
+                    let config = RendererConfig::new(scheduler.kind())
+                        .features(features)
+                        .scheduler(scheduler);
+                    let r = GpuRenderer::new(gpu, config).map_err(|e| e.to_string())?;
                     renderers.push((name.clone(), r));
                 }
                 let renderer = &renderers.iter().find(|r| r.0 == name).unwrap().1;

@@ -184,7 +184,7 @@ pub fn run_suite(gpu: &Gpu, o: &SuiteOptions) -> Result<bool, String> {
         runs: o.runs,
         command: o.command.clone(),
         seconds: start.elapsed().as_secs_f64(),
-        cpu_adapter: gpu.info.device_type == wgpu::DeviceType::Cpu,
+        cpu_adapter: gpu.is_cpu_adapter(),
         not_built,
     };
     let md = summary::markdown(&header, &records);

@@ -4,6 +4,7 @@
 
 use crate::buckets;
 use crate::frame::{Frame, FrameData, PatchItem, SceneFeatures};
+use crate::gpu::{FrameTarget, Pipelines, SceneBuffers, scene_layout_entries};
 use crate::image::FrameImage;
 use crate::progress::Progress;
 use crate::shaders;
@@ -11,7 +12,7 @@ use crate::stages::{C_MAX_DEPTH, COUNTERS};
 use scheduler::timing::PassTimer;
 use scheduler::{
     Gpu, ItemType, MultipassConfig, Procedure, Program, RunError, RunStats, Scheduler, Seed,
-    StrategyKind, UserBindings, storage_entry,
+    StrategyKind, UserBindings,
 };
 use std::time::Instant;
 
@@ -64,7 +65,7 @@ pub fn program_for(features: SceneFeatures) -> Result<Program, RunError> {
         ]
         .concat(),
         // 0-3 frame, materials, lights, patch info; 4-5 samples, counters; 6 primvars.
-        layout: (0..7).map(|b| storage_entry(b, b < 4 || b == 6)).collect(),
+        layout: scene_layout_entries(),
     };
     Program::new(vec![bound, splitu, splitv, diceshade, dicesmall], user)
 }
@@ -93,16 +94,81 @@ pub struct GpuFrame {
 /// Queue slots a renderer's scheduler starts with (queues grow by doubling beyond).
 pub const INITIAL_CAPACITY: u32 = 1 << 14;
 
+/// How a [`GpuRenderer`] is built: the scheduling strategy, whether multi-pass times its
+/// stages, the scene features the program is compiled for, and optionally a scheduler the
+/// caller compiled itself. A bare [`StrategyKind`] converts into the default configuration.
+pub struct RendererConfig {
+    /// The scheduling strategy (ignored when [`RendererConfig::scheduler`] is given).
+    pub strategy: StrategyKind,
+    /// Multi-pass times each procedure's passes on their own (`RunStats::stage_gpu_ms`); the
+    /// megakernel interleaves its stages in one launch, where only their sum can be timed.
+    pub stage_timing: bool,
+    /// What the program is compiled for ([`program_for`]): frames needing more are refused by
+    /// [`GpuRenderer::render`]; e.g. [`FrameData::features`] of the frames to render, the
+    /// fastest program for them. Default: [`SceneFeatures::ALL`].
+    pub features: SceneFeatures,
+    /// A scheduler compiled by the caller from [`program_for`]`(features)` with its own
+    /// configuration (e.g. another queue policy; [`INITIAL_CAPACITY`] is the usual start).
+    pub scheduler: Option<Scheduler>,
+}
+
+impl RendererConfig {
+    /// The default configuration of `strategy`: no stage timing, every feature, the
+    /// renderer's own scheduler.
+    pub fn new(strategy: StrategyKind) -> RendererConfig {
+        RendererConfig {
+            strategy,
+            stage_timing: false,
+            features: SceneFeatures::ALL,
+            scheduler: None,
+        }
+    }
+
+    /// With `stage_timing` ([`RendererConfig::stage_timing`]).
+    pub fn stage_timing(self, stage_timing: bool) -> RendererConfig {
+        RendererConfig {
+            stage_timing,
+            ..self
+        }
+    }
+
+    /// Compiled for frames that need at most `features` ([`RendererConfig::features`]).
+    pub fn features(self, features: SceneFeatures) -> RendererConfig {
+        RendererConfig { features, ..self }
+    }
+
+    /// On the caller's `scheduler`, compiled from [`program_for`]`(features)` for the
+    /// configuration's features ([`RendererConfig::scheduler`]); the strategy becomes the
+    /// scheduler's.
+    pub fn scheduler(self, scheduler: Scheduler) -> RendererConfig {
+        RendererConfig {
+            strategy: scheduler.kind(),
+            scheduler: Some(scheduler),
+            ..self
+        }
+    }
+}
+
+impl From<StrategyKind> for RendererConfig {
+    fn from(strategy: StrategyKind) -> RendererConfig {
+        RendererConfig::new(strategy)
+    }
+}
+
+/// The offline renderer: one frame at a time from host-made root items, on a scene uploaded
+/// once and a target reused by every frame of one size.
 pub struct GpuRenderer {
+    /// The Reyes program the scheduler runs.
     pub program: Program,
     /// What the program was compiled for; frames needing more are refused.
     pub features: SceneFeatures,
+    /// The strategy's scheduler.
     pub scheduler: Scheduler,
-    pub(crate) user_layout: wgpu::BindGroupLayout,
-    pub(crate) resolve: wgpu::ComputePipeline,
-    /// The last frame's per-frame buffers, reused by the next frame of the same size, so
-    /// that a frame allocates nothing large (a 1080p frame's samples are 66 MB).
-    frame_buffers: std::sync::Mutex<Option<FrameBuffers>>,
+    pub(crate) pipelines: Pipelines,
+    /// The last frame's scene tables and target: a frame of the same scene writes only what
+    /// changed, a frame of the same size allocates nothing large (a 1080p frame's samples are
+    /// 66 MB).
+    resources: std::sync::Mutex<Option<(SceneBuffers, Option<FrameTarget>)>>,
 }
 
 /// Full GPU load before frames are timed (`scheduler::clocks::raise_clocks`): frames alone,
@@ -113,66 +179,55 @@ pub const WARM_UP: std::time::Duration = std::time::Duration::from_millis(500);
 /// Timed frames of one setting: the last frame, and each timed frame's GPU ms (scheduler
 /// run plus resolve, when timestamps exist) and wall ms.
 pub struct TimedFrames {
+    /// The last timed frame.
     pub last: GpuFrame,
+    /// Each timed frame's GPU ms, when timestamps exist.
     pub gpu_ms: Vec<Option<f64>>,
+    /// Each timed frame's wall ms.
     pub wall_ms: Vec<f64>,
 }
 
-/// Buffers every frame of one size needs: samples of the largest bucket, the frame constants,
-/// counters, and the resolved image.
-struct FrameBuffers {
-    /// (sample words, pixels)
-    size: (u64, u64),
-    samples: wgpu::Buffer,
-    frame: wgpu::Buffer,
-    counters: wgpu::Buffer,
-    rgba: wgpu::Buffer,
-    depth: wgpu::Buffer,
-}
-
-impl FrameBuffers {
-    fn new(gpu: &Gpu, size: (u64, u64)) -> Result<FrameBuffers, RunError> {
-        Ok(FrameBuffers {
-            size,
-            samples: gpu.storage_buffer("samples", size.0)?,
-            frame: gpu.storage_buffer("frame", (size_of::<Frame>() / 4) as u64)?,
-            counters: gpu.storage_buffer("counters", COUNTERS as u64)?,
-            rgba: gpu.storage_buffer("rgba", size.1 * 4)?,
-            depth: gpu.storage_buffer("depth", size.1)?,
+impl GpuRenderer {
+    /// A renderer of `config` ([`RendererConfig`]; a bare [`StrategyKind`] is its default).
+    /// Errors: a program or pipeline the device rejects.
+    pub fn new(gpu: &Gpu, config: impl Into<RendererConfig>) -> Result<GpuRenderer, RunError> {
+        let RendererConfig {
+            strategy,
+            stage_timing,
+            features,
+            scheduler,
+        } = config.into();
+        let (program, scheduler) = match scheduler {
+            Some(s) => (s.program().clone(), s),
+            None => {
+                let program = program_for(features)?;
+                let s = Self::scheduler(gpu, &program, strategy, stage_timing, features)?;
+                (program, s)
+            }
+        };
+        let pipelines = Pipelines::new(gpu);
+        pipelines.resolve(gpu)?;
+        Ok(GpuRenderer {
+            program,
+            features,
+            scheduler,
+            pipelines,
+            resources: Default::default(),
         })
     }
-}
 
-impl GpuRenderer {
-    pub fn new(gpu: &Gpu, strategy: StrategyKind) -> Result<GpuRenderer, RunError> {
-        Self::with_stage_timing(gpu, strategy, false)
-    }
-
-    /// With `stage_timing`, multi-pass times each procedure's passes on their own
-    /// (`RunStats::stage_gpu_ms`); the megakernel interleaves its stages in one launch, where
-    /// only their sum can be timed.
-    pub fn with_stage_timing(
+    /// The scheduler of `strategy` for `program`.
+    fn scheduler(
         gpu: &Gpu,
-        strategy: StrategyKind,
-        stage_timing: bool,
-    ) -> Result<GpuRenderer, RunError> {
-        Self::for_features(gpu, strategy, stage_timing, SceneFeatures::ALL)
-    }
-
-    /// A renderer compiled for frames that need at most `features` (e.g.
-    /// [`FrameData::features`](crate::frame::FrameData::features) of the frames it will
-    /// render): the fastest program for them. Other frames are refused by [`Self::render`].
-    pub fn for_features(
-        gpu: &Gpu,
+        program: &Program,
         strategy: StrategyKind,
         stage_timing: bool,
         features: SceneFeatures,
-    ) -> Result<GpuRenderer, RunError> {
-        let program = program_for(features)?;
-        let scheduler = match strategy {
+    ) -> Result<Scheduler, RunError> {
+        Ok(match strategy {
             StrategyKind::Multipass => Scheduler::multipass(
                 gpu,
-                &program,
+                program,
                 MultipassConfig {
                     initial_capacity: INITIAL_CAPACITY,
                     stage_timing,
@@ -182,49 +237,52 @@ impl GpuRenderer {
             // lavapipe ends every loop of an invocation after 65,535 iterations in total over
             // the persistent loop and what it nests; blurred micropolygons sample in loops that
             // grow with the blur, so there each launch runs one turn (the host relaunches).
-            StrategyKind::Megakernel if features.uvt && gpu.info.name.contains("llvmpipe") => {
-                Scheduler::megakernel(
-                    gpu,
-                    &program,
-                    scheduler::MegakernelConfig {
-                        initial_capacity: INITIAL_CAPACITY,
-                        max_iterations: 1,
-                        ..Default::default()
-                    },
-                )?
-            }
-            _ => Scheduler::new(gpu, &program, strategy, INITIAL_CAPACITY)?,
-        };
-        Self::from_scheduler(gpu, program, scheduler, features)
-    }
-
-    /// A renderer on a scheduler the caller compiled from [`program_for`]`(features)` with its
-    /// own configuration (e.g. another queue policy); [`INITIAL_CAPACITY`] is the usual start.
-    pub fn from_scheduler(
-        gpu: &Gpu,
-        program: Program,
-        scheduler: Scheduler,
-        features: SceneFeatures,
-    ) -> Result<GpuRenderer, RunError> {
-        let user_layout = gpu
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("reyes scene"),
-                entries: &program.user.layout,
-            });
-        let resolve = gpu.compute_pipeline("reyes resolve", shaders::RESOLVE, "resolve")?;
-        Ok(GpuRenderer {
-            program,
-            features,
-            scheduler,
-            user_layout,
-            resolve,
-            frame_buffers: Default::default(),
+            StrategyKind::Megakernel if features.uvt && gpu.is_lavapipe() => Scheduler::megakernel(
+                gpu,
+                program,
+                scheduler::MegakernelConfig {
+                    initial_capacity: INITIAL_CAPACITY,
+                    max_iterations: 1,
+                    ..Default::default()
+                },
+            )?,
+            _ => Scheduler::new(gpu, program, strategy, INITIAL_CAPACITY)?,
         })
     }
 
     /// Renders a frame; under `data.memory_budget` in screen buckets (see [`crate::buckets`]).
+    /// The scene's tables are uploaded by the first frame and rewritten only where a later
+    /// frame's differ; the target is reused while the size stays. Errors: a frame needing
+    /// features the program was not compiled for ([`RunError::Program`]), and those of a run.
     pub fn render(&self, gpu: &Gpu, data: &FrameData) -> Result<GpuFrame, RunError> {
+        self.check_features(data)?;
+        let start = Instant::now();
+        let f = &data.frame;
+        let mut cache = self.resources.lock().unwrap();
+        match cache.as_mut() {
+            Some((scene, _)) => scene.update(gpu, data)?,
+            None => *cache = Some((SceneBuffers::new(gpu, data)?, None)),
+        }
+        let (scene, target) = cache.as_mut().unwrap();
+        let largest = (buckets::plan(f, data.memory_budget).iter())
+            .map(|t| t.w as u64 * t.h as u64)
+            .max()
+            .unwrap();
+        let pixels = f.width as u64 * f.height as u64;
+        let size = (largest * buckets::sample_bytes_per_pixel(f) / 4, pixels);
+        if target.as_ref().is_none_or(|t| t.size() != size) {
+            // The old buffers go before the new ones are made.
+            scene.forget_bind_group();
+            *target = None;
+            *target = Some(FrameTarget::new(gpu, size.0, size.1, false)?);
+        }
+        let target = target.as_ref().unwrap();
+        let bind = scene.bind_group(gpu, self.pipelines.scene_layout(), target);
+        self.render_on(gpu, scene, target, &bind, data, start)
+    }
+
+    /// Refuses a frame that needs features the program was not compiled for.
+    fn check_features(&self, data: &FrameData) -> Result<(), RunError> {
         let need = data.features();
         if !self.features.covers(need) {
             return Err(RunError::Program(format!(
@@ -232,39 +290,35 @@ impl GpuRenderer {
                 self.features
             )));
         }
-        let start = Instant::now();
+        Ok(())
+    }
+
+    /// Renders `data` on `scene` (whose tables hold `data`'s) into `target` (large enough for
+    /// `data`'s largest bucket), `bind` being their scene bind group: the core of every frame
+    /// rendered from host-made root items. `start`: when the frame's wall time began.
+    pub(crate) fn render_on(
+        &self,
+        gpu: &Gpu,
+        scene: &SceneBuffers,
+        target: &FrameTarget,
+        bind: &wgpu::BindGroup,
+        data: &FrameData,
+        start: Instant,
+    ) -> Result<GpuFrame, RunError> {
+        self.check_features(data)?;
         let f = &data.frame;
-        // Each table holds at least one element, also for an empty scene (Gpu::upload).
-        let materials = gpu.upload("materials", &data.materials)?;
-        let lights = gpu.upload("lights", &data.lights)?;
-        let infos = gpu.upload("patch info", &data.patch_info)?;
-        let primvars = gpu.upload("primvars", &data.primvars)?;
         let mut todo = buckets::plan(f, data.memory_budget);
         todo.reverse();
         let per_pixel = buckets::sample_bytes_per_pixel(f);
         let largest = todo.iter().map(|t| t.w as u64 * t.h as u64).max().unwrap();
         let pixels = f.width as u64 * f.height as u64;
-        let mut cache = self.frame_buffers.lock().unwrap();
-        let size = (largest * per_pixel / 4, pixels);
-        if cache.as_ref().is_none_or(|b| b.size != size) {
-            *cache = None; // the old buffers go before the new ones are made
-            *cache = Some(FrameBuffers::new(gpu, size)?);
-        }
-        let FrameBuffers {
+        let FrameTarget {
             samples,
-            frame: frame_buf,
             counters,
             rgba,
             depth,
             ..
-        } = cache.as_ref().unwrap();
-        let bind = gpu.bind_buffers(
-            "reyes scene",
-            &self.user_layout,
-            &[
-                frame_buf, &materials, &lights, &infos, samples, counters, &primvars,
-            ],
-        );
+        } = target;
         let mut out = GpuFrame {
             image: FrameImage::default(),
             counters: [0; COUNTERS],
@@ -295,8 +349,7 @@ impl GpuRenderer {
             let queue_budget = data
                 .memory_budget
                 .map(|b| b.saturating_sub(tile_sample_bytes));
-            gpu.queue
-                .write_buffer(frame_buf, 0, bytemuck::bytes_of(&tile_frame));
+            scene.write_frame(gpu, &tile_frame);
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             enc.clear_buffer(samples, 0, Some(tile_sample_bytes));
             gpu.queue.submit([enc.finish()]);
@@ -313,7 +366,7 @@ impl GpuRenderer {
                 let seeds = [Seed::new::<PatchItem>("bound", &items[batch.clone()])];
                 let run = match self
                     .scheduler
-                    .run_within(gpu, &seeds, Some(&bind), queue_budget)
+                    .run_within(gpu, &seeds, Some(bind), queue_budget)
                 {
                     Err(RunError::QueueOverflow { .. }) if batch.len() > 1 => {
                         let mid = batch.start + batch.len() / 2;
@@ -429,7 +482,8 @@ impl GpuRenderer {
         let params_buf = gpu.storage_buffer("resolve params", params.len() as u64)?;
         gpu.queue
             .write_buffer(&params_buf, 0, bytemuck::cast_slice(&params));
-        let layout = self.resolve.get_bind_group_layout(0);
+        let resolve = self.pipelines.resolve(gpu)?;
+        let layout = resolve.get_bind_group_layout(0);
         let bind = gpu.bind_buffers("resolve", &layout, &[&params_buf, samples, rgba, depth]);
         let mut timer = PassTimer::new(gpu);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
@@ -438,7 +492,7 @@ impl GpuRenderer {
                 label: Some("resolve"),
                 timestamp_writes: timer.writes(),
             });
-            pass.set_pipeline(&self.resolve);
+            pass.set_pipeline(resolve);
             pass.set_bind_group(0, &bind, &[]);
             pass.dispatch_workgroups(gx, gy, 1);
         }

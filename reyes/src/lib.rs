@@ -8,6 +8,7 @@ pub mod cpu_render;
 pub mod driver_env;
 pub mod error;
 pub mod frame;
+pub mod gpu;
 pub mod gpu_render;
 pub mod image;
 pub mod orbit;

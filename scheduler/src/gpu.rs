@@ -404,3 +404,21 @@ pub(crate) fn bind_buffers(
         entries: &entries,
     })
 }
+
+/// Adapter quirks, named once: callers ask these instead of testing the adapter's name or type.
+impl Gpu {
+    /// True on an adapter that is a CPU (software Vulkan such as lavapipe, WARP): it has no
+    /// clocks to raise, runs a megakernel's persistent workgroups one per hardware thread, and
+    /// shares its cores with the host.
+    pub fn is_cpu_adapter(&self) -> bool {
+        self.info.device_type == wgpu::DeviceType::Cpu
+    }
+
+    /// True on Mesa's LLVM software rasterizer (adapter name `llvmpipe`: lavapipe under
+    /// Vulkan), whose code generator ends every loop of an invocation after 65,535 iterations
+    /// in total over an outermost loop and what it nests: long-running shaders relaunch
+    /// instead (see [`Gpu::driver_bounds_loops`] for the Vulkan-only consequence).
+    pub fn is_lavapipe(&self) -> bool {
+        self.info.name.contains("llvmpipe")
+    }
+}

@@ -7,7 +7,7 @@
 //! Reyes image of the first and last timed frame ([`PeerReport`]).
 
 use crate::cli::{BenchCmd, Peer};
-use reyes::gpu_render::{WARM_UP, required_features};
+use reyes::gpu_render::WARM_UP;
 use reyes::progress::NoProgress;
 use reyes::raster_peer::{PeerFrame, RasterPeer};
 use reyes::realtime::{Pixels, RealtimeFrame, RealtimeRenderer};
@@ -151,13 +151,12 @@ pub struct PeerRow {
 }
 
 pub fn main(a: BenchCmd) -> Result<(), String> {
-    let (mut scene, name) = crate::measure::load_scene(a.scene.as_deref())?;
-    a.render.change_scene(&mut scene)?;
-    for w in &scene.warnings {
-        log::warn!("{w}");
-    }
-    let options = a.render.options();
-    let gpu = Gpu::from_env_requiring(required_features()).map_err(|e| e.to_string())?;
+    let crate::setup::Setup {
+        scene,
+        name,
+        options,
+    } = crate::setup::Setup::load(a.scene.as_deref(), &a.render)?;
+    let gpu = crate::setup::open_gpu()?;
     let strategy = a.render.strategy_for(&gpu);
     let mut r = RealtimeRenderer::new(&gpu, &scene, &options, strategy, Pixels::None)
         .map_err(|e| e.to_string())?;

@@ -204,7 +204,7 @@ impl RenderArgs {
         if let Some(s) = self.strategy {
             return s;
         }
-        if gpu.info.device_type == scheduler::wgpu::DeviceType::Cpu {
+        if gpu.is_cpu_adapter() {
             eprintln!(
                 "note: strategy multipass, the default on a CPU adapter ({}): the megakernel's \
                  persistent workgroups do not run side by side there (--strategy megakernel to \
@@ -329,7 +329,7 @@ impl RenderCmd {
     /// about 2.5 s where the CPU reference, the same pipeline compiled natively, takes 0.2 s)
     /// and nothing GPU-only was asked for ([`RenderCmd::gpu_only`]). Says so on stderr.
     pub fn cpu_by_default(&self, gpu: &scheduler::Gpu) -> bool {
-        let cpu = gpu.info.device_type == scheduler::wgpu::DeviceType::Cpu && !self.gpu_only();
+        let cpu = gpu.is_cpu_adapter() && !self.gpu_only();
         if cpu {
             eprintln!(
                 "note: rendering with the CPU reference (the same pipeline, compiled natively): \

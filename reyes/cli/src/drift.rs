@@ -5,7 +5,6 @@
 use crate::cli::DriftCmd;
 use reyes::cpu_render::render_cpu;
 use reyes::frame::{FrameData, RenderOptions};
-use reyes::scene;
 use reyes_accuracy::drift::{self, PathOptions};
 
 /// Runs the subcommand.
@@ -16,13 +15,11 @@ pub fn main(a: DriftCmd) -> Result<(), String> {
         seed: a.seed,
     };
     let scene_path = a.scene;
-    let (scene, name) = match &scene_path {
-        None => (scene::builtin_teapot(), "teapot".to_string()),
-        Some(p) if p.as_os_str() == "teapot" => (scene::builtin_teapot(), "teapot".to_string()),
-        Some(p) => (
-            scene::load(p).map_err(|e| e.to_string())?,
-            p.display().to_string(),
-        ),
+    let (scene, _) = crate::setup::load_scene(scene_path.as_deref())?;
+    // The table names a file by its path, not its stem.
+    let name = match &scene_path {
+        Some(p) if p.as_os_str() != "teapot" => p.display().to_string(),
+        _ => "teapot".to_string(),
     };
     let options = RenderOptions {
         width: Some(width),

@@ -6,12 +6,11 @@
 //! modes*).
 
 use crate::cli::{HOLES_COLUMNS, HoleReference, HolesCmd};
-use crate::measure::load_scene;
+use crate::setup::{self, Setup};
 use reyes::frame::{FrameData, RasterMode, RenderOptions};
-use reyes::gpu_render::{GpuRenderer, required_features};
+use reyes::gpu_render::RendererConfig;
 use reyes::stages;
 use reyes_accuracy::holes::{Holes, coverage_of, holes};
-use scheduler::Gpu;
 use serde::Serialize;
 
 /// What `reyes holes --json` prints.
@@ -34,17 +33,16 @@ struct HolesReport {
 
 /// Runs the subcommand.
 pub fn main(a: HolesCmd) -> Result<(), String> {
-    let (mut scene, name) = load_scene(a.scene.as_deref())?;
-    a.render.change_scene(&mut scene)?;
-    for w in &scene.warnings {
-        log::warn!("{w}");
-    }
-    let options = a.render.options();
-    let data = FrameData::new(&scene, &options).map_err(|e| e.to_string())?;
-    let gpu = Gpu::from_env_requiring(required_features()).map_err(|e| e.to_string())?;
-    let renderer =
-        GpuRenderer::for_features(&gpu, a.render.strategy_for(&gpu), false, data.features())
-            .map_err(|e| e.to_string())?;
+    let setup = Setup::load(a.scene.as_deref(), &a.render)?;
+    let data = setup.frame_data()?;
+    let gpu = setup::open_gpu()?;
+    let config = RendererConfig::new(a.render.strategy_for(&gpu)).features(data.features());
+    let renderer = setup::renderer(&gpu, config)?;
+    let Setup {
+        scene,
+        name,
+        options,
+    } = setup;
     let frame = renderer.render(&gpu, &data).map_err(|e| e.to_string())?;
     let f = &data.frame;
     let reference = match a.reference {

@@ -8,46 +8,24 @@ mod drift;
 mod frames;
 mod holes;
 mod measure;
+mod setup;
 mod sweep;
 mod view;
 
 use clap::Parser;
 use cli::{Cli, Command, RenderCmd};
 use reyes::frame::{FrameData, SceneFeatures};
-use reyes::gpu_render::{GpuRenderer, required_features};
+use reyes::gpu_render::{GpuRenderer, RendererConfig};
 use reyes::image::FrameImage;
-use reyes::scene::{self, FrameSequence, Scene};
+use reyes::scene::Scene;
 use reyes::stats::{RunSummary, frame_stats};
 use scheduler::{Gpu, StrategyKind};
 use std::process::ExitCode;
 
-/// The scene file's frames (the built-in teapot: one) and its stem for default names.
-fn load_sequence(a: &RenderCmd) -> Result<(FrameSequence, String), String> {
-    Ok(match &a.scene {
-        None => (
-            FrameSequence::single(scene::builtin_teapot()),
-            "teapot".into(),
-        ),
-        Some(p) if p.as_os_str() == "teapot" => (
-            FrameSequence::single(scene::builtin_teapot()),
-            "teapot".into(),
-        ),
-        Some(p) => (
-            scene::load_frames(p).map_err(|e| e.to_string())?,
-            p.file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or("out".into()),
-        ),
-    })
-}
-
 /// Renders every selected frame of the scene; the whole file is read (and every output name
 /// decided) before the first frame renders, so a bad file writes nothing.
 fn run(a: RenderCmd) -> Result<(), String> {
-    let (mut seq, stem) = load_sequence(&a)?;
-    for f in &mut seq.frames {
-        a.render.change_scene(&mut f.scene)?;
-    }
+    let (seq, stem) = setup::load_sequence(a.scene.as_deref(), &a.render)?;
     // The reference of --compare-to, read before anything renders.
     let reference = match &a.compare_to {
         Some(p) => Some((
@@ -82,7 +60,7 @@ fn run(a: RenderCmd) -> Result<(), String> {
         (false, false) => {
             // One program for every frame: compiled for what they need together.
             let need = (data.iter()).fold(SceneFeatures::default(), |f, d| f.union(d.features()));
-            let gpu = Gpu::from_env_requiring(required_features()).map_err(|e| e.to_string())?;
+            let gpu = setup::open_gpu()?;
             match a.cpu_by_default(&gpu) {
                 true => None,
                 false => Some(gpu_renderer(&a, gpu, need)?),
@@ -133,8 +111,10 @@ fn gpu_renderer(
             "--stage-times: the megakernel's stages share one launch; only multipass times them apart"
         );
     }
-    let renderer = GpuRenderer::for_features(&gpu, strategy, a.stage_times, features)
-        .map_err(|e| e.to_string())?;
+    let config = RendererConfig::new(strategy)
+        .stage_timing(a.stage_times)
+        .features(features);
+    let renderer = setup::renderer(&gpu, config)?;
     Ok((gpu, renderer))
 }
 

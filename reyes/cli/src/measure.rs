@@ -6,33 +6,16 @@
 //! render shows a progress bar on a terminal (`reyes_cli::progress`).
 
 use crate::cli::MeasureCmd;
+use crate::setup::{self, Setup};
 use reyes::frame::FrameData;
-use reyes::gpu_render::{GpuFrame, GpuRenderer, required_features};
+use reyes::gpu_render::{GpuFrame, GpuRenderer, RendererConfig};
 use reyes::progress::NoProgress;
-use reyes::scene::{self, Scene};
 use reyes::stats::frame_stats;
 use reyes_accuracy::exact_image::{ReferenceImage, render_reference};
 use reyes_accuracy::geometry::geometry;
 use reyes_accuracy::image_error::image_error;
 use reyes_accuracy::measure::{Measurement, MetricsCpuMs, pinhole_count};
 use scheduler::Gpu;
-use std::path::Path;
-
-/// The scene named on the command line (none or `teapot`: the built-in teapot) and a short
-/// name for it.
-pub fn load_scene(path: Option<&Path>) -> Result<(Scene, String), String> {
-    match path {
-        None => Ok((scene::builtin_teapot(), "teapot".into())),
-        Some(p) if p.as_os_str() == "teapot" => Ok((scene::builtin_teapot(), "teapot".into())),
-        Some(p) => {
-            let s = scene::load(p).map_err(|e| e.to_string())?;
-            let name = p
-                .file_stem()
-                .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
-            Ok((s, name))
-        }
-    }
-}
 
 /// [`GpuRenderer::timed_frames`]: the last frame and each timed frame's GPU and wall ms.
 pub fn timed_frames(
@@ -50,16 +33,12 @@ pub fn timed_frames(
 /// Runs the subcommand.
 pub fn main(a: MeasureCmd) -> Result<(), String> {
     let (json, ref_samples, reference_png) = (a.json, a.ref_samples, &a.reference_png);
-    let (mut scene, name) = load_scene(a.scene.as_deref())?;
-    a.render.change_scene(&mut scene)?;
-    for w in &scene.warnings {
-        log::warn!("{w}");
-    }
-    let data = FrameData::new(&scene, &a.render.options()).map_err(|e| e.to_string())?;
-    let gpu = Gpu::from_env_requiring(required_features()).map_err(|e| e.to_string())?;
-    let renderer =
-        GpuRenderer::for_features(&gpu, a.render.strategy_for(&gpu), false, data.features())
-            .map_err(|e| e.to_string())?;
+    let setup = Setup::load(a.scene.as_deref(), &a.render)?;
+    let data = setup.frame_data()?;
+    let gpu = setup::open_gpu()?;
+    let config = RendererConfig::new(a.render.strategy_for(&gpu)).features(data.features());
+    let renderer = setup::renderer(&gpu, config)?;
+    let Setup { scene, name, .. } = setup;
     let (frame, gpu_ms, wall_ms) = timed_frames(&gpu, &renderer, &data, a.runs)?;
     let mut stats = frame_stats(&data, &frame, &gpu.adapter_name(), &scene.warnings);
     let gpu_ms: Vec<f64> = gpu_ms.into_iter().flatten().collect();

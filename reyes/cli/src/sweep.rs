@@ -13,9 +13,10 @@
 //! strategy) and another the rows of each scene's reference render (`reyes_cli::progress`).
 
 use crate::cli::SweepCmd;
-use crate::measure::{load_scene, timed_frames};
+use crate::measure::timed_frames;
+use crate::setup::{self, load_scene};
 use reyes::frame::{FrameData, RenderOptions};
-use reyes::gpu_render::{GpuRenderer, required_features};
+use reyes::gpu_render::GpuRenderer;
 use reyes::image::FrameImage;
 use reyes::stages::C_MICROPOLYGONS;
 use reyes_accuracy::exact_image::render_reference;
@@ -24,8 +25,8 @@ use reyes_accuracy::image_error::{ImageError, composite_srgb8, srgb8_errors};
 use reyes_accuracy::measure::pinhole_count;
 use reyes_accuracy::pareto::pareto_front;
 use reyes_accuracy::plot::{Figure, Panel, Point, Shape, Style};
+use scheduler::StrategyKind;
 use scheduler::stats::median_and_mad;
-use scheduler::{Gpu, StrategyKind};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -116,12 +117,12 @@ impl Row {
 pub fn main(a: SweepCmd) -> Result<(), String> {
     let c = Config::new(a);
     std::fs::create_dir_all(&c.out).map_err(|e| format!("{}: {e}", c.out.display()))?;
-    let gpu = Gpu::from_env_requiring(required_features()).map_err(|e| e.to_string())?;
+    let gpu = setup::open_gpu()?;
     let adapter = gpu.adapter_name();
     let renderers: Vec<(StrategyKind, GpuRenderer)> = c
         .strategies
         .iter()
-        .map(|&k| Ok((k, GpuRenderer::new(&gpu, k).map_err(|e| e.to_string())?)))
+        .map(|&k| Ok((k, setup::renderer(&gpu, k)?)))
         .collect::<Result<_, String>>()?;
     let start = std::time::Instant::now();
     let mut rows = Vec::new();

@@ -17,7 +17,7 @@
 
 use crate::cli::ViewCmd;
 use reyes::camera::ViewCamera;
-use reyes::frame::{FrameData, MAX_PIXEL_SAMPLES, RenderOptions};
+use reyes::frame::{MAX_PIXEL_SAMPLES, RenderOptions};
 use reyes::gpu_render::required_features;
 use reyes::present::Presenter;
 use reyes::progress::NoProgress;
@@ -42,17 +42,15 @@ const MP_SIZE_RANGE: (f32, f32) = (0.125, 64.0);
 const PIXELS_PER_STEP: f64 = 40.0;
 
 pub fn main(a: ViewCmd) -> Result<(), String> {
-    let (mut scene, name) = crate::measure::load_scene(a.scene.as_deref())?;
-    a.render.change_scene(&mut scene)?;
-    for w in &scene.warnings {
-        log::warn!("{w}");
-    }
     // The scene's own size and samples, unless the flags say otherwise; a bad option fails
     // here, before a window opens.
-    let options = a.render.options();
-    let first = FrameData::new(&scene, &options)
-        .map_err(|e| e.to_string())?
-        .frame;
+    let setup = crate::setup::Setup::load(a.scene.as_deref(), &a.render)?;
+    let first = setup.frame_data()?.frame;
+    let crate::setup::Setup {
+        scene,
+        name,
+        options,
+    } = setup;
     let event_loop = EventLoop::new().map_err(|e| {
         format!(
             "cannot open a window: {e} (no display? set DISPLAY, or run it under Xvfb: \

@@ -3,8 +3,9 @@
 //! frame needs more ([`RasterPeer`]'s `fit`).
 
 use super::{COUNT_WORDS, MAX_RATE, RasterPeer, TESS_TILE, TessCounts, TessParams};
+use crate::gpu::SceneBuffers;
 use crate::gpu_render::dispatch_2d;
-use crate::realtime::{HEADROOM, SceneTables};
+use crate::realtime::HEADROOM;
 use scheduler::{Gpu, RunError};
 
 /// The vertex, index and draw buffers, sized for a number of vertices and quads.
@@ -100,12 +101,12 @@ impl RasterPeer {
         gpu: &Gpu,
         layout: &wgpu::BindGroupLayout,
         orbit: &wgpu::Buffer,
-        tables: &SceneTables,
+        tables: &SceneBuffers,
         g: &Geometry,
     ) -> wgpu::BindGroup {
         let entries = [
             (0, orbit),
-            (1, &tables.objects),
+            (1, tables.objects()),
             (3, &g.params),
             (4, &g.vertices),
             (5, &g.indices),

@@ -49,10 +49,11 @@ use geometry::Geometry;
 pub use tessellation::*;
 
 use crate::frame::{Frame, FrameData, RenderOptions};
+use crate::gpu::{Pipelines, SceneBuffers};
 use crate::gpu_render::dispatch_2d;
 use crate::image::FrameImage;
 use crate::orbit;
-use crate::realtime::{IN_FLIGHT, Orbit, Pixels, SceneTables, map_buffer, read_mapped};
+use crate::realtime::{IN_FLIGHT, Orbit, Pixels, map_buffer, read_mapped};
 use crate::scene::Scene;
 use crate::shaders;
 use scheduler::timing::SpanTimer;
@@ -143,7 +144,8 @@ pub struct RasterPeer {
     centre: glam::DVec3,
     patches: u32,
     samples: u32,
-    tables: SceneTables,
+    tables: SceneBuffers,
+    pipelines: Pipelines,
     tess_layout: wgpu::BindGroupLayout,
     /// `tess_rates`, `tile_dispatch`, `tess_points`, `tess_quads`.
     tessellate: [wgpu::ComputePipeline; 4],
@@ -152,7 +154,6 @@ pub struct RasterPeer {
     draw: wgpu::RenderPipeline,
     resolve: wgpu::ComputePipeline,
     resolve_bind: wgpu::BindGroup,
-    rgba8_pipeline: wgpu::ComputePipeline,
     rgba8_bind: wgpu::BindGroup,
     color: wgpu::TextureView,
     /// The single-sample target the hardware resolves into; `None` with one sample.
@@ -225,7 +226,7 @@ impl RasterPeer {
         }
         let n = scene.patches.len() as u32;
         let samples = msaa_samples(gpu, f.spp_x * f.spp_y);
-        let tables = SceneTables::upload(gpu, scene, &base)?;
+        let tables = SceneBuffers::with_patches(gpu, scene, &base)?;
         let ro = |b| storage_entry(b, true);
         let rw = |b| storage_entry(b, false);
         let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
@@ -291,14 +292,7 @@ impl RasterPeer {
         let scene_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("raster scene"),
             layout: &scene_layout,
-            entries: &[
-                (0, &tables.frame),
-                (1, &tables.materials),
-                (2, &tables.lights),
-                (3, &tables.infos),
-                (6, &tables.primvars),
-            ]
-            .map(|(binding, b)| wgpu::BindGroupEntry {
+            entries: &tables.tables().map(|(binding, b)| wgpu::BindGroupEntry {
                 binding,
                 resource: b.as_entire_binding(),
             }),
@@ -391,8 +385,8 @@ impl RasterPeer {
                 },
             ],
         });
-        let src = [shaders::COMMON, shaders::SHADE, shaders::RGBA8].concat();
-        let rgba8_pipeline = gpu.compute_pipeline("raster rgba8", &src, "to_rgba8")?;
+        let pipelines = Pipelines::new(gpu);
+        let rgba8_pipeline = pipelines.rgba8(gpu)?;
         let rgba8_params = gpu.upload("raster rgba8 params", &[pixels_n as u32, row, 0, 0])?;
         let rgba8_bind = gpu.bind_buffers(
             "raster rgba8",
@@ -424,7 +418,7 @@ impl RasterPeer {
             draw,
             resolve,
             resolve_bind,
-            rgba8_pipeline,
+            pipelines,
             rgba8_bind,
             color,
             resolved,
@@ -690,7 +684,7 @@ impl RasterPeer {
             pass.set_pipeline(&self.resolve);
             pass.set_bind_group(0, &self.resolve_bind, &[]);
             pass.dispatch_workgroups(self.resolve_groups.0, self.resolve_groups.1, 1);
-            pass.set_pipeline(&self.rgba8_pipeline);
+            pass.set_pipeline(self.pipelines.rgba8(gpu)?);
             pass.set_bind_group(0, &self.rgba8_bind, &[]);
             pass.dispatch_workgroups(self.resolve_groups.0, self.resolve_groups.1, 1);
         }

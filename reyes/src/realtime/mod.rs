@@ -2,16 +2,16 @@
 //! under a moving camera: the turntable of [`crate::orbit`] (`reyes bench`), or any camera-space
 //! transform per frame, as the viewer's orbit, pan and dolly ([`crate::camera`], `reyes view`).
 //!
-//! [`GpuRenderer::render`] makes everything per frame: uploads, a run that reads counters back
-//! between launches, and a read-back of the f32 image. Here, instead:
-//! - the scene is uploaded once: each patch's homogeneous control points (`x w, y w, z w, w`) in
-//!   a table, the materials, lights and patch flags; a frame writes only an 80-byte [`Orbit`]
-//!   (its camera transform);
+//! [`GpuRenderer::render`] makes its root items on the host, runs with counters read back
+//! between launches, and reads back the f32 image. Here, instead:
+//! - the scene is uploaded once ([`SceneBuffers::with_patches`]): each patch's homogeneous
+//!   control points (`x w, y w, z w, w`) in a table, the materials, lights and patch flags; a
+//!   frame writes only an 80-byte [`Orbit`] (its camera transform);
 //! - the root items are made on the GPU (`roots.wgsl`: the transform, then the same root item
 //!   as [`crate::frame::FrameData::new`] makes on the host), every frame rebuilt from the
 //!   patches; nothing is cached between frames but buffers and pipelines;
-//! - every buffer is allocated once ([`RealtimeRenderer::new`]) and reused: samples, counters,
-//!   image, the queues of a [`RecordedRun`] (the scheduler's run of fixed sizes, recorded
+//! - every buffer is allocated once ([`RealtimeRenderer::new`]) and reused: the
+//!   [`FrameTarget`] (samples, counters, image), the queues of a [`RecordedRun`] (the scheduler's run of fixed sizes, recorded
 //!   without host waits);
 //! - frames are pipelined: frame i+1 is recorded and submitted while the GPU runs frame i (at
 //!   most [`IN_FLIGHT`] submitted and unfinished); each frame's status (the scheduler's control
@@ -23,8 +23,8 @@
 //!
 //! A frame whose fixed sizes did not suffice (a queue out of room, a megakernel launch at its
 //! loop bound, multi-pass out of rounds) is found a frame late from its status and rendered again
-//! by [`GpuRenderer::render`] from the same root items (read back from the GPU), which grows its
-//! queues, splits batches and cuts buckets as needed: the frame comes out right and says that it
+//! by the offline renderer's core (that of [`GpuRenderer::render`], on this renderer's scene
+//! tables and target) from the same root items (read back from the GPU), which grows its queues, splits batches and cuts buckets as needed: the frame comes out right and says that it
 //! was rendered again ([`RealtimeFrame::rerendered`]); the fixed sizes then grow to what that
 //! render needed. A wrong frame is never returned.
 //!
@@ -38,12 +38,12 @@
 
 use crate::buckets;
 use crate::frame::{FrameData, PatchItem, RenderOptions};
-use crate::gpu_render::{GpuRenderer, dispatch_2d, resolve_params};
+use crate::gpu::{FrameTarget, SceneBuffers};
+use crate::gpu_render::{GpuFrame, GpuRenderer, RendererConfig, dispatch_2d, resolve_params};
 use crate::image::FrameImage;
 use crate::orbit;
 use crate::progress::Progress;
 use crate::scene::Scene;
-use crate::shaders;
 use crate::stages::COUNTERS;
 use bytemuck::{Pod, Zeroable};
 use glam::DMat4;
@@ -99,44 +99,6 @@ impl Orbit {
             row,
             pad: [0; 2],
         }
-    }
-}
-
-/// The scene as the renderers of many frames upload it once (this module's and
-/// [`crate::raster_peer`]'s): the object table of homogeneous control points and the tables of
-/// [`FrameData`] that common.wgsl binds (group 1: frame, materials, lights, patch info,
-/// primitive variables).
-pub(crate) struct SceneTables {
-    /// Homogeneous control points (x w, y w, z w, w), 16 per patch, cp[4*v + u], whose xyz
-    /// are the host's root item and whose w its patch's weight table
-    /// (frame::homogeneous_points: weights scaled to a largest of 1); `objects` in roots.wgsl.
-    pub objects: wgpu::Buffer,
-    pub frame: wgpu::Buffer,
-    pub materials: wgpu::Buffer,
-    pub lights: wgpu::Buffer,
-    pub infos: wgpu::Buffer,
-    pub primvars: wgpu::Buffer,
-}
-
-impl SceneTables {
-    /// Uploads `scene`'s patches and `base`'s tables. Errors: a table beyond the device's
-    /// binding limit.
-    pub(crate) fn upload(
-        gpu: &Gpu,
-        scene: &Scene,
-        base: &FrameData,
-    ) -> Result<SceneTables, RunError> {
-        let objects: Vec<[f32; 4]> = (scene.patches.iter())
-            .flat_map(crate::frame::homogeneous_points)
-            .collect();
-        Ok(SceneTables {
-            objects: gpu.upload("patch table", &objects)?,
-            frame: gpu.upload("frame", &[base.frame])?,
-            materials: gpu.upload("materials", &base.materials)?,
-            lights: gpu.upload("lights", &base.lights)?,
-            infos: gpu.upload("patch info", &base.patch_info)?,
-            primvars: gpu.upload("primvars", &base.primvars)?,
-        })
     }
 }
 
@@ -197,18 +159,15 @@ pub struct RealtimeRenderer {
     centre: glam::DVec3,
     patches: u32,
     pixels: Pixels,
-    roots_pipeline: wgpu::ComputePipeline,
-    rgba8_pipeline: wgpu::ComputePipeline,
+    /// The scene's tables and patch table, uploaded once.
+    scene: SceneBuffers,
+    /// What every frame renders into, with its 8-bit image.
+    target: FrameTarget,
     scene_bind: wgpu::BindGroup,
     resolve_bind: wgpu::BindGroup,
     rgba8_bind: wgpu::BindGroup,
-    samples: wgpu::Buffer,
-    counters: wgpu::Buffer,
-    rgba: wgpu::Buffer,
-    depth: wgpu::Buffer,
-    rgba8: wgpu::Buffer,
-    /// Kept alive for the bind groups.
-    _tables: (SceneTables, Vec<wgpu::Buffer>),
+    /// Kept alive for the bind groups: the resolve and rgba8 parameters.
+    _params: Vec<wgpu::Buffer>,
     slots: Vec<Slot>,
     timer: SpanTimer,
     /// The pipelined run; `None` when frames are not pipelined (`not_pipelined` says why).
@@ -256,50 +215,31 @@ impl RealtimeRenderer {
         pixels: Pixels,
     ) -> Result<RealtimeRenderer, RunError> {
         let base = FrameData::new(scene, options).map_err(|e| RunError::Program(e.to_string()))?;
-        let renderer = GpuRenderer::for_features(gpu, strategy, false, base.features())?;
+        let renderer =
+            GpuRenderer::new(gpu, RendererConfig::new(strategy).features(base.features()))?;
         let f = base.frame;
         let n = scene.patches.len() as u32;
-        let tables = SceneTables::upload(gpu, scene, &base)?;
-        let SceneTables {
-            objects,
-            frame: frame_buf,
-            materials,
-            lights,
-            infos,
-            primvars,
-        } = &tables;
+        let mut scene_buffers = SceneBuffers::with_patches(gpu, scene, &base)?;
         let pixels_n = f.width as u64 * f.height as u64;
         let spp = (f.spp_x * f.spp_y) as u64;
-        let samples = gpu.storage_buffer("samples", pixels_n * spp * 2)?;
-        let counters = gpu.storage_buffer("counters", STATUS_COUNTERS)?;
-        let rgba = gpu.storage_buffer("rgba", pixels_n * 4)?;
-        let depth = gpu.storage_buffer("depth", pixels_n)?;
-        let rgba8 = gpu.storage_buffer("rgba8", pixels_n)?;
-        let scene_bind = gpu.bind_buffers(
-            "reyes scene",
-            &renderer.user_layout,
-            &[
-                frame_buf, materials, lights, infos, &samples, &counters, primvars,
-            ],
-        );
+        let target = FrameTarget::new(gpu, pixels_n * spp * 2, pixels_n, true)?;
+        let pipelines = &renderer.pipelines;
+        let scene_bind = scene_buffers.bind_group(gpu, pipelines.scene_layout(), &target);
         let (resolve, resolve_groups) = resolve_params(&f);
         let resolve_buf = gpu.upload("resolve params", &resolve)?;
         let resolve_bind = gpu.bind_buffers(
             "resolve",
-            &renderer.resolve.get_bind_group_layout(0),
-            &[&resolve_buf, &samples, &rgba, &depth],
+            &pipelines.resolve(gpu)?.get_bind_group_layout(0),
+            &[&resolve_buf, &target.samples, &target.rgba, &target.depth],
         );
         let (rgba8_groups, row) = dispatch_2d(pixels_n, 256);
         let rgba8_buf = gpu.upload("rgba8 params", &[pixels_n as u32, row, 0, 0])?;
-        let src = [shaders::COMMON, shaders::SHADE, shaders::RGBA8].concat();
-        let rgba8_pipeline = gpu.compute_pipeline("reyes rgba8", &src, "to_rgba8")?;
         let rgba8_bind = gpu.bind_buffers(
             "rgba8",
-            &rgba8_pipeline.get_bind_group_layout(0),
-            &[&rgba8_buf, &rgba, &rgba8],
+            &pipelines.rgba8(gpu)?.get_bind_group_layout(0),
+            &[&rgba8_buf, &target.rgba, target.rgba8()],
         );
-        let src = [shaders::PATCH_ITEM, shaders::ROOTS].concat();
-        let roots_pipeline = gpu.compute_pipeline("reyes roots", &src, "make_roots")?;
+        let roots_pipeline = pipelines.roots(gpu)?;
         let (roots_groups, _) = dispatch_2d(n as u64, 64);
         let mut slots = Vec::new();
         for _ in 0..IN_FLIGHT {
@@ -308,7 +248,7 @@ impl RealtimeRenderer {
             let roots_bind = gpu.bind_buffers(
                 "roots",
                 &roots_pipeline.get_bind_group_layout(0),
-                &[&orbit, objects, &roots],
+                &[&orbit, scene_buffers.objects(), &roots],
             );
             slots.push(Slot {
                 orbit,
@@ -324,17 +264,12 @@ impl RealtimeRenderer {
             centre: orbit::scene_centre(scene),
             patches: n,
             pixels: Pixels::None,
-            roots_pipeline,
-            rgba8_pipeline,
+            scene: scene_buffers,
+            target,
             scene_bind,
             resolve_bind,
             rgba8_bind,
-            samples,
-            counters,
-            rgba,
-            depth,
-            rgba8,
-            _tables: (tables, vec![resolve_buf, rgba8_buf]),
+            _params: vec![resolve_buf, rgba8_buf],
             slots,
             timer: SpanTimer::new(gpu, IN_FLIGHT as u32),
             recorded: None,
@@ -363,7 +298,7 @@ impl RealtimeRenderer {
                 r.base.memory_budget.unwrap_or(0)
             ));
         } else {
-            let first = r.renderer.render(gpu, &r.base)?;
+            let first = r.render_on_target(gpu, &r.base.clone())?;
             let size = r.size_from(&first.run);
             r.resize(gpu, size)?;
         }
@@ -408,7 +343,7 @@ impl RealtimeRenderer {
     /// the last returned frame (a frame rendered again is written here too), until the next
     /// call's frames overwrite it: work submitted in between (a draw to a window) reads it.
     pub fn image_buffer(&self) -> &wgpu::Buffer {
-        &self.rgba8
+        self.target.rgba8()
     }
 
     /// The strategy's scheduler and the renderer that renders a frame again.
@@ -458,11 +393,23 @@ impl RealtimeRenderer {
 
     /// The GPU buffers [`Pixels`] copies back: rgba8, or rgba and depth.
     fn pixel_sources(&self) -> Vec<&wgpu::Buffer> {
-        (self.pixels).sources(&self.rgba8, &self.rgba, &self.depth)
+        let t = &self.target;
+        (self.pixels).sources(t.rgba8(), &t.rgba, &t.depth)
     }
 
     fn pixels_n(&self) -> u64 {
         self.base.frame.width as u64 * self.base.frame.height as u64
+    }
+
+    /// Renders `data` (this scene's frame with host-made or read-back root items) by the
+    /// offline core on this renderer's scene tables and target: the frame that sizes the
+    /// pipelined run, and a frame rendered again. Queue order keeps frames already submitted
+    /// apart: they read the tables and target before this frame's writes.
+    fn render_on_target(&mut self, gpu: &Gpu, data: &FrameData) -> Result<GpuFrame, RunError> {
+        self.scene.update(gpu, data)?;
+        let bind =
+            (self.scene).bind_group(gpu, self.renderer.pipelines.scene_layout(), &self.target);
+        (self.renderer).render_on(gpu, &self.scene, &self.target, &bind, data, Instant::now())
     }
 
     fn size_from(&self, run: &RunStats) -> RecordedSize {
@@ -519,18 +466,17 @@ impl RealtimeRenderer {
     }
 
     /// Records and submits one frame in ring slot `slot`.
-    fn submit(&self, gpu: &Gpu, slot: usize, transform: DMat4) -> Result<InFlight, RunError> {
+    fn submit(&mut self, gpu: &Gpu, slot: usize, transform: DMat4) -> Result<InFlight, RunError> {
+        if !self.motion.is_empty() && self.motion_written.get() != transform {
+            // Queue order: the frames already submitted read the table before this write.
+            let table = motion_primvars(&self.base.primvars, &self.motion, transform);
+            self.scene.write_primvars(gpu, &table)?;
+            self.motion_written.set(transform);
+        }
         let s = &self.slots[slot];
         let orbit = Orbit::from_transform(transform, self.patches);
         gpu.queue
             .write_buffer(&s.orbit, 0, bytemuck::bytes_of(&orbit));
-        if !self.motion.is_empty() && self.motion_written.get() != transform {
-            // Queue order: the frames already submitted read the table before this write.
-            let table = motion_primvars(&self.base.primvars, &self.motion, transform);
-            gpu.queue
-                .write_buffer(&self._tables.0.primvars, 0, bytemuck::cast_slice(&table));
-            self.motion_written.set(transform);
-        }
         let recorded = self.recorded.clone();
         let timer_slot = slot as u32;
         let mut enc = gpu.device.create_command_encoder(&Default::default());
@@ -544,14 +490,14 @@ impl RealtimeRenderer {
                 label: Some("roots"),
                 timestamp_writes: recorded.as_ref().and_then(|_| self.timer.begin(timer_slot)),
             });
-            pass.set_pipeline(&self.roots_pipeline);
+            pass.set_pipeline(self.renderer.pipelines.roots(gpu)?);
             pass.set_bind_group(0, &s.roots_bind, &[]);
             groups(&mut pass, self.roots_groups);
         }
         let mut maps = Vec::new();
         if let Some(rec) = &recorded {
-            enc.clear_buffer(&self.samples, 0, None);
-            enc.clear_buffer(&self.counters, 0, None);
+            enc.clear_buffer(&self.target.samples, 0, None);
+            enc.clear_buffer(&self.target.counters, 0, None);
             let seeds = [DeviceSeeds {
                 procedure: "bound",
                 buffer: &s.roots,
@@ -566,16 +512,23 @@ impl RealtimeRenderer {
                 0,
             )?;
             let at = rec.status_words();
-            enc.copy_buffer_to_buffer(&self.counters, 0, &s.status, at * 4, STATUS_COUNTERS * 4);
+            enc.copy_buffer_to_buffer(
+                &self.target.counters,
+                0,
+                &s.status,
+                at * 4,
+                STATUS_COUNTERS * 4,
+            );
             {
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("resolve"),
                     timestamp_writes: self.timer.end(timer_slot),
                 });
-                pass.set_pipeline(&self.renderer.resolve);
+                let pipelines = &self.renderer.pipelines;
+                pass.set_pipeline(pipelines.resolve(gpu)?);
                 pass.set_bind_group(0, &self.resolve_bind, &[]);
                 groups(&mut pass, self.resolve_groups);
-                pass.set_pipeline(&self.rgba8_pipeline);
+                pass.set_pipeline(pipelines.rgba8(gpu)?);
                 pass.set_bind_group(0, &self.rgba8_bind, &[]);
                 groups(&mut pass, self.rgba8_groups);
             }
@@ -682,11 +635,13 @@ impl RealtimeRenderer {
             primvars: motion_primvars(&self.base.primvars, &self.motion, transform),
             ..self.base.clone()
         };
-        let g = self.renderer.render(gpu, &data)?;
+        let g = self.render_on_target(gpu, &data)?;
+        // The table now holds this frame's motion: the next frame writes its own.
+        self.motion_written.set(transform);
         // The GPU image holds the incomplete attempt: the right frame replaces it (converted
         // on the host: FrameImage::rgba8, within one step of rgba8.wgsl).
         let rgba8 = g.image.rgba8();
-        gpu.queue.write_buffer(&self.rgba8, 0, &rgba8);
+        gpu.queue.write_buffer(self.target.rgba8(), 0, &rgba8);
         if self.recorded.is_some() {
             let size = self.size_from(&g.run).max(&self.wanted);
             if size != self.wanted {
@@ -717,6 +672,7 @@ impl RealtimeRenderer {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::shaders;
 
     /// One read-back buffer per source buffer, each sized for its pixels: 1 word a pixel for
     /// packed sRGB and depth, 4 for f32 RGBA.

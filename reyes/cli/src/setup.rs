@@ -1,0 +1,99 @@
+//! From command-line options to a frame, one way for every subcommand: the scene named on the
+//! command line (or the built-in teapot) with `--spin` and `--dof` applied and its warnings
+//! logged, the render options, the frame data, the GPU with the features the pipeline needs,
+//! and the offline renderer of a configuration. Messages and their order are the subcommands'
+//! own: a bad scene or option fails before the GPU is opened.
+
+use crate::cli::RenderArgs;
+use reyes::frame::{FrameData, RenderOptions};
+use reyes::gpu_render::{GpuRenderer, RendererConfig, required_features};
+use reyes::scene::{self, FrameSequence, Scene};
+use scheduler::Gpu;
+use std::path::Path;
+
+/// The scene named on the command line (none or `teapot`: the built-in teapot) and a short
+/// name for it (the file's stem). Errors: the file's, as text.
+pub fn load_scene(path: Option<&Path>) -> Result<(Scene, String), String> {
+    match path {
+        None => Ok((scene::builtin_teapot(), "teapot".into())),
+        Some(p) if p.as_os_str() == "teapot" => Ok((scene::builtin_teapot(), "teapot".into())),
+        Some(p) => {
+            let s = scene::load(p).map_err(|e| e.to_string())?;
+            let name = p
+                .file_stem()
+                .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+            Ok((s, name))
+        }
+    }
+}
+
+/// The scene file's frames (the built-in teapot: one) with `render`'s scene edits applied to
+/// each, and the file's stem for default output names. Errors: the file's, and the edits'.
+pub fn load_sequence(
+    path: Option<&Path>,
+    render: &RenderArgs,
+) -> Result<(FrameSequence, String), String> {
+    let (mut seq, stem) = match path {
+        None => (
+            FrameSequence::single(scene::builtin_teapot()),
+            "teapot".into(),
+        ),
+        Some(p) if p.as_os_str() == "teapot" => (
+            FrameSequence::single(scene::builtin_teapot()),
+            "teapot".into(),
+        ),
+        Some(p) => (
+            scene::load_frames(p).map_err(|e| e.to_string())?,
+            p.file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or("out".into()),
+        ),
+    };
+    for f in &mut seq.frames {
+        render.change_scene(&mut f.scene)?;
+    }
+    Ok((seq, stem))
+}
+
+/// One scene ready to render: loaded, edited by the flags, its warnings logged.
+pub struct Setup {
+    /// The scene after `--spin` and `--dof`.
+    pub scene: Scene,
+    /// Its short name ([`load_scene`]).
+    pub name: String,
+    /// The render options of the flags.
+    pub options: RenderOptions,
+}
+
+impl Setup {
+    /// Loads the scene at `path` ([`load_scene`]), applies `render`'s scene edits, logs the
+    /// scene's warnings and takes `render`'s options. Errors: the file's and the edits'.
+    pub fn load(path: Option<&Path>, render: &RenderArgs) -> Result<Setup, String> {
+        let (mut scene, name) = load_scene(path)?;
+        render.change_scene(&mut scene)?;
+        for w in &scene.warnings {
+            log::warn!("{w}");
+        }
+        Ok(Setup {
+            scene,
+            name,
+            options: render.options(),
+        })
+    }
+
+    /// The frame of the scene under the options. Errors: the options' ([`FrameData::new`]).
+    pub fn frame_data(&self) -> Result<FrameData, String> {
+        FrameData::new(&self.scene, &self.options).map_err(|e| e.to_string())
+    }
+}
+
+/// The GPU from the environment, with the features the Reyes pipeline needs. Errors: no
+/// adapter, or one without them.
+pub fn open_gpu() -> Result<Gpu, String> {
+    Gpu::from_env_requiring(required_features()).map_err(|e| e.to_string())
+}
+
+/// The offline renderer of `config` on `gpu`. Errors: the device's, as text.
+pub fn renderer(gpu: &Gpu, config: impl Into<RendererConfig>) -> Result<GpuRenderer, String> {
+    GpuRenderer::new(gpu, config).map_err(|e| e.to_string())
+}

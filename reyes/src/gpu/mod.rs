@@ -1,0 +1,19 @@
+//! The GPU resources every renderer of the crate shares, one type each: the scene's tables on
+//! the device ([`SceneBuffers`], uploaded once and rewritten only where a frame changes them),
+//! the per-frame targets of one image size ([`FrameTarget`]: samples, counters, the resolved
+//! image and its 8-bit form), and the pipelines that are not the scheduler's ([`Pipelines`]:
+//! resolve, 8-bit conversion, GPU-made root items), built once per renderer and device.
+//!
+//! The offline renderer ([`crate::gpu_render::GpuRenderer`]) keeps one scene and one target
+//! across its frames; the pipelined renderer ([`crate::realtime::RealtimeRenderer`]) holds its
+//! own and renders a frame again on them; the raster peer ([`crate::raster_peer`]) draws from
+//! the same scene tables.
+
+mod pipelines;
+mod scene;
+mod target;
+
+pub use pipelines::Pipelines;
+pub(crate) use pipelines::scene_layout_entries;
+pub use scene::SceneBuffers;
+pub use target::FrameTarget;
