@@ -130,7 +130,7 @@ impl RecordedRun {
     /// megakernel's first use probes its workgroup count with it). Errors:
     /// [`RunError::Program`] for the host-driven multi-pass, an unknown procedure, or `size` of
     /// the wrong length; [`RunError::QueueOverflow`] when the seeds alone exceed a queue's
-    /// limit; a probe's errors.
+    /// limit; the errors of the megakernel's co-residency probe.
     pub fn new(
         gpu: &Gpu,
         scheduler: &Scheduler,

@@ -207,7 +207,6 @@ pub fn fma_is_fused(gpu: &Gpu) -> Result<bool, RunError> {
     let (fused, unfused) = (2f32.powi(-11) + 2f32.powi(-24), 2f32.powi(-11));
     debug_assert_eq!(a.mul_add(a, -1.0), fused);
     debug_assert_eq!(a * a - 1.0, unfused);
-    // Labels and the error message keep their wording ("fma probe"): error texts stay as they were.
     let io = gpu.storage_buffer("fma probe", 4)?;
     gpu.queue
         .write_buffer(&io, 0, bytemuck::cast_slice(&[a, a, -1.0, 0.0]));
