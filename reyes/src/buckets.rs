@@ -4,7 +4,7 @@
 //! buffer and only the patches that may reach it. A bucket whose queues still overflow is cut
 //! into four and rendered again; nothing is dropped.
 
-use crate::frame::{Frame, PatchItem, Tile};
+use crate::frame::{FrameUniforms, PatchItem, Tile};
 use crate::stages::{Weights, bound::CULL_MARGIN_PX, cp_point, project};
 
 /// Buckets are never cut below this side (pixels); a budget that a bucket this small cannot
@@ -12,13 +12,13 @@ use crate::stages::{Weights, bound::CULL_MARGIN_PX, cp_point, project};
 pub const MIN_BUCKET_SIDE: u32 = 16;
 
 /// Bytes of one pixel's sub-samples (one 64-bit key each).
-pub fn sample_bytes_per_pixel(f: &Frame) -> u64 {
+pub fn sample_bytes_per_pixel(f: &FrameUniforms) -> u64 {
     (f.spp_x * f.spp_y) as u64 * 8
 }
 
 /// The buckets to start with: the whole image when its samples fit in half the budget (the
 /// other half is for the queues), else a grid of equal buckets that do.
-pub fn plan(f: &Frame, budget: Option<u64>) -> Vec<Tile> {
+pub fn plan(f: &FrameUniforms, budget: Option<u64>) -> Vec<Tile> {
     let whole = f.whole_image();
     let Some(budget) = budget else {
         return vec![whole];
@@ -68,7 +68,7 @@ pub fn quarter(t: Tile) -> Option<Vec<Tile>> {
 /// patch too), and always true for a patch crossing the near plane, which
 /// has no screen bound yet. `w`: the item's weights if its patch is rational
 /// (`stages::item_weights`).
-pub fn may_reach(f: &Frame, item: &PatchItem, w: Option<&Weights>, t: Tile) -> bool {
+pub fn may_reach(f: &FrameUniforms, item: &PatchItem, w: Option<&Weights>, t: Tile) -> bool {
     // Motion blur and depth of field move patches beyond this bound: Bound culls them.
     if f.uvt != crate::frame::UVT_OFF {
         return true;
@@ -101,7 +101,7 @@ pub fn may_reach(f: &Frame, item: &PatchItem, w: Option<&Weights>, t: Tile) -> b
 mod tests {
     use super::*;
 
-    fn frame(w: u32, h: u32) -> Frame {
+    fn frame(w: u32, h: u32) -> FrameUniforms {
         let scene = crate::scene::builtin_teapot();
         let o = crate::frame::RenderOptions {
             width: Some(w),
@@ -113,7 +113,7 @@ mod tests {
     }
 
     /// Every pixel belongs to exactly one bucket, and each bucket's samples fit half the budget.
-    fn assert_partition(f: &Frame, tiles: &[Tile], budget: u64) {
+    fn assert_partition(f: &FrameUniforms, tiles: &[Tile], budget: u64) {
         let mut hits = vec![0u8; (f.width * f.height) as usize];
         for t in tiles {
             assert!(t.w as u64 * t.h as u64 * sample_bytes_per_pixel(f) <= budget / 2);

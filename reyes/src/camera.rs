@@ -87,7 +87,7 @@ impl ViewCamera {
     /// A drag of `(dx, dy)` window pixels with the pan button: the centre follows the mouse
     /// exactly on screen. `centre_depth`: the scene centre's camera-space z (> 0) before the
     /// dolly; `focal`: the projection's focal length in pixels
-    /// ([`crate::frame::Frame::focal`]: raster x = w/2 + focal x / z).
+    /// ([`crate::frame::FrameUniforms::focal`]: raster x = w/2 + focal x / z).
     pub fn pan_by_pixels(&mut self, dx: f64, dy: f64, centre_depth: f64, focal: f64) {
         // At depth d = dolly * centre_depth a pixel is d / focal camera units; the pan is
         // scaled by the dolly in the transform, so the dolly cancels.

@@ -3,7 +3,7 @@
 //! either strategy, then a resolve pass from sub-samples to pixels.
 
 use crate::buckets;
-use crate::frame::{Frame, FrameData, PatchItem, SceneFeatures};
+use crate::frame::{FrameData, FrameUniforms, PatchItem, SceneFeatures};
 use crate::gpu::{FrameTarget, Pipelines, SceneBuffers, scene_layout_entries};
 use crate::image::FrameImage;
 use crate::progress::Progress;
@@ -473,7 +473,7 @@ impl GpuRenderer {
     fn resolve(
         &self,
         gpu: &Gpu,
-        f: &Frame,
+        f: &FrameUniforms,
         samples: &wgpu::Buffer,
         rgba: &wgpu::Buffer,
         depth: &wgpu::Buffer,
@@ -515,7 +515,7 @@ pub(crate) fn dispatch_2d(threads: u64, per_group: u32) -> ((u32, u32), u32) {
 
 /// The resolve pass's parameters for the bucket of `f` (`ResolveParams` in resolve.wgsl) and
 /// its dispatch size.
-pub(crate) fn resolve_params(f: &Frame) -> ([u32; 8], (u32, u32)) {
+pub(crate) fn resolve_params(f: &FrameUniforms) -> ([u32; 8], (u32, u32)) {
     let pixels = f.tile_w as u64 * f.tile_h as u64;
     let ((gx, gy), row) = dispatch_2d(pixels, 256);
     let params = [

@@ -20,7 +20,7 @@
 //!   same grid, against the exact one: split drift plus the dicer's own rounding.
 
 use glam::{DVec2, DVec3, DVec4};
-use reyes::frame::{Frame, FrameData, PatchItem};
+use reyes::frame::{FrameData, FrameUniforms, PatchItem};
 use reyes::reference::homogeneous::{HomNet, euclidean_net, eval_net, homogeneous};
 use reyes::scene::Scene;
 use reyes::stages::bound::{Decision, bound};
@@ -42,7 +42,7 @@ pub struct Projector {
 }
 
 impl Projector {
-    pub fn new(scene: &Scene, frame: &Frame) -> Projector {
+    pub fn new(scene: &Scene, frame: &FrameUniforms) -> Projector {
         let short = frame.width.min(frame.height) as f64;
         Projector {
             half_w: frame.width as f64 / 2.0,
@@ -54,7 +54,7 @@ impl Projector {
 
     /// Whether the projected hull of `cp` (all beyond the near plane) meets the image: only
     /// such sub-patches can make pixels; the renderer culls the others.
-    pub fn overlaps_image(&self, cp: &[DVec3; 16], frame: &Frame) -> bool {
+    pub fn overlaps_image(&self, cp: &[DVec3; 16], frame: &FrameUniforms) -> bool {
         let mut lo = DVec2::splat(f64::INFINITY);
         let mut hi = DVec2::splat(f64::NEG_INFINITY);
         for p in cp {
@@ -170,7 +170,7 @@ fn measure(
     original: &HomNet,
     w: Option<&Weights>,
     cam: &Projector,
-    frame: &Frame,
+    frame: &FrameUniforms,
 ) -> PatchDrift {
     let rational = w.is_some();
     let dist = |a: Option<DVec2>, b: Option<DVec2>| match (a, b) {

@@ -42,9 +42,12 @@ impl PatchItem {
     }
 }
 
+/// The frame's uniform block, `Frame` in common.wgsl (the layout test below checks it against
+/// naga's reflection): image size, sub-samples, camera, dicing limits, the tile a bucket renders,
+/// and the sampling modes. One per frame or bucket, bound read-only by every stage.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
-pub struct Frame {
+pub struct FrameUniforms {
     pub width: u32,
     pub height: u32,
     pub spp_x: u32,
@@ -85,13 +88,13 @@ pub struct Frame {
     pub inv_focus: f32,
 }
 
-/// [`Frame::uvt`]: no time or lens sampling; the sampler of a still pinhole frame runs.
+/// [`FrameUniforms::uvt`]: no time or lens sampling; the sampler of a still pinhole frame runs.
 pub const UVT_OFF: u32 = 0;
-/// [`Frame::uvt`] of [`Sampling::Simple`].
+/// [`FrameUniforms::uvt`] of [`Sampling::Simple`].
 pub const UVT_SIMPLE: u32 = 1;
-/// [`Frame::uvt`] of [`Sampling::Interleave`].
+/// [`FrameUniforms::uvt`] of [`Sampling::Interleave`].
 pub const UVT_INTERLEAVE: u32 = 2;
-/// [`Frame::uvt`] of [`Sampling::BoundingBox`].
+/// [`FrameUniforms::uvt`] of [`Sampling::BoundingBox`].
 pub const UVT_BBOX: u32 = 3;
 
 /// How a frame with motion blur or depth of field samples time and the lens (Sattler &
@@ -115,7 +118,7 @@ pub enum Sampling {
 }
 
 impl Sampling {
-    /// The value of [`Frame::uvt`] for a frame that has motion or depth of field.
+    /// The value of [`FrameUniforms::uvt`] for a frame that has motion or depth of field.
     pub fn gpu_code(self) -> u32 {
         match self {
             Sampling::Simple => UVT_SIMPLE,
@@ -134,10 +137,10 @@ impl Sampling {
     }
 }
 
-impl Frame {
+impl FrameUniforms {
     /// This frame restricted to one bucket.
-    pub fn with_tile(&self, t: Tile) -> Frame {
-        Frame {
+    pub fn with_tile(&self, t: Tile) -> FrameUniforms {
+        FrameUniforms {
             tile_x0: t.x0,
             tile_y0: t.y0,
             tile_w: t.w,
@@ -195,7 +198,7 @@ pub struct GpuLight {
 /// Everything uploaded for one frame.
 #[derive(Clone, Debug)]
 pub struct FrameData {
-    pub frame: Frame,
+    pub frame: FrameUniforms,
     pub materials: Vec<GpuMaterial>,
     pub lights: Vec<GpuLight>,
     pub patch_info: Vec<PatchInfo>,
@@ -408,7 +411,7 @@ impl FrameData {
         let patch_info: Vec<PatchInfo> = (scene.patches.iter())
             .map(|p| patch_info(p, &mut primvars, &mut maps))
             .collect::<Result<_, _>>()?;
-        let frame = Frame {
+        let frame = FrameUniforms {
             width,
             height,
             spp_x: sx,
@@ -639,25 +642,25 @@ mod tests {
         );
         check(
             "Frame",
-            size_of::<Frame>(),
+            size_of::<FrameUniforms>(),
             &[
-                ("focal", offset_of!(Frame, focal)),
-                ("bound_px", offset_of!(Frame, bound_px)),
-                ("n_lights", offset_of!(Frame, n_lights)),
-                ("seed", offset_of!(Frame, seed)),
-                ("tile_x0", offset_of!(Frame, tile_x0)),
-                ("tile_h", offset_of!(Frame, tile_h)),
-                ("crack_dilation", offset_of!(Frame, crack_dilation)),
+                ("focal", offset_of!(FrameUniforms, focal)),
+                ("bound_px", offset_of!(FrameUniforms, bound_px)),
+                ("n_lights", offset_of!(FrameUniforms, n_lights)),
+                ("seed", offset_of!(FrameUniforms, seed)),
+                ("tile_x0", offset_of!(FrameUniforms, tile_x0)),
+                ("tile_h", offset_of!(FrameUniforms, tile_h)),
+                ("crack_dilation", offset_of!(FrameUniforms, crack_dilation)),
                 (
                     "displacement_normals",
-                    offset_of!(Frame, displacement_normals),
+                    offset_of!(FrameUniforms, displacement_normals),
                 ),
-                ("raster", offset_of!(Frame, raster)),
-                ("uvt", offset_of!(Frame, uvt)),
-                ("il_tile", offset_of!(Frame, il_tile)),
-                ("il_perms", offset_of!(Frame, il_perms)),
-                ("coc_scale", offset_of!(Frame, coc_scale)),
-                ("inv_focus", offset_of!(Frame, inv_focus)),
+                ("raster", offset_of!(FrameUniforms, raster)),
+                ("uvt", offset_of!(FrameUniforms, uvt)),
+                ("il_tile", offset_of!(FrameUniforms, il_tile)),
+                ("il_perms", offset_of!(FrameUniforms, il_perms)),
+                ("coc_scale", offset_of!(FrameUniforms, coc_scale)),
+                ("inv_focus", offset_of!(FrameUniforms, inv_focus)),
             ],
         );
         check(

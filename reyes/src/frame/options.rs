@@ -55,7 +55,7 @@ pub enum RasterMode {
 }
 
 impl RasterMode {
-    /// The value of [`Frame::raster`] (`RASTER_BBOX`, `RASTER_NEAREST` in common.wgsl).
+    /// The value of [`FrameUniforms::raster`] (`RASTER_BBOX`, `RASTER_NEAREST` in common.wgsl).
     pub fn gpu_code(self) -> u32 {
         match self {
             RasterMode::BoundingBox => RASTER_BBOX,
@@ -63,7 +63,7 @@ impl RasterMode {
         }
     }
 
-    /// The mode of a [`Frame::raster`] value (anything but `RASTER_NEAREST` is bounding-box).
+    /// The mode of a [`FrameUniforms::raster`] value (anything but `RASTER_NEAREST` is bounding-box).
     pub fn from_gpu_code(code: u32) -> RasterMode {
         if code == RASTER_NEAREST {
             RasterMode::NearestSample
@@ -81,9 +81,9 @@ impl RasterMode {
     }
 }
 
-/// [`Frame::raster`] of [`RasterMode::BoundingBox`].
+/// [`FrameUniforms::raster`] of [`RasterMode::BoundingBox`].
 pub const RASTER_BBOX: u32 = 0;
-/// [`Frame::raster`] of [`RasterMode::NearestSample`].
+/// [`FrameUniforms::raster`] of [`RasterMode::NearestSample`].
 pub const RASTER_NEAREST: u32 = 1;
 
 impl Default for RenderOptions {

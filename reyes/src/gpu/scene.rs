@@ -4,7 +4,7 @@
 //! that joins them to a [`FrameTarget`]'s samples and counters.
 
 use super::FrameTarget;
-use crate::frame::{Frame, FrameData};
+use crate::frame::{FrameData, FrameUniforms};
 use crate::scene::Scene;
 use scheduler::{Gpu, RunError};
 
@@ -49,7 +49,7 @@ impl Table {
 /// A scene's tables on the device, uploaded once and shared by every frame rendered from it
 /// (see the module documentation).
 pub struct SceneBuffers {
-    /// The frame uniform (`Frame`, common.wgsl); the offline renderer writes each bucket's.
+    /// The frame uniform (`FrameUniforms`, common.wgsl); the offline renderer writes each bucket's.
     frame: wgpu::Buffer,
     materials: Table,
     lights: Table,
@@ -111,7 +111,7 @@ impl SceneBuffers {
     }
 
     /// Writes the frame uniform (queue order: work submitted before reads the old one).
-    pub(crate) fn write_frame(&self, gpu: &Gpu, f: &Frame) {
+    pub(crate) fn write_frame(&self, gpu: &Gpu, f: &FrameUniforms) {
         gpu.queue
             .write_buffer(&self.frame, 0, bytemuck::bytes_of(f));
     }

@@ -48,7 +48,7 @@ mod tessellation;
 use geometry::Geometry;
 pub use tessellation::*;
 
-use crate::frame::{Frame, FrameData, RenderOptions};
+use crate::frame::{FrameData, FrameUniforms, RenderOptions};
 use crate::gpu::{Pipelines, SceneBuffers};
 use crate::gpu_render::dispatch_2d;
 use crate::image::FrameImage;
@@ -176,7 +176,7 @@ pub struct RasterPeer {
 fn target(
     gpu: &Gpu,
     label: &str,
-    f: &Frame,
+    f: &FrameUniforms,
     format: wgpu::TextureFormat,
     samples: u32,
     usage: wgpu::TextureUsages,

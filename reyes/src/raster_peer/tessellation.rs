@@ -2,7 +2,7 @@
 //! tessellate.wgsl and raster_resolve.wgsl (layouts checked against naga), and the CPU twins of
 //! its rate ([`grid_rate`], [`edge_param`]) and of its grid points ([`tessellate_cpu`]).
 
-use crate::frame::{Frame, FrameData, root_item};
+use crate::frame::{FrameData, FrameUniforms, root_item};
 use crate::scene::Patch;
 use crate::stages;
 use bytemuck::{Pod, Zeroable};
@@ -131,7 +131,7 @@ pub struct GridRate {
 /// The grid of the patch whose Euclidean camera-space control points are `e` (`e[4*v + u]`);
 /// twin of `grid_rate` in tessellate.wgsl (see there). The GPU's `distance` may round
 /// differently, so a rate can differ by one.
-pub fn grid_rate(f: &Frame, e: &[Vec3; 16], max_rate: u32) -> GridRate {
+pub fn grid_rate(f: &FrameUniforms, e: &[Vec3; 16], max_rate: u32) -> GridRate {
     let culled = GridRate {
         n: [0; 2],
         edges: [0; 4],
@@ -325,14 +325,14 @@ mod tests {
     /// plane, and about one segment per mp_size pixels of the projected control polygon.
     #[test]
     fn grid_rate_follows_the_projected_size() {
-        let f = Frame {
+        let f = FrameUniforms {
             width: 100,
             height: 100,
             focal: 100.0,
             near: 0.1,
             far: 100.0,
             mp_size: 1.0,
-            ..Frame::zeroed()
+            ..FrameUniforms::zeroed()
         };
         // A flat 1 x 1 patch at z = 10 spans 10 x 10 pixels.
         let at = |dx: f32, z: f32| -> [Vec3; 16] {
@@ -355,7 +355,7 @@ mod tests {
         let mut crossing = at(0.0, 10.0);
         crossing[0].z = -1.0;
         assert_eq!(grid_rate(&f, &crossing, 64).n, [64, 64]);
-        let coarse = Frame { mp_size: 4.0, ..f };
+        let coarse = FrameUniforms { mp_size: 4.0, ..f };
         assert_eq!(grid_rate(&coarse, &at(0.0, 10.0), 64).n, [3, 3]);
         // A patch whose row v = 1 is half as long: that boundary gets fewer segments.
         let mut taper = at(0.0, 10.0);

@@ -322,7 +322,7 @@ impl RealtimeRenderer {
     }
 
     /// The frame's settings (size, samples, focal length, micropolygon size).
-    pub fn frame(&self) -> &crate::frame::Frame {
+    pub fn frame(&self) -> &crate::frame::FrameUniforms {
         &self.base.frame
     }
 

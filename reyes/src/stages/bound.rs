@@ -7,7 +7,7 @@
 use super::{
     ControlNet, Weights, coc, cp_h, cp_point, item_weights, moved_point, project, to_euclidean,
 };
-use crate::frame::{Frame, PATCH_MOVING, PatchInfo, PatchItem};
+use crate::frame::{FrameUniforms, PATCH_MOVING, PatchInfo, PatchItem};
 use glam::{Vec2, Vec3, Vec4};
 
 /// See `MAX_DILATE_PX` and `CULL_MARGIN_PX` in common.wgsl: bucketed renders stay exact.
@@ -44,7 +44,12 @@ pub enum Decision {
 /// Bound's decision for `item` (the work of all 16 threads and of thread 0's reduction);
 /// `primvars` is the table of [`crate::frame::FrameData::primvars`], where a rational patch
 /// has its weights.
-pub fn bound(item: &PatchItem, f: &Frame, info: &PatchInfo, primvars: &[[f32; 4]]) -> Decision {
+pub fn bound(
+    item: &PatchItem,
+    f: &FrameUniforms,
+    info: &PatchInfo,
+    primvars: &[[f32; 4]],
+) -> Decision {
     // Each thread's weight is the same bits as thread 0's rational_weights (common.wgsl).
     let weights = item_weights(item, info, primvars);
     let rational = weights.is_some();
@@ -200,7 +205,7 @@ pub fn displacement_radius(info: &PatchInfo, primvars: &[[f32; 4]]) -> f32 {
 /// Screen bound (lo, hi) of the part of the patch in front of the near plane: the projections
 /// of the front control points and of the crossings of the near plane by segments from a front
 /// to a behind control point (`near_visible_bound` in bound.wgsl gives the argument).
-pub fn near_visible_bound(f: &Frame, cp: &ControlNet) -> (Vec2, Vec2) {
+pub fn near_visible_bound(f: &FrameUniforms, cp: &ControlNet) -> (Vec2, Vec2) {
     let (mut lo, mut hi) = (Vec2::splat(3.0e38), Vec2::splat(-3.0e38));
     for a in 0..16 {
         let p = cp_point(cp, a);
@@ -258,7 +263,7 @@ fn polygon_length(cp: &ControlNet, step: usize, across: usize) -> f32 {
 }
 
 /// (0 dice | 1 split u | 2 split v, rate u, rate v).
-fn dice_decision(f: &Frame, lu: f32, lv: f32, extent: Vec2) -> (u32, u32, u32) {
+fn dice_decision(f: &FrameUniforms, lu: f32, lv: f32, extent: Vec2) -> (u32, u32, u32) {
     let gmax = f.grid_max as f32;
     if f.bound_px > 0.0 {
         let split = extent.x.max(extent.y) > f.bound_px;
@@ -279,7 +284,7 @@ fn dice_decision(f: &Frame, lu: f32, lv: f32, extent: Vec2) -> (u32, u32, u32) {
 /// docs/reyes.md. `cp` holds Euclidean points ([`to_euclidean`]) and `w` their weights (read
 /// only if `rational`).
 pub fn crack_dilation(
-    f: &Frame,
+    f: &FrameUniforms,
     cp: &ControlNet,
     w: &Weights,
     rational: bool,
@@ -353,7 +358,7 @@ pub fn curve_c2_rational(p: [Vec4; 4]) -> f32 {
 /// grows the shutter-open bound by `c` and takes the union. `cp`: Euclidean points; `r`: the
 /// displacement radius; (zmin, zmax): depths at shutter open.
 pub fn uvt_bound(
-    f: &Frame,
+    f: &FrameUniforms,
     cp: &ControlNet,
     info: &PatchInfo,
     table: &[[f32; 4]],

@@ -129,7 +129,7 @@ pub fn item_weights(
     (info.flags & PATCH_RATIONAL != 0).then(|| rational_weights(primvars, info.weights, item.uv))
 }
 
-pub fn project(f: &crate::frame::Frame, p: Vec3) -> [f32; 2] {
+pub fn project(f: &crate::frame::FrameUniforms, p: Vec3) -> [f32; 2] {
     [
         0.5 * f.width as f32 + f.focal * p.x / p.z,
         0.5 * f.height as f32 - f.focal * p.y / p.z,
@@ -151,7 +151,7 @@ pub fn moved_point(table: &[[f32; 4]], at: u32, p: Vec3) -> Vec3 {
 }
 
 /// `coc` in common.wgsl: the signed circle of confusion in pixels of depth z.
-pub fn coc(f: &crate::frame::Frame, z: f32) -> f32 {
+pub fn coc(f: &crate::frame::FrameUniforms, z: f32) -> f32 {
     f.coc_scale * (f.inv_focus - 1.0 / z)
 }
 

@@ -2,7 +2,7 @@
 //! bounding-box rasterization or the nearest sample ([`crate::frame::RasterMode`]).
 
 use super::reyes_hash;
-use crate::frame::{Frame, RASTER_NEAREST};
+use crate::frame::{FrameUniforms, RASTER_NEAREST};
 use glam::{Vec2, Vec3, Vec4};
 
 fn cross2(a: Vec2, b: Vec2) -> f32 {
@@ -11,13 +11,13 @@ fn cross2(a: Vec2, b: Vec2) -> f32 {
 
 /// `sample_id` in sample.wgsl: the index of sub-sample (sx, sy) of pixel (px, py) in the whole
 /// image (not the bucket).
-pub fn sample_id(f: &Frame, px: u32, py: u32, sx: u32, sy: u32) -> u32 {
+pub fn sample_id(f: &FrameUniforms, px: u32, py: u32, sx: u32, sy: u32) -> u32 {
     ((py * f.width + px) * f.spp_y + sy) * f.spp_x + sx
 }
 
 /// `sample_position` in sample.wgsl: sub-sample (sx, sy) of pixel (px, py), stratified and
 /// jittered by a hash.
-pub fn sample_position(f: &Frame, px: u32, py: u32, sx: u32, sy: u32) -> Vec2 {
+pub fn sample_position(f: &FrameUniforms, px: u32, py: u32, sx: u32, sy: u32) -> Vec2 {
     let h = reyes_hash(sample_id(f, px, py, sx, sy) ^ f.seed);
     let j = Vec2::new((h & 0xffff) as f32, (h >> 16) as f32) / 65536.0;
     Vec2::new(px as f32, py as f32)
@@ -136,7 +136,7 @@ impl Cover {
 
 /// `covers` in sample.wgsl: whether the micropolygon covers sample `id` (always when
 /// opaque; else when a hash of the sample and the patch, as 24 bits, is below alpha * 2^24).
-pub fn covers(f: &Frame, c: Cover, id: u32) -> bool {
+pub fn covers(f: &FrameUniforms, c: Cover, id: u32) -> bool {
     if c.alpha >= 1.0 {
         return true;
     }
@@ -146,7 +146,7 @@ pub fn covers(f: &Frame, c: Cover, id: u32) -> bool {
 
 /// Keeps the nearest key at sub-sample (sx, sy) of pixel (px, py) of the bucket.
 pub(super) fn write_sample(
-    f: &Frame,
+    f: &FrameUniforms,
     samples: &mut [u64],
     [px, py, sx, sy]: [u32; 4],
     z: f32,
@@ -161,7 +161,7 @@ pub(super) fn write_sample(
 /// every sub-sample of the bucket inside the bound [lo, hi] whose `depth` is not negative and
 /// that `cover` covers keeps the nearest key.
 fn sample_under(
-    f: &Frame,
+    f: &FrameUniforms,
     samples: &mut [u64],
     (lo, hi): (Vec2, Vec2),
     color: u32,
@@ -204,7 +204,7 @@ pub fn sample_micropolygon(
     grow: [f32; 4],
     two_sided: bool,
     cover: Cover,
-    f: &Frame,
+    f: &FrameUniforms,
     samples: &mut [u64],
 ) -> bool {
     let Some(color) = micropolygon_color(&q, two_sided) else {
@@ -237,7 +237,13 @@ pub fn sample_micropolygon(
 /// at the mean depth of its corners, when the centre lies in the image and the sample in the
 /// bucket. Searches the stratum cells within one cell diagonal of the centre, which hold the
 /// nearest sample since the centre's own cell's sample is at most that far.
-fn sample_nearest(q: &[[f32; 4]; 4], color: u32, cover: Cover, f: &Frame, samples: &mut [u64]) {
+fn sample_nearest(
+    q: &[[f32; 4]; 4],
+    color: u32,
+    cover: Cover,
+    f: &FrameUniforms,
+    samples: &mut [u64],
+) {
     let centre = (xy(q[0]) + xy(q[1]) + xy(q[2]) + xy(q[3])) * 0.25;
     let size = Vec2::new(f.width as f32, f.height as f32);
     if !(centre.x >= 0.0 && centre.y >= 0.0 && centre.x < size.x && centre.y < size.y) {
@@ -284,7 +290,7 @@ pub const GUARD_BAND_PX: f32 = 16.0;
 
 /// `clip_plane` in sample.wgsl: 0 the near plane, 1-4 the guard band's sides through the eye;
 /// (a, b, c, d) keeps a x + b y + c z + d >= 0.
-fn clip_plane(f: &Frame, k: usize) -> Vec4 {
+fn clip_plane(f: &FrameUniforms, k: usize) -> Vec4 {
     let gx = 0.5 * f.width as f32 + GUARD_BAND_PX;
     let gy = 0.5 * f.height as f32 + GUARD_BAND_PX;
     let fo = f.focal;
@@ -325,7 +331,7 @@ pub fn sample_near_clipped(
     grow: [f32; 4],
     two_sided: bool,
     cover: Cover,
-    f: &Frame,
+    f: &FrameUniforms,
     samples: &mut [u64],
 ) -> bool {
     if q.iter().map(|v| v[2]).fold(f32::MAX, f32::min) >= f.near {
@@ -353,7 +359,7 @@ fn sample_clipped_triangle(
     tri: &[Vec3; 3],
     grow: f32,
     (color, cover): (u32, Cover),
-    f: &Frame,
+    f: &FrameUniforms,
     samples: &mut [u64],
 ) {
     let mut poly = tri.to_vec();
@@ -406,8 +412,8 @@ mod tests {
     use crate::frame::{RASTER_BBOX, RASTER_NEAREST};
     use bytemuck::Zeroable;
 
-    fn frame(spp: [u32; 2], raster: u32) -> Frame {
-        Frame {
+    fn frame(spp: [u32; 2], raster: u32) -> FrameUniforms {
+        FrameUniforms {
             width: 9,
             height: 7,
             spp_x: spp[0],
@@ -416,7 +422,7 @@ mod tests {
             tile_w: 9,
             tile_h: 7,
             raster,
-            ..Frame::zeroed()
+            ..FrameUniforms::zeroed()
         }
     }
 

@@ -7,7 +7,7 @@ use super::sample::{
     triangle_setup, write_sample,
 };
 use super::{coc, reyes_hash};
-use crate::frame::{Frame, UVT_INTERLEAVE, UVT_SIMPLE};
+use crate::frame::{FrameUniforms, UVT_INTERLEAVE, UVT_SIMPLE};
 use glam::{Vec2, Vec3};
 
 /// `UVT_SALT` and `PERM_SALT` in sample_uvt.wgsl.
@@ -34,7 +34,7 @@ pub fn concentric_disc(s: Vec2) -> Vec2 {
 }
 
 /// `uvt_sample`: lens position in the unit disc (x, y) and time (z), stratum `stratum` of `n`.
-pub fn uvt_sample(f: &Frame, key: u32, stratum: u32, n: u32) -> Vec3 {
+pub fn uvt_sample(f: &FrameUniforms, key: u32, stratum: u32, n: u32) -> Vec3 {
     let h1 = reyes_hash(key ^ f.seed ^ UVT_SALT);
     let h2 = reyes_hash(h1.wrapping_add(1));
     let h3 = reyes_hash(h2.wrapping_add(1));
@@ -44,7 +44,7 @@ pub fn uvt_sample(f: &Frame, key: u32, stratum: u32, n: u32) -> Vec3 {
 }
 
 /// `uvt_table_sample`: the bounding-box algorithm's sample k of pixel (px, py).
-pub fn uvt_table_sample(f: &Frame, px: u32, py: u32, k: u32, n: u32) -> Vec3 {
+pub fn uvt_table_sample(f: &FrameUniforms, px: u32, py: u32, k: u32, n: u32) -> Vec3 {
     let texel = (py % UVT_TABLE) * UVT_TABLE + px % UVT_TABLE;
     let shift = reyes_hash(texel ^ PERM_SALT) % n;
     uvt_sample(f, texel.wrapping_mul(n).wrapping_add(k), (k + shift) % n, n)
@@ -86,7 +86,7 @@ pub fn permute(index: u32, l: u32, p: u32) -> u32 {
 }
 
 /// `uvt_corner`: corner `p0` (colour bits in `[3]`) moved to sample `s`; `p1` at shutter close.
-fn uvt_corner(f: &Frame, p0: [f32; 4], p1: [f32; 4], s: Vec3) -> [f32; 4] {
+fn uvt_corner(f: &FrameUniforms, p0: [f32; 4], p1: [f32; 4], s: Vec3) -> [f32; 4] {
     let a = Vec3::new(p0[0], p0[1], p0[2]);
     let b = Vec3::new(p1[0], p1[1], p1[2]);
     let p = a + (b - a) * s.z;
@@ -103,7 +103,7 @@ struct MovedQuad {
 }
 
 fn moved_quad(
-    f: &Frame,
+    f: &FrameUniforms,
     q0: &[[f32; 4]; 4],
     q1: &[[f32; 4]; 4],
     s: Vec3,
@@ -123,7 +123,7 @@ fn moved_quad(
 
 /// `uvt_test`: sub-sample (sx, sy) of pixel (px, py) against the moved quad.
 fn uvt_test(
-    f: &Frame,
+    f: &FrameUniforms,
     samples: &mut [u64],
     m: &MovedQuad,
     [px, py, k]: [u32; 3],
@@ -145,7 +145,7 @@ fn uvt_test(
 }
 
 /// `bucket_pixels`: the bucket's pixels under [lo, hi], inclusive, or `None`.
-fn bucket_pixels(f: &Frame, lo: Vec2, hi: Vec2) -> Option<([u32; 2], [u32; 2])> {
+fn bucket_pixels(f: &FrameUniforms, lo: Vec2, hi: Vec2) -> Option<([u32; 2], [u32; 2])> {
     let t0 = [f.tile_x0, f.tile_y0];
     let t1 = [f.tile_x0 + f.tile_w, f.tile_y0 + f.tile_h];
     let inside = |k: usize| hi[k] >= t0[k] as f32 && lo[k] < t1[k] as f32;
@@ -165,7 +165,7 @@ pub fn sample_micropolygon_uvt(
     grow: [f32; 4],
     two_sided: bool,
     cover: Cover,
-    f: &Frame,
+    f: &FrameUniforms,
     samples: &mut [u64],
 ) -> bool {
     let Some(color) = micropolygon_color(&q0, two_sided) else {
@@ -257,7 +257,7 @@ mod tests {
     /// Lens positions lie in the unit disc; times in [0, 1) in their strata.
     #[test]
     fn samples_lie_in_the_disc_and_their_time_strata() {
-        let f = Frame {
+        let f = FrameUniforms {
             seed: 0x5eed,
             ..bytemuck::Zeroable::zeroed()
         };

@@ -33,7 +33,7 @@ impl Interp {
                 f.number, f.line
             )));
         }
-        self.push(Block::Frame, req)?;
+        self.push(Block::FrameUniforms, req)?;
         self.frame = Some(OpenFrame {
             number,
             line: req.line,
@@ -45,7 +45,7 @@ impl Interp {
 
     pub(super) fn frame_end(&mut self, req: &Request, a: &mut Args) -> Result<(), SceneError> {
         a.done()?;
-        self.pop(Block::Frame, req)?;
+        self.pop(Block::FrameUniforms, req)?;
         let frame = self.frame.take().expect("a frame block is open");
         self.next_number = frame.number.saturating_add(1);
         match frame.world {

@@ -87,7 +87,7 @@ impl Default for Options {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Block {
-    Frame,
+    FrameUniforms,
     World,
     Attribute,
     Transform,
@@ -96,7 +96,7 @@ pub(super) enum Block {
 impl Block {
     pub(super) fn begin(self) -> &'static str {
         match self {
-            Block::Frame => "FrameBegin",
+            Block::FrameUniforms => "FrameBegin",
             Block::World => "WorldBegin",
             Block::Attribute => "AttributeBegin",
             Block::Transform => "TransformBegin",
@@ -226,7 +226,7 @@ impl Interp {
             file: req.file.clone(),
             line: req.line,
             attrs: self.attrs.clone(),
-            options: (block == Block::Frame).then(|| Box::new(self.options.clone())),
+            options: (block == Block::FrameUniforms).then(|| Box::new(self.options.clone())),
         });
         Ok(())
     }
