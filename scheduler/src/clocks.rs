@@ -24,7 +24,7 @@ fn busy(@builtin(global_invocation_id) id: vec3<u32>) {
 /// Keeps every compute unit busy for about `duration` (several submissions, each waited
 /// for). Does nothing on CPU adapters (lavapipe), which have no clocks to raise.
 pub fn raise_clocks(gpu: &Gpu, duration: Duration) -> Result<(), RunError> {
-    if gpu.info.device_type == wgpu::DeviceType::Cpu {
+    if gpu.is_cpu_adapter() {
         return Ok(());
     }
     let pipeline = gpu.compute_pipeline("raise clocks", BUSY, "busy")?;

@@ -345,7 +345,7 @@ impl Gpu {
     /// about 2.5 times slower (the Reyes megakernel's pipeline: 1.9 s against 0.6-0.8 s), for
     /// frames no faster (docs/scheduler.md, "Start-up on lavapipe").
     pub fn driver_bounds_loops(&self) -> bool {
-        self.info.backend == wgpu::Backend::Vulkan && self.info.name.contains("llvmpipe")
+        self.info.backend == wgpu::Backend::Vulkan && self.is_lavapipe()
     }
 
     /// A compute pipeline of one entry point of a WGSL source, its layout derived from the

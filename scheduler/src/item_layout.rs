@@ -52,7 +52,7 @@ impl ItemLayout {
     /// once). Interleaved on CPU adapters such as lavapipe, whose caches favour an item's words
     /// together (planar was 3x slower there on the 64-word tree).
     pub fn for_program(gpu: &Gpu, program: &Program) -> ItemLayout {
-        Self::choose(gpu.info.device_type == wgpu::DeviceType::Cpu, program)
+        Self::choose(gpu.is_cpu_adapter(), program)
     }
 
     /// [`ItemLayout::for_program`] on a CPU adapter (`cpu`) or a GPU.

@@ -187,7 +187,7 @@ impl Megakernel {
         program: &Program,
         mut config: MegakernelConfig,
     ) -> Result<Megakernel, RunError> {
-        if gpu.info.name.contains("llvmpipe") {
+        if gpu.is_lavapipe() {
             // lavapipe's loop limiter is one counter per invocation for a whole outermost loop
             // and everything nested in it: after 65,535 iterations in total, every loop exits at
             // its first test. A persistent launch must stay far below that, bodies included.
@@ -330,7 +330,7 @@ impl Megakernel {
     /// spinning workgroups one after another: probing more than that many only costs time
     /// (seconds on two cores), so its `max` is capped there.
     fn probe(&self, gpu: &Gpu, max: u32, user: Option<&wgpu::BindGroup>) -> Result<u32, RunError> {
-        let max = if gpu.info.device_type == wgpu::DeviceType::Cpu {
+        let max = if gpu.is_cpu_adapter() {
             let threads = std::thread::available_parallelism().map_or(1, |n| n.get() as u32);
             max.min(threads)
         } else {
