@@ -4,8 +4,11 @@
 use scheduler::*;
 use workloads::tree::{Fanout, TreeParams, TreeRun};
 
+#[path = "common/adapter.rs"]
+mod adapter;
+
 fn gpu() -> Gpu {
-    Gpu::from_env().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"))
+    adapter::open_gpu(wgpu::Features::empty())
 }
 
 fn small_tree(seed: u32) -> TreeParams {

@@ -7,8 +7,11 @@ use workloads::bfs::{BfsParams, BfsRun, UNREACHED};
 use workloads::frontier_bfs::FrontierBfs;
 use workloads::mandelbrot::{self, MandelParams, MandelRun};
 
+#[path = "common/adapter.rs"]
+mod adapter;
+
 fn gpu() -> Gpu {
-    Gpu::from_env().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"))
+    adapter::open_gpu(wgpu::Features::empty())
 }
 
 /// Small views, in the arithmetic of `gpu`'s `fma`.

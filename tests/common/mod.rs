@@ -5,6 +5,8 @@
 
 #![allow(dead_code)] // each test binary uses its own subset
 
+mod adapter;
+
 use reyes::frame::{FrameData, RenderOptions};
 use reyes::gpu_render::{GpuFrame, GpuRenderer, required_features};
 use reyes::image::FrameImage;
@@ -34,10 +36,7 @@ pub const CPU_TWIN_OVER_MOTION: f64 = 0.01;
 /// renderer needs; none is a panic, never a skip.
 pub fn gpu() -> &'static Gpu {
     static GPU: OnceLock<Gpu> = OnceLock::new();
-    GPU.get_or_init(|| {
-        Gpu::from_env_requiring(required_features())
-            .unwrap_or_else(|e| panic!("GPU tests need an adapter with 64-bit atomics: {e}"))
-    })
+    GPU.get_or_init(|| adapter::open_gpu(required_features()))
 }
 
 pub fn renderer(kind: StrategyKind) -> &'static GpuRenderer {
