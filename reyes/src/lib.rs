@@ -2,6 +2,8 @@
 //! bounded, split, diced, shaded and sampled on the GPU by either scheduling strategy, with a
 //! CPU twin of every stage as the reference.
 
+#![warn(missing_docs)]
+
 pub mod buckets;
 pub mod camera;
 pub mod cpu_render;
@@ -19,7 +21,7 @@ pub mod raster_peer;
 pub mod realtime;
 pub mod reference;
 pub mod scene;
-pub mod shaders;
+pub(crate) mod shaders;
 pub mod stages;
 pub mod stats;
 pub mod warnings;

@@ -12,8 +12,11 @@ use reyes::scene::{Light, Material, Patch, Scene, SurfaceKind};
 /// An exact surface point of a patch.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SurfacePoint {
+    /// Position, camera space.
     pub p: DVec3,
+    /// Partial derivative dP/du, camera space.
     pub dpdu: DVec3,
+    /// Partial derivative dP/dv, camera space.
     pub dpdv: DVec3,
     /// Unit outside normal (after the patch's `flip_normal`).
     pub n: DVec3,

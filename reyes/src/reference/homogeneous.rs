@@ -26,7 +26,7 @@ pub fn euclidean_net(h: &HomNet) -> [DVec3; 16] {
 }
 
 /// Point, d/du and d/dv of the rational patch with homogeneous net `h` at (u, v)
-/// ([`crate::scene::rational::eval_homogeneous`]).
+/// (`scene::rational::eval_homogeneous`).
 pub fn eval_rational(h: &HomNet, u: f64, v: f64) -> (DVec3, DVec3, DVec3) {
     crate::scene::rational::eval_homogeneous(h, u, v)
 }
