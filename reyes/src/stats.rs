@@ -7,7 +7,7 @@ use crate::gpu_render::GpuFrame;
 use crate::stages as s;
 use serde::{Deserialize, Serialize};
 
-/// `raster` of statistics written before `--raster` existed: `bbox`.
+/// `raster` of statistics JSON that has no `raster` key: `bbox`.
 pub fn default_raster() -> String {
     RasterMode::BoundingBox.name().to_string()
 }
@@ -31,7 +31,7 @@ pub struct FrameStats {
     /// Fixed-bound dicing's screen bound (px); null for adaptive dicing.
     pub bound_px: Option<f64>,
     /// Micropolygon rasterization (`--raster`): `bbox` or `nearest` (`RasterMode::name`);
-    /// `bbox` when read from JSON written before the option existed.
+    /// `bbox` when read from JSON without the key.
     #[serde(default = "default_raster")]
     pub raster: String,
     /// Root patches of the scene.

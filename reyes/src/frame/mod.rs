@@ -287,12 +287,12 @@ pub struct SceneFeatures {
     /// Some patch is displaced (`PATCH_DISPLACED`).
     pub displacement: bool,
     /// The frame is rasterized with [`RasterMode::NearestSample`] (`SCENE_NEAREST_RASTER`):
-    /// without it the program holds bounding-box rasterization alone, so the default mode
-    /// runs exactly the code it ran before the option existed.
+    /// without it the program holds bounding-box rasterization alone, and the default mode
+    /// pays nothing for the other.
     pub nearest_raster: bool,
     /// The frame samples time or the lens (`SCENE_UVT`: motion blur or depth of field):
-    /// without it none of that code is compiled, and a still pinhole frame runs exactly the
-    /// sampler it ran before.
+    /// without it none of that code is compiled, and a still pinhole frame runs the plain
+    /// sampler alone.
     pub uvt: bool,
 }
 
