@@ -10,8 +10,11 @@ use crate::stages::{self, bound::Cull, bound::Decision};
 /// The image plus what each stage did, in the GPU's terms (`stages::C_*` counters; executed
 /// items per procedure: bound, splitu, splitv, diceshade, dicesmall).
 pub struct CpuRender {
+    /// The resolved image, as the GPU path gives it.
     pub image: FrameImage,
+    /// The stages' counters, indexed by `stages::C_*`.
     pub counters: [u64; stages::COUNTERS],
+    /// Items executed per procedure: bound, splitu, splitv, diceshade, dicesmall.
     pub executed: [u64; 5],
 }
 

@@ -73,22 +73,29 @@ pub fn program_for(features: SceneFeatures) -> Result<Program, RunError> {
 /// What one GPU frame produced and cost; with several buckets, run statistics are summed
 /// (peaks are maxima).
 pub struct GpuFrame {
+    /// The resolved image.
     pub image: FrameImage,
+    /// The stages' counters (`stages::C_*`), summed over the runs ([`crate::stages::C_MAX_DEPTH`]:
+    /// the maximum).
     pub counters: [u64; COUNTERS],
+    /// The scheduler's statistics, summed over the runs (peaks are maxima).
     pub run: RunStats,
     /// GPU time of the resolve passes, when timestamps exist.
     pub resolve_gpu_ms: Option<f64>,
     /// Bytes of the sample buffer (one bucket's).
     pub sample_bytes: u64,
-    /// Screen buckets rendered, and how many were cut in four after their queues overflowed.
+    /// Screen buckets rendered.
     pub buckets: u32,
+    /// Buckets cut in four after their queues overflowed.
     pub buckets_recut: u32,
-    /// Scheduler runs that finished (one per bucket, more where a bucket's patches were
-    /// split into batches), and batches split in two because their work did not fit.
+    /// Scheduler runs that finished: one per bucket, more where a bucket's patches were split
+    /// into batches.
     pub runs: u32,
+    /// Batches split in two because their work did not fit.
     pub batches_split: u32,
     /// Largest working memory of one bucket: sample buffer plus queue storage.
     pub peak_working_bytes: u64,
+    /// Host time of [`GpuRenderer::render`], milliseconds.
     pub wall_ms: f64,
 }
 /// Queue slots a renderer's scheduler starts with (queues grow by doubling beyond).
@@ -357,6 +364,10 @@ impl GpuRenderer {
             // queues is halved and each half run on its own. Samples keep the nearest key
             // (atomicMax), so batches, in any order and even a refused batch's partial work run
             // again, give the same image bit for bit; counters are read per finished batch.
+            #[allow(
+                clippy::single_range_in_vec_init,
+                reason = "a stack of batches, each a range of items"
+            )]
             let mut batches = vec![0..items.len()];
             let mut recut = false;
             while let Some(batch) = batches.pop() {

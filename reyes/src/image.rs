@@ -23,13 +23,19 @@ pub struct ImageDifference {
 /// pixel (3e38 where the background shows).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FrameImage {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
+    /// Row-major pixels from the top row, `width * height`: linear RGB and coverage.
     pub rgba: Vec<[f32; 4]>,
+    /// Row-major like `rgba`: the nearest camera-space z of each pixel.
     pub depth: Vec<f32>,
 }
 
 impl FrameImage {
+    /// 8-bit RGBA, row-major: colour clamped to [0, 1] and sRGB-encoded, alpha linear. Not
+    /// composited: the colour is straight.
     pub fn rgba8(&self) -> Vec<u8> {
         let q = |x: f32| (srgb_encode(x) * 255.0).round() as u8;
         self.rgba
@@ -94,6 +100,8 @@ impl FrameImage {
         self.rgba.iter().filter(|p| p[3] > 0.0).count()
     }
 
+    /// Writes [`FrameImage::rgba8`] to `path` as a PNG, atomically (a temporary file renamed).
+    /// Errors: encoding or writing the file ([`Error`]).
     pub fn write_png(&self, path: &Path) -> Result<(), Error> {
         let img = image::RgbaImage::from_raw(self.width, self.height, self.rgba8())
             .ok_or(Error::BufferSizeMismatch)?;

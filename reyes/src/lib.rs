@@ -1,6 +1,33 @@
 //! Real-time Reyes on the `scheduler` crate: bicubic Bezier patch scenes (RIB, Newell, BPT)
 //! bounded, split, diced, shaded and sampled on the GPU by either scheduling strategy, with a
 //! CPU twin of every stage as the reference.
+//!
+//! The stages are those of Patney & Owens, "Real-Time Reyes-Style Adaptive Surface
+//! Subdivision", with the sampling of Sattler & Steinberger, "Reyes Rendering on the GPU":
+//! Bound (cull, choose split or dice), SplitU / SplitV (de Casteljau halving), DiceShade and
+//! DiceSmall (grids of micropolygons, shaded at their points) and the sampling into a buffer of
+//! jittered sub-samples, resolved to an image. Each is a procedure of a `scheduler` program in
+//! WGSL (`shaders/reyes/*.wgsl`) with a Rust twin in [`stages`].
+//!
+//! Entry points, in the order a frame takes them:
+//! - scenes: [`scene::load`] (a file of any supported format; [`scene::load_frames`] for
+//!   every frame of a RIB file) or [`scene::builtin_teapot`], giving a [`scene::Scene`] in
+//!   camera space, f64;
+//! - the frame: [`frame::FrameData::new`] of a scene under [`frame::RenderOptions`], the f32
+//!   tables every stage reads (uniforms, materials, lights, per-patch tables, root items);
+//! - the GPU: [`gpu_render::GpuRenderer`], built from a [`gpu_render::RendererConfig`]
+//!   (strategy, stage timing, compiled features), renders a [`frame::FrameData`] into a
+//!   [`gpu_render::GpuFrame`] (image, counters, run statistics; [`stats`] makes its JSON);
+//! - many frames of one scene under a moving camera at GPU speed: [`realtime`]
+//!   ([`realtime::RealtimeRenderer`]), and the rasterizing peer it is compared with,
+//!   [`raster_peer`];
+//! - the CPU: [`cpu_render::render_cpu`], the same pipeline on the host, the twin the GPU
+//!   output is tested against; [`mod@reference`] holds the exact f64 references.
+//!
+//! Errors: [`Error`] for scenes, options and files (a scene file's: [`scene::SceneError`]); a
+//! GPU run's are the scheduler's `RunError`.
+
+#![warn(missing_docs)]
 
 pub mod buckets;
 pub mod camera;
@@ -19,7 +46,7 @@ pub mod raster_peer;
 pub mod realtime;
 pub mod reference;
 pub mod scene;
-pub mod shaders;
+pub(crate) mod shaders;
 pub mod stages;
 pub mod stats;
 pub mod warnings;

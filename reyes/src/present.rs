@@ -16,16 +16,19 @@ pub const BACKGROUND: [u8; 4] = [48, 48, 48, 255];
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Pod, Zeroable)]
 pub struct PresentParams {
-    /// Image size in pixels.
+    /// Image width in pixels.
     pub image_w: u32,
+    /// Image height in pixels.
     pub image_h: u32,
-    /// Target (window surface) size in pixels.
+    /// Target (window surface) width in pixels.
     pub target_w: u32,
+    /// Target height in pixels.
     pub target_h: u32,
     /// 1: the target format encodes sRGB on store, so the shader decodes first.
     pub srgb_target: u32,
     /// The background as an rgba8 word (bytes r, g, b, a in memory order).
     pub background: u32,
+    /// Padding to the WGSL struct's 32 bytes.
     pub pad: [u32; 2],
 }
 

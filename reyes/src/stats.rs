@@ -7,7 +7,7 @@ use crate::gpu_render::GpuFrame;
 use crate::stages as s;
 use serde::{Deserialize, Serialize};
 
-/// `raster` of statistics written before `--raster` existed: `bbox`.
+/// `raster` of statistics JSON that has no `raster` key: `bbox`.
 pub fn default_raster() -> String {
     RasterMode::BoundingBox.name().to_string()
 }
@@ -20,8 +20,9 @@ pub struct FrameStats {
     pub strategy: String,
     /// The GPU adapter's name.
     pub adapter: String,
-    /// Image size in pixels.
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// Samples per pixel, [x, y].
     pub pixel_samples: [u32; 2],
@@ -30,7 +31,7 @@ pub struct FrameStats {
     /// Fixed-bound dicing's screen bound (px); null for adaptive dicing.
     pub bound_px: Option<f64>,
     /// Micropolygon rasterization (`--raster`): `bbox` or `nearest` (`RasterMode::name`);
-    /// `bbox` when read from JSON written before the option existed.
+    /// `bbox` when read from JSON without the key.
     #[serde(default = "default_raster")]
     pub raster: String,
     /// Root patches of the scene.
@@ -39,10 +40,13 @@ pub struct FrameStats {
     pub bounds: u64,
     /// Splits (`splits_u + splits_v`).
     pub splits: u64,
+    /// Splits along u (SplitU executions).
     pub splits_u: u64,
+    /// Splits along v (SplitV executions).
     pub splits_v: u64,
     /// Splits forced by the near plane.
     pub eye_splits: u64,
+    /// Pieces and micropolygons culled, by reason.
     pub culls: Culls,
     /// Grids diced at the split limit (coarser than asked).
     pub depth_limited: u64,
@@ -56,11 +60,13 @@ pub struct FrameStats {
     pub micropolygons: u64,
     /// Pixels with any coverage.
     pub covered_pixels: usize,
+    /// `micropolygons / covered_pixels`.
     pub micropolygons_per_covered_pixel: f64,
     /// Deepest split level reached.
     pub max_split_depth: u64,
     /// Executions per procedure.
     pub executed: Executed,
+    /// GPU ms per stage ([`StageTimes`]).
     pub gpu_ms_per_stage: StageTimes,
     /// GPU time of the scheduler run plus the resolve pass; null without timestamp queries.
     /// `reyes measure`: the median over its timed frames.
@@ -116,8 +122,9 @@ pub struct FrameStats {
 pub struct UvtStats {
     /// `simple`, `interleave` or `bbox` (`Sampling::name`).
     pub sampling: String,
-    /// Interleave UVT's tile side K (pixels) and permutations P.
+    /// Interleave UVT's tile side K, pixels.
     pub il_tile: u32,
+    /// Interleave UVT's number of permutations P.
     pub il_perms: u32,
     /// Root patches that move over the shutter.
     pub moving_patches: usize,
@@ -153,10 +160,15 @@ pub struct Culls {
 /// Executions of each procedure (the names of `gpu_render::PROCEDURES`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Executed {
+    /// Bound executions.
     pub bound: u64,
+    /// SplitU executions.
     pub splitu: u64,
+    /// SplitV executions.
     pub splitv: u64,
+    /// DiceShade executions.
     pub diceshade: u64,
+    /// DiceSmall (small-grid dicing) executions.
     pub dicesmall: u64,
 }
 
@@ -166,22 +178,32 @@ pub struct Executed {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(untagged)]
 pub enum StageTimes {
+    /// Every procedure timed apart (multi-pass with `--stage-times`).
     PerStage {
+        /// GPU ms of Bound.
         bound: f64,
+        /// GPU ms of SplitU.
         splitu: f64,
+        /// GPU ms of SplitV.
         splitv: f64,
+        /// GPU ms of DiceShade.
         diceshade: f64,
+        /// GPU ms of DiceSmall.
         dicesmall: f64,
         /// Multi-pass's queue bookkeeping passes (counts, prefix sums, compaction).
         queue_work: f64,
+        /// GPU ms of the resolve pass.
         resolve: Option<f64>,
     },
+    /// The scheduler run timed as one.
     Whole {
+        /// GPU ms of the scheduler run.
         schedule: Option<f64>,
         /// Why the stages are not timed apart: only the megakernel's, whose stages share one
         /// launch (multi-pass without `--stage-times` has none).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         note: Option<String>,
+        /// GPU ms of the resolve pass.
         resolve: Option<f64>,
     },
 }
@@ -189,8 +211,11 @@ pub enum StageTimes {
 /// Median, median absolute deviation and every value of a time over the timed frames (ms).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MedianMad {
+    /// Median.
     pub median: f64,
+    /// Median absolute deviation from the median.
     pub mad: f64,
+    /// Every value, in run order.
     pub all: Vec<f64>,
 }
 
@@ -216,6 +241,7 @@ pub struct RunSummary {
     pub count: usize,
     /// Null without timestamp queries.
     pub gpu_ms: Option<MedianMad>,
+    /// Host ms of each timed frame.
     pub wall_ms: Option<MedianMad>,
 }
 

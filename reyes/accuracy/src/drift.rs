@@ -42,6 +42,8 @@ pub struct Projector {
 }
 
 impl Projector {
+    /// The projection of `frame`'s image size under the scene camera's field of view and near
+    /// plane.
     pub fn new(scene: &Scene, frame: &FrameUniforms) -> Projector {
         let short = frame.width.min(frame.height) as f64;
         Projector {
@@ -82,7 +84,9 @@ impl Projector {
 /// One split: the direction and which half is kept.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Step {
+    /// Split along u, else along v.
     pub along_u: bool,
+    /// Keep the second half (parameters from the midpoint up), else the first.
     pub second: bool,
 }
 
@@ -205,14 +209,21 @@ fn measure(
 /// sub-patch's largest distance.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DepthRow {
+    /// Splits from the original patch.
     pub depth: u32,
     /// Sub-patches measured.
     pub subpatches: usize,
+    /// Control-point drift (`cp`, see the module doc): maximum over the sub-patches.
     pub cp_max: f64,
+    /// Control-point drift: 99th percentile.
     pub cp_p99: f64,
+    /// Surface drift (`surface`): maximum.
     pub surface_max: f64,
+    /// Surface drift: 99th percentile.
     pub surface_p99: f64,
+    /// Diced-grid drift (`grid`: split drift plus the dicer's rounding): maximum.
     pub grid_max: f64,
+    /// Diced-grid drift: 99th percentile.
     pub grid_p99: f64,
 }
 
@@ -253,6 +264,8 @@ impl DepthRow {
         self.cp_max.max(self.surface_max)
     }
 
+    /// This row as JSON: `depth`, `subpatches`, and `{max, p99}` of `cp_px`, `surface_px`,
+    /// `grid_px`.
     pub fn json(&self) -> Value {
         json!({
             "depth": self.depth,
@@ -269,6 +282,7 @@ impl DepthRow {
 pub struct PathOptions {
     /// Random-direction paths per patch, besides the two alternating ones.
     pub random_paths: usize,
+    /// Seed of the random paths' directions and halves.
     pub seed: u64,
 }
 
@@ -368,6 +382,7 @@ impl TreeDrift {
             .fold(0.0, f64::max)
     }
 
+    /// This measurement as JSON (the `--json` of `reyes drift`).
     pub fn json(&self) -> Value {
         json!({
             "max_split_depth": self.max_depth,

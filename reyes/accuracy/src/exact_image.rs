@@ -36,15 +36,19 @@ const BAND_ROWS: usize = 4;
 const NEWTON_TOL_PX: f64 = 1.0e-6;
 const NEWTON_STEPS: usize = 12;
 
+/// The reference render of a frame ([`render_reference`]) and what it cost.
 pub struct ReferenceImage {
     /// Straight linear colour, alpha = covered fraction, nearest camera-space depth.
     pub image: FrameImage,
     /// The same covered fractions, for `reference::pinholes`.
     pub coverage: Coverage,
+    /// Samples per pixel along each axis (`n`; `n * n` per pixel).
     pub samples_per_axis: u32,
-    /// Covered samples whose surface point Newton did not pin down to [`NEWTON_TOL_PX`].
+    /// Covered samples whose surface point Newton did not pin down to `NEWTON_TOL_PX` (1e-6 px).
     pub unconverged_samples: u64,
+    /// Samples a surface covers.
     pub covered_samples: u64,
+    /// Host time of the render, milliseconds.
     pub cpu_ms: f64,
 }
 

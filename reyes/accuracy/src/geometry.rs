@@ -24,6 +24,7 @@ use reyes::reference::project;
 use reyes::scene::Scene;
 use reyes::stages::dice_shade::dice;
 
+/// Geometric accuracy of a frame's micropolygons against the exact surfaces, in pixels.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GeometryStats {
     /// Micropolygons measured (drawn ones, see the module doc).

@@ -52,10 +52,14 @@ pub fn flip_mean(reference: &[u8], test: &[u8], width: u32, height: u32) -> f64 
 /// PSNR and FLIP of a render against a reference of the same size.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ImageError {
+    /// PSNR in dB over the 8-bit sRGB values; infinite for identical images.
     pub psnr_db: f64,
+    /// Mean of FLIP's per-pixel error map, in [0, 1] (0: identical).
     pub flip_mean: f64,
 }
 
+/// PSNR and FLIP of `test` against `reference`, both composited over black (see the module
+/// doc). Panics when their sizes differ.
 pub fn image_error(reference: &FrameImage, test: &FrameImage) -> ImageError {
     assert_eq!(
         (reference.width, reference.height),

@@ -1,5 +1,7 @@
 //! Accuracy measurements of the renderer against f64 references.
 
+#![warn(missing_docs)]
+
 pub mod drift;
 pub mod exact_image;
 pub mod geometry;

@@ -21,14 +21,19 @@ pub fn pinhole_count(image: &FrameImage, reference: &ReferenceImage) -> usize {
 
 /// The metrics of one render, with where they came from.
 pub struct Measurement<'a> {
+    /// The scene's short name (file stem, or `teapot`).
     pub scene: &'a str,
     /// `stats::frame_stats` of the render (settings, counts, times).
     pub stats: &'a FrameStats,
+    /// Geometric accuracy of the micropolygons.
     pub geometry: &'a GeometryStats,
+    /// Image error against the reference.
     pub image: &'a ImageError,
+    /// Pinholes ([`pinhole_count`]).
     pub pinholes: usize,
     /// Covered area of the render: the sum of its alpha, in square pixels.
     pub coverage_px: f64,
+    /// The reference render.
     pub reference: &'a ReferenceImage,
     /// Timed GPU frames behind `gpu_ms` and `wall_ms`.
     pub runs: u32,
@@ -42,6 +47,7 @@ pub struct Measurement<'a> {
 pub struct MeasureReport {
     /// The scene's short name (file stem, or `teapot`).
     pub scene: String,
+    /// The render's settings.
     pub settings: Settings,
     /// Median GPU ms (scheduler run plus resolve) over the timed frames; null without
     /// timestamp queries.
@@ -60,6 +66,7 @@ pub struct MeasureReport {
     pub micropolygons: u64,
     /// Micropolygons the geometric metrics measured (the CPU twin's drawn ones).
     pub micropolygons_measured: u64,
+    /// `micropolygons / ` the pixels with any coverage.
     pub micropolygons_per_covered_pixel: f64,
     /// PSNR (dB) of the 8-bit sRGB image over black against the reference; null when equal
     /// byte for byte (infinite).
@@ -73,18 +80,24 @@ pub struct MeasureReport {
     pub coverage_px: f64,
     /// Covered area of the exact surfaces (px²).
     pub reference_coverage_px: f64,
+    /// The reference render's settings and cost.
     pub reference: ReferenceInfo,
     /// Timed GPU frames.
     pub runs: u32,
+    /// Host ms of each metric.
     pub metrics_cpu_ms: MetricsCpuMs,
 }
 
 /// The render's settings (as in `FrameStats`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Settings {
+    /// The scheduling strategy (`megakernel`, `multipass`, `multipass-host`).
     pub strategy: String,
+    /// The GPU adapter's name.
     pub adapter: String,
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// Samples per pixel, [x, y].
     pub pixel_samples: [u32; 2],
@@ -113,8 +126,11 @@ pub struct ReferenceInfo {
 /// Host ms of each metric.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MetricsCpuMs {
+    /// The reference render ([`crate::exact_image::render_reference`]).
     pub reference: f64,
+    /// The geometric metrics ([`crate::geometry`]).
     pub geometry: f64,
+    /// PSNR and FLIP ([`crate::image_error::image_error`]).
     pub image_error: f64,
 }
 

@@ -17,25 +17,35 @@ use std::sync::Once;
 /// Marker shapes (one per pixel-sample setting in the sweep).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Shape {
+    /// A disc.
     Circle,
+    /// An axis-aligned square.
     Square,
+    /// A triangle, point up.
     Triangle,
+    /// A square turned 45 degrees.
     Diamond,
 }
 
+/// How a point is drawn.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Style {
     /// sRGB.
     pub colour: [u8; 3],
+    /// Marker shape.
     pub shape: Shape,
     /// Outline only.
     pub hollow: bool,
 }
 
+/// One marker of a panel, in data coordinates.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Point {
+    /// Position on the (log) x axis.
     pub x: f64,
+    /// Position on the (log) y axis.
     pub y: f64,
+    /// Its marker.
     pub style: Style,
     /// On the Pareto front: ringed and joined.
     pub front: bool,
@@ -46,9 +56,13 @@ pub struct Point {
 /// One chart. Points with a non-positive or non-finite coordinate are left out (log axes).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Panel {
+    /// Title above the chart.
     pub title: String,
+    /// Label of the x axis.
     pub x_label: String,
+    /// Label of the y axis.
     pub y_label: String,
+    /// The markers.
     pub points: Vec<Point>,
     /// A dashed horizontal reference line and its label (e.g. the 0.5 px requirement).
     pub hline: Option<(f64, String)>,
@@ -58,20 +72,30 @@ pub struct Panel {
 /// marker style, or None for a plain line of text, and its text).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Figure<'a> {
+    /// Title above the panels.
     pub title: &'a str,
+    /// The charts, row by row.
     pub panels: &'a [Panel],
+    /// Panels per row.
     pub columns: usize,
+    /// Legend lines: a marker style (or `None` for text alone) and its text.
     pub legend: &'a [(Option<Style>, String)],
 }
 
-/// Pixels of one panel.
+/// Panel width in pixels.
 pub const PANEL_W: u32 = 640;
+/// Panel height in pixels.
 pub const PANEL_H: u32 = 440;
+
+/// Per panel, the pixel position of each of its points in the figure, in the order of its
+/// points: `None` for a point left out.
+pub type PointPositions = Vec<Vec<Option<(i32, i32)>>>;
 const HEADER: u32 = 36;
 const LEGEND_LINE: u32 = 18;
 
 const FONT: &str = "sans-serif";
 const DARK: RGBColor = RGBColor(70, 70, 70);
+/// The highlight ring's colour, sRGB.
 pub const RED: [u8; 3] = [220, 20, 20];
 
 fn rgb(c: [u8; 3]) -> RGBColor {
@@ -133,7 +157,7 @@ impl Figure<'_> {
 
     /// The figure as PNG bytes, and each panel's drawn points' pixel positions (in the order
     /// of their points, `None` for points left out).
-    pub fn png(&self) -> Result<(Vec<u8>, Vec<Vec<Option<(i32, i32)>>>), PlotError> {
+    pub fn png(&self) -> Result<(Vec<u8>, PointPositions), PlotError> {
         let (w, h) = self.size();
         let mut buf = vec![0u8; (w * h * 3) as usize];
         let positions = {
@@ -175,7 +199,7 @@ impl Figure<'_> {
     fn draw<DB: DrawingBackend>(
         &self,
         root: &DrawingArea<DB, Shift>,
-    ) -> Result<Vec<Vec<Option<(i32, i32)>>>, PlotError> {
+    ) -> Result<PointPositions, PlotError> {
         register_fonts();
         root.fill(&WHITE).map_err(err)?;
         let (header, rest) = root.split_vertically(HEADER);

@@ -12,8 +12,11 @@ use reyes::scene::{Light, Material, Patch, Scene, SurfaceKind};
 /// An exact surface point of a patch.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SurfacePoint {
+    /// Position, camera space.
     pub p: DVec3,
+    /// Partial derivative dP/du, camera space.
     pub dpdu: DVec3,
+    /// Partial derivative dP/dv, camera space.
     pub dpdv: DVec3,
     /// Unit outside normal (after the patch's `flip_normal`).
     pub n: DVec3,
@@ -30,7 +33,7 @@ pub fn eval(patch: &Patch, u: f64, v: f64) -> SurfacePoint {
     let mut n = dpdu.cross(dpdv);
     // A rational patch's tangent along a collapsed edge is not exactly zero but rounding noise
     // of about 1e-16 |P| (quotient rule), at any angle: call it degenerate below 1e-12 of the
-    // control points' distance from the eye. (Polynomial: tiny = 0, the test as before.)
+    // control points' distance from the eye. (Polynomial: tiny = 0, an exact zero test.)
     let tiny = if patch.is_rational() {
         1.0e-12 * patch.cp.iter().map(|c| c.length()).fold(0.0, f64::max)
     } else {

@@ -23,6 +23,7 @@ pub struct PatchItem {
     pub cp: [f32; 48],
     /// Parameter range in the original patch: u0, u1, v0, v1.
     pub uv: [f32; 4],
+    /// Index of the original patch: into [`FrameData::patch_info`] and the scene's patches.
     pub patch_id: u32,
     /// Bits 0..7: splits so far; bits 8..15: splits made because of the near plane.
     pub depth: u32,
@@ -34,9 +35,11 @@ pub struct PatchItem {
 }
 
 impl PatchItem {
+    /// Splits from the original patch so far (bits 0..7 of `depth`).
     pub fn splits(&self) -> u32 {
         self.depth & 255
     }
+    /// Of those, the splits made because the item crossed the near plane (bits 8..15 of `depth`).
     pub fn eye_splits(&self) -> u32 {
         (self.depth >> 8) & 255
     }
@@ -48,24 +51,45 @@ impl PatchItem {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct FrameUniforms {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
+    /// Sub-samples per pixel along x (`PixelSamples`).
     pub spp_x: u32,
+    /// Sub-samples per pixel along y.
     pub spp_y: u32,
+    /// Focal length in pixels: half the shorter image side over tan(fov / 2), so that
+    /// [`crate::stages::project`] maps camera space to pixels.
     pub focal: f32,
+    /// Near clipping distance along camera-space z (`Clipping`).
     pub near: f32,
+    /// Far clipping distance along camera-space z (`Clipping`; capped at `f32::MAX`).
     pub far: f32,
+    /// Target micropolygon edge in pixels (adaptive dicing; [`RenderOptions::mp_size`]).
     pub mp_size: f32,
+    /// Fixed-bound dicing's screen bound in pixels ([`RenderOptions::bound_px`]); 0 for adaptive
+    /// dicing.
     pub bound_px: f32,
+    /// Most segments per grid side, 1..=15 (15 under fixed-bound dicing).
     pub grid_max: u32,
+    /// Most splits of one item (at most 255, the width of its split count); an item there is diced
+    /// however large it is (`C_DEPTH_LIMIT`).
     pub max_depth: u32,
+    /// Most near-plane splits of one item (at most 255); see [`RenderOptions::max_eye_splits`].
     pub max_eye_splits: u32,
+    /// Entries of the light table ([`FrameData::lights`]).
     pub n_lights: u32,
+    /// Seed of the per-sample hashes: sub-sample jitter and stochastic transparency.
     pub seed: u32,
-    /// The screen bucket a run renders; the sample buffer holds only its pixels.
+    /// The screen bucket a run renders (the whole image without a memory budget); the sample
+    /// buffer holds only its pixels. This is its left column, pixels.
     pub tile_x0: u32,
+    /// Top row of the bucket, pixels.
     pub tile_y0: u32,
+    /// Bucket width in pixels.
     pub tile_w: u32,
+    /// Bucket height in pixels.
     pub tile_h: u32,
     /// 1: micropolygons grow by their crack bound; 0 only to show what that buys.
     pub crack_dilation: u32,
@@ -149,6 +173,7 @@ impl FrameUniforms {
         }
     }
 
+    /// The tile covering the whole image (the frame without buckets).
     pub fn whole_image(&self) -> Tile {
         Tile {
             x0: 0,
@@ -162,9 +187,13 @@ impl FrameUniforms {
 /// A screen-space bucket: pixels `x0..x0 + w`, `y0..y0 + h`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Tile {
+    /// Left column, pixels.
     pub x0: u32,
+    /// Top row, pixels.
     pub y0: u32,
+    /// Width in pixels.
     pub w: u32,
+    /// Height in pixels.
     pub h: u32,
 }
 
@@ -173,39 +202,55 @@ pub struct Tile {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct GpuMaterial {
+    /// `Color` (Cs), linear RGB.
     pub color: [f32; 3],
     /// 0 constant, 1 matte, 2 plastic
     pub kind: u32,
+    /// `specularcolor`, linear RGB (plastic's highlight).
     pub specular: [f32; 3],
+    /// `Ka`: weight of the ambient light.
     pub ka: f32,
+    /// `Kd`: weight of the diffuse term.
     pub kd: f32,
+    /// `Ks`: weight of the specular term.
     pub ks: f32,
+    /// `roughness`: the highlight's exponent is `1 / roughness`.
     pub roughness: f32,
     /// `Opacity` (Os) as one fraction: the mean of its channels (docs/reyes.md, Opacity).
     pub opacity: f32,
 }
 
+/// A light as the GPU stages read it (`Light` in common.wgsl), camera space: the f32 form of a
+/// [`crate::scene::Light`]. 32 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct GpuLight {
+    /// Intensity times light colour, linear RGB; a point light's falls off as 1 / distance².
     pub color: [f32; 3],
     /// 0 ambient, 1 distant (`vec` = direction of travel), 2 point (`vec` = position)
     pub kind: u32,
+    /// Direction of travel (distant) or position (point), camera space; unused for ambient.
     pub vec: [f32; 3],
+    /// Padding to the WGSL struct's 32 bytes.
     pub pad: f32,
 }
 
 /// Everything uploaded for one frame.
 #[derive(Clone, Debug)]
 pub struct FrameData {
+    /// The uniform block (`Frame` in common.wgsl).
     pub frame: FrameUniforms,
+    /// The material table, indexed by [`PatchInfo::material`].
     pub materials: Vec<GpuMaterial>,
+    /// The light table, [`FrameUniforms::n_lights`] entries.
     pub lights: Vec<GpuLight>,
+    /// Per original patch, indexed by [`PatchItem::patch_id`].
     pub patch_info: Vec<PatchInfo>,
     /// The colour fields of the patches that have primitive variables, referenced by
     /// `PatchInfo::cs` / `os` ([`field_ref`]), and the weights of the rational patches
     /// (`PatchInfo::weights`); empty when no patch has either.
     pub primvars: Vec<[f32; 4]>,
+    /// The root items: one per scene patch, in scene order, the input of Bound.
     pub items: Vec<PatchItem>,
     /// See [`RenderOptions::memory_budget`].
     pub memory_budget: Option<u64>,
@@ -242,12 +287,12 @@ pub struct SceneFeatures {
     /// Some patch is displaced (`PATCH_DISPLACED`).
     pub displacement: bool,
     /// The frame is rasterized with [`RasterMode::NearestSample`] (`SCENE_NEAREST_RASTER`):
-    /// without it the program holds bounding-box rasterization alone, so the default mode
-    /// runs exactly the code it ran before the option existed.
+    /// without it the program holds bounding-box rasterization alone, and the default mode
+    /// pays nothing for the other.
     pub nearest_raster: bool,
     /// The frame samples time or the lens (`SCENE_UVT`: motion blur or depth of field):
-    /// without it none of that code is compiled, and a still pinhole frame runs exactly the
-    /// sampler it ran before.
+    /// without it none of that code is compiled, and a still pinhole frame runs the plain
+    /// sampler alone.
     pub uvt: bool,
 }
 
@@ -750,8 +795,8 @@ mod tests {
             if i == 5 {
                 assert_eq!(info.flags & PATCH_RATIONAL, PATCH_RATIONAL);
                 assert_eq!(info.weights, 0);
-                for k in 0..16 {
-                    assert_eq!(d.primvars[k / 4][k % 4], h[k][3]);
+                for (k, q) in h.iter().enumerate() {
+                    assert_eq!(d.primvars[k / 4][k % 4], q[3]);
                 }
                 assert_eq!(h[6][3], 1.0, "scaled to a largest of 1");
                 assert_eq!(h[9][3], 0.125);

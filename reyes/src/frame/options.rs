@@ -7,8 +7,11 @@ use super::*;
 /// Quality and size settings of a render; `None` fields come from the scene.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderOptions {
+    /// Image width in pixels; `None`: the scene's `Format`.
     pub width: Option<u32>,
+    /// Image height in pixels; `None`: the scene's `Format`.
     pub height: Option<u32>,
+    /// Sub-samples per pixel (x, y); `None`: the scene's `PixelSamples`.
     pub pixel_samples: Option<(u32, u32)>,
     /// Target micropolygon edge in pixels (RenderMan's shading rate is its square).
     pub mp_size: f32,
@@ -16,10 +19,13 @@ pub struct RenderOptions {
     pub bound_px: Option<f32>,
     /// Most segments per grid side (grid points = segments + 1 <= 16).
     pub grid_max: u32,
+    /// Most splits of one item (clamped to 255); an item that reaches it is diced as it is.
     pub max_depth: u32,
     /// Most of an item's splits made because it crosses the near plane (each is also one of
     /// `max_depth`); a piece that reaches it is diced and clipped, never dropped.
     pub max_eye_splits: u32,
+    /// Seed of the sub-sample jitter and stochastic transparency; the same seed gives the same
+    /// image.
     pub seed: u32,
     /// Bytes of working memory (sample buffer plus queues) a frame may use; beyond it the
     /// frame renders in screen buckets.

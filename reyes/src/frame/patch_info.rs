@@ -9,6 +9,7 @@ use super::*;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct PatchInfo {
+    /// Index into [`FrameData::materials`].
     pub material: u32,
     /// bit 0: flip the normal; bit 1: two-sided; bit 2 ([`PATCH_RATIONAL`]): some weight of
     /// the patch is not 1.
@@ -53,7 +54,9 @@ pub fn motion_ref(table: &mut Vec<[f32; 4]>, m: &glam::DMat4) -> Result<u32, Err
 /// `PatchInfo::cs` / `os`; `FIELD_*` in common.wgsl): one value, 4 bilinear corners, or 16
 /// bicubic Bezier coefficients (`crate::scene::ColorField`).
 pub const FIELD_FLAT: u32 = 1;
+/// 4 values at the corners (u, v) = (0, 0), (1, 0), (0, 1), (1, 1), interpolated bilinearly.
 pub const FIELD_BILINEAR: u32 = 2;
+/// 16 bicubic Bezier coefficients, `4*v + u` order.
 pub const FIELD_BEZIER: u32 = 3;
 
 /// Appends `field` to the primitive-variable table (one `[r, g, b, 0]` entry per value, in
@@ -96,6 +99,7 @@ pub const PATCH_DISPLACED: u32 = 8;
 
 /// Kinds of displacement pattern in a displacement entry (`DISPLACE_*` in common.wgsl).
 pub const DISPLACE_BUMPS: u32 = 0;
+/// A displacement map's texels ([`crate::scene::DisplacementPattern::Map`]).
 pub const DISPLACE_MAP: u32 = 1;
 
 /// Which normal displaced grid points move along (`--displacement-normals`).

@@ -22,10 +22,10 @@ pub struct Pipelines {
 }
 
 /// The pipeline in `cell`, built by `make` the first time.
-fn get_or_make<'a>(
-    cell: &'a OnceLock<wgpu::ComputePipeline>,
+fn get_or_make(
+    cell: &OnceLock<wgpu::ComputePipeline>,
     make: impl FnOnce() -> Result<wgpu::ComputePipeline, RunError>,
-) -> Result<&'a wgpu::ComputePipeline, RunError> {
+) -> Result<&wgpu::ComputePipeline, RunError> {
     if let Some(p) = cell.get() {
         return Ok(p);
     }

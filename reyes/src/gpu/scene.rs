@@ -98,7 +98,7 @@ impl SceneBuffers {
 
     /// Makes the tables hold `data`'s, writing only those that changed (a frame of the same
     /// scene writes nothing). The frame uniform is left alone: renderers write it per bucket
-    /// ([`SceneBuffers::write_frame`]). Errors: as [`SceneBuffers::new`].
+    /// (`SceneBuffers::write_frame`). Errors: as [`SceneBuffers::new`].
     pub fn update(&mut self, gpu: &Gpu, data: &FrameData) -> Result<(), RunError> {
         let mut stale = self.materials.set(gpu, &data.materials)?;
         stale |= self.lights.set(gpu, &data.lights)?;

@@ -73,6 +73,7 @@ pub struct PeerFrame {
     pub gpu_ms: Option<f64>,
     /// Host time between this frame's completion and the previous one's.
     pub wall_ms: f64,
+    /// What the frame's tessellation counted.
     pub counts: TessCounts,
     /// Why the frame was drawn again (its patches did not fit the buffers).
     pub redrawn: Option<String>,
@@ -113,9 +114,11 @@ pub struct Tessellation {
     pub grids: Vec<[u32; 4]>,
     /// Per patch: its boundaries' segments ([`GridRate::edges`]).
     pub edges: Vec<[u32; 4]>,
+    /// The grid points of every drawn patch, each grid's from its first vertex (`grids`).
     pub vertices: Vec<RasterVertex>,
     /// 6 per quad: triangles (a, b, c) and (a, c, d) of quad corners a b c d.
     pub indices: Vec<u32>,
+    /// What the tessellation counted.
     pub counts: TessCounts,
 }
 

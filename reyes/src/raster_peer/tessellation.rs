@@ -26,6 +26,7 @@ pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct TessParams {
+    /// Patches in the frame (threads of `tess_rates`).
     pub patches: u32,
     /// Threads per row of `tess_rates`'s 2D dispatch (one thread per patch).
     pub row: u32,
@@ -37,6 +38,7 @@ pub struct TessParams {
     pub max_rate: u32,
     /// Tiles (64 grid points and quads of one patch) the tile list holds.
     pub tile_capacity: u32,
+    /// Padding to a multiple of 16 bytes.
     pub pad: [u32; 2],
 }
 
@@ -47,9 +49,13 @@ pub struct TessParams {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct RasterVertex {
+    /// Clip x over the near distance: `2 focal px / (width near)`.
     pub x: f32,
+    /// Clip y over the near distance: `2 focal py / (height near)`.
     pub y: f32,
+    /// Clip w: `pz / near`.
     pub w: f32,
+    /// Shaded colour, packed by [`stages::shade::pack_color`].
     pub color: u32,
 }
 
@@ -57,7 +63,9 @@ pub struct RasterVertex {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct RasterResolveParams {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// Samples of the depth target.
     pub samples: u32,
@@ -65,6 +73,7 @@ pub struct RasterResolveParams {
     pub row: u32,
     /// The near distance (depth = near / z).
     pub near: f32,
+    /// Padding to a multiple of 16 bytes.
     pub pad: [u32; 3],
 }
 
@@ -124,7 +133,9 @@ impl TessCounts {
 /// sharing a boundary place the same points on it (no T-junction cracks; [`edge_param`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct GridRate {
+    /// Segments `[nu, nv]` of the grid's interior; `[0, 0]` when culled.
     pub n: [u32; 2],
+    /// Segments of the boundary curves v = 0, v = 1, u = 0, u = 1.
     pub edges: [u32; 4],
 }
 

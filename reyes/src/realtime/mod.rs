@@ -76,9 +76,11 @@ pub struct Orbit {
     /// Column-major affine transform of camera-space points ([`orbit::orbit_matrix`],
     /// [`crate::camera::ViewCamera::transform`]).
     pub m: [[f32; 4]; 4],
+    /// Root patches (threads of the roots dispatch).
     pub patches: u32,
     /// Threads per row of the 2D dispatch.
     pub row: u32,
+    /// Padding to a multiple of 16 bytes.
     pub pad: [u32; 2],
 }
 

@@ -3,7 +3,7 @@
 //!
 //! Method. Each patch is split recursively (de Casteljau halving of its control net, so every
 //! cell corner is an exact surface point) until the cell's projected control net is smaller
-//! than [`SIZE_PX`] and within [`FLAT_PX`] of the bilinear map of its projected corners (a
+//! than `SIZE_PX` (0.25 px) and within `FLAT_PX` (0.02 px) of the bilinear map of its projected corners (a
 //! bound on the brief's "centre versus bilinear corners" test that also catches curved
 //! edges and folds). Cells whose projected control net (a conservative bound: the surface
 //! lies in the net's convex hull, and a perspective projection keeps hulls) holds no sample
@@ -12,7 +12,7 @@
 //! A leaf covers the samples inside its projected boundary loop (non-zero winding, boundary
 //! inclusive). The loop is the cell's four boundary curves, each refined by halving wherever
 //! a sample lies inside the projected hull of the piece, until the piece is straight to
-//! [`EDGE_EPS_PX`]. That rule depends only on the piece itself and on the global sample grid,
+//! `EDGE_EPS_PX` (1e-7 px). That rule depends only on the piece itself and on the global sample grid,
 //! and halving is bit-exact in either direction, so two cells sharing a curve (within a
 //! patch, or across patches whose boundary control points are bit-identical) classify every
 //! sample identically on both sides: the result is watertight, with no T-junction cracks.
@@ -52,7 +52,9 @@ const BOX_SLACK: f64 = 1e-9;
 /// Per-pixel covered fraction of a regular sub-sample grid.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Coverage {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// Row-major, `frac[y * width + x]`, in [0, 1].
     pub frac: Vec<f32>,

@@ -26,13 +26,13 @@ pub fn euclidean_net(h: &HomNet) -> [DVec3; 16] {
 }
 
 /// Point, d/du and d/dv of the rational patch with homogeneous net `h` at (u, v)
-/// ([`crate::scene::rational::eval_homogeneous`]).
+/// (`scene::rational::eval_homogeneous`).
 pub fn eval_rational(h: &HomNet, u: f64, v: f64) -> (DVec3, DVec3, DVec3) {
     crate::scene::rational::eval_homogeneous(h, u, v)
 }
 
-/// Point, d/du and d/dv of patch `p` at (u, v): [`eval_bezier`] for a polynomial patch (the
-/// same numbers as before rational patches existed), [`eval_rational`] otherwise.
+/// Point, d/du and d/dv of patch `p` at (u, v): [`eval_bezier`] for a polynomial patch (no
+/// division by a weight of 1 in its numbers), [`eval_rational`] otherwise.
 pub fn eval_patch(p: &Patch, u: f64, v: f64) -> (DVec3, DVec3, DVec3) {
     if p.is_rational() {
         eval_rational(&homogeneous(p), u, v)

@@ -14,7 +14,9 @@ pub type Mat4x4 = [[f64; 4]; 4];
 /// a `PatchMesh`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Basis {
+    /// The basis matrix, rows for t^3, t^2, t, 1.
     pub matrix: Mat4x4,
+    /// Control points from one patch of a `PatchMesh` to the next.
     pub step: u32,
 }
 
@@ -64,22 +66,27 @@ const BEZIER_INV: Mat4x4 = [
 ];
 
 impl Basis {
+    /// `"bezier"`, step 3.
     pub const BEZIER: Basis = Basis {
         matrix: BEZIER,
         step: 3,
     };
+    /// `"b-spline"` (uniform cubic B-spline), step 1.
     pub const B_SPLINE: Basis = Basis {
         matrix: B_SPLINE,
         step: 1,
     };
+    /// `"catmull-rom"`, step 1.
     pub const CATMULL_ROM: Basis = Basis {
         matrix: CATMULL_ROM,
         step: 1,
     };
+    /// `"hermite"`: control points alternate positions and tangents, step 2.
     pub const HERMITE: Basis = Basis {
         matrix: HERMITE,
         step: 2,
     };
+    /// `"power"`: the control points are the polynomial's coefficients, step 4.
     pub const POWER: Basis = Basis {
         matrix: POWER,
         step: 4,
@@ -97,7 +104,7 @@ impl Basis {
         })
     }
 
-    pub fn is_bezier(&self) -> bool {
+    pub(crate) fn is_bezier(&self) -> bool {
         self.matrix == BEZIER
     }
 

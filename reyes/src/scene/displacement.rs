@@ -19,7 +19,10 @@ pub enum DisplacementPattern {
     /// `"bumps"`: (sin(pi f u) sin(pi f v))^2 with f = `frequency` (RIB `"frequency"`, a
     /// whole number 1..=[`MAX_BUMPS_FREQUENCY`], default 1): f x f bumps per patch, 0 on every
     /// patch edge, so neighbouring patches agree wherever they meet.
-    Bumps { frequency: u32 },
+    Bumps {
+        /// Bumps per patch side, 1..=[`MAX_BUMPS_FREQUENCY`].
+        frequency: u32,
+    },
     /// `"mapped"` with `"mapname"`: an image's luminance, sampled bilinearly at (u, v) (texel
     /// centres at (x + 0.5) / width, clamped at the edges; v = 0 is the image's top row).
     Map(Arc<DisplacementMap>),
@@ -31,8 +34,11 @@ pub const MAX_BUMPS_FREQUENCY: u32 = 64;
 /// A displacement map: luminance per texel, row-major from the top row, in [0, 1].
 #[derive(Clone, Debug, PartialEq)]
 pub struct DisplacementMap {
+    /// Width in texels.
     pub width: u32,
+    /// Height in texels.
     pub height: u32,
+    /// `width * height` luminances in [0, 1], row-major from the top row.
     pub texels: Vec<f32>,
 }
 
@@ -71,6 +77,7 @@ impl DisplacementMap {
 /// A patch's displacement, in camera space.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Displacement {
+    /// The scalar field, in [0, 1] over the original patch's (u, v).
     pub pattern: DisplacementPattern,
     /// Camera-space distance per unit of the pattern: `"Km"` times the object-to-camera
     /// transform's mean scale (the cube root of its determinant's magnitude; exact for

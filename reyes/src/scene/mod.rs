@@ -115,6 +115,7 @@ pub struct Scene {
     pub height: u32,
     /// Samples per pixel in x and y (`PixelSamples`, default (2, 2)).
     pub pixel_samples: (u32, u32),
+    /// Projection, clipping, shutter and lens.
     pub camera: Camera,
     /// Bicubic Bezier patches, control points in camera space.
     pub patches: Vec<Patch>,
@@ -152,6 +153,7 @@ pub struct Patch {
     /// sum(B_i B_j w_ij P_ij) / sum(B_i B_j w_ij). All 1.0 for a polynomial patch (every loader
     /// but rational `NuPatch` "Pw" and the quadrics); always finite and positive.
     pub w: [f64; 16],
+    /// Index into [`Scene::materials`].
     pub material: u32,
     /// True when the camera-space geometric normal dPdu x dPdv must be negated to get the
     /// surface's OUTSIDE normal as RenderMan defines it (`Orientation`/`ReverseOrientation`
@@ -188,16 +190,22 @@ impl Patch {
 /// (0-based; for meshes and NURBS, the index of the sub-patch or span).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct PatchSource {
+    /// The scene file, as named to the loader.
     pub file: String,
+    /// Line of the request in that file.
     pub line: u32,
+    /// Index of the patch within the request.
     pub index: u32,
 }
 
 /// The three standard RenderMan surface shaders this renderer implements.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum SurfaceKind {
+    /// `constant`: the surface colour, unlit.
     Constant,
+    /// `matte`: `Cs * (Ka ambient + Kd diffuse)`.
     Matte,
+    /// `plastic`: matte plus a highlight in `specularcolor`, `Ks specular`.
     Plastic,
     /// RenderMan's `metal`: `Cs * (Ka ambient + Ks specular)`, no diffuse term, the highlight
     /// tinted by the surface colour.
@@ -207,15 +215,21 @@ pub enum SurfaceKind {
 /// A surface shader instance with its parameters plus the `Color`/`Opacity` attributes.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
+    /// Which shader.
     pub kind: SurfaceKind,
     /// `Color` (Cs), default (1, 1, 1).
     pub color: DVec3,
     /// `Opacity` (Os), default (1, 1, 1).
     pub opacity: DVec3,
+    /// `"Ka"`: weight of the ambient light.
     pub ka: f64,
+    /// `"Kd"`: weight of the diffuse term.
     pub kd: f64,
+    /// `"Ks"`: weight of the specular term.
     pub ks: f64,
+    /// `"roughness"`: the highlight's exponent is `1 / roughness`.
     pub roughness: f64,
+    /// `"specularcolor"` of plastic, default (1, 1, 1).
     pub specular_color: DVec3,
 }
 
@@ -245,16 +259,23 @@ impl Material {
 /// A light in camera space. `color` is already intensity * lightcolor.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Light {
+    /// `ambientlight`: the same light on every point, from no direction.
     Ambient {
+        /// Intensity times light colour, linear RGB.
         color: DVec3,
     },
     /// `dir` is a unit vector in the direction the light TRAVELS (from -> to).
     Distant {
+        /// Intensity times light colour, linear RGB.
         color: DVec3,
+        /// Unit direction of travel, camera space.
         dir: DVec3,
     },
+    /// `pointlight`: from a position, falling off as 1 / distance².
     Point {
+        /// Intensity times light colour, linear RGB.
         color: DVec3,
+        /// Position, camera space.
         pos: DVec3,
     },
 }
@@ -262,8 +283,11 @@ pub enum Light {
 /// The input formats `load` understands.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum InputFormat {
+    /// RenderMan Interface Bytestream (`.rib`).
     Rib,
+    /// Newell's indexed teapot format: patches as 16 vertex indices each, then the vertices.
     Newell,
+    /// Plain BPT (Bezier patch text): per patch its degrees `3 3` and 16 control points.
     Bpt,
 }
 

@@ -14,6 +14,10 @@ use glam::DVec3;
 /// How one colour-valued primitive variable varies over one bicubic patch, in the patch's
 /// own parameters (u, v) in [0, 1]².
 #[derive(Clone, Debug, PartialEq)]
+#[allow(
+    clippy::large_enum_variant,
+    reason = "fields live in a patch's boxed `Primvars`; boxing `Bezier` too would add an allocation per field"
+)]
 pub enum ColorField {
     /// Class constant or uniform: one value over the whole patch.
     Flat(DVec3),

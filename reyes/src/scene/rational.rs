@@ -126,7 +126,7 @@ pub fn eval_homogeneous(h: &[DVec4; 16], u: f64, v: f64) -> (DVec3, DVec3, DVec3
 
 /// Evaluates the rational bicubic Bezier patch sum(B_i(u) B_j(v) w_ij P_ij) / sum(B_i B_j w_ij)
 /// (cp and w indexed [4*j + i], u varies fastest, as in [`Patch`](super::Patch)) at (u, v) in
-/// [0, 1]^2: the point and its derivatives dP/du and dP/dv ([`eval_homogeneous`]). With all
+/// [0, 1]^2: the point and its derivatives dP/du and dP/dv (`eval_homogeneous`). With all
 /// weights 1 this is [`eval_bezier`](super::eval_bezier).
 pub fn eval_rational_bezier(
     cp: &[DVec3; 16],

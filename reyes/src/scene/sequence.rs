@@ -46,6 +46,7 @@ pub struct SceneFrame {
 pub struct FrameSequence {
     /// At least one frame.
     pub frames: Vec<SceneFrame>,
+    /// The file's warnings, one per kind of skipped input.
     pub warnings: Vec<String>,
 }
 
@@ -128,6 +129,7 @@ impl FrameRanges {
         Ok(FrameRanges(out))
     }
 
+    /// True when frame `n` lies in one of the ranges (ends included).
     pub fn contains(&self, n: u32) -> bool {
         self.0.iter().any(|&(a, b)| (a..=b).contains(&n))
     }

@@ -16,7 +16,7 @@ pub fn teapot_object_patches() -> Vec<[DVec3; 16]> {
         .collect()
 }
 
-/// The Utah teapot, 800x600, framed by [`frame`].
+/// The Utah teapot, 800x600, framed by [`super::framed_scene`].
 pub fn builtin_teapot() -> Scene {
     let patches = teapot_object_patches()
         .into_iter()

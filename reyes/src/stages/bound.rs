@@ -12,8 +12,11 @@ use glam::{Vec2, Vec3, Vec4};
 
 /// See `MAX_DILATE_PX` and `CULL_MARGIN_PX` in common.wgsl: bucketed renders stay exact.
 pub const MAX_DILATE_PX: f32 = 2.0;
+/// Pixels beyond the bucket within which an item is kept rather than culled as off screen
+/// (larger than `MAX_DILATE_PX`, so no dilated micropolygon that reaches the bucket is lost).
 pub const CULL_MARGIN_PX: f32 = 3.0;
 
+/// Why Bound drops an item (the `C_CULL_*` counters).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Cull {
     /// Wholly in front of the near plane or behind the far plane.
@@ -24,19 +27,26 @@ pub enum Cull {
     Backface,
 }
 
+/// What Bound does with an item ([`bound`]).
 #[derive(Clone, Debug, PartialEq)]
 pub enum Decision {
+    /// Drop it, for this reason.
     Cull(Cull),
     /// Split along u (else v); `eye` marks a near-plane split (the item's count is already raised).
     Split {
+        /// Split along u, else along v.
         along_u: bool,
+        /// The item to split.
         item: PatchItem,
+        /// A near-plane split.
         eye: bool,
     },
     /// Dice with the rates and dilation filled in; `depth_limited` when it wanted another split.
     /// A grid still crossing the near plane has [`super::NEAR_CLIP_GRID`] set in its rates.
     Dice {
+        /// The item with its rates and dilation set.
         item: PatchItem,
+        /// It wanted another split but had reached [`crate::frame::FrameUniforms::max_depth`].
         depth_limited: bool,
     },
 }

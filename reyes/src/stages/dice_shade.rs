@@ -183,6 +183,10 @@ pub fn color_field(table: &[[f32; 4]], field: u32, u: f32, v: f32) -> Vec3 {
         _ => {
             let (bu, bv) = (bern3(u), bern3(v));
             let mut out = Vec3::ZERO;
+            #[allow(
+                clippy::needless_range_loop,
+                reason = "the index form of the WGSL twin, summed in the same order"
+            )]
             for j in 0..4 {
                 for i in 0..4 {
                     out += c(4 * j + i) * (bu[i] * bv[j]);

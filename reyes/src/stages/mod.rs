@@ -14,16 +14,24 @@ use glam::{Vec3, Vec4};
 
 /// Counters the stages keep, indexed like `C_*` in `shaders/reyes/common.wgsl`.
 pub const C_CULL_CLIP: usize = 0;
+/// Items culled because their screen bound misses the bucket.
 pub const C_CULL_OFFSCREEN: usize = 1;
 /// Grids diced with near-plane clipping: pieces still crossing the plane after the allowed
 /// eye splits.
 pub const C_NEAR_CLIPPED: usize = 2;
+/// Grids diced at `max_depth` although they wanted another split.
 pub const C_DEPTH_LIMIT: usize = 3;
+/// Micropolygons shaded and sampled.
 pub const C_MICROPOLYGONS: usize = 4;
+/// Deepest split count of a diced item (a maximum, not a sum).
 pub const C_MAX_DEPTH: usize = 5;
+/// Splits made because an item crossed the near plane.
 pub const C_EYE_SPLITS: usize = 6;
+/// Micropolygons culled as back-facing (`Sides 1`).
 pub const C_BACKFACE: usize = 7;
+/// Items culled in Bound as back-facing at every point.
 pub const C_CULL_BACKFACE: usize = 8;
+/// Words of the counter buffer (the `C_*` indices and room to spare).
 pub const COUNTERS: usize = 16;
 
 /// `NEAR_CLIP_GRID` in common.wgsl: a bit of `PatchItem::rates` marking a grid that crosses the
@@ -67,6 +75,10 @@ pub fn cp_h(cp: &ControlNet, w: &Weights, i: usize) -> Vec4 {
 }
 
 /// `to_euclidean` in common.wgsl: each homogeneous point divided by its weight.
+#[allow(
+    clippy::needless_range_loop,
+    reason = "the index form of the WGSL twin"
+)]
 pub fn to_euclidean(cp: &ControlNet, w: &Weights) -> ControlNet {
     let mut e = *cp;
     for k in 0..16 {
@@ -129,6 +141,9 @@ pub fn item_weights(
     (info.flags & PATCH_RATIONAL != 0).then(|| rational_weights(primvars, info.weights, item.uv))
 }
 
+/// Pixel position (x right, y down, origin at the image's top left) of the camera-space point
+/// `p`, `z > 0`: the pinhole projection with [`crate::frame::FrameUniforms::focal`]
+/// (`project` in common.wgsl).
 pub fn project(f: &crate::frame::FrameUniforms, p: Vec3) -> [f32; 2] {
     [
         0.5 * f.width as f32 + f.focal * p.x / p.z,

@@ -116,7 +116,9 @@ pub(super) fn micropolygon_color(q: &[[f32; 4]; 4], two_sided: bool) -> Option<u
 /// (stochastic transparency, Enderton et al. 2010, "Stochastic Transparency").
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Cover {
+    /// Fraction of samples covered, in [0, 1]: the micropolygon's opacity.
     pub alpha: f32,
+    /// Hash of the original patch, mixed into each sample's coverage decision.
     pub salt: u32,
 }
 

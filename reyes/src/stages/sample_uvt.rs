@@ -12,6 +12,7 @@ use glam::{Vec2, Vec3};
 
 /// `UVT_SALT` and `PERM_SALT` in sample_uvt.wgsl.
 pub const UVT_SALT: u32 = 0x9e3779b9;
+/// Salt of the hash that picks an Interleave UVT tile's permutation.
 pub const PERM_SALT: u32 = 0x632be5ab;
 /// `UVT_TABLE`: the side of the repeated table of per-pixel samples (bounding box).
 pub const UVT_TABLE: u32 = 64;

@@ -44,6 +44,7 @@ pub fn shade(p: Vec3, n: Vec3, m: &GpuMaterial, cs: Vec3, lights: &[GpuLight]) -
     c
 }
 
+/// The sRGB transfer function (IEC 61966-2-1) of a linear value, clamped to [0, 1] first.
 pub fn srgb_encode(x: f32) -> f32 {
     let c = x.clamp(0.0, 1.0);
     if c <= 0.0031308 {
@@ -53,6 +54,7 @@ pub fn srgb_encode(x: f32) -> f32 {
     }
 }
 
+/// The inverse of [`srgb_encode`]: linear value of an sRGB-encoded `x` in [0, 1].
 pub fn srgb_decode(x: f32) -> f32 {
     if x <= 0.04045 {
         x / 12.92
