@@ -445,7 +445,7 @@ fn frame_sequences_write_one_image_per_frame() {
             assert!(png(&p) == *img, "{folder}: {}", p.display());
             std::fs::remove_file(p).unwrap();
         }
-        assert!(!dir.join(format!("teapot.0001.png")).exists(), "{folder}");
+        assert!(!dir.join("teapot.0001.png").exists(), "{folder}");
     }
     // One frame selected and a plain `-o` name: that name.
     let (ok, err) = reyes(&dir, &[&scene, "--cpu", "-o", "one.png", "--frames", "2"]);

@@ -3,6 +3,7 @@
 //! BFS (`workloads::frontier_bfs`), every run's levels equal to the CPU BFS's. Runs
 //! record the Graph500 traversed edges, so the report gives GTEPS.
 
+use crate::error::Error;
 use crate::strategy::GpuConfig;
 use crate::suite::Scale;
 use crate::workload::{ProblemWorkload, ScheduledProblem};
@@ -124,7 +125,7 @@ pub fn scales(scale: Scale) -> Vec<u32> {
 pub fn suite_workload(
     scale: Scale,
     config: GpuConfig,
-) -> Result<ProblemWorkload<BfsParams>, String> {
+) -> Result<ProblemWorkload<BfsParams>, Error> {
     let sizes = scales(scale)
         .into_iter()
         .map(|s| graph(s).map(|p| (format!("scale={s}"), p)))
@@ -133,10 +134,7 @@ pub fn suite_workload(
 }
 
 /// One graph of the command line's scale: `bfs`, one size.
-pub fn single_workload(
-    scale: u32,
-    config: GpuConfig,
-) -> Result<ProblemWorkload<BfsParams>, String> {
+pub fn single_workload(scale: u32, config: GpuConfig) -> Result<ProblemWorkload<BfsParams>, Error> {
     Ok(ProblemWorkload::new(
         "bfs",
         vec![(format!("scale={scale}"), graph(scale)?)],
@@ -144,6 +142,6 @@ pub fn single_workload(
     ))
 }
 
-fn graph(scale: u32) -> Result<BfsParams, String> {
-    BfsParams::graph500(scale, SEED).map_err(|e| format!("R-MAT scale {scale}: {e}"))
+fn graph(scale: u32) -> Result<BfsParams, Error> {
+    BfsParams::graph500(scale, SEED).map_err(|source| Error::Graph { scale, source })
 }

@@ -1,5 +1,6 @@
 //! The workloads `schedbench` knows, by command-line name, and which of them the suite runs.
 
+use crate::error::Error;
 use crate::reyes_frames::{ReyesWorkload, SuiteScene};
 use crate::strategy::GpuConfig;
 use crate::suite::Scale;
@@ -45,7 +46,7 @@ impl WorkloadName {
 
     /// The suite's workloads of this kind at `scale`; an error when their input cannot be read
     /// (Killeroo's file) or generated (an R-MAT graph).
-    pub fn suite(self, scale: Scale, config: &GpuConfig) -> Result<Vec<Box<dyn Workload>>, String> {
+    pub fn suite(self, scale: Scale, config: &GpuConfig) -> Result<Vec<Box<dyn Workload>>, Error> {
         let c = config.clone();
         match self {
             WorkloadName::Tree => {

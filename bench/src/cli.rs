@@ -156,6 +156,10 @@ pub enum Enqueue {
     Outbox,
 }
 
+// The value parsers below return `Result<T, String>`: that is clap's contract for a
+// `value_parser` function (the text becomes the usage error, exit 2), not the command's error
+// type (`crate::error::Error`).
+
 fn parse_item_layout(s: &str) -> Result<ItemLayout, String> {
     ItemLayout::parse(s)
         .ok_or_else(|| format!("unknown item layout `{s}` (known: interleaved, planar)"))

@@ -1,6 +1,7 @@
 //! Report files written whole or not at all: each is written to a temporary file in the
 //! target folder (`tempfile`, removed if anything fails) and renamed over its name at the end.
 
+use crate::error::Error;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use tempfile::NamedTempFile;
@@ -12,41 +13,44 @@ pub struct PendingFile {
 }
 
 impl PendingFile {
-    pub fn new(dir: &Path, name: &str) -> Result<PendingFile, String> {
+    pub fn new(dir: &Path, name: &str) -> Result<PendingFile, Error> {
         let tmp = tempfile::Builder::new()
             .prefix(&format!(".{name}."))
             .suffix(".partial")
             .permissions(reyes::output::new_file_permissions())
             .tempfile_in(dir)
-            .map_err(|e| format!("{}: {e}", dir.display()))?;
+            .map_err(|source| Error::File {
+                path: dir.to_path_buf(),
+                source,
+            })?;
         Ok(PendingFile {
             tmp,
             path: dir.join(name),
         })
     }
 
-    pub fn write(&mut self, bytes: &[u8]) -> Result<(), String> {
-        self.tmp
-            .write_all(bytes)
-            .map_err(|e| format!("{}: {e}", self.path.display()))
+    pub fn write(&mut self, bytes: &[u8]) -> Result<(), Error> {
+        self.tmp.write_all(bytes).map_err(|source| Error::File {
+            path: self.path.clone(),
+            source,
+        })
     }
 
     /// Flushes to disk and renames the file to its name.
-    pub fn finish(self) -> Result<PathBuf, String> {
+    pub fn finish(self) -> Result<PathBuf, Error> {
         let path = self.path;
-        self.tmp
-            .as_file()
-            .sync_all()
-            .map_err(|e| format!("{}: {e}", path.display()))?;
-        self.tmp
-            .persist(&path)
-            .map_err(|e| format!("{}: {}", path.display(), e.error))?;
+        let file_error = |source| Error::File {
+            path: path.clone(),
+            source,
+        };
+        self.tmp.as_file().sync_all().map_err(file_error)?;
+        self.tmp.persist(&path).map_err(|e| file_error(e.error))?;
         Ok(path)
     }
 }
 
 /// Writes `bytes` as `dir/name` through a temporary file.
-pub fn write_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf, String> {
+pub fn write_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf, Error> {
     let mut f = PendingFile::new(dir, name)?;
     f.write(bytes)?;
     f.finish()

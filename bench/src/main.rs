@@ -10,6 +10,7 @@
 mod bfs;
 mod catalog;
 mod cli;
+mod error;
 mod files;
 mod mandelbrot;
 mod plot;
@@ -25,18 +26,18 @@ mod workload;
 use catalog::WorkloadName;
 use clap::Parser;
 use cli::Cli;
+use error::Error;
 use scheduler::Gpu;
 use std::process::ExitCode;
 
-fn run_suite(cli: &Cli) -> Result<bool, String> {
+fn run_suite(cli: &Cli) -> Result<bool, Error> {
     let only: Vec<WorkloadName> = cli.workload.into_iter().collect();
     let needs_reyes = only.is_empty() || only.contains(&WorkloadName::Reyes);
     let gpu = if needs_reyes {
         Gpu::from_env_requiring(reyes::gpu_render::required_features())
     } else {
         Gpu::from_env()
-    }
-    .map_err(|e| e.to_string())?;
+    }?;
     let options = suite::SuiteOptions {
         out: cli.out.clone().expect("clap requires --out with --suite"),
         scale: cli.size,

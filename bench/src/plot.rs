@@ -4,6 +4,7 @@
 //! compiled into the binary (Ubuntu Light, from `epaint_default_fonts`), so no system font or
 //! fontconfig is needed; pixels go into a buffer that the `image` crate encodes.
 
+use crate::error::Error;
 use crate::files::write_file;
 use crate::record::RunRecord;
 use crate::summary::{Cell, cells};
@@ -101,9 +102,12 @@ fn log_range(v: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
 }
 
 /// Draws one workload's plot into an RGB buffer of `WIDTH` x `HEIGHT`.
-fn draw(workload: &str, cs: &[Cell], buf: &mut [u8]) -> Result<(), String> {
+fn draw(workload: &str, cs: &[Cell], buf: &mut [u8]) -> Result<(), Error> {
     register();
-    let err = |e: &dyn std::fmt::Display| format!("plot {workload}: {e}");
+    let err = |e: &dyn std::fmt::Display| Error::Plot {
+        workload: workload.to_string(),
+        message: e.to_string(),
+    };
     let root = BitMapBackend::with_buffer(buf, (WIDTH, HEIGHT)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let root = root.titled(workload, (FONT, 22)).map_err(|e| err(&e))?;
@@ -170,19 +174,18 @@ fn draw(workload: &str, cs: &[Cell], buf: &mut [u8]) -> Result<(), String> {
 }
 
 /// Encodes an RGB buffer as PNG.
-fn png(buf: Vec<u8>) -> Result<Vec<u8>, String> {
-    let img = image::RgbImage::from_raw(WIDTH, HEIGHT, buf).ok_or("plot buffer size")?;
+fn png(buf: Vec<u8>) -> Result<Vec<u8>, Error> {
+    let img = image::RgbImage::from_raw(WIDTH, HEIGHT, buf).ok_or(Error::PlotBufferSize)?;
     let mut bytes = Vec::new();
     img.write_to(
         &mut std::io::Cursor::new(&mut bytes),
         image::ImageFormat::Png,
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     Ok(bytes)
 }
 
 /// Writes one plot per workload into `dir`; their paths.
-pub fn write_plots(dir: &Path, records: &[RunRecord]) -> Result<Vec<PathBuf>, String> {
+pub fn write_plots(dir: &Path, records: &[RunRecord]) -> Result<Vec<PathBuf>, Error> {
     let mut out = Vec::new();
     for (workload, cs) in cells(records) {
         let mut buf = vec![0u8; (WIDTH * HEIGHT * 3) as usize];

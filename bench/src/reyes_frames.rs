@@ -9,6 +9,7 @@
 //! to the first one's of the same size (samples combine with atomicMax: the order of work
 //! cannot change them).
 
+use crate::error::Error;
 use crate::strategy::{GpuConfig, Strategy, compile};
 use crate::suite::Scale;
 use crate::workload::{Measurement, Prepared, Workload, ms_since};
@@ -62,7 +63,7 @@ impl SuiteScene {
         }
     }
 
-    pub fn load(self) -> Result<Scene, String> {
+    pub fn load(self) -> Result<Scene, Error> {
         match self {
             SuiteScene::Teapot => Ok(scene::builtin_teapot()),
             SuiteScene::Killeroo => load_scene(&reyes::shared_data_dir().join("rib/killeroo.rib")),
@@ -70,8 +71,11 @@ impl SuiteScene {
     }
 }
 
-pub fn load_scene(path: &Path) -> Result<Scene, String> {
-    scene::load(path).map_err(|e| format!("{}: {e}", path.display()))
+pub fn load_scene(path: &Path) -> Result<Scene, Error> {
+    scene::load(path).map_err(|source| Error::SceneFile {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 struct Current {
@@ -97,7 +101,7 @@ pub struct ReyesWorkload {
 
 impl ReyesWorkload {
     /// `reyes-<scene>` at the suite's sizes.
-    pub fn suite(which: SuiteScene, scale: Scale, config: GpuConfig) -> Result<Self, String> {
+    pub fn suite(which: SuiteScene, scale: Scale, config: GpuConfig) -> Result<Self, Error> {
         Ok(Self::new(
             format!("reyes-{}", which.name()),
             which.load()?,
@@ -155,9 +159,9 @@ impl Workload for ReyesWorkload {
         self.sizes.iter().map(|&s| self.label(s)).collect()
     }
 
-    fn prepare(&mut self, _gpu: &Gpu, i: usize) -> Result<Prepared, String> {
+    fn prepare(&mut self, _gpu: &Gpu, i: usize) -> Result<Prepared, Error> {
         let size = self.sizes[i];
-        let data = FrameData::new(&self.scene, &self.options(size)).map_err(|e| e.to_string())?;
+        let data = FrameData::new(&self.scene, &self.options(size))?;
         let cpu = render_cpu(&data);
         let f = &data.frame;
         let prepared = Prepared {
@@ -181,7 +185,7 @@ impl Workload for ReyesWorkload {
         Ok(prepared)
     }
 
-    fn run(&mut self, gpu: &Gpu, strategy: &Strategy) -> Result<Measurement, String> {
+    fn run(&mut self, gpu: &Gpu, strategy: &Strategy) -> Result<Measurement, Error> {
         let cur = self.current.as_mut().expect("prepare before run");
         let name = strategy.name();
         let mut problems = Vec::new();
@@ -199,24 +203,23 @@ impl Workload for ReyesWorkload {
                     ..Default::default()
                 }
             }
-            Strategy::Baseline(b) => return Err(format!("Reyes has no baseline `{b}`")),
+            Strategy::Baseline(b) => return Err(Error::NoReyesBaseline(b.to_string())),
             Strategy::Scheduler { .. } => {
                 let mut renderers = self.renderers.borrow_mut();
                 if !renderers.iter().any(|r| r.0 == name) {
                     // Compiled for what this workload's frame needs, as `reyes render` does.
                     let features = cur.data.features();
-                    let program = program_for(features).map_err(|e| e.to_string())?;
+                    let program = program_for(features)?;
                     let capacity = self.config.capacity.unwrap_or(INITIAL_CAPACITY);
-                    let scheduler = compile(gpu, &program, strategy, &self.config, capacity)
-                        .map_err(|e| e.to_string())?;
+                    let scheduler = compile(gpu, &program, strategy, &self.config, capacity)?;
                     let config = RendererConfig::new(scheduler.kind())
                         .features(features)
                         .scheduler(scheduler);
-                    let r = GpuRenderer::new(gpu, config).map_err(|e| e.to_string())?;
+                    let r = GpuRenderer::new(gpu, config)?;
                     renderers.push((name.clone(), r));
                 }
                 let renderer = &renderers.iter().find(|r| r.0 == name).unwrap().1;
-                let frame = renderer.render(gpu, &cur.data).map_err(|e| e.to_string())?;
+                let frame = renderer.render(gpu, &cur.data)?;
                 if frame.run.executed[..] != cur.cpu.executed[..] {
                     problems.push(format!(
                         "items per procedure {:?}, the CPU twin's {:?}",

@@ -3,6 +3,7 @@
 
 use crate::catalog::WorkloadName;
 use crate::cli::Cli;
+use crate::error::Error;
 use crate::record::RunRecord;
 use crate::reyes_frames::{ReyesWorkload, load_scene};
 use crate::strategy::Strategy;
@@ -85,15 +86,14 @@ fn strategies(cli: &Cli, w: &dyn Workload) -> Vec<Strategy> {
 }
 
 /// Runs and prints; Ok(true) when every run was verified.
-pub fn run(cli: &Cli) -> Result<bool, String> {
+pub fn run(cli: &Cli) -> Result<bool, Error> {
     let mut w = workload(cli);
     let strategies = strategies(cli, w.as_ref());
     let gpu = if cli.workload == Some(WorkloadName::Reyes) {
         Gpu::from_env_requiring(reyes::gpu_render::required_features())
     } else {
         Gpu::from_env()
-    }
-    .map_err(|e| e.to_string())?;
+    }?;
     let prepared = w.prepare(&gpu, 0)?;
     let runs = cli.runs.unwrap_or(DEFAULT_RUNS);
     let mut records: Vec<RunRecord> = Vec::new();

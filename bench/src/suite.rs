@@ -3,6 +3,7 @@
 //! a plot per workload into the output folder (each file whole or not at all).
 
 use crate::catalog::WorkloadName;
+use crate::error::Error;
 use crate::files::{PendingFile, write_file};
 use crate::record::{RunKey, RunRecord};
 use crate::strategy::{GpuConfig, Strategy};
@@ -74,25 +75,25 @@ pub fn measure(
         run,
     };
     let warm = w.run(gpu, strategy).and_then(|m| match m.mismatch {
-        Some(e) if !m.verified => Err(format!("warm-up run: {e}")),
+        Some(e) if !m.verified => Err(Error::WarmUpMismatch(e)),
         _ => Ok(()),
     });
     let warm = warm.and_then(|()| {
         if strategy.is_gpu() {
-            scheduler::clocks::raise_clocks(gpu, WARM_UP).map_err(|e| e.to_string())
+            scheduler::clocks::raise_clocks(gpu, WARM_UP).map_err(Error::from)
         } else {
             Ok(())
         }
     });
     if let Err(e) = warm {
-        return vec![RunRecord::failed(&key(0), e)];
+        return vec![RunRecord::failed(&key(0), e.to_string())];
     }
     let mut out = Vec::new();
     for run in 0..runs {
         match w.run(gpu, strategy) {
             Ok(m) => out.push(RunRecord::new(&key(run), &m)),
             Err(e) => {
-                out.push(RunRecord::failed(&key(run), e));
+                out.push(RunRecord::failed(&key(run), e.to_string()));
                 break;
             }
         }
@@ -102,9 +103,12 @@ pub fn measure(
 
 /// Runs the suite; true when every run was verified. Errors: the output folder or a file
 /// cannot be written, or a workload's input cannot be read.
-pub fn run_suite(gpu: &Gpu, o: &SuiteOptions) -> Result<bool, String> {
+pub fn run_suite(gpu: &Gpu, o: &SuiteOptions) -> Result<bool, Error> {
     let start = Instant::now();
-    std::fs::create_dir_all(&o.out).map_err(|e| format!("{}: {e}", o.out.display()))?;
+    std::fs::create_dir_all(&o.out).map_err(|source| Error::File {
+        path: o.out.clone(),
+        source,
+    })?;
     let names: Vec<WorkloadName> = if o.only.is_empty() {
         WorkloadName::ALL
             .into_iter()

@@ -3,6 +3,7 @@
 //! `workloads::tree` (parameters with a CPU reference and a rayon twin, a GPU run of
 //! one program) in a few lines; Reyes implements [`Workload`] itself (`crate::reyes`).
 
+use crate::error::Error;
 use crate::strategy::{GpuConfig, Strategy, compile};
 use scheduler::{Gpu, Program, RunError, RunStats, Scheduler};
 use std::cell::RefCell;
@@ -54,9 +55,9 @@ pub trait Workload {
     fn sizes(&self) -> Vec<String>;
     /// Prepares size `i` (index into [`Workload::sizes`]): builds its input and computes its CPU
     /// reference, untimed.
-    fn prepare(&mut self, gpu: &Gpu, i: usize) -> Result<Prepared, String>;
+    fn prepare(&mut self, gpu: &Gpu, i: usize) -> Result<Prepared, Error>;
     /// One run of the prepared size under `strategy` (compiled on first use), verified.
-    fn run(&mut self, gpu: &Gpu, strategy: &Strategy) -> Result<Measurement, String>;
+    fn run(&mut self, gpu: &Gpu, strategy: &Strategy) -> Result<Measurement, Error>;
 }
 
 /// A workload in the shape of `workloads::tree`, adapted by [`ProblemWorkload`]:
@@ -197,9 +198,9 @@ impl<P: ScheduledProblem> Workload for ProblemWorkload<P> {
         self.sizes.iter().map(|s| s.0.clone()).collect()
     }
 
-    fn prepare(&mut self, gpu: &Gpu, i: usize) -> Result<Prepared, String> {
+    fn prepare(&mut self, gpu: &Gpu, i: usize) -> Result<Prepared, Error> {
         let (label, p) = self.sizes[i].clone();
-        let p = p.for_device(gpu).map_err(|e| e.to_string())?;
+        let p = p.for_device(gpu)?;
         let reference = p.reference();
         let mut slot = self.slot.borrow_mut();
         let reused = slot.run.as_mut().is_some_and(|r| p.retarget(r));
@@ -207,7 +208,7 @@ impl<P: ScheduledProblem> Workload for ProblemWorkload<P> {
             // The old buffers go before the new ones are made.
             slot.run = None;
             slot.schedulers.clear();
-            slot.run = Some(p.new_run(gpu).map_err(|e| e.to_string())?);
+            slot.run = Some(p.new_run(gpu)?);
         }
         let prepared = Prepared {
             size: label,
@@ -218,12 +219,11 @@ impl<P: ScheduledProblem> Workload for ProblemWorkload<P> {
         Ok(prepared)
     }
 
-    fn run(&mut self, gpu: &Gpu, strategy: &Strategy) -> Result<Measurement, String> {
+    fn run(&mut self, gpu: &Gpu, strategy: &Strategy) -> Result<Measurement, Error> {
         let (p, reference) = self.current.as_ref().expect("prepare before run");
         let mut slot = self.slot.borrow_mut();
         let RunSlot { run, schedulers } = &mut *slot;
         let run = run.as_ref().expect("prepared");
-        let err = |e: RunError| e.to_string();
         let (stats, out, gpu_ms, wall_ms) = match strategy {
             Strategy::Cpu => {
                 let start = Instant::now();
@@ -232,7 +232,7 @@ impl<P: ScheduledProblem> Workload for ProblemWorkload<P> {
             }
             Strategy::Baseline(name) => {
                 let start = Instant::now();
-                let (stats, out) = p.baseline(name, run, gpu).map_err(err)?;
+                let (stats, out) = p.baseline(name, run, gpu)?;
                 let gpu_ms = stats.as_ref().and_then(|s| s.gpu_ms);
                 (stats, out, gpu_ms, ms_since(start))
             }
@@ -243,13 +243,12 @@ impl<P: ScheduledProblem> Workload for ProblemWorkload<P> {
                 let capacity = self.config.capacity.unwrap_or(p.capacity(reference));
                 let have = |s: &&(String, u32, Scheduler)| s.0 == name && s.1 == capacity;
                 if !schedulers.iter().any(|s| have(&s)) {
-                    let s = compile(gpu, P::program(run), strategy, &self.config, capacity)
-                        .map_err(err)?;
+                    let s = compile(gpu, P::program(run), strategy, &self.config, capacity)?;
                     schedulers.push((name.clone(), capacity, s));
                 }
                 let scheduler = &schedulers.iter().find(have).unwrap().2;
                 let start = Instant::now();
-                let (stats, out) = P::run(run, gpu, scheduler).map_err(err)?;
+                let (stats, out) = P::run(run, gpu, scheduler)?;
                 let wall = ms_since(start);
                 (Some(stats.clone()), out, stats.gpu_ms, wall)
             }

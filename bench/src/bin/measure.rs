@@ -14,6 +14,7 @@ mod measure;
 
 use clap::{CommandFactory, Parser};
 use measure::cli::Cli;
+use measure::error::Error;
 use measure::plan::{self, Case, PlanInput, Program};
 use measure::read::read;
 use measure::run::{self, Build, Runner};
@@ -29,7 +30,7 @@ type Programs = Vec<Vec<(Build, Option<PathBuf>)>>;
 
 /// Finds every case's program in the builds. Errors name a missing `schedbench` or `reyes`,
 /// or every test binary looked for when none is there.
-fn find_programs(cases: &[Case], builds: &[(Build, PathBuf)]) -> Result<Programs, String> {
+fn find_programs(cases: &[Case], builds: &[(Build, PathBuf)]) -> Result<Programs, Error> {
     let mut found = Vec::new();
     for case in cases {
         let mut per_build = Vec::new();
@@ -40,11 +41,11 @@ fn find_programs(cases: &[Case], builds: &[(Build, PathBuf)]) -> Result<Programs
                     Build::New => "--bin",
                     Build::Base => "--compare",
                 };
-                return Err(format!(
-                    "no `{}` in {} (cargo build --release --bin {0}; or give {flag} DIR)",
-                    case.program,
-                    dir.display()
-                ));
+                return Err(Error::MissingProgram {
+                    program: case.program.to_string(),
+                    dir: dir.clone(),
+                    flag,
+                });
             }
             per_build.push((*build, exe));
         }
@@ -59,12 +60,10 @@ fn find_programs(cases: &[Case], builds: &[(Build, PathBuf)]) -> Result<Programs
             .all(|&i| found[i].iter().all(|b| b.1.is_none()))
     {
         let dirs: Vec<String> = builds.iter().map(|b| b.1.display().to_string()).collect();
-        return Err(format!(
-            "gpu-tests: none of the test binaries {} in {} (as NAME or deps/NAME-HASH: cargo test \
-             --release --no-run)",
-            plan::GPU_TESTS.join(", "),
-            dirs.join(" or ")
-        ));
+        return Err(Error::NoTestBinaries {
+            tests: plan::GPU_TESTS.join(", "),
+            dirs: dirs.join(" or "),
+        });
     }
     for &i in &tests {
         for (build, exe) in &found[i] {
@@ -178,11 +177,11 @@ fn main() -> ExitCode {
 }
 
 /// Ok(true) when every process succeeded and every checked row was verified.
-fn measure(cli: &Cli) -> Result<bool, String> {
+fn measure(cli: &Cli) -> Result<bool, Error> {
     let new_dir = match &cli.bin {
         Some(d) => d.clone(),
         None => std::env::current_exe()
-            .map_err(|e| format!("finding this executable's folder: {e}"))?
+            .map_err(Error::CurrentExe)?
             .parent()
             .map(Path::to_path_buf)
             .unwrap_or_default(),
@@ -193,16 +192,18 @@ fn measure(cli: &Cli) -> Result<bool, String> {
     }
     builds.push((Build::New, new_dir));
     let data = cli.data.clone().unwrap_or_else(reyes::shared_data_dir);
-    let scratch = tempfile::tempdir().map_err(|e| format!("creating a scratch folder: {e}"))?;
+    let scratch = tempfile::tempdir().map_err(Error::ScratchFolder)?;
     let temporary_work;
     let work = match &cli.out {
         Some(out) => {
-            std::fs::create_dir_all(out).map_err(|e| format!("creating {}: {e}", out.display()))?;
+            std::fs::create_dir_all(out).map_err(|source| Error::CreateFolder {
+                path: out.clone(),
+                source,
+            })?;
             out.clone()
         }
         None => {
-            temporary_work =
-                tempfile::tempdir().map_err(|e| format!("creating a work folder: {e}"))?;
+            temporary_work = tempfile::tempdir().map_err(Error::WorkFolder)?;
             temporary_work.path().to_path_buf()
         }
     };
@@ -246,8 +247,10 @@ fn measure(cli: &Cli) -> Result<bool, String> {
     let (text, markdown) = (table.text(&labels), table.markdown(&labels));
     if cli.out.is_some() {
         for (name, t) in [("table.txt", &text), ("table.md", &markdown)] {
-            std::fs::write(work.join(name), t)
-                .map_err(|e| format!("writing {}: {e}", work.join(name).display()))?;
+            std::fs::write(work.join(name), t).map_err(|source| Error::Write {
+                path: work.join(name),
+                source,
+            })?;
         }
     }
     let mut stdout = std::io::stdout().lock();
@@ -255,6 +258,6 @@ fn measure(cli: &Cli) -> Result<bool, String> {
     stdout
         .write_all(shown.as_bytes())
         .and_then(|()| stdout.flush())
-        .map_err(|e| format!("writing the table: {e}"))?;
+        .map_err(Error::Table)?;
     Ok(table.all_good())
 }

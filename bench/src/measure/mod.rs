@@ -2,6 +2,7 @@
 //! plan of commands, running them, reading their outputs and the table.
 
 pub mod cli;
+pub mod error;
 pub mod md5;
 pub mod plan;
 pub mod read;

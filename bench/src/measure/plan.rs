@@ -4,6 +4,7 @@
 //! shrinks the problems, never the kind of run.
 
 use super::cli::{Size, Suite};
+use super::error::Error;
 use std::ffi::OsString;
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -112,7 +113,7 @@ pub struct PlanInput<'a> {
 }
 
 /// The cases of `suites` in order. Errors: a scene that cannot be found or generated, named.
-pub fn plan(suites: &[Suite], input: &PlanInput) -> Result<Vec<Case>, String> {
+pub fn plan(suites: &[Suite], input: &PlanInput) -> Result<Vec<Case>, Error> {
     let mut cases = Vec::new();
     for &suite in suites {
         let mut p = Planner {
@@ -348,7 +349,7 @@ impl Planner<'_, '_> {
     }
 
     /// The `--scene`s, else `default`, as (name, argument).
-    fn scenes(&self, default: &[&str]) -> Result<Vec<(String, OsString)>, String> {
+    fn scenes(&self, default: &[&str]) -> Result<Vec<(String, OsString)>, Error> {
         let names: Vec<String> = if self.input.scenes.is_empty() {
             default.iter().map(|s| s.to_string()).collect()
         } else {
@@ -385,7 +386,7 @@ impl Planner<'_, '_> {
         self.add(name, Some(strategy), Program::Reyes, all, Reader::Render)
     }
 
-    fn frames(&mut self) -> Result<(), String> {
+    fn frames(&mut self) -> Result<(), Error> {
         let runs = self.runs(10, 2);
         for (scene, arg) in self.scenes(&["teapot", "killeroo"])? {
             for (w, h) in self.sizes(&[(1920, 1080)]) {
@@ -444,7 +445,7 @@ impl Planner<'_, '_> {
         );
     }
 
-    fn bench(&mut self) -> Result<(), String> {
+    fn bench(&mut self) -> Result<(), Error> {
         let frames = self.runs(200, 5);
         for (scene, arg) in self.scenes(&["teapot", "uteapot", "killeroo"])? {
             for size in self.sizes(&[(1920, 1080), (3840, 2160)]) {
@@ -457,7 +458,7 @@ impl Planner<'_, '_> {
         Ok(())
     }
 
-    fn peer(&mut self) -> Result<(), String> {
+    fn peer(&mut self) -> Result<(), Error> {
         let frames = self.runs(100, 5);
         for (scene, arg) in self.scenes(&["teapot", "uteapot", "killeroo"])? {
             for size in self.sizes(&[(1920, 1080), (3840, 2160)]) {
@@ -471,7 +472,7 @@ impl Planner<'_, '_> {
         Ok(())
     }
 
-    fn raster_modes(&mut self) -> Result<(), String> {
+    fn raster_modes(&mut self) -> Result<(), Error> {
         let frames = self.runs(100, 5);
         let size = self.sizes(&[(1920, 1080)])[0];
         for (scene, arg) in self.scenes(&["teapot", "killeroo"])? {
@@ -490,7 +491,7 @@ impl Planner<'_, '_> {
     /// 16x16 samples, then every sampling algorithm at 4x4, 5x5 and 8x8 against it; the still
     /// frame without effect flags; displacement (the model's `disp_textured` shaders, which
     /// the renderer lacks, replaced by its built-in `bumps`) with both normal modes.
-    fn effects(&mut self) -> Result<(), String> {
+    fn effects(&mut self) -> Result<(), Error> {
         let runs = self.runs(10, 2);
         let killeroo = scene_arg("killeroo", self.input.data)?;
         let (w, h) = if self.small() { (160, 120) } else { (800, 600) };
@@ -590,7 +591,7 @@ impl Planner<'_, '_> {
     /// Scenes of `nx * ny` tiny bilinear patches ([`write_many_patches`]) on every strategy
     /// (`reyes render --runs N`, the file's 640x480) and the CPU twin (`--cpu`): process time
     /// (parsing included) in the notes.
-    fn many_patches(&mut self) -> Result<(), String> {
+    fn many_patches(&mut self) -> Result<(), Error> {
         let runs = self.runs(3, 1);
         let grids: &[(u32, u32)] = if self.small() {
             &[(20, 20)]
@@ -599,8 +600,10 @@ impl Planner<'_, '_> {
         };
         for &(nx, ny) in grids {
             let file = self.input.scratch.join(format!("many-{nx}x{ny}.rib"));
-            write_many_patches(&file, nx, ny)
-                .map_err(|e| format!("writing {}: {e}", file.display()))?;
+            write_many_patches(&file, nx, ny).map_err(|source| Error::Write {
+                path: file.clone(),
+                source,
+            })?;
             let scene: OsString = file.into();
             let name = format!("{} patches", nx * ny);
             for strategy in FRAME_STRATEGIES {
@@ -631,7 +634,7 @@ fn scene_label(name: &str) -> String {
 
 /// The `reyes` argument for a scene: `teapot` as is (built in), else an existing file, a path
 /// in the shared data, or `rib/NAME.rib` there. Errors name the places looked at.
-pub fn scene_arg(name: &str, data: &Path) -> Result<OsString, String> {
+pub fn scene_arg(name: &str, data: &Path) -> Result<OsString, Error> {
     if name == "teapot" {
         return Ok(name.into());
     }
@@ -646,27 +649,32 @@ pub fn scene_arg(name: &str, data: &Path) -> Result<OsString, String> {
         .map(|p| p.clone().into_os_string())
         .ok_or_else(|| {
             let looked: Vec<String> = candidates.iter().map(|p| p.display().to_string()).collect();
-            format!(
-                "scene `{name}` not found (looked for {}; set REYES_SHARED_DATA or give --data DIR)",
-                looked.join(", ")
-            )
+            Error::SceneNotFound {
+                name: name.to_string(),
+                looked: looked.join(", "),
+            }
         })
 }
 
 /// Writes Killeroo with its `disp_textured` displacement (a shader the renderer does not have)
 /// replaced by the built-in `"bumps"` at frequency 4, keeping `Km`.
-fn write_bumps_killeroo(killeroo: &Path, out: &Path) -> Result<(), String> {
-    let text = std::fs::read_to_string(killeroo)
-        .map_err(|e| format!("reading {}: {e}", killeroo.display()))?;
+fn write_bumps_killeroo(killeroo: &Path, out: &Path) -> Result<(), Error> {
+    let text = std::fs::read_to_string(killeroo).map_err(|source| Error::Read {
+        path: killeroo.to_path_buf(),
+        source,
+    })?;
     const SHADER: &str = "Displacement \"disp_textured\"";
     if !text.contains(SHADER) {
-        return Err(format!(
-            "{} has no `{SHADER}` to replace by the built-in bumps",
-            killeroo.display()
-        ));
+        return Err(Error::NoShaderToReplace {
+            path: killeroo.to_path_buf(),
+            shader: SHADER,
+        });
     }
     let bumps = text.replace(SHADER, "Displacement \"bumps\" \"frequency\" 4");
-    std::fs::write(out, bumps).map_err(|e| format!("writing {}: {e}", out.display()))
+    std::fs::write(out, bumps).map_err(|source| Error::Write {
+        path: out.to_path_buf(),
+        source,
+    })
 }
 
 /// Writes a 640x480 scene of `nx * ny` bilinear patches, each half a grid step wide, in a
@@ -749,7 +757,9 @@ mod tests {
     #[test]
     fn a_missing_scene_is_named() {
         let dir = tempfile::tempdir().unwrap();
-        let e = plan(&[Suite::Frames], &input(Size::Full, dir.path(), dir.path())).unwrap_err();
+        let e = plan(&[Suite::Frames], &input(Size::Full, dir.path(), dir.path()))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("scene `killeroo` not found"), "{e}");
         assert!(e.contains("REYES_SHARED_DATA"), "{e}");
     }

@@ -3,6 +3,7 @@
 //! [`Sample`]s: the timed values of one strategy with what was checked. Only the keys the
 //! table needs are read; the rest stays in the files.
 
+use super::error::Error;
 use super::md5::md5_hex;
 use super::plan::{Case, Reader};
 use super::run::Process;
@@ -195,13 +196,13 @@ pub fn read(case: &Case, process: &Process) -> Vec<Sample> {
             json.push(".json");
             match render_sample(strategy, Path::new(&json)) {
                 Ok(s) => vec![s],
-                Err(e) => vec![Sample::failed(strategy, e)],
+                Err(e) => vec![Sample::failed(strategy, e.to_string())],
             }
         }
         Reader::Bench { peer } => {
             let text = std::fs::read_to_string(&process.stdout).unwrap_or_default();
             bench_samples(strategy, &text, peer)
-                .unwrap_or_else(|e| vec![Sample::failed(strategy, e)])
+                .unwrap_or_else(|e| vec![Sample::failed(strategy, e.to_string())])
         }
         Reader::Tests => {
             let text = std::fs::read_to_string(&process.stdout).unwrap_or_default();
@@ -280,11 +281,15 @@ fn schedbench_samples(text: &str, by_case: bool) -> Vec<Sample> {
     samples
 }
 
-fn render_sample(strategy: &str, json: &Path) -> Result<Sample, String> {
-    let text =
-        std::fs::read_to_string(json).map_err(|e| format!("reading {}: {e}", json.display()))?;
-    let stats: RenderStats =
-        serde_json::from_str(&text).map_err(|e| format!("reading {}: {e}", json.display()))?;
+fn render_sample(strategy: &str, json: &Path) -> Result<Sample, Error> {
+    let text = std::fs::read_to_string(json).map_err(|source| Error::Read {
+        path: json.to_path_buf(),
+        source,
+    })?;
+    let stats: RenderStats = serde_json::from_str(&text).map_err(|source| Error::ParseJson {
+        path: json.to_path_buf(),
+        source,
+    })?;
     let mut s = Sample {
         adapter: Some(stats.adapter),
         ..Sample::new(strategy)
@@ -301,9 +306,8 @@ fn render_sample(strategy: &str, json: &Path) -> Result<Sample, String> {
     Ok(s)
 }
 
-fn bench_samples(strategy: &str, text: &str, with_peer: bool) -> Result<Vec<Sample>, String> {
-    let r: BenchReport =
-        serde_json::from_str(text).map_err(|e| format!("reading reyes bench --json: {e}"))?;
+fn bench_samples(strategy: &str, text: &str, with_peer: bool) -> Result<Vec<Sample>, Error> {
+    let r: BenchReport = serde_json::from_str(text).map_err(Error::ParseBenchJson)?;
     let mut reyes = Sample {
         adapter: Some(r.adapter.clone()),
         gpu_ms: r.per_frame.iter().filter_map(|f| f.gpu_ms).collect(),

@@ -7,6 +7,7 @@
 //! Reyes image of the first and last timed frame ([`PeerReport`]).
 
 use crate::cli::{BenchCmd, Peer};
+use crate::error::CliError;
 use reyes::gpu_render::WARM_UP;
 use reyes::progress::NoProgress;
 use reyes::raster_peer::{PeerFrame, RasterPeer};
@@ -150,7 +151,7 @@ pub struct PeerRow {
     pub redrawn: Option<String>,
 }
 
-pub fn main(a: BenchCmd) -> Result<(), String> {
+pub fn main(a: BenchCmd) -> Result<(), CliError> {
     let crate::setup::Setup {
         scene,
         name,
@@ -158,43 +159,36 @@ pub fn main(a: BenchCmd) -> Result<(), String> {
     } = crate::setup::Setup::load(a.scene.as_deref(), &a.render)?;
     let gpu = crate::setup::open_gpu()?;
     let strategy = a.render.strategy_for(&gpu);
-    let mut r = RealtimeRenderer::new(&gpu, &scene, &options, strategy, Pixels::None)
-        .map_err(|e| e.to_string())?;
+    let mut r = RealtimeRenderer::new(&gpu, &scene, &options, strategy, Pixels::None)?;
     let step = if a.turntable {
         360.0 / a.frames as f64
     } else {
         0.0
     };
     let angle = |i: u32| (a.angle + step * i as f64).to_radians();
-    scheduler::clocks::raise_clocks(&gpu, WARM_UP).map_err(|e| e.to_string())?;
+    scheduler::clocks::raise_clocks(&gpu, WARM_UP)?;
     // Warm-up and timed frames in one pipelined stream, so that the first timed frame finds the
     // pipeline full as every later one does.
     let timed: Vec<f64> = (0..a.frames).map(angle).collect();
     let warm = (0..a.warmup).map(|i| angle(i % a.frames));
     let all: Vec<f64> = warm.chain(timed.iter().copied()).collect();
     let bar = reyes_cli::progress::bar(all.len() as u64, "frames (warm-up and timed)");
-    let mut frames = r
-        .render(&gpu, &all, &|n| bar.inc(n))
-        .map_err(|e| e.to_string())?;
+    let mut frames = r.render(&gpu, &all, &|n| bar.inc(n))?;
     bar.finish_and_clear();
     frames.drain(..a.warmup as usize);
     if let Some(out) = &a.out {
-        r.set_pixels(&gpu, Pixels::Rgba8)
-            .map_err(|e| e.to_string())?;
-        let last = r
-            .render(&gpu, &timed[timed.len() - 1..], &NoProgress)
-            .map_err(|e| e.to_string())?;
+        r.set_pixels(&gpu, Pixels::Rgba8)?;
+        let last = r.render(&gpu, &timed[timed.len() - 1..], &NoProgress)?;
         let (w, h, _) = r.frame_size();
         let img = image::RgbaImage::from_raw(w, h, last[0].rgba8.clone().unwrap_or_default())
-            .ok_or("image buffer size mismatch")?;
-        reyes::output::write_atomic(out, &reyes::output::png(&img).map_err(|e| e.to_string())?)
-            .map_err(|e| e.to_string())?;
+            .ok_or(reyes::Error::BufferSizeMismatch)?;
+        reyes::output::write_atomic(out, &reyes::output::png(&img)?)?;
         eprintln!("wrote {}", out.display());
     }
     let peer = match a.peer {
         Some(Peer::Raster) => {
             let o = (&scene, &options);
-            Some(raster_peer(&gpu, o, &all, a.warmup, &timed, &mut r).map_err(|e| e.to_string())?)
+            Some(raster_peer(&gpu, o, &all, a.warmup, &timed, &mut r)?)
         }
         None => None,
     };

@@ -4,6 +4,7 @@
 //! scene file, a GPU error, a setting the renderer cannot make) are the subcommands' own and
 //! exit 1.
 
+use crate::error::CliError;
 use clap::{Args, Parser, Subcommand, ValueEnum, value_parser};
 use reyes::frame::{DisplacementNormals, RasterMode, RenderOptions, Sampling};
 use reyes::scene::{DepthOfField, FrameRanges, Scene};
@@ -94,16 +95,13 @@ impl Command {
     /// 2, like clap's own): `--raster nearest` samples no motion or lens, so it cannot go with
     /// `--spin` or `--dof`. (A scene file's own motion with `--raster nearest` is refused when
     /// the scene is read, naming the flag.)
-    pub fn check_conflicts(&self) -> Result<(), String> {
+    pub fn check_conflicts(&self) -> Result<(), CliError> {
         if let Some(r) = self.render_args()
             && r.raster == Raster::Nearest
             && (r.spin.is_some() || r.dof.is_some())
         {
             let flag = if r.spin.is_some() { "--spin" } else { "--dof" };
-            return Err(format!(
-                "the argument '--raster nearest' cannot be used with '{flag}': motion blur and \
-                 depth of field need bounding-box rasterization (--raster bbox)"
-            ));
+            return Err(CliError::Conflict { flag });
         }
         Ok(())
     }
@@ -237,9 +235,9 @@ impl RenderArgs {
     }
 
     /// What `--spin` and `--dof` change in a loaded scene.
-    pub fn change_scene(&self, scene: &mut Scene) -> Result<(), String> {
+    pub fn change_scene(&self, scene: &mut Scene) -> Result<(), CliError> {
         if let Some(deg) = self.spin {
-            reyes::scene::spin(scene, deg).map_err(|e| format!("--spin: {e}"))?;
+            reyes::scene::spin(scene, deg).map_err(CliError::Spin)?;
         }
         if let Some(d) = self.dof {
             scene.camera.depth_of_field = Some(d);
@@ -663,10 +661,14 @@ pub struct DriftCmd {
     pub json: bool,
 }
 
-/// `N` (NxN) or `NxM`, each >= 1.
 /// Largest image side (`reyes::frame::MAX_IMAGE_SIDE`), as a clap range bound.
 const MAX_SIDE: i64 = reyes::frame::MAX_IMAGE_SIDE as i64;
 
+// The value parsers below return `Result<T, String>`: that is clap's contract for a
+// `value_parser` function (the text becomes the usage error, exit 2), not the command's
+// error type (`CliError`).
+
+/// `N` (NxN) or `NxM`, each in 1..=`reyes::frame::MAX_PIXEL_SAMPLES`.
 fn parse_samples(v: &str) -> Result<(u32, u32), String> {
     let (x, y) = v.split_once('x').unwrap_or((v, v));
     let max = reyes::frame::MAX_PIXEL_SAMPLES;

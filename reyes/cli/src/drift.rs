@@ -3,12 +3,13 @@
 //! `reyes_accuracy::drift`), and how deep the scene really splits (CPU pipeline).
 
 use crate::cli::DriftCmd;
+use crate::error::CliError;
 use reyes::cpu_render::render_cpu;
 use reyes::frame::{FrameData, RenderOptions};
 use reyes_accuracy::drift::{self, PathOptions};
 
 /// Runs the subcommand.
-pub fn main(a: DriftCmd) -> Result<(), String> {
+pub fn main(a: DriftCmd) -> Result<(), CliError> {
     let (width, height, as_json) = (a.width, a.height, a.json);
     let o = PathOptions {
         random_paths: a.paths,
@@ -26,7 +27,7 @@ pub fn main(a: DriftCmd) -> Result<(), String> {
         height: Some(height),
         ..Default::default()
     };
-    let data = FrameData::new(&scene, &options).map_err(|e| e.to_string())?;
+    let data = FrameData::new(&scene, &options)?;
     // The depth the CPU pipeline reaches, and the same split tree walked with exact twins.
     let cpu = render_cpu(&data);
     let cpu_depth = cpu.counters[reyes::stages::C_MAX_DEPTH];
@@ -34,10 +35,12 @@ pub fn main(a: DriftCmd) -> Result<(), String> {
     let cpu_grids: u64 = cpu.executed[3..].iter().sum();
     let tree = drift::tree_drift(&scene, &data);
     if tree.max_depth as u64 != cpu_depth || tree.grids != cpu_grids {
-        return Err(format!(
-            "the split-tree walk disagrees with cpu_render: depth {} vs {cpu_depth}, grids {} vs {cpu_grids}",
-            tree.max_depth, tree.grids
-        ));
+        return Err(CliError::DriftDisagrees {
+            tree_depth: tree.max_depth as u64,
+            cpu_depth,
+            tree_grids: tree.grids,
+            cpu_grids,
+        });
     }
     let rows = drift::path_drift(&scene, &data, &o);
     if as_json {

@@ -12,6 +12,7 @@
 //!
 //! Frames the renderer cannot make (shadow-map passes) are skipped with a warning.
 
+use crate::error::CliError;
 use reyes::scene::{FrameRanges, FrameSequence, SceneFrame};
 use std::path::{Path, PathBuf};
 
@@ -37,22 +38,25 @@ pub struct Requested<'a> {
 }
 
 /// The frames to render (indices into `seq.frames`) with their outputs, and warnings for the
-/// selected frames that are skipped. Errors: a selection that matches no frame, a `--stats`
+/// selected frames that are skipped.
+pub type Plan = (Vec<(usize, Outputs)>, Vec<String>);
+
+/// The frames to render (indices into `seq.frames`) with their outputs, and warnings for the
+/// selected frames that are skipped ([`Plan`]). Errors: a selection that matches no frame, a `--stats`
 /// (etc.) name without `#` when several frames are rendered, two frames writing one file.
 pub fn plan(
     seq: &FrameSequence,
     selection: Option<&FrameRanges>,
     req: &Requested,
-) -> Result<(Vec<(usize, Outputs)>, Vec<String>), String> {
+) -> Result<Plan, CliError> {
     let selected: Vec<usize> = (0..seq.frames.len())
         .filter(|&i| selection.is_none_or(|s| s.contains(seq.frames[i].number)))
         .collect();
     if selected.is_empty() {
         let numbers: Vec<String> = seq.frames.iter().map(|f| f.number.to_string()).collect();
-        return Err(format!(
-            "--frames selects none of the file's frames ({})",
-            numbers.join(", ")
-        ));
+        return Err(CliError::NoFrameSelected {
+            numbers: numbers.join(", "),
+        });
     }
     let mut warnings = Vec::new();
     let mut jobs = Vec::new();
@@ -65,16 +69,15 @@ pub fn plan(
     }
     let several = jobs.len() > 1;
     let sequence = seq.frames.len() > 1;
-    let side = |p: Option<&Path>, flag: &str, n: u32| -> Result<Option<PathBuf>, String> {
-        match p {
-            None => Ok(None),
-            Some(p) if has_pattern(p) => Ok(Some(numbered(p, n))),
-            Some(_) if several => Err(format!(
-                "{flag}: several frames are rendered; give a name with #### for the frame number"
-            )),
-            Some(p) => Ok(Some(p.to_path_buf())),
-        }
-    };
+    let side =
+        |p: Option<&Path>, flag: &'static str, n: u32| -> Result<Option<PathBuf>, CliError> {
+            match p {
+                None => Ok(None),
+                Some(p) if has_pattern(p) => Ok(Some(numbered(p, n))),
+                Some(_) if several => Err(CliError::UnnumberedOutput { flag }),
+                Some(p) => Ok(Some(p.to_path_buf())),
+            }
+        };
     let mut out = Vec::new();
     for i in jobs {
         let frame = &seq.frames[i];
@@ -90,11 +93,11 @@ pub fn plan(
             .iter()
             .find(|(_, o): &&(usize, Outputs)| o.image == outputs.image)
         {
-            return Err(format!(
-                "frames {} and {n} would both write {}",
-                seq.frames[*j].number,
-                outputs.image.display()
-            ));
+            return Err(CliError::SameOutput {
+                first: seq.frames[*j].number,
+                second: n,
+                path: outputs.image,
+            });
         }
         check_folders(&outputs)?;
         out.push((i, outputs));
@@ -104,7 +107,7 @@ pub fn plan(
 
 /// Every output's folder exists, so that a frame never fails after rendering (or after an
 /// earlier frame was written) for want of one.
-fn check_folders(o: &Outputs) -> Result<(), String> {
+fn check_folders(o: &Outputs) -> Result<(), CliError> {
     let paths = [
         Some(&o.image),
         o.stats.as_ref(),
@@ -117,11 +120,10 @@ fn check_folders(o: &Outputs) -> Result<(), String> {
         if let Some(d) = dir
             && !d.is_dir()
         {
-            return Err(format!(
-                "{}: the folder {} does not exist",
-                p.display(),
-                d.display()
-            ));
+            return Err(CliError::MissingFolder {
+                path: p.to_path_buf(),
+                folder: d.to_path_buf(),
+            });
         }
     }
     Ok(())
@@ -274,12 +276,16 @@ mod tests {
             .map(|n| dir.join(format!("teapot.000{n}.png")).display().to_string())
             .collect();
         assert_eq!(got, want);
-        let e = plan(&s, None, &req(Some("/nonexistent/d/x.png"), None)).unwrap_err();
+        let e = plan(&s, None, &req(Some("/nonexistent/d/x.png"), None))
+            .unwrap_err()
+            .to_string();
         assert_eq!(
             e,
             "/nonexistent/d/teapot.0001.png: the folder /nonexistent/d does not exist"
         );
-        let e = plan(&s, None, &req(None, Some("/nonexistent/s.####.json"))).unwrap_err();
+        let e = plan(&s, None, &req(None, Some("/nonexistent/s.####.json")))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("the folder /nonexistent does not exist"), "{e}");
         assert_eq!(
             images(&s, None, &req(None, None)),
@@ -320,18 +326,22 @@ mod tests {
         assert_eq!(jobs[0].1.stats.as_deref(), Some(Path::new("s.json")));
         assert_eq!(warnings, ["skipped frame 1: a shadow-map pass"]);
         let two = seq(&[(1, None, None), (2, None, None)]);
-        let e = plan(&two, None, &req(None, Some("s.json"))).unwrap_err();
+        let e = plan(&two, None, &req(None, Some("s.json")))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("--stats: several frames"), "{e}");
         let (jobs, _) = plan(&two, None, &req(None, Some("s.####.json"))).unwrap();
         assert_eq!(jobs[1].1.stats.as_deref(), Some(Path::new("s.0002.json")));
         let sel = FrameRanges::parse("5").unwrap();
-        let e = plan(&two, Some(&sel), &req(None, None)).unwrap_err();
+        let e = plan(&two, Some(&sel), &req(None, None))
+            .unwrap_err()
+            .to_string();
         assert!(
             e.contains("selects none of the file's frames (1, 2)"),
             "{e}"
         );
         let same = seq(&[(1, Some("x.png"), None), (2, Some("x.tif"), None)]);
-        let e = plan(&same, None, &req(None, None)).unwrap_err();
+        let e = plan(&same, None, &req(None, None)).unwrap_err().to_string();
         assert_eq!(e, "frames 1 and 2 would both write x.png");
     }
 }

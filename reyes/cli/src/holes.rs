@@ -6,6 +6,7 @@
 //! modes*).
 
 use crate::cli::{HOLES_COLUMNS, HoleReference, HolesCmd};
+use crate::error::CliError;
 use crate::setup::{self, Setup};
 use reyes::frame::{FrameData, RasterMode, RenderOptions};
 use reyes::gpu_render::RendererConfig;
@@ -32,7 +33,7 @@ struct HolesReport {
 }
 
 /// Runs the subcommand.
-pub fn main(a: HolesCmd) -> Result<(), String> {
+pub fn main(a: HolesCmd) -> Result<(), CliError> {
     let setup = Setup::load(a.scene.as_deref(), &a.render)?;
     let data = setup.frame_data()?;
     let gpu = setup::open_gpu()?;
@@ -43,7 +44,7 @@ pub fn main(a: HolesCmd) -> Result<(), String> {
         name,
         options,
     } = setup;
-    let frame = renderer.render(&gpu, &data).map_err(|e| e.to_string())?;
+    let frame = renderer.render(&gpu, &data)?;
     let f = &data.frame;
     let reference = match a.reference {
         HoleReference::Exact => {
@@ -56,9 +57,8 @@ pub fn main(a: HolesCmd) -> Result<(), String> {
                     raster: RasterMode::BoundingBox,
                     ..options.clone()
                 },
-            )
-            .map_err(|e| e.to_string())?;
-            let g = renderer.render(&gpu, &bbox).map_err(|e| e.to_string())?;
+            )?;
+            let g = renderer.render(&gpu, &bbox)?;
             coverage_of(&g.image)
         }
     };
@@ -78,10 +78,7 @@ pub fn main(a: HolesCmd) -> Result<(), String> {
         holes: holes(&frame.image, &reference, f.spp_x * f.spp_y),
     };
     if a.json {
-        println!(
-            "{}",
-            serde_json::to_string(&report).map_err(|e| e.to_string())?
-        );
+        println!("{}", serde_json::to_string(&report)?);
     } else {
         let r = &report;
         if !a.no_header {

@@ -5,6 +5,7 @@
 mod bench;
 mod cli;
 mod drift;
+mod error;
 mod frames;
 mod holes;
 mod measure;
@@ -14,6 +15,7 @@ mod view;
 
 use clap::Parser;
 use cli::{Cli, Command, RenderCmd};
+use error::CliError;
 use reyes::frame::{FrameData, SceneFeatures};
 use reyes::gpu_render::{GpuRenderer, RendererConfig};
 use reyes::image::FrameImage;
@@ -24,13 +26,13 @@ use std::process::ExitCode;
 
 /// Renders every selected frame of the scene; the whole file is read (and every output name
 /// decided) before the first frame renders, so a bad file writes nothing.
-fn run(a: RenderCmd) -> Result<(), String> {
+fn run(a: RenderCmd) -> Result<(), CliError> {
     let (seq, stem) = setup::load_sequence(a.scene.as_deref(), &a.render)?;
     // The reference of --compare-to, read before anything renders.
     let reference = match &a.compare_to {
         Some(p) => Some((
             p.clone(),
-            FrameImage::read_exr(p).map_err(|e| format!("--compare-to {e}"))?,
+            FrameImage::read_exr(p).map_err(CliError::CompareToUnreadable)?,
         )),
         None => None,
     };
@@ -54,8 +56,7 @@ fn run(a: RenderCmd) -> Result<(), String> {
     let data = jobs
         .iter()
         .map(|(i, _)| FrameData::new(&seq.frames[*i].scene, &options))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| e.to_string())?;
+        .collect::<Result<Vec<_>, _>>()?;
     let gpu = match (a.cpu, jobs.is_empty()) {
         (false, false) => {
             // One program for every frame: compiled for what they need together.
@@ -104,7 +105,7 @@ fn gpu_renderer(
     a: &RenderCmd,
     gpu: Gpu,
     features: SceneFeatures,
-) -> Result<(Gpu, GpuRenderer), String> {
+) -> Result<(Gpu, GpuRenderer), CliError> {
     let strategy = a.render.strategy_for(&gpu);
     if a.stage_times && strategy == StrategyKind::Megakernel {
         log::warn!(
@@ -131,7 +132,7 @@ fn render_frame(
     out: &frames::Outputs,
     (gpu, reference): (Option<&(Gpu, GpuRenderer)>, Option<&Reference>),
     progress: &indicatif::ProgressBar,
-) -> Result<(), String> {
+) -> Result<(), CliError> {
     let Some((gpu, renderer)) = gpu else {
         let t0 = std::time::Instant::now();
         let r = reyes::cpu_render::render_cpu(data);
@@ -144,7 +145,7 @@ fn render_frame(
         for w in reyes::warnings::frame_warnings(data, &r.counters) {
             log::warn!("{w}");
         }
-        r.image.write_png(&out.image).map_err(|e| e.to_string())?;
+        r.image.write_png(&out.image)?;
         reyes_cli::progress::note(format!(
             "wrote {} ({}x{}, CPU reference, {:.2} s)",
             out.image.display(),
@@ -157,9 +158,7 @@ fn render_frame(
     // One frame makes the image; with --runs N > 1, N frames are timed after a warm-up
     // (GpuRenderer::timed_frames).
     let (frame, times) = if a.runs > 1 {
-        let t = renderer
-            .timed_frames(gpu, data, a.runs, &|n| progress.inc(n))
-            .map_err(|e| e.to_string())?;
+        let t = renderer.timed_frames(gpu, data, a.runs, &|n| progress.inc(n))?;
         for (i, (g, w)) in t.gpu_ms.iter().zip(&t.wall_ms).enumerate() {
             let g = g.map_or("n/a".into(), |g| format!("{g:.3}"));
             reyes_cli::progress::note(format!("run {i}: GPU {g} ms, wall {w:.2} ms"));
@@ -172,7 +171,7 @@ fn render_frame(
             .collect();
         (t.last, times)
     } else {
-        let f = renderer.render(gpu, data).map_err(|e| e.to_string())?;
+        let f = renderer.render(gpu, data)?;
         progress.inc(1);
         let gpu_ms = f.run.gpu_ms.zip(f.resolve_gpu_ms).map(|(x, y)| x + y);
         let wall_ms = f.wall_ms;
@@ -194,22 +193,19 @@ fn render_frame(
     if let Some(reference) = reference {
         stats.image_error = Some(compare_to(reference, &frame.image)?);
     }
-    frame
-        .image
-        .write_png(&out.image)
-        .map_err(|e| e.to_string())?;
+    frame.image.write_png(&out.image)?;
     if let Some(p) = &out.float {
-        frame.image.write_pfm(p).map_err(|e| e.to_string())?;
+        frame.image.write_pfm(p)?;
     }
     if let Some(p) = &out.depth {
-        frame.image.write_depth(p).map_err(|e| e.to_string())?;
+        frame.image.write_depth(p)?;
     }
     if let Some(p) = &out.exr {
-        frame.image.write_exr(p).map_err(|e| e.to_string())?;
+        frame.image.write_exr(p)?;
     }
     if let Some(p) = &out.stats {
         let text = serde_json::to_string_pretty(&stats).unwrap();
-        reyes::output::write_atomic(p, (text + "\n").as_bytes()).map_err(|e| e.to_string())?;
+        reyes::output::write_atomic(p, (text + "\n").as_bytes())?;
     }
     reyes_cli::progress::note(format!(
         "wrote {} ({}x{}, {}{}: {} grids, {} micropolygons, {})",
@@ -236,16 +232,13 @@ fn render_frame(
 fn compare_to(
     (path, reference): &Reference,
     image: &FrameImage,
-) -> Result<reyes::stats::ImageErrorStats, String> {
+) -> Result<reyes::stats::ImageErrorStats, CliError> {
     if (reference.width, reference.height) != (image.width, image.height) {
-        return Err(format!(
-            "--compare-to {}: the reference is {}x{}, the frame {}x{}",
-            path.display(),
-            reference.width,
-            reference.height,
-            image.width,
-            image.height
-        ));
+        return Err(CliError::CompareToSize {
+            path: path.clone(),
+            reference: (reference.width, reference.height),
+            frame: (image.width, image.height),
+        });
     }
     let e = reyes_accuracy::image_error::image_error(reference, image);
     reyes_cli::progress::note(format!(

@@ -6,6 +6,7 @@
 //! render shows a progress bar on a terminal (`reyes_cli::progress`).
 
 use crate::cli::MeasureCmd;
+use crate::error::CliError;
 use crate::setup::{self, Setup};
 use reyes::frame::FrameData;
 use reyes::gpu_render::{GpuFrame, GpuRenderer, RendererConfig};
@@ -17,21 +18,23 @@ use reyes_accuracy::image_error::image_error;
 use reyes_accuracy::measure::{Measurement, MetricsCpuMs, pinhole_count};
 use scheduler::Gpu;
 
+/// The last of several timed frames, and each timed frame's GPU ms (`None` without
+/// timestamps) and wall ms.
+pub type TimedFrames = (GpuFrame, Vec<Option<f64>>, Vec<f64>);
+
 /// [`GpuRenderer::timed_frames`]: the last frame and each timed frame's GPU and wall ms.
 pub fn timed_frames(
     gpu: &Gpu,
     renderer: &GpuRenderer,
     data: &FrameData,
     runs: u32,
-) -> Result<(GpuFrame, Vec<Option<f64>>, Vec<f64>), String> {
-    let t = renderer
-        .timed_frames(gpu, data, runs, &NoProgress)
-        .map_err(|e| e.to_string())?;
+) -> Result<TimedFrames, CliError> {
+    let t = renderer.timed_frames(gpu, data, runs, &NoProgress)?;
     Ok((t.last, t.gpu_ms, t.wall_ms))
 }
 
 /// Runs the subcommand.
-pub fn main(a: MeasureCmd) -> Result<(), String> {
+pub fn main(a: MeasureCmd) -> Result<(), CliError> {
     let (json, ref_samples, reference_png) = (a.json, a.ref_samples, &a.reference_png);
     let setup = Setup::load(a.scene.as_deref(), &a.render)?;
     let data = setup.frame_data()?;
@@ -47,14 +50,14 @@ pub fn main(a: MeasureCmd) -> Result<(), String> {
     }
     stats.wall_ms = scheduler::stats::median_and_mad(&wall_ms).0;
     if let Some(p) = &a.out {
-        frame.image.write_png(p).map_err(|e| e.to_string())?;
+        frame.image.write_png(p)?;
     }
     let (w, h) = (data.frame.width, data.frame.height);
     let rows = reyes_cli::progress::bar(h as u64, "reference render: pixel rows");
     let reference: ReferenceImage = render_reference(&scene, w, h, ref_samples, &|n| rows.inc(n));
     rows.finish_and_clear();
     if let Some(p) = &reference_png {
-        reference.image.write_png(p).map_err(|e| e.to_string())?;
+        reference.image.write_png(p)?;
     }
     let t = std::time::Instant::now();
     let geom = geometry(&scene, &data);
@@ -77,7 +80,7 @@ pub fn main(a: MeasureCmd) -> Result<(), String> {
             image_error: image_ms,
         },
     };
-    let out = serde_json::to_value(m.report()).map_err(|e| e.to_string())?;
+    let out = serde_json::to_value(m.report())?;
     if json {
         println!("{out}");
     } else {

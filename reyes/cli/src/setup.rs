@@ -5,6 +5,7 @@
 //! own: a bad scene or option fails before the GPU is opened.
 
 use crate::cli::RenderArgs;
+use crate::error::CliError;
 use reyes::frame::{FrameData, RenderOptions};
 use reyes::gpu_render::{GpuRenderer, RendererConfig, required_features};
 use reyes::scene::{self, FrameSequence, Scene};
@@ -12,13 +13,13 @@ use scheduler::Gpu;
 use std::path::Path;
 
 /// The scene named on the command line (none or `teapot`: the built-in teapot) and a short
-/// name for it (the file's stem). Errors: the file's, as text.
-pub fn load_scene(path: Option<&Path>) -> Result<(Scene, String), String> {
+/// name for it (the file's stem). Errors: the file's.
+pub fn load_scene(path: Option<&Path>) -> Result<(Scene, String), CliError> {
     match path {
         None => Ok((scene::builtin_teapot(), "teapot".into())),
         Some(p) if p.as_os_str() == "teapot" => Ok((scene::builtin_teapot(), "teapot".into())),
         Some(p) => {
-            let s = scene::load(p).map_err(|e| e.to_string())?;
+            let s = scene::load(p)?;
             let name = p
                 .file_stem()
                 .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
@@ -32,7 +33,7 @@ pub fn load_scene(path: Option<&Path>) -> Result<(Scene, String), String> {
 pub fn load_sequence(
     path: Option<&Path>,
     render: &RenderArgs,
-) -> Result<(FrameSequence, String), String> {
+) -> Result<(FrameSequence, String), CliError> {
     let (mut seq, stem) = match path {
         None => (
             FrameSequence::single(scene::builtin_teapot()),
@@ -43,7 +44,7 @@ pub fn load_sequence(
             "teapot".into(),
         ),
         Some(p) => (
-            scene::load_frames(p).map_err(|e| e.to_string())?,
+            scene::load_frames(p)?,
             p.file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or("out".into()),
@@ -68,7 +69,7 @@ pub struct Setup {
 impl Setup {
     /// Loads the scene at `path` ([`load_scene`]), applies `render`'s scene edits, logs the
     /// scene's warnings and takes `render`'s options. Errors: the file's and the edits'.
-    pub fn load(path: Option<&Path>, render: &RenderArgs) -> Result<Setup, String> {
+    pub fn load(path: Option<&Path>, render: &RenderArgs) -> Result<Setup, CliError> {
         let (mut scene, name) = load_scene(path)?;
         render.change_scene(&mut scene)?;
         for w in &scene.warnings {
@@ -82,18 +83,18 @@ impl Setup {
     }
 
     /// The frame of the scene under the options. Errors: the options' ([`FrameData::new`]).
-    pub fn frame_data(&self) -> Result<FrameData, String> {
-        FrameData::new(&self.scene, &self.options).map_err(|e| e.to_string())
+    pub fn frame_data(&self) -> Result<FrameData, CliError> {
+        Ok(FrameData::new(&self.scene, &self.options)?)
     }
 }
 
 /// The GPU from the environment, with the features the Reyes pipeline needs. Errors: no
 /// adapter, or one without them.
-pub fn open_gpu() -> Result<Gpu, String> {
-    Gpu::from_env_requiring(required_features()).map_err(|e| e.to_string())
+pub fn open_gpu() -> Result<Gpu, CliError> {
+    Ok(Gpu::from_env_requiring(required_features())?)
 }
 
-/// The offline renderer of `config` on `gpu`. Errors: the device's, as text.
-pub fn renderer(gpu: &Gpu, config: impl Into<RendererConfig>) -> Result<GpuRenderer, String> {
-    GpuRenderer::new(gpu, config).map_err(|e| e.to_string())
+/// The offline renderer of `config` on `gpu`. Errors: the device's.
+pub fn renderer(gpu: &Gpu, config: impl Into<RendererConfig>) -> Result<GpuRenderer, CliError> {
+    Ok(GpuRenderer::new(gpu, config)?)
 }

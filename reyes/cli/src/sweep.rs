@@ -13,6 +13,7 @@
 //! strategy) and another the rows of each scene's reference render (`reyes_cli::progress`).
 
 use crate::cli::SweepCmd;
+use crate::error::CliError;
 use crate::measure::timed_frames;
 use crate::setup::{self, load_scene};
 use reyes::frame::{FrameData, RenderOptions};
@@ -114,16 +115,19 @@ impl Row {
 }
 
 /// Runs the subcommand.
-pub fn main(a: SweepCmd) -> Result<(), String> {
+pub fn main(a: SweepCmd) -> Result<(), CliError> {
     let c = Config::new(a);
-    std::fs::create_dir_all(&c.out).map_err(|e| format!("{}: {e}", c.out.display()))?;
+    std::fs::create_dir_all(&c.out).map_err(|source| CliError::CreateFolder {
+        path: c.out.clone(),
+        source,
+    })?;
     let gpu = setup::open_gpu()?;
     let adapter = gpu.adapter_name();
     let renderers: Vec<(StrategyKind, GpuRenderer)> = c
         .strategies
         .iter()
         .map(|&k| Ok((k, setup::renderer(&gpu, k)?)))
-        .collect::<Result<_, String>>()?;
+        .collect::<Result<_, CliError>>()?;
     let start = std::time::Instant::now();
     let mut rows = Vec::new();
     let defaults = RenderOptions::default();
@@ -174,12 +178,9 @@ pub fn main(a: SweepCmd) -> Result<(), String> {
                 },
                 ..RenderOptions::default()
             };
-            let geom = geometry(
-                &scene,
-                &FrameData::new(&scene, &options((1, 1))).map_err(|e| e.to_string())?,
-            );
+            let geom = geometry(&scene, &FrameData::new(&scene, &options((1, 1)))?);
             for &spp in &sample_set {
-                let data = FrameData::new(&scene, &options(spp)).map_err(|e| e.to_string())?;
+                let data = FrameData::new(&scene, &options(spp))?;
                 // This setting's distinct images (the strategies' are normally identical).
                 let mut seen: Vec<(FrameImage, usize, usize)> = Vec::new();
                 for (kind, renderer) in &renderers {
@@ -262,8 +263,8 @@ pub fn main(a: SweepCmd) -> Result<(), String> {
     Ok(())
 }
 
-fn write(path: &Path, text: &str) -> Result<(), String> {
-    reyes::output::write_atomic(path, text.as_bytes()).map_err(|e| e.to_string())
+fn write(path: &Path, text: &str) -> Result<(), CliError> {
+    Ok(reyes::output::write_atomic(path, text.as_bytes())?)
 }
 
 /// Pareto fronts per scene: cost against geometric error and against FLIP.
@@ -422,7 +423,7 @@ fn style(r: &Row) -> Style {
 }
 
 /// Writes `sweep.png` and `sweep.svg` into `dir`.
-fn plots(dir: &Path, rows: &[Row], c: &Config, adapter: &str) -> Result<(), String> {
+fn plots(dir: &Path, rows: &[Row], c: &Config, adapter: &str) -> Result<(), CliError> {
     let timed = if rows.iter().all(|r| r.gpu_ms.is_some()) {
         "GPU ms (median)"
     } else {
@@ -492,10 +493,7 @@ fn plots(dir: &Path, rows: &[Row], c: &Config, adapter: &str) -> Result<(), Stri
         columns: 2,
         legend: &legend,
     };
-    figure
-        .write_png(&dir.join("sweep.png"))
-        .map_err(|e| e.to_string())?;
-    figure
-        .write_svg(&dir.join("sweep.svg"))
-        .map_err(|e| e.to_string())
+    figure.write_png(&dir.join("sweep.png"))?;
+    figure.write_svg(&dir.join("sweep.svg"))?;
+    Ok(())
 }

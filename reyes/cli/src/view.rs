@@ -16,6 +16,7 @@
 //! timeout; a scripted run that shows no frame within it fails).
 
 use crate::cli::ViewCmd;
+use crate::error::CliError;
 use reyes::camera::ViewCamera;
 use reyes::frame::{MAX_PIXEL_SAMPLES, RenderOptions};
 use reyes::gpu_render::required_features;
@@ -41,7 +42,7 @@ const MP_SIZE_RANGE: (f32, f32) = (0.125, 64.0);
 /// Wheel pixels (touchpads) per dolly step.
 const PIXELS_PER_STEP: f64 = 40.0;
 
-pub fn main(a: ViewCmd) -> Result<(), String> {
+pub fn main(a: ViewCmd) -> Result<(), CliError> {
     // The scene's own size and samples, unless the flags say otherwise; a bad option fails
     // here, before a window opens.
     let setup = crate::setup::Setup::load(a.scene.as_deref(), &a.render)?;
@@ -51,12 +52,7 @@ pub fn main(a: ViewCmd) -> Result<(), String> {
         name,
         options,
     } = setup;
-    let event_loop = EventLoop::new().map_err(|e| {
-        format!(
-            "cannot open a window: {e} (no display? set DISPLAY, or run it under Xvfb: \
-             `xvfb-run reyes view ...`)"
-        )
-    })?;
+    let event_loop = EventLoop::new().map_err(CliError::NoDisplay)?;
     let mut app = Viewer {
         deadline: a.frames.map(|_| Instant::now()),
         settings: Settings {
@@ -81,9 +77,7 @@ pub fn main(a: ViewCmd) -> Result<(), String> {
         error: None,
         pending_shot: None,
     };
-    event_loop
-        .run_app(&mut app)
-        .map_err(|e| format!("the window's event loop: {e}"))?;
+    event_loop.run_app(&mut app).map_err(CliError::EventLoop)?;
     match app.error {
         Some(e) => Err(e),
         None => Ok(()),
@@ -138,13 +132,13 @@ struct Viewer {
     /// Scripted runs (--frames): when the last frame was shown (or the run began); no frame
     /// within the GPU's timeout is an error.
     deadline: Option<Instant>,
-    error: Option<String>,
+    error: Option<CliError>,
     /// S was pressed after a change: saved here after the next frame.
     pending_shot: Option<PathBuf>,
 }
 
 impl Viewer {
-    fn fail(&mut self, event_loop: &ActiveEventLoop, e: String) {
+    fn fail(&mut self, event_loop: &ActiveEventLoop, e: CliError) {
         if self.error.is_none() {
             self.error = Some(e);
         }
@@ -152,22 +146,17 @@ impl Viewer {
     }
 
     /// Opens the window, its surface, and a device that can present to it.
-    fn open(&mut self, event_loop: &ActiveEventLoop) -> Result<State, String> {
+    fn open(&mut self, event_loop: &ActiveEventLoop) -> Result<State, CliError> {
         let (w, h) = self.first_size;
         let attrs = Window::default_attributes()
             .with_title(format!("reyes view: {}", self.name))
             .with_inner_size(PhysicalSize::new(w, h));
-        let window = Arc::new(
-            event_loop
-                .create_window(attrs)
-                .map_err(|e| format!("cannot open a window: {e}"))?,
-        );
+        let window = Arc::new(event_loop.create_window(attrs).map_err(CliError::Window)?);
         let instance = Gpu::instance_from_env();
         let surface = instance
             .create_surface(window.clone())
-            .map_err(|e| format!("cannot make a wgpu surface for the window: {e}"))?;
-        let gpu = Gpu::from_env_for_surface(&instance, &surface, required_features())
-            .map_err(|e| e.to_string())?;
+            .map_err(CliError::Surface)?;
+        let gpu = Gpu::from_env_for_surface(&instance, &surface, required_features())?;
         let caps = surface.get_capabilities(&gpu.adapter);
         // An 8-bit UNORM format shows the image's sRGB bytes as they are; an sRGB one makes the
         // draw decode them first (present.wgsl).
@@ -176,7 +165,9 @@ impl Viewer {
             .into_iter()
             .find(|f| caps.formats.contains(f))
             .or(caps.formats.first().copied())
-            .ok_or_else(|| format!("{} cannot present to this window", gpu.adapter_name()))?;
+            .ok_or_else(|| CliError::CannotPresent {
+                adapter: gpu.adapter_name(),
+            })?;
         let size = window.inner_size();
         let config = wgpu::SurfaceConfiguration {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
@@ -190,7 +181,7 @@ impl Viewer {
             color_space: wgpu::SurfaceColorSpace::Auto,
         };
         surface.configure(&gpu.device, &config);
-        let presenter = Presenter::new(&gpu, format).map_err(|e| e.to_string())?;
+        let presenter = Presenter::new(&gpu, format)?;
         if self.settings.strategy.is_none() {
             self.settings.strategy = Some(self.a.render.strategy_for(&gpu));
         }
@@ -206,7 +197,7 @@ impl Viewer {
 
     /// Renders the camera's frame and shows it; `Ok(false)` when the surface had no texture
     /// to draw to this time (it is drawn again on the next event).
-    fn redraw(&mut self) -> Result<bool, String> {
+    fn redraw(&mut self) -> Result<bool, CliError> {
         let Some(st) = self.state.as_mut() else {
             return Ok(false);
         };
@@ -222,8 +213,7 @@ impl Viewer {
                 ..self.options.clone()
             };
             let strategy = self.settings.strategy.unwrap_or(StrategyKind::Multipass);
-            let r = RealtimeRenderer::new(&st.gpu, &self.scene, &options, strategy, Pixels::None)
-                .map_err(|e| e.to_string())?;
+            let r = RealtimeRenderer::new(&st.gpu, &self.scene, &options, strategy, Pixels::None)?;
             if let Some(why) = r.not_pipelined() {
                 log::info!("frames not pipelined: {why}");
             }
@@ -232,8 +222,7 @@ impl Viewer {
         }
         let r = st.renderer.as_mut().expect("made above");
         let transform = self.camera.transform(r.centre());
-        let frame = (r.render_transforms(&st.gpu, &[transform], &NoProgress))
-            .map_err(|e| e.to_string())?
+        let frame = (r.render_transforms(&st.gpu, &[transform], &NoProgress))?
             .pop()
             .expect("one frame per transform");
         let texture = match st.surface.get_current_texture() {
@@ -251,9 +240,8 @@ impl Viewer {
                 return Ok(false);
             }
             wgpu::CurrentSurfaceTexture::Validation => {
-                return Err(format!(
-                    "the window's surface: {}",
-                    st.gpu.take_error().unwrap_or("a validation error".into())
+                return Err(CliError::SurfaceValidation(
+                    st.gpu.take_error().unwrap_or("a validation error".into()),
                 ));
             }
         };
@@ -272,7 +260,7 @@ impl Viewer {
         st.window.pre_present_notify();
         st.gpu.queue.present(texture);
         if let Some(e) = st.gpu.take_error() {
-            return Err(format!("drawing the frame: {e}"));
+            return Err(CliError::Draw(e));
         }
         let now = Instant::now();
         if let Some(t) = self.last_shown {
@@ -312,17 +300,15 @@ impl Viewer {
     }
 
     /// Saves the last frame as PNG (one read-back of the GPU image) to `path`.
-    fn screenshot(&self, path: &std::path::Path) -> Result<(), String> {
-        let st = self.state.as_ref().ok_or("no window yet")?;
-        let r = st.renderer.as_ref().ok_or("no frame yet")?;
+    fn screenshot(&self, path: &std::path::Path) -> Result<(), CliError> {
+        let st = self.state.as_ref().ok_or(CliError::NoWindow)?;
+        let r = st.renderer.as_ref().ok_or(CliError::NoFrame)?;
         let f = r.frame();
-        let bytes = (st.gpu)
-            .read_buffer(r.image_buffer(), 0, f.width as u64 * f.height as u64 * 4)
-            .map_err(|e| e.to_string())?;
+        let bytes =
+            (st.gpu).read_buffer(r.image_buffer(), 0, f.width as u64 * f.height as u64 * 4)?;
         let img = image::RgbaImage::from_raw(f.width, f.height, bytes)
-            .ok_or("image buffer size mismatch")?;
-        reyes::output::write_atomic(path, &reyes::output::png(&img).map_err(|e| e.to_string())?)
-            .map_err(|e| e.to_string())?;
+            .ok_or(reyes::Error::BufferSizeMismatch)?;
+        reyes::output::write_atomic(path, &reyes::output::png(&img)?)?;
         eprintln!("wrote {}", path.display());
         Ok(())
     }
@@ -339,7 +325,7 @@ impl Viewer {
     }
 
     /// A key press; `Ok(true)` to quit.
-    fn key(&mut self, key: &Key) -> Result<bool, String> {
+    fn key(&mut self, key: &Key) -> Result<bool, CliError> {
         let s = &mut self.settings;
         let before = *s;
         match key {
@@ -409,10 +395,9 @@ impl ApplicationHandler for Viewer {
         if let (Some(t), Some(st)) = (self.deadline, &self.state) {
             let limit = st.gpu.timeout;
             if t.elapsed() > limit {
-                let e = format!(
-                    "no frame shown in {:.0} s (the window never drew)",
-                    limit.as_secs_f64()
-                );
+                let e = CliError::NoFrameShown {
+                    seconds: limit.as_secs_f64(),
+                };
                 self.fail(event_loop, e);
             }
         }

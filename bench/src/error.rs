@@ -1,0 +1,64 @@
+//! `schedbench`'s errors: one enum, [`Error`], with a variant per kind of failure (a failed
+//! GPU run, a scene or frame the renderer library refuses, an input that cannot be read or
+//! generated, a report file that cannot be written, a plot that cannot be drawn). A failure
+//! of one run is recorded in the report (its text in `runs.jsonl`) and the suite goes on;
+//! the others end the command with `schedbench: ` and the message (exit 1).
+
+use reyes::scene::SceneError;
+use scheduler::RunError;
+use std::path::PathBuf;
+
+/// What can make a run, a workload or the whole command fail.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A GPU run that failed (no adapter, a device error, a timeout, a queue overflow).
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// The renderer library's error: a frame's options out of range.
+    #[error(transparent)]
+    Reyes(#[from] reyes::Error),
+    /// A scene file that could not be read or parsed.
+    #[error("{}: {source}", path.display())]
+    SceneFile {
+        /// The scene's file.
+        path: PathBuf,
+        /// The reader's error.
+        source: SceneError,
+    },
+    /// An R-MAT graph that could not be generated.
+    #[error("R-MAT scale {scale}: {source}")]
+    Graph {
+        /// The graph's scale (log2 of its vertices).
+        scale: u32,
+        /// The generator's error.
+        source: RunError,
+    },
+    /// A baseline strategy asked of the Reyes workload, which has none.
+    #[error("Reyes has no baseline `{0}`")]
+    NoReyesBaseline(String),
+    /// The warm-up run did not match the CPU reference.
+    #[error("warm-up run: {0}")]
+    WarmUpMismatch(String),
+    /// A report file or folder that could not be made or written.
+    #[error("{}: {source}", path.display())]
+    File {
+        /// The file or folder.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// A plot the plotting backend could not draw.
+    #[error("plot {workload}: {message}")]
+    Plot {
+        /// The plot's workload.
+        workload: String,
+        /// The backend's error, as text (its type depends on the backend).
+        message: String,
+    },
+    /// A drawn plot whose buffer is not the plot's size.
+    #[error("plot buffer size")]
+    PlotBufferSize,
+    /// A plot that could not be encoded as PNG.
+    #[error(transparent)]
+    Encode(#[from] image::ImageError),
+}
