@@ -223,6 +223,12 @@ impl GpuRenderer {
         })
     }
 
+    /// The renderer's pipelines besides the scheduler's ([`Pipelines`]), for another renderer
+    /// on the same device to share ([`RasterPeer::with_pipelines`](crate::raster_peer::RasterPeer::with_pipelines)).
+    pub fn pipelines(&self) -> &Pipelines {
+        &self.pipelines
+    }
+
     /// The scheduler of `strategy` for `program`.
     fn scheduler(
         gpu: &Gpu,

@@ -212,7 +212,8 @@ fn raster_peer(
     timed: &[f64],
     r: &mut RealtimeRenderer,
 ) -> Result<PeerReport, scheduler::RunError> {
-    let mut p = RasterPeer::new(gpu, scene, options, Pixels::None)?;
+    let pipelines = r.renderer().pipelines();
+    let mut p = RasterPeer::with_pipelines(gpu, pipelines, scene, options, Pixels::None)?;
     let warnings = p.warnings();
     for w in &warnings {
         log::warn!("{w}");

@@ -2,7 +2,8 @@
 //! the device ([`SceneBuffers`], uploaded once and rewritten only where a frame changes them),
 //! the per-frame targets of one image size ([`FrameTarget`]: samples, counters, the resolved
 //! image and its 8-bit form), and the pipelines that are not the scheduler's ([`Pipelines`]:
-//! resolve, 8-bit conversion, GPU-made root items), built once per renderer and device.
+//! resolve, 8-bit conversion, GPU-made root items, the raster peer's tessellation, draw and
+//! resolve), each built once per registry and device, on first use.
 //!
 //! The offline renderer ([`crate::gpu_render::GpuRenderer`]) keeps one scene and one target
 //! across its frames; the pipelined renderer ([`crate::realtime::RealtimeRenderer`]) holds its
@@ -14,6 +15,7 @@ mod scene;
 mod target;
 
 pub use pipelines::Pipelines;
+pub(crate) use pipelines::RasterPipelines;
 pub(crate) use pipelines::scene_layout_entries;
 pub use scene::SceneBuffers;
 pub use target::FrameTarget;

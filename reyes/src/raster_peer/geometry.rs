@@ -144,7 +144,7 @@ impl RasterPeer {
         for s in &mut self.slots {
             s.tess_bind = Self::tess_bind(
                 gpu,
-                &self.tess_layout,
+                &self.raster.tess_layout,
                 &s.orbit,
                 &self.tables,
                 &self.geometry,

@@ -27,6 +27,10 @@
 //!    linear RGB with coverage as alpha and the nearest camera-space depth, and rgba8.wgsl the
 //!    8-bit image.
 //!
+//! The pipelines (tessellation, draw, resolve, 8-bit conversion) are the crate's registry's
+//! ([`Pipelines`]): built once per device, feature set and sample count, and shared with the
+//! real-time renderer through [`RasterPeer::with_pipelines`].
+//!
 //! MSAA samples: the frame's pixel samples N x M when the adapter supports N*M for both
 //! targets ([`msaa_samples`]), else the nearest supported count (WebGPU guarantees 1 and 4).
 //!
@@ -49,15 +53,14 @@ use geometry::Geometry;
 pub use tessellation::*;
 
 use crate::frame::{FrameData, FrameUniforms, RenderOptions};
-use crate::gpu::{Pipelines, SceneBuffers};
+use crate::gpu::{Pipelines, RasterPipelines, SceneBuffers};
 use crate::gpu_render::dispatch_2d;
 use crate::image::FrameImage;
 use crate::orbit;
 use crate::realtime::{IN_FLIGHT, Orbit, Pixels, map_buffer, read_mapped};
 use crate::scene::Scene;
-use crate::shaders;
 use scheduler::timing::SpanTimer;
-use scheduler::{Gpu, RunError, storage_entry};
+use scheduler::{Gpu, RunError};
 use std::collections::VecDeque;
 use std::sync::Arc;
 use std::sync::atomic::AtomicUsize;
@@ -148,14 +151,11 @@ pub struct RasterPeer {
     patches: u32,
     samples: u32,
     tables: SceneBuffers,
-    pipelines: Pipelines,
-    tess_layout: wgpu::BindGroupLayout,
-    /// `tess_rates`, `tile_dispatch`, `tess_points`, `tess_quads`.
-    tessellate: [wgpu::ComputePipeline; 4],
-    finish_draw: wgpu::ComputePipeline,
+    /// The tessellation, draw and resolve, from the registry ([`Pipelines`]).
+    raster: Arc<RasterPipelines>,
+    /// The registry's 8-bit conversion.
+    rgba8_pipeline: wgpu::ComputePipeline,
     scene_bind: wgpu::BindGroup,
-    draw: wgpu::RenderPipeline,
-    resolve: wgpu::ComputePipeline,
     resolve_bind: wgpu::BindGroup,
     rgba8_bind: wgpu::BindGroup,
     color: wgpu::TextureView,
@@ -201,13 +201,27 @@ fn target(
 }
 
 impl RasterPeer {
-    /// Uploads `scene` for frames of `options`, compiles the stages, and draws the unturned
-    /// frame once to size the buffers ([`HEADROOM`](crate::realtime::HEADROOM) above its needs). Errors: the options'
+    /// Uploads `scene` for frames of `options`, compiles the stages into a registry of its
+    /// own, and draws the unturned frame once to size the buffers
+    /// ([`HEADROOM`](crate::realtime::HEADROOM) above its needs). Errors: the options'
     /// ([`FrameData::new`]) and too many patches ([`MAX_PATCHES`]) as [`RunError::Program`];
     /// an image larger than the device's render targets, buffers beyond its limits, and those
     /// of a frame, as [`RunError::Device`] or [`RunError::Timeout`].
     pub fn new(
         gpu: &Gpu,
+        scene: &Scene,
+        options: &RenderOptions,
+        pixels: Pixels,
+    ) -> Result<RasterPeer, RunError> {
+        Self::with_pipelines(gpu, &Pipelines::new(gpu), scene, options, pixels)
+    }
+
+    /// [`RasterPeer::new`] taking its pipelines from `pipelines` (another renderer's on the
+    /// same device, such as [`GpuRenderer::pipelines`](crate::gpu_render::GpuRenderer::pipelines)),
+    /// which builds those it lacks and keeps them. Errors: as [`RasterPeer::new`].
+    pub fn with_pipelines(
+        gpu: &Gpu,
+        pipelines: &Pipelines,
         scene: &Scene,
         options: &RenderOptions,
         pixels: Pixels,
@@ -230,77 +244,16 @@ impl RasterPeer {
         let n = scene.patches.len() as u32;
         let samples = msaa_samples(gpu, f.spp_x * f.spp_y);
         let tables = SceneBuffers::with_patches(gpu, scene, &base)?;
-        let ro = |b| storage_entry(b, true);
-        let rw = |b| storage_entry(b, false);
-        let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
-            gpu.device
-                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                    label: Some(label),
-                    entries,
-                })
-        };
-        // Group 0: orbit, objects (roots.wgsl), then tessellate.wgsl's; group 1: common.wgsl's
-        // tables (frame, materials, lights, patch info, primvars; not the samples, counters).
-        let tess_layout = layout(
-            "raster tessellate",
-            &[
-                ro(0),
-                ro(1),
-                ro(3),
-                rw(4),
-                rw(5),
-                rw(6),
-                rw(7),
-                rw(8),
-                rw(9),
-            ],
-        );
-        let scene_layout = layout("raster scene", &[ro(0), ro(1), ro(2), ro(3), ro(6)]);
-        let pipeline_layout = gpu
-            .device
-            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("raster tessellate"),
-                bind_group_layouts: &[Some(&tess_layout), Some(&scene_layout)],
-                immediate_size: 0,
-            });
-        let src = [
-            &base.features().wgsl(),
-            shaders::PATCH_ITEM,
-            shaders::ROOTS,
-            shaders::COMMON,
-            shaders::SHADE,
-            shaders::SURFACE,
-            shaders::TESSELLATE,
-        ]
-        .concat();
-        let module = gpu.shader("raster tessellate", &src)?;
-        let compute = |entry: &str| {
-            gpu.device
-                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(entry),
-                    layout: Some(&pipeline_layout),
-                    module: &module,
-                    entry_point: Some(entry),
-                    compilation_options: Default::default(),
-                    cache: None,
-                })
-        };
-        let tessellate = [
-            compute("tess_rates"),
-            compute("tile_dispatch"),
-            compute("tess_points"),
-            compute("tess_quads"),
-        ];
-        let finish_draw = compute("finish_draw");
+        let raster = pipelines.raster(gpu, base.features(), samples)?;
+        let rgba8_pipeline = pipelines.rgba8(gpu)?.clone();
         let scene_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("raster scene"),
-            layout: &scene_layout,
+            layout: &raster.scene_layout,
             entries: &tables.tables().map(|(binding, b)| wgpu::BindGroupEntry {
                 binding,
                 resource: b.as_entire_binding(),
             }),
         });
-        let draw = Self::draw_pipeline(gpu, samples)?;
         let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
         let binding = wgpu::TextureUsages::TEXTURE_BINDING;
         let mut textures = vec![target(
@@ -340,16 +293,6 @@ impl RasterPeer {
         let rgba = gpu.storage_buffer("raster rgba", pixels_n * 4)?;
         let depth = gpu.storage_buffer("raster depth", pixels_n)?;
         let rgba8 = gpu.storage_buffer("raster rgba8", pixels_n)?;
-        let depth_type = if samples > 1 {
-            "texture_depth_multisampled_2d"
-        } else {
-            "texture_depth_2d"
-        };
-        let src = format!(
-            "alias RasterDepth = {depth_type};\n{}",
-            shaders::RASTER_RESOLVE
-        );
-        let resolve = gpu.compute_pipeline("raster resolve", &src, "raster_resolve")?;
         let (resolve_groups, row) = dispatch_2d(pixels_n, 256);
         let params = RasterResolveParams {
             width: f.width,
@@ -362,7 +305,7 @@ impl RasterPeer {
         let params = gpu.upload("raster resolve params", &[params])?;
         let resolve_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("raster resolve"),
-            layout: &resolve.get_bind_group_layout(0),
+            layout: &raster.resolve.get_bind_group_layout(0),
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,
@@ -388,8 +331,6 @@ impl RasterPeer {
                 },
             ],
         });
-        let pipelines = Pipelines::new(gpu);
-        let rgba8_pipeline = pipelines.rgba8(gpu)?;
         let rgba8_params = gpu.upload("raster rgba8 params", &[pixels_n as u32, row, 0, 0])?;
         let rgba8_bind = gpu.bind_buffers(
             "raster rgba8",
@@ -401,7 +342,7 @@ impl RasterPeer {
         for _ in 0..IN_FLIGHT {
             let orbit = gpu.storage_buffer("raster orbit", (size_of::<Orbit>() / 4) as u64)?;
             slots.push(Slot {
-                tess_bind: Self::tess_bind(gpu, &tess_layout, &orbit, &tables, &geometry),
+                tess_bind: Self::tess_bind(gpu, &raster.tess_layout, &orbit, &tables, &geometry),
                 orbit,
                 status: map_buffer(gpu, "raster status", COUNT_WORDS + SpanTimer::WORDS)?,
                 pixels: Vec::new(),
@@ -414,14 +355,10 @@ impl RasterPeer {
             centre: orbit::scene_centre(scene),
             patches: n,
             samples,
-            tess_layout,
-            tessellate,
-            finish_draw,
+            raster,
+            rgba8_pipeline,
             scene_bind,
-            draw,
-            resolve,
             resolve_bind,
-            pipelines,
             rgba8_bind,
             color,
             resolved,
@@ -443,66 +380,6 @@ impl RasterPeer {
         peer.fit(gpu, &first[0].counts)?;
         peer.set_pixels(gpu, pixels)?;
         Ok(peer)
-    }
-
-    fn draw_pipeline(gpu: &Gpu, samples: u32) -> Result<wgpu::RenderPipeline, RunError> {
-        let src = [shaders::RESOLVE, shaders::RASTER_DRAW].concat();
-        let module = gpu.shader("raster draw", &src)?;
-        let layout = gpu
-            .device
-            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("raster draw"),
-                bind_group_layouts: &[],
-                immediate_size: 0,
-            });
-        let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32];
-        Ok(gpu
-            .device
-            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("raster draw"),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("raster_vertex"),
-                    compilation_options: Default::default(),
-                    buffers: &[Some(wgpu::VertexBufferLayout {
-                        array_stride: size_of::<RasterVertex>() as u64,
-                        step_mode: wgpu::VertexStepMode::Vertex,
-                        attributes: &attributes,
-                    })],
-                },
-                primitive: wgpu::PrimitiveState {
-                    topology: wgpu::PrimitiveTopology::TriangleList,
-                    // One-sided patches' back faces are culled per quad in tessellate.wgsl,
-                    // as Reyes culls them; the winding of a patch's grid says nothing.
-                    cull_mode: None,
-                    ..Default::default()
-                },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Greater),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: wgpu::MultisampleState {
-                    count: samples,
-                    mask: !0,
-                    alpha_to_coverage_enabled: false,
-                },
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("raster_fragment"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: COLOR_FORMAT,
-                        blend: None,
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            }))
     }
 
     /// The MSAA sample count the peer draws with ([`msaa_samples`]).
@@ -623,10 +500,10 @@ impl RasterPeer {
             pass.set_bind_group(0, &s.tess_bind, &[]);
             pass.set_bind_group(1, &self.scene_bind, &[]);
             if self.patches > 0 {
-                pass.set_pipeline(&self.tessellate[0]);
+                pass.set_pipeline(&self.raster.tessellate[0]);
                 pass.dispatch_workgroups(self.tess_groups.0, self.tess_groups.1, 1);
             }
-            pass.set_pipeline(&self.tessellate[1]);
+            pass.set_pipeline(&self.raster.tessellate[1]);
             pass.dispatch_workgroups(1, 1, 1);
         }
         enc.copy_buffer_to_buffer(&g.counts, DISPATCH_WORD * 4, &g.tile_args, 0, 12);
@@ -638,11 +515,11 @@ impl RasterPeer {
             });
             pass.set_bind_group(0, &s.tess_bind, &[]);
             pass.set_bind_group(1, &self.scene_bind, &[]);
-            for p in &self.tessellate[2..] {
+            for p in &self.raster.tessellate[2..] {
                 pass.set_pipeline(p);
                 pass.dispatch_workgroups_indirect(&g.tile_args, 0);
             }
-            pass.set_pipeline(&self.finish_draw);
+            pass.set_pipeline(&self.raster.finish_draw);
             pass.dispatch_workgroups(1, 1, 1);
         }
         {
@@ -674,7 +551,7 @@ impl RasterPeer {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&self.draw);
+            pass.set_pipeline(&self.raster.draw);
             pass.set_vertex_buffer(0, g.vertices.slice(..));
             pass.set_index_buffer(g.indices.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed_indirect(&g.draw_args, 0);
@@ -684,10 +561,10 @@ impl RasterPeer {
                 label: Some("raster resolve"),
                 timestamp_writes: self.timer.end(slot as u32),
             });
-            pass.set_pipeline(&self.resolve);
+            pass.set_pipeline(&self.raster.resolve);
             pass.set_bind_group(0, &self.resolve_bind, &[]);
             pass.dispatch_workgroups(self.resolve_groups.0, self.resolve_groups.1, 1);
-            pass.set_pipeline(self.pipelines.rgba8(gpu)?);
+            pass.set_pipeline(&self.rgba8_pipeline);
             pass.set_bind_group(0, &self.rgba8_bind, &[]);
             pass.dispatch_workgroups(self.resolve_groups.0, self.resolve_groups.1, 1);
         }
