@@ -4,8 +4,8 @@
 //! record the Graph500 traversed edges, so the report gives GTEPS.
 
 use crate::error::Error;
+use crate::scale::Scale;
 use crate::strategy::GpuConfig;
-use crate::suite::Scale;
 use crate::workload::{ProblemWorkload, ScheduledProblem};
 use scheduler::{Gpu, Program, RunError, RunStats, Scheduler};
 use std::cell::OnceCell;

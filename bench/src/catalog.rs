@@ -2,8 +2,8 @@
 
 use crate::error::Error;
 use crate::reyes_frames::{ReyesWorkload, SuiteScene};
+use crate::scale::Scale;
 use crate::strategy::GpuConfig;
-use crate::suite::Scale;
 use crate::tree::preset_workload;
 use crate::workload::Workload;
 use workloads::tree::TreePreset::*;

@@ -2,8 +2,8 @@
 //! name the flag; `--help` exits 0 and shows the defaults.
 
 use crate::catalog::WorkloadName;
+use crate::scale::Scale;
 use crate::strategy::{GpuConfig, Policy};
-use crate::suite::Scale;
 use clap::error::ErrorKind;
 use clap::{CommandFactory, Parser, value_parser};
 use scheduler::ItemLayout;

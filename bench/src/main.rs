@@ -16,6 +16,7 @@ mod mandelbrot;
 mod plot;
 mod record;
 mod reyes_frames;
+mod scale;
 mod single;
 mod strategy;
 mod suite;

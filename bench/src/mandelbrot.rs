@@ -3,8 +3,8 @@
 //! when prepared ([`ScheduledProblem::for_device`]), so its brute-force reference is the image
 //! this device must produce exactly.
 
+use crate::scale::Scale;
 use crate::strategy::GpuConfig;
-use crate::suite::Scale;
 use crate::workload::{ProblemWorkload, ScheduledProblem};
 use scheduler::{Gpu, Program, RunError, RunStats, Scheduler};
 use workloads::mandelbrot::{MandelParams, MandelResult, MandelRun};

@@ -7,7 +7,7 @@
 use crate::error::Error;
 use crate::files::write_file;
 use crate::record::RunRecord;
-use crate::summary::{Cell, cells};
+use crate::summary::{Cell, cells, plot_file_name};
 use plotters::prelude::*;
 use plotters::style::{FontStyle, register_font};
 use std::path::{Path, PathBuf};
@@ -28,11 +28,6 @@ const PALETTE: [RGBColor; 8] = [
     RGBColor(227, 119, 194),
     RGBColor(127, 127, 127),
 ];
-
-/// The plot's file name for a workload.
-pub fn file_name(workload: &str) -> String {
-    format!("{workload}.png")
-}
 
 fn register() {
     static ONCE: Once = Once::new();
@@ -190,7 +185,7 @@ pub fn write_plots(dir: &Path, records: &[RunRecord]) -> Result<Vec<PathBuf>, Er
     for (workload, cs) in cells(records) {
         let mut buf = vec![0u8; (WIDTH * HEIGHT * 3) as usize];
         draw(&workload, &cs, &mut buf)?;
-        out.push(write_file(dir, &file_name(&workload), &png(buf)?)?);
+        out.push(write_file(dir, &plot_file_name(&workload), &png(buf)?)?);
     }
     Ok(out)
 }

@@ -10,8 +10,8 @@
 //! cannot change them).
 
 use crate::error::Error;
+use crate::scale::Scale;
 use crate::strategy::{GpuConfig, Strategy, compile};
-use crate::suite::Scale;
 use crate::workload::{Measurement, Prepared, Workload, ms_since};
 use reyes::cpu_render::{CpuRender, render_cpu};
 use reyes::frame::{FrameData, RenderOptions};

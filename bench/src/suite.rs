@@ -6,38 +6,13 @@ use crate::catalog::WorkloadName;
 use crate::error::Error;
 use crate::files::{PendingFile, write_file};
 use crate::record::{RunKey, RunRecord};
+use crate::scale::Scale;
 use crate::strategy::{GpuConfig, Strategy};
 use crate::workload::{Prepared, Workload};
 use crate::{plot, summary};
 use scheduler::Gpu;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
-
-/// Problem sizes of the suite.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Scale {
-    /// Sizes lavapipe on two cores runs in a couple of minutes (what the test runs).
-    Small,
-    /// Sizes for a real GPU: up to and past each workload's benchmark size.
-    Full,
-}
-
-impl Scale {
-    pub fn name(self) -> &'static str {
-        match self {
-            Scale::Small => "small",
-            Scale::Full => "full",
-        }
-    }
-
-    /// Timed runs per strategy and size when `--runs` is not given.
-    pub fn default_runs(self) -> u32 {
-        match self {
-            Scale::Small => 2,
-            Scale::Full => 10,
-        }
-    }
-}
 
 pub struct SuiteOptions {
     pub out: PathBuf,

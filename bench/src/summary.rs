@@ -5,7 +5,7 @@
 //! [`MANY_ROUNDS`] rounds, a line saying why from its statistics.
 
 use crate::record::RunRecord;
-use crate::suite::Scale;
+use crate::scale::Scale;
 use scheduler::stats::median_and_mad;
 use std::fmt::Write as _;
 
@@ -374,9 +374,14 @@ pub fn markdown(h: &Header, records: &[RunRecord]) -> String {
                 let _ = writeln!(s, "- {w}");
             }
         }
-        let _ = writeln!(s, "\n![{workload}]({})\n", crate::plot::file_name(workload));
+        let _ = writeln!(s, "\n![{workload}]({})\n", plot_file_name(workload));
     }
     s
+}
+
+/// The file name of a workload's plot (`plot.rs` draws it, the summary links it).
+pub fn plot_file_name(workload: &str) -> String {
+    format!("{workload}.png")
 }
 
 #[cfg(test)]

@@ -1,8 +1,8 @@
 //! The split tree (`workloads::tree`) as a suite workload: one workload per preset,
 //! its sizes by number of roots.
 
+use crate::scale::Scale;
 use crate::strategy::GpuConfig;
-use crate::suite::Scale;
 use crate::workload::{ProblemWorkload, ScheduledProblem};
 use scheduler::{Gpu, Program, RunError, RunStats, Scheduler};
 use workloads::tree::{Fanout, TreeParams, TreePreset, TreeResult, TreeRun};

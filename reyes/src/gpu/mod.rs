@@ -15,6 +15,7 @@ mod scene;
 mod target;
 
 pub use pipelines::Pipelines;
+pub mod raster;
 pub(crate) use pipelines::RasterPipelines;
 pub(crate) use pipelines::scene_layout_entries;
 pub use scene::SceneBuffers;

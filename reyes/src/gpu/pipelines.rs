@@ -5,8 +5,8 @@
 //! count). Each is built on first use and kept: a renderer that never converts to 8-bit never
 //! compiles it.
 
+use super::raster::{COLOR_FORMAT, DEPTH_FORMAT, RasterVertex};
 use crate::frame::SceneFeatures;
-use crate::raster_peer::{COLOR_FORMAT, DEPTH_FORMAT, RasterVertex};
 use crate::shaders;
 use scheduler::{Gpu, RunError, storage_entry};
 use std::collections::HashMap;

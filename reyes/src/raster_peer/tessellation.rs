@@ -12,15 +12,12 @@ use glam::{Vec2, Vec3};
 /// `GL_MAX_TESS_GEN_LEVEL` is at least 64; Direct3D 11's is 64).
 pub const MAX_RATE: u32 = 64;
 
+/// The draw's targets and vertex live with the pipelines that use them (`gpu::raster`).
+pub use crate::gpu::raster::{COLOR_FORMAT, DEPTH_FORMAT, RasterVertex};
+
 /// Patches the peer accepts: each grid has at most 65 x 65 points, and the GPU counts the
 /// frame's points in 32 bits.
 pub const MAX_PATCHES: usize = 1_000_000;
-
-/// The colour target: linear RGB, alpha 1 where drawn, so the resolve's alpha is coverage.
-pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-
-/// The depth target (reversed depth near / z: a float's precision where it is needed).
-pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// `TessParams` in tessellate.wgsl.
 #[repr(C)]
@@ -40,23 +37,6 @@ pub struct TessParams {
     pub tile_capacity: u32,
     /// Padding to a multiple of 16 bytes.
     pub pad: [u32; 2],
-}
-
-/// A vertex of the peer's triangles (`RasterVertex` in tessellate.wgsl; 16 bytes): the clip
-/// position divided by the near distance, `(x, y, 1, w)` with `x = 2 focal px / (width near)`,
-/// `y = 2 focal py / (height near)` and `w = pz / near` for the camera-space point `p` (so
-/// depth `1 / w = near / pz`), and the packed colour of [`stages::shade::pack_color`].
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
-pub struct RasterVertex {
-    /// Clip x over the near distance: `2 focal px / (width near)`.
-    pub x: f32,
-    /// Clip y over the near distance: `2 focal py / (height near)`.
-    pub y: f32,
-    /// Clip w: `pz / near`.
-    pub w: f32,
-    /// Shaded colour, packed by [`stages::shade::pack_color`].
-    pub color: u32,
 }
 
 /// `RasterResolveParams` in raster_resolve.wgsl.

@@ -125,7 +125,7 @@ mod tests {
     fn split_halves_are_the_parent_surface() {
         let mut seed = 0x9e37_79b9u32;
         let mut rnd = || {
-            seed = crate::stages::reyes_hash(seed);
+            seed = scheduler::hash::lowbias32(seed);
             seed
         };
         for p in rational_sphere(DVec3::new(0.0, 0.0, 4.0), 1.0) {
