@@ -297,28 +297,28 @@ impl Planner<'_, '_> {
     }
 
     fn bfs(&mut self) {
-        let runs = self.runs(10, 2);
         let scales: &[u32] = if self.small() { &[10] } else { &[20, 22] };
-        for scale in scales {
-            let args = ["--workload", "bfs", "--strategy", "all", "--scale"]
-                .map(String::from)
-                .into_iter()
-                .chain([scale.to_string()])
-                .collect();
-            self.schedbench(format!("scale {scale}"), args, runs.clone());
-        }
+        self.sweep("bfs", "--scale", scales, |scale| format!("scale {scale}"));
     }
 
     fn mandelbrot(&mut self) {
-        let runs = self.runs(10, 2);
         let sides: &[u32] = if self.small() { &[256] } else { &[1024, 4096] };
-        for side in sides {
-            let args = ["--workload", "mandelbrot", "--strategy", "all", "--size-px"]
+        self.sweep("mandelbrot", "--size-px", sides, |side| {
+            format!("{side}x{side}")
+        });
+    }
+
+    /// `schedbench --workload WORKLOAD --strategy all FLAG V` for each of `values`, 10 timed
+    /// runs (2 small), each case named by `name`.
+    fn sweep(&mut self, workload: &str, flag: &str, values: &[u32], name: impl Fn(u32) -> String) {
+        let runs = self.runs(10, 2);
+        for &v in values {
+            let args = ["--workload", workload, "--strategy", "all", flag]
                 .map(String::from)
                 .into_iter()
-                .chain([side.to_string()])
+                .chain([v.to_string()])
                 .collect();
-            self.schedbench(format!("{side}x{side}"), args, runs.clone());
+            self.schedbench(name(v), args, runs.clone());
         }
     }
 

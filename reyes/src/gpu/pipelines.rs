@@ -158,17 +158,7 @@ impl RasterPipelines {
                 bind_group_layouts: &[Some(&tess_layout), Some(&scene_layout)],
                 immediate_size: 0,
             });
-        let src = [
-            &features.wgsl(),
-            shaders::PATCH_ITEM,
-            shaders::ROOTS,
-            shaders::COMMON,
-            shaders::SHADE,
-            shaders::SURFACE,
-            shaders::TESSELLATE,
-        ]
-        .concat();
-        let module = gpu.shader("raster tessellate", &src)?;
+        let module = gpu.shader("raster tessellate", &tessellate_source(features))?;
         let compute = |entry: &str| {
             gpu.device
                 .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -269,4 +259,19 @@ fn raster_draw(gpu: &Gpu, samples: u32) -> Result<wgpu::RenderPipeline, RunError
             multiview_mask: None,
             cache: None,
         }))
+}
+
+/// The raster peer's tessellation shader for frames of `features`: root items made from the
+/// patch table, shaded grid points, quads (`tessellate.wgsl` and what it calls).
+pub(crate) fn tessellate_source(features: SceneFeatures) -> String {
+    [
+        &features.wgsl(),
+        shaders::PATCH_ITEM,
+        shaders::ROOTS,
+        shaders::COMMON,
+        shaders::SHADE,
+        shaders::SURFACE,
+        shaders::TESSELLATE,
+    ]
+    .concat()
 }

@@ -255,16 +255,7 @@ mod tests {
     #[test]
     fn host_structs_match_their_wgsl_layouts() {
         use std::mem::offset_of;
-        let tess = [
-            &crate::frame::SceneFeatures::ALL.wgsl(),
-            shaders::PATCH_ITEM,
-            shaders::ROOTS,
-            shaders::COMMON,
-            shaders::SHADE,
-            shaders::SURFACE,
-            shaders::TESSELLATE,
-        ]
-        .concat();
+        let tess = crate::gpu::pipelines::tessellate_source(crate::frame::SceneFeatures::ALL);
         check(
             &tess,
             "TessParams",
