@@ -405,8 +405,9 @@ fn a_t_junction_cracks_without_dilation_and_not_with_it() {
 }
 
 /// A renderer compiled for a scene's features only (`SceneFeatures`: no rational patches,
-/// primitive variables or transparency for the teapot) draws the same image bit for bit as the
-/// one compiled for every feature, and refuses a frame that needs more than it was built for.
+/// primitive variables or transparency for the teapot) draws the same image as the one compiled
+/// for every feature (bit for bit on lavapipe; within one 8-bit step on a GPU), with the same
+/// counters, and refuses a frame that needs more than it was built for.
 #[test]
 fn a_renderer_compiled_for_the_scenes_features_draws_the_same_image() {
     use reyes::frame::SceneFeatures;
@@ -418,8 +419,19 @@ fn a_renderer_compiled_for_the_scenes_features_draws_the_same_image() {
         let plain = reyes::gpu_render::GpuRenderer::new(gpu(), config).unwrap();
         let a = plain.render(gpu(), &data).unwrap();
         let b = renderer(kind).render(gpu(), &data).unwrap();
-        assert!(a.image == b.image, "{kind:?}: images differ");
         assert_eq!(a.counters, b.counters);
+        if gpu().is_cpu_adapter() {
+            assert!(a.image == b.image, "{kind:?}: images differ");
+        } else {
+            // A GPU's compiler may contract multiply-adds differently in two different
+            // programs (seen on NVIDIA: one pixel of thousands off by 4e-4), which moves a
+            // colour by less than one 8-bit step and never a sample across an edge.
+            let (max, over) = a.image.compare(&b.image);
+            assert!(
+                max <= 1 && over == 0.0,
+                "{kind:?}: images differ by {max} steps"
+            );
+        }
         let mut rational = scene.clone();
         rational.patches[0].w[5] = 2.0;
         let needs = FrameData::new(&rational, &small(96, 72)).unwrap();
