@@ -11,6 +11,8 @@ use scheduler::{Gpu, StrategyKind};
 use std::path::Path;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    // Mesa's Vulkan drivers want a runtime folder; without a login session they complain.
+    reyes::driver_env::ensure_xdg_runtime_dir();
     let args: Vec<String> = std::env::args().skip(1).collect();
     let scene = match args.first() {
         Some(path) => scene::load(Path::new(path))?,

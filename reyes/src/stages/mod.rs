@@ -173,8 +173,8 @@ pub fn coc(f: &crate::frame::FrameUniforms, z: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::reference::homogeneous::{split_u, split_v};
     use glam::DVec4;
-    use reyes_accuracy::drift::split_half_f64;
 
     /// Blossoming a patch's weights at an item's range gives the sub-patch's weights: those
     /// f64 de Casteljau halving gives, to f32 rounding, down random paths of 20 splits. A root
@@ -218,7 +218,12 @@ mod tests {
                 }
                 let take_second = rnd() < 0.5;
                 uv = if take_second { second } else { first };
-                net = split_half_f64(&net, along_u, take_second);
+                let halves = if along_u {
+                    split_u(&net)
+                } else {
+                    split_v(&net)
+                };
+                net = if take_second { halves.1 } else { halves.0 };
                 let got = rational_weights(&table, 0, uv);
                 for k in 0..16 {
                     let i = k % 4;
