@@ -11,8 +11,9 @@ use std::path::PathBuf;
 /// What can make a run, a workload or the whole command fail.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
-    /// A GPU run that failed (no adapter, a device error, a timeout, a queue overflow).
-    #[error(transparent)]
+    /// A GPU run that failed (no adapter, a device error, a timeout, a queue overflow; an
+    /// overflow's advice names schedbench's options).
+    #[error("{}", run_message(.0))]
     Run(#[from] RunError),
     /// The renderer library's error: a frame's options out of range.
     #[error(transparent)]
@@ -61,4 +62,22 @@ pub enum Error {
     /// A plot that could not be encoded as PNG.
     #[error(transparent)]
     Encode(#[from] image::ImageError),
+}
+
+/// A run error's message; a queue overflow's advice in schedbench's terms: its queues grow
+/// to the device's largest storage binding (or the strategy's limit), so what makes room is
+/// fewer items alive at once or smaller ones.
+fn run_message(e: &RunError) -> String {
+    match e {
+        RunError::QueueOverflow {
+            queue,
+            capacity,
+            needed_more_than,
+        } => format!(
+            "queue `{queue}` overflowed: capacity {capacity} items, live work needs more than \
+             {needed_more_than}; no item was lost (make room with a smaller --payload, or fewer \
+             items alive at once: fewer --roots, a smaller --fanout)"
+        ),
+        other => other.to_string(),
+    }
 }
