@@ -240,23 +240,24 @@ impl Cli {
                 );
             }
         }
-        if workload == WorkloadName::Tree && !self.suite {
-            if let Some(why) = self.tree().too_large() {
-                let given: Vec<&str> = tree_flags
-                    .iter()
-                    .filter(|(f, given)| *given && *f != "--payload" && *f != "--seed")
-                    .map(|(f, _)| *f)
-                    .collect();
-                let flags = if given.is_empty() {
-                    "--preset".to_string()
-                } else {
-                    given.join(", ")
-                };
-                Self::usage_error(
-                    ErrorKind::ValueValidation,
-                    format!("{flags}: {why} (see --help, Tree)"),
-                );
-            }
+        if workload == WorkloadName::Tree
+            && !self.suite
+            && let Some(why) = self.tree().too_large()
+        {
+            let given: Vec<&str> = tree_flags
+                .iter()
+                .filter(|(f, given)| *given && *f != "--payload" && *f != "--seed")
+                .map(|(f, _)| *f)
+                .collect();
+            let flags = if given.is_empty() {
+                "--preset".to_string()
+            } else {
+                given.join(", ")
+            };
+            Self::usage_error(
+                ErrorKind::ValueValidation,
+                format!("{flags}: {why} (see --help, Tree)"),
+            );
         }
         for (flag, given) in reyes_flags {
             if given && (self.suite || workload != WorkloadName::Reyes) {
