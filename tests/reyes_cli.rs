@@ -1188,3 +1188,50 @@ fn nearest_rasterization_with_motion_or_depth_of_field_is_a_usage_error() {
     }
     assert!(!dir.join("x.png").exists());
 }
+
+/// `-o` naming a symbolic link writes the file it points to and keeps the link; naming a FIFO
+/// writes the PNG into it, in place (issue 24: both were replaced by a regular file, and as
+/// root `-o /dev/null` would have replaced /dev/null).
+#[cfg(unix)]
+#[test]
+fn output_through_links_and_into_fifos_never_replaces_them() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = scratch("special-out");
+    let args = |out: &'static str| {
+        [
+            "teapot", "--cpu", "--width", "40", "--height", "30", "-o", out,
+        ]
+    };
+    let _ = std::fs::remove_file(dir.join("link.png"));
+    std::fs::write(dir.join("real.png"), b"old").unwrap();
+    std::os::unix::fs::symlink("real.png", dir.join("link.png")).unwrap();
+    let (ok, err) = reyes(&dir, &args("link.png"));
+    assert!(ok, "{err}");
+    assert!(
+        std::fs::symlink_metadata(dir.join("link.png"))
+            .unwrap()
+            .is_symlink()
+    );
+    let png = std::fs::read(dir.join("real.png")).unwrap();
+    assert!(
+        png.starts_with(b"\x89PNG"),
+        "the link's file holds the image"
+    );
+
+    let fifo = dir.join("pipe.png");
+    let _ = std::fs::remove_file(&fifo);
+    if Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success())
+    {
+        let reader = {
+            let fifo = fifo.clone();
+            std::thread::spawn(move || std::fs::read(fifo).unwrap())
+        };
+        let (ok, err) = reyes(&dir, &args("pipe.png"));
+        assert!(ok, "{err}");
+        assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+        assert!(reader.join().unwrap().starts_with(b"\x89PNG"));
+    }
+}

@@ -90,9 +90,11 @@ fn a_turntable_frame_is_render_of_the_scene_turned_on_the_host() {
 }
 
 /// Five frames pipelined (each recorded while the GPU runs the one before) equal the same
-/// angles rendered one call at a time, bit for bit; at this size every frame stays on the
-/// pipelined path (nothing rendered again; on lavapipe one megakernel launch of 96 loop turns
-/// suffices here).
+/// angles rendered one call at a time, bit for bit. At this size the sizes fit: a frame is
+/// rendered again only for a scheduling event of the megakernel (a bounded wait that ran out,
+/// or a launch that reached its loop bound, while a workgroup was descheduled on a loaded CPU
+/// adapter; CI failed so once, "1 abandoned"), and then says so; its image and counters are
+/// the same either way.
 #[test]
 fn pipelined_frames_each_equal_their_single_frame_render() {
     let o = small(W, H);
@@ -107,9 +109,18 @@ fn pipelined_frames_each_equal_their_single_frame_render() {
             assert_eq!(image(f), image(&one[0]), "{kind:?} at {a} rad");
             assert_eq!(f.counters, one[0].counters, "{kind:?} at {a} rad");
             assert!(f.wall_ms > 0.0);
-            // Every frame on the pipelined path: one recorded run, no host round trip.
-            assert_eq!(f.rerendered, None, "{kind:?} at {a} rad");
-            assert!(f.run.executed.iter().sum::<u64>() > 0 && f.run.submits == 0);
+            assert!(
+                f.run.executed.iter().sum::<u64>() > 0,
+                "{kind:?} at {a} rad"
+            );
+            match f.rerendered.as_deref() {
+                // On the pipelined path: one recorded run, no host round trip.
+                None => assert_eq!(f.run.submits, 0, "{kind:?} at {a} rad"),
+                Some(why) => assert!(
+                    kind == StrategyKind::Megakernel && scheduling_event(why),
+                    "{kind:?} at {a} rad: rendered again for want of room: {why}"
+                ),
+            }
         }
         // 8-bit output converted on the GPU: FrameImage::rgba8 of the same frame within one
         // step (the GPU's pow may round the other way at a step).
@@ -170,11 +181,12 @@ fn an_overflowing_frame_is_rendered_again_not_shown_wrong() {
         assert!(r.size().unwrap().capacity.iter().sum::<u32>() > grown.capacity.len() as u32);
         // The grown sizes fit: frame 3 is not rendered again for want of room. On a loaded CPU
         // adapter a megakernel slot's bounded wait may run out while its writer is descheduled
-        // (a scheduling event, not a size: CI failed so once, "2 abandoned"); such a frame is
-        // also rendered again, correctly, and is the only other reason accepted here.
+        // (a scheduling event, not a size: CI failed so once, "2 abandoned"), or a launch
+        // may reach its loop bound; such a frame is also rendered again, correctly, and these are
+        // the only other reasons accepted here (`scheduling_event`).
         let why = frames[3].rerendered.as_deref();
         assert!(
-            why.is_none_or(|w| w.contains("abandoned after a bounded wait")),
+            why.is_none_or(|w| kind == StrategyKind::Megakernel && scheduling_event(w)),
             "{kind:?}: the grown sizes fit: {why:?}"
         );
     }
@@ -188,6 +200,15 @@ fn an_overflowing_frame_is_rendered_again_not_shown_wrong() {
         assert!(f.rerendered.is_some());
         assert_eq!(image(&f), &reference);
     }
+}
+
+/// Whether a pipelined megakernel frame's reason for being rendered again is a scheduling
+/// event, which a loaded machine may cause at any size (`RecordedMegakernel`'s outcome): a
+/// slot's bounded wait ran out while its writer was descheduled, or a launch reached its loop
+/// bound because its workgroups' turns went to waiting. Never "out of room".
+fn scheduling_event(why: &str) -> bool {
+    !why.contains("out of room")
+        && (why.contains("abandoned after a bounded wait") || why.contains("loop bound"))
 }
 
 /// A scene without patches: every buffer still valid (at least one element), frames pipelined

@@ -103,3 +103,44 @@ fn small_suite_verifies_every_run_and_writes_its_report() {
         assert!(!name.starts_with('.'), "temporary file {name} left");
     }
 }
+
+/// Trees that aborted allocating, took 4 GB or never ended (issue 24) are refused before any
+/// GPU work: exit 2, naming the flags that made them too large; `--help` states the limits.
+#[test]
+fn trees_too_large_to_run_are_refused_naming_their_flags() {
+    for (args, flags) in [
+        (&["--roots", "4294967295"][..], &["--roots"][..]),
+        (&["--depth", "4294967295"], &["--depth"]),
+        (&["--depth", "40"], &["--depth"]),
+        (
+            &["--fanout", "fixed:16", "--depth", "12"],
+            &["--depth", "--fanout"],
+        ),
+        (&["--work", "4294967295"], &["--work"]),
+        (
+            &["--work", "65536", "--roots", "64"],
+            &["--roots", "--work"],
+        ),
+        (&["--preset", "deep", "--depth", "4294967295"], &["--depth"]),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
+            .args(["--workload", "tree", "--strategy", "cpu"])
+            .args(args)
+            .output()
+            .expect("schedbench runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        for flag in flags {
+            assert!(err.contains(flag), "{args:?}: no {flag} in {err}");
+        }
+    }
+    let help = Command::new(env!("CARGO_BIN_EXE_schedbench"))
+        .arg("--help")
+        .output()
+        .unwrap();
+    let help = String::from_utf8_lossy(&help.stdout);
+    assert!(
+        help.contains("2^30 nodes") && help.contains("0..=65536"),
+        "{help}"
+    );
+}

@@ -466,12 +466,15 @@ fn a_run_started_at_capacity_16_grows_geometrically_and_stays_exact() {
             assert!(growths >= 1, "{kind:?} never grew from 16: {stats:?}");
             assert!(growths <= growth_bound(&stats), "{kind:?}: {stats:?}");
             match kind {
-                // Every launch that stopped for want of room grew before the next one; the
-                // roomy run's launches are the relaunches lavapipe's short loops need anyway.
-                StrategyKind::Megakernel => assert!(
-                    stats.launches <= 2 * (growths + 1) + 2 * base.launches,
-                    "{stats:?}"
-                ),
+                // Every launch ends for a reason: done, a queue out of room (then it grew),
+                // its loop bound, or slots abandoned after a bounded wait. The last two are
+                // scheduling events (more of them on a loaded CPU adapter, where waiting
+                // workgroups spend their loop turns), so the count of launches is not bounded
+                // by the growths; what holds under any load is that every launch but the last
+                // ran a batch or made room, so launches stay within batches plus growths.
+                StrategyKind::Megakernel => {
+                    assert!(stats.launches <= stats.batches + growths + 1, "{stats:?}")
+                }
                 // A refused round costs one submission, and the growth after it anticipates
                 // the work's growth over a horizon doubling with each refusal: O(log rounds)
                 // submissions. The rounds encoded after a refused one run empty; the next

@@ -61,11 +61,14 @@ pub struct Cli {
     #[arg(long, value_parser = parse_preset, default_value = "binary", help_heading = "Tree")]
     pub preset: TreePreset,
 
-    /// Root nodes.
+    /// Root nodes. The tree (roots x fanout^depth; for uniform:K the mean K/2) may have at
+    /// most 2^30 nodes, and nodes x (1 + work) at most 2^36 hash rounds: a larger tree is
+    /// refused (exit 2) before it runs.
     #[arg(long, help_heading = "Tree")]
     pub roots: Option<u32>,
 
-    /// Depth of the deepest nodes (roots are at depth 0).
+    /// Depth of the deepest nodes (roots are at depth 0); within the tree's size limit
+    /// (--roots).
     #[arg(long, help_heading = "Tree")]
     pub depth: Option<u32>,
 
@@ -73,8 +76,9 @@ pub struct Cli {
     #[arg(long, value_parser = parse_fanout, help_heading = "Tree")]
     pub fanout: Option<Fanout>,
 
-    /// Hash rounds per inner node (work per item).
-    #[arg(long, help_heading = "Tree")]
+    /// Hash rounds per inner node (work per item), 0..=65536; within the tree's work limit
+    /// (--roots).
+    #[arg(long, value_parser = value_parser!(u32).range(0..=65536), help_heading = "Tree")]
     pub work: Option<u32>,
 
     /// Payload words per item (item = 2 + payload words).
@@ -235,6 +239,25 @@ impl Cli {
                     format!("{flag} applies to --workload tree without --suite"),
                 );
             }
+        }
+        if workload == WorkloadName::Tree
+            && !self.suite
+            && let Some(why) = self.tree().too_large()
+        {
+            let given: Vec<&str> = tree_flags
+                .iter()
+                .filter(|(f, given)| *given && *f != "--payload" && *f != "--seed")
+                .map(|(f, _)| *f)
+                .collect();
+            let flags = if given.is_empty() {
+                "--preset".to_string()
+            } else {
+                given.join(", ")
+            };
+            Self::usage_error(
+                ErrorKind::ValueValidation,
+                format!("{flags}: {why} (see --help, Tree)"),
+            );
         }
         for (flag, given) in reyes_flags {
             if given && (self.suite || workload != WorkloadName::Reyes) {

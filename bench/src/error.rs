@@ -11,8 +11,9 @@ use std::path::PathBuf;
 /// What can make a run, a workload or the whole command fail.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
-    /// A GPU run that failed (no adapter, a device error, a timeout, a queue overflow).
-    #[error(transparent)]
+    /// A GPU run that failed (no adapter, a device error, a timeout, a queue overflow; an
+    /// overflow's advice names schedbench's options).
+    #[error("{}", run_message(.0))]
     Run(#[from] RunError),
     /// The renderer library's error: a frame's options out of range.
     #[error(transparent)]
@@ -61,4 +62,61 @@ pub enum Error {
     /// A plot that could not be encoded as PNG.
     #[error(transparent)]
     Encode(#[from] image::ImageError),
+}
+
+/// A run error's message; a queue overflow's advice in schedbench's terms: its queues grow
+/// to the device's largest storage binding (or the strategy's limit), so what makes room is
+/// fewer items alive at once (at most the whole tree) or smaller ones.
+fn run_message(e: &RunError) -> String {
+    match e {
+        RunError::QueueOverflow {
+            queue,
+            capacity,
+            needed_more_than,
+        } => format!(
+            "queue `{queue}` overflowed: capacity {capacity} items, live work needs more than \
+             {needed_more_than}; no item was lost (make room with a smaller --payload, or a \
+             smaller tree, fewer items alive at once: fewer --roots, a lower --depth, a smaller \
+             --fanout)"
+        ),
+        other => other.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    /// A queue overflow's advice names only options schedbench has (issue 24: it named "a
+    /// larger memory budget" and "the strategy's max_capacity", neither one of them).
+    #[test]
+    fn overflow_advice_names_existing_options() {
+        let e = Error::Run(RunError::QueueOverflow {
+            queue: "branch".into(),
+            capacity: 65535,
+            needed_more_than: 65535,
+        });
+        let text = e.to_string();
+        assert!(
+            text.starts_with("queue `branch` overflowed: capacity 65535"),
+            "{text}"
+        );
+        let cmd = crate::cli::Cli::command();
+        let named: Vec<&str> = text
+            .split(|c: char| !(c.is_ascii_alphanumeric() || c == '-'))
+            .filter_map(|w| w.strip_prefix("--"))
+            .collect();
+        assert!(named.len() >= 3, "{text}");
+        for flag in named {
+            assert!(
+                cmd.get_arguments().any(|a| a.get_long() == Some(flag)),
+                "--{flag} is no schedbench option: {text}"
+            );
+        }
+        assert!(
+            !text.contains("max_capacity") && !text.contains("memory budget"),
+            "{text}"
+        );
+    }
 }

@@ -28,8 +28,8 @@ pub enum RunError {
     /// the run stopped with the queues intact.
     #[error(
         "queue `{queue}` overflowed: capacity {capacity} items, live work needs more than \
-         {needed_more_than}; no item was lost (more room: a larger memory budget, or the \
-         strategy's max_capacity)"
+         {needed_more_than}; no item was lost (more room: a larger `max_capacity` in the \
+         strategy's config, or a larger budget given to `run_within`)"
     )]
     QueueOverflow {
         /// The procedure whose queue overflowed.
@@ -83,8 +83,8 @@ mod tests {
                     needed_more_than: 17,
                 },
                 "queue `leaf` overflowed: capacity 16 items, live work needs more than 17; no \
-                 item was lost (more room: a larger memory budget, or the strategy's \
-                 max_capacity)",
+                 item was lost (more room: a larger `max_capacity` in the strategy's config, \
+                 or a larger budget given to `run_within`)",
             ),
             (
                 RunError::EmitLimit {

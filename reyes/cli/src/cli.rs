@@ -262,12 +262,13 @@ pub struct RenderCmd {
     #[arg(long, value_name = "OUT.json")]
     pub stats: Option<PathBuf>,
 
-    /// Write the linear float image as PFM.
-    #[arg(long, value_name = "OUT.pfm")]
+    /// Write the linear float image as PFM (a name ending in .exr is refused: --exr writes
+    /// OpenEXR).
+    #[arg(long, value_name = "OUT.pfm", value_parser = pfm_path)]
     pub float: Option<PathBuf>,
 
-    /// Write the depth image as PFM.
-    #[arg(long, value_name = "OUT.pfm")]
+    /// Write the depth image as PFM (not to a .exr name: --exr holds depth as channel Z).
+    #[arg(long, value_name = "OUT.pfm", value_parser = pfm_path)]
     pub depth: Option<PathBuf>,
 
     /// Write colour, alpha and depth as one OpenEXR file: channels R, G, B (premultiplied by
@@ -374,6 +375,10 @@ pub struct MeasureCmd {
     pub render: RenderArgs,
 }
 
+/// The most timed (and, apart, warm-up) frames of `reyes bench`: every frame's record is
+/// held for the report, and 100,000 teapot frames take minutes even on a large GPU.
+pub const MAX_BENCH_FRAMES: u32 = 100_000;
+
 /// `reyes bench`: frames of a turning scene rendered by the persistent pipelined renderer
 /// (`reyes::realtime`), after 0.5 s of full GPU load (clocks) and `--warmup` untimed frames.
 #[derive(Debug, Args)]
@@ -383,8 +388,9 @@ pub struct BenchCmd {
     #[arg(value_name = "SCENE")]
     pub scene: Option<PathBuf>,
 
-    /// Frames to time.
-    #[arg(long, value_name = "N", default_value_t = 100, value_parser = value_parser!(u32).range(1..))]
+    /// Frames to time, 1..=100000 (each frame's record is kept for the report).
+    #[arg(long, value_name = "N", default_value_t = 100,
+          value_parser = value_parser!(u32).range(1..=MAX_BENCH_FRAMES as i64))]
     pub frames: u32,
 
     /// Turn the scene one full turn over the timed frames (360/N degrees per frame) about the
@@ -396,8 +402,9 @@ pub struct BenchCmd {
     #[arg(long, value_name = "DEG", default_value_t = 0.0, value_parser = finite_f64)]
     pub angle: f64,
 
-    /// Untimed frames before the timed ones (after the clock warm-up).
-    #[arg(long, value_name = "N", default_value_t = 10)]
+    /// Untimed frames before the timed ones (after the clock warm-up), 0..=100000.
+    #[arg(long, value_name = "N", default_value_t = 10,
+          value_parser = value_parser!(u32).range(0..=MAX_BENCH_FRAMES as i64))]
     pub warmup: u32,
 
     /// Print one JSON object instead of the table.
@@ -683,6 +690,20 @@ fn parse_samples(v: &str) -> Result<(u32, u32), String> {
 }
 
 /// A finite number.
+/// A PFM output's name: any but one ending in `.exr`, which would hold PFM bytes under an
+/// OpenEXR name (`--exr` writes OpenEXR).
+fn pfm_path(v: &str) -> Result<PathBuf, String> {
+    let p = PathBuf::from(v);
+    let exr = p.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    if exr {
+        return Err(format!(
+            "`{v}`: this option writes PFM, not OpenEXR; name it .pfm, or write OpenEXR with \
+             --exr"
+        ));
+    }
+    Ok(p)
+}
+
 fn finite_f64(v: &str) -> Result<f64, String> {
     v.trim()
         .parse::<f64>()
@@ -813,7 +834,13 @@ mod tests {
             &["sweep", "--mp-sizes", "1,-1"],
             &["sweep", "--strategies", "megakernel,magic"],
             &["drift", "--height", "0"],
+            &["render", "--float", "out.exr"],
+            &["render", "--depth", "d.EXR"],
             &["bench", "--frames", "0"],
+            // Once aborted allocating 34 GB (issue 24).
+            &["bench", "--frames", "4294967295"],
+            &["bench", "--warmup", "4294967295"],
+            &["bench", "--frames", "100001"],
             &["bench", "--angle", "inf"],
             &["bench", "--runs", "3"],
             &["view", "--frames", "0"],

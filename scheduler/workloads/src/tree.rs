@@ -132,6 +132,74 @@ impl TreeParams {
         }
     }
 
+    /// Nodes the tree is expected to have, computed without walking it: with
+    /// [`Fanout::Fixed`] (K) exactly `roots * (1 + K + ... + K^depth)`; with
+    /// [`Fanout::Uniform`] (0..=K from a hash, mean K/2) the same sum with K/2, the mean over
+    /// seeds. Infinite where it does not fit an f64. What a caller checks before a run that
+    /// might never end ([`TreeParams::MAX_ITEMS`]).
+    pub fn expected_items(&self) -> f64 {
+        let m = match self.fanout {
+            Fanout::Fixed(k) => k as f64,
+            Fanout::Uniform(k) => k as f64 / 2.0,
+        };
+        if self.roots == 0 {
+            return 0.0;
+        }
+        let levels = self.max_depth as f64 + 1.0;
+        let per_root = if (m - 1.0).abs() < 1e-12 {
+            levels
+        } else {
+            (m.powf(levels) - 1.0) / (m - 1.0)
+        };
+        self.roots as f64 * per_root
+    }
+
+    /// The most nodes a tree may be expected to have ([`TreeParams::expected_items`]): the
+    /// GPU strategies count executed items per procedure in 32-bit words, and a tree past
+    /// 2^30 nodes takes minutes to hours on a CPU adapter. The benchmark's largest tree has
+    /// 8.4M.
+    pub const MAX_ITEMS: f64 = (1u64 << 30) as f64;
+
+    /// The most hash rounds over the whole tree: nodes times (1 + `work`).
+    pub const MAX_WORK: f64 = (1u64 << 36) as f64;
+
+    /// The most hash rounds per inner node (`work`): one GPU thread runs them all.
+    pub const MAX_WORK_PER_ITEM: u32 = 1 << 16;
+
+    /// Why this tree cannot run in bounded time and memory, or `None` when it can: more
+    /// nodes than [`TreeParams::MAX_ITEMS`], more work per node than
+    /// [`TreeParams::MAX_WORK_PER_ITEM`], or more hash rounds than [`TreeParams::MAX_WORK`].
+    pub fn too_large(&self) -> Option<String> {
+        let items = self.expected_items();
+        if items > Self::MAX_ITEMS {
+            return Some(format!(
+                "the tree would have about {items:.3e} nodes (roots {} x fanout {}^depth {}), \
+                 more than the {} that can run",
+                self.roots,
+                self.max_children(),
+                self.max_depth,
+                Self::MAX_ITEMS
+            ));
+        }
+        if self.work > Self::MAX_WORK_PER_ITEM {
+            return Some(format!(
+                "{} hash rounds per node is more than the {} one GPU thread may run",
+                self.work,
+                Self::MAX_WORK_PER_ITEM
+            ));
+        }
+        let rounds = items * (1.0 + self.work as f64);
+        if rounds > Self::MAX_WORK {
+            return Some(format!(
+                "about {items:.3e} nodes x {} hash rounds each is {rounds:.3e} rounds, more \
+                 than the {} that can run",
+                self.work,
+                Self::MAX_WORK
+            ));
+        }
+        None
+    }
+
     /// One line of every parameter, for reports.
     pub fn describe(&self) -> String {
         let f = match self.fanout {
@@ -600,6 +668,61 @@ impl TreeRun {
 
 #[cfg(test)]
 mod tests {
+    /// The expected size is the exact count for fixed fanouts, the presets all run, and the
+    /// trees of the issue that never ended (or aborted) are refused.
+    #[test]
+    fn expected_size_refuses_trees_that_cannot_run() {
+        for p in TreePreset::ALL {
+            assert_eq!(p.params().too_large(), None, "{}", p.name());
+        }
+        let binary = TreeParams::binary_benchmark();
+        assert_eq!(binary.expected_items(), 2_097_088.0);
+        let small = TreeParams {
+            roots: 3,
+            max_depth: 5,
+            fanout: Fanout::Fixed(3),
+            ..binary.clone()
+        };
+        let r = small.reference();
+        assert_eq!(small.expected_items(), (r.branches + r.leaves) as f64);
+        for bad in [
+            TreeParams {
+                roots: u32::MAX,
+                ..binary.clone()
+            },
+            TreeParams {
+                max_depth: u32::MAX,
+                ..binary.clone()
+            },
+            TreeParams {
+                max_depth: 40,
+                ..binary.clone()
+            },
+            TreeParams {
+                fanout: Fanout::Fixed(16),
+                max_depth: 12,
+                ..binary.clone()
+            },
+            TreeParams {
+                work: u32::MAX,
+                ..binary.clone()
+            },
+            TreeParams {
+                max_depth: u32::MAX,
+                ..TreePreset::Deep.params()
+            },
+        ] {
+            assert!(bad.too_large().is_some(), "{}", bad.describe());
+        }
+        // A dying tree (mean fanout 1/2) is small at any depth.
+        let dying = TreeParams {
+            fanout: Fanout::Uniform(1),
+            max_depth: u32::MAX,
+            ..binary
+        };
+        assert_eq!(dying.too_large(), None);
+    }
+
     #[test]
     fn payload_loops_unroll_to_one_statement_per_word() {
         let b = super::unrolled(super::BRANCH_WGSL, 3);
