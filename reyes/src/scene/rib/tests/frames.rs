@@ -161,17 +161,17 @@ fn stream(text: &str) -> crate::scene::RibFrames<'_> {
     ))
 }
 
-const QUAD: &str = "Patch \"bilinear\" \"P\" [-1 -1 5  1 -1 5  -1 1 5  1 1 5]";
+const FARM_QUAD: &str = "Patch \"bilinear\" \"P\" [-1 -1 5  1 -1 5  -1 1 5  1 1 5]";
 
 /// An error inside a frame block is that frame's: the frames after it still come, with the
 /// options the file set before the frames (not those the broken frame set).
 #[test]
 fn a_frame_after_a_broken_one_is_still_delivered() {
     let text = format!(
-        "Format 32 24 1\nFrameBegin 1\nWorldBegin\n{QUAD}\nWorldEnd\nFrameEnd\n\
+        "Format 32 24 1\nFrameBegin 1\nWorldBegin\n{FARM_QUAD}\nWorldEnd\nFrameEnd\n\
          FrameBegin 2\nFormat 64 48 1\nWorldBegin\nAttributeBegin\nPatch \"bilinear\" \"P\" [1 2]\n\
          AttributeEnd\nWorldEnd\nFrameEnd\n\
-         FrameBegin 3\nWorldBegin\n{QUAD}\nWorldEnd\nFrameEnd\n"
+         FrameBegin 3\nWorldBegin\n{FARM_QUAD}\nWorldEnd\nFrameEnd\n"
     );
     let items: Vec<_> = stream(&text).collect();
     assert_eq!(items.len(), 3);
@@ -191,12 +191,15 @@ fn a_frame_after_a_broken_one_is_still_delivered() {
     // An error at `FrameEnd` itself skips nothing after it; one outside a frame block ends
     // the stream.
     let text = format!(
-        "FrameBegin 1\nWorldBegin\n{QUAD}\nFrameEnd\nFrameBegin 2\nWorldBegin\n{QUAD}\nWorldEnd\nFrameEnd\n"
+        "FrameBegin 1\nWorldBegin\n{FARM_QUAD}\nFrameEnd\nFrameBegin 2\nWorldBegin\n{FARM_QUAD}\nWorldEnd\nFrameEnd\n"
     );
     let items: Vec<_> = stream(&text).collect();
     assert_eq!(items[0].as_ref().unwrap_err().number, Some(1));
     assert_eq!(items[1].as_ref().unwrap().number, 2);
-    let items: Vec<_> = stream(&format!("Bogus\nWorldBegin\n{QUAD}\nWorldEnd\n")).collect();
+    let items: Vec<_> = stream(&format!(
+        "AttributeEnd\nWorldBegin\n{FARM_QUAD}\nWorldEnd\n"
+    ))
+    .collect();
     assert_eq!(items.len(), 1);
     assert_eq!(items[0].as_ref().unwrap_err().number, None);
 }
@@ -217,7 +220,7 @@ fn frames_stream_one_at_a_time() {
             if self.at == self.buf.len() {
                 self.next += 1;
                 self.buf = format!(
-                    "FrameBegin {}\nDisplay \"f.{:04}.tif\" \"file\" \"rgba\"\nWorldBegin\n{QUAD}\nWorldEnd\nFrameEnd\n",
+                    "FrameBegin {}\nDisplay \"f.{:04}.tif\" \"file\" \"rgba\"\nWorldBegin\n{FARM_QUAD}\nWorldEnd\nFrameEnd\n",
                     self.next, self.next
                 )
                 .into_bytes();
