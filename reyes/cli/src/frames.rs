@@ -257,6 +257,9 @@ mod tests {
     use super::*;
     use reyes::scene::{Display, FrameRanges, FrameSequence, Scene};
 
+    /// The frames rendered (indices) with their outputs, and the skipped frames' warnings.
+    type Plan = (Vec<(usize, Outputs)>, Vec<String>);
+
     /// What `reyes render` names for the frames of `seq` (selected by `selection`) as they
     /// stream: the frames rendered with their outputs, the skipped frames' warnings; the first
     /// error.
@@ -264,7 +267,7 @@ mod tests {
         seq: &FrameSequence,
         selection: Option<&FrameRanges>,
         req: &Requested,
-    ) -> Result<(Vec<(usize, Outputs)>, Vec<String>), CliError> {
+    ) -> Result<Plan, CliError> {
         let sequence = seq.frames.len() > 1;
         let several = sequence && selection.is_none_or(|s| s.single().is_none());
         let mut namer = Namer::new(req, sequence, several)?;

@@ -140,7 +140,7 @@ fn run(a: RenderCmd) -> Result<(), CliError> {
 enum Device {
     Unopened,
     Cpu,
-    Gpu(Box<Gpu>, Option<(GpuRenderer, SceneFeatures)>),
+    Gpu(Box<Gpu>, Option<Box<(GpuRenderer, SceneFeatures)>>),
 }
 
 /// One frame to render and what it needs from the run.
@@ -197,7 +197,7 @@ fn render_job(
             let have = renderer.as_ref().map(|r| r.1);
             if have.is_none_or(|h| h.union(need) != h) {
                 let all = have.map_or(need, |h| h.union(need));
-                *renderer = Some((gpu_renderer(a, gpu, all).map_err(at)?, all));
+                *renderer = Some(Box::new((gpu_renderer(a, gpu, all).map_err(at)?, all)));
             }
             Some((&**gpu, &renderer.as_ref().expect("made above").0))
         }

@@ -317,7 +317,7 @@ pub fn load_frames(path: &Path) -> Result<FrameSequence, SceneError> {
     match stream_frames(path)? {
         FrameStream(Stream::Rib(r)) => r.collect_sequence(),
         FrameStream(Stream::One(frame, warnings)) => Ok(FrameSequence {
-            frames: frame.into_iter().collect(),
+            frames: frame.into_iter().map(|f| *f).collect(),
             warnings,
         }),
     }
@@ -364,7 +364,7 @@ pub struct FrameStream(Stream);
 
 enum Stream {
     Rib(Box<RibFrames<'static>>),
-    One(Option<SceneFrame>, Vec<String>),
+    One(Option<Box<SceneFrame>>, Vec<String>),
 }
 
 impl FrameStream {
@@ -372,7 +372,7 @@ impl FrameStream {
     /// the stream's.
     pub fn single(scene: Scene) -> FrameStream {
         let mut seq = FrameSequence::single(scene);
-        let frame = seq.frames.pop();
+        let frame = seq.frames.pop().map(Box::new);
         FrameStream(Stream::One(frame, seq.warnings))
     }
 
@@ -391,7 +391,7 @@ impl Iterator for FrameStream {
     fn next(&mut self) -> Option<Self::Item> {
         match &mut self.0 {
             Stream::Rib(r) => r.next(),
-            Stream::One(f, _) => f.take().map(Ok),
+            Stream::One(f, _) => f.take().map(|f| Ok(*f)),
         }
     }
 }
