@@ -489,6 +489,161 @@ fn frame_sequences_write_one_image_per_frame() {
     assert!(!dir.join("s.json").exists() && !dir.join("teapot.0001.png").exists());
 }
 
+/// A three-frame RIB of 32x24 quads, one at a different place in each frame (frame 2 broken
+/// when `broken`: a patch of too few points).
+fn farm_scene(dir: &Path, broken: bool) -> &'static str {
+    let quad = |x: f64| {
+        format!(
+            "Patch \"bilinear\" \"P\" [{} -1 5  {} -1 5  {} 1 5  {} 1 5]",
+            x - 1.0,
+            x + 1.0,
+            x - 1.0,
+            x + 1.0
+        )
+    };
+    let two = if broken {
+        "Patch \"bilinear\" \"P\" [0 0 5]".to_string()
+    } else {
+        quad(0.0)
+    };
+    std::fs::write(
+        dir.join("shot.rib"),
+        format!(
+            "Format 32 24 1\n\
+             FrameBegin 1\nWorldBegin\n{}\nWorldEnd\nFrameEnd\n\
+             FrameBegin 2\nWorldBegin\n{two}\nWorldEnd\nFrameEnd\n\
+             FrameBegin 3\nWorldBegin\n{}\nWorldEnd\nFrameEnd\n",
+            quad(-0.5),
+            quad(0.5)
+        ),
+    )
+    .unwrap();
+    "shot.rib"
+}
+
+fn mtime(p: &Path) -> std::time::SystemTime {
+    std::fs::metadata(p)
+        .and_then(|m| m.modified())
+        .unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+/// `-o` with a printf-style frame number: `%04d` zero-padded, `%d` not; `--frame N` is
+/// `--frames N`, and not both.
+#[test]
+fn printf_frame_number_patterns_name_the_outputs() {
+    let dir = scratch("printf");
+    let scene = farm_scene(&dir, false);
+    let (ok, err) = reyes(&dir, &[scene, "--cpu", "-o", "shot.%04d.png"]);
+    assert!(ok, "{err}");
+    for n in 1..=3 {
+        assert!(covered(&png(&dir.join(format!("shot.000{n}.png")))) > 0);
+    }
+    let (ok, err) = reyes(&dir, &[scene, "--cpu", "-o", "s%d.png", "--frame", "2"]);
+    assert!(ok, "{err}");
+    assert!(png(&dir.join("s2.png")) == png(&dir.join("shot.0002.png")));
+    assert!(!dir.join("s1.png").exists() && !dir.join("s3.png").exists());
+    let (code, err) = render_code(&dir, &[scene, "--frame", "1", "--frames", "2"]);
+    assert_eq!(code, 2, "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The farm contract: with --frames, a frame whose output exists is skipped (one stderr line
+/// each) unless --overwrite, so a resubmitted task renders only what is missing.
+#[test]
+fn existing_frames_are_skipped_unless_overwrite() {
+    let dir = scratch("skip");
+    let scene = farm_scene(&dir, false);
+    let args = [scene, "--cpu", "-o", "f.####.png", "--frames", "1-3"];
+    let (ok, err) = reyes(&dir, &args);
+    assert!(ok, "{err}");
+    let paths: Vec<PathBuf> = (1..=3).map(|n| dir.join(format!("f.000{n}.png"))).collect();
+    let before: Vec<_> = paths.iter().map(|p| mtime(p)).collect();
+    let image2 = png(&paths[1]);
+    // A lost frame (a task killed, a file deleted): only it renders again.
+    std::fs::remove_file(&paths[1]).unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    let (ok, err) = reyes(&dir, &args);
+    assert!(ok, "{err}");
+    for n in [1, 3] {
+        assert!(
+            err.contains(&format!("frame {n}: skipped, f.000{n}.png exists")),
+            "{err}"
+        );
+    }
+    assert_eq!(err.matches("skipped").count(), 2, "{err}");
+    assert!(png(&paths[1]) == image2);
+    assert_eq!(mtime(&paths[0]), before[0]);
+    assert_eq!(mtime(&paths[2]), before[2]);
+    // All there: nothing renders, exit 0.
+    let (ok, err) = reyes(&dir, &args);
+    assert!(
+        ok && err.matches("skipped").count() == 3 && !err.contains("wrote"),
+        "{err}"
+    );
+    // --overwrite renders them all again.
+    let mut again = args.to_vec();
+    again.push("--overwrite");
+    let (ok, err) = reyes(&dir, &again);
+    assert!(
+        ok && !err.contains("skipped") && err.matches("wrote").count() == 3,
+        "{err}"
+    );
+    assert!(mtime(&paths[0]) > before[0]);
+    // Without a selection, as before: the files are written again.
+    let (ok, err) = reyes(&dir, &[scene, "--cpu", "-o", "f.####.png"]);
+    assert!(ok && !err.contains("skipped"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A broken frame 2 does not fail a task of frame 1; a task of 1-3 writes 1 and 3, names
+/// frame 2 (and its file and line), leaves no file for it and exits 1; once frame 2 is
+/// fixed, the resubmitted task renders frame 2 only.
+#[test]
+fn a_broken_frame_fails_alone() {
+    let dir = scratch("broken");
+    let scene = farm_scene(&dir, true);
+    let (ok, err) = reyes(&dir, &[scene, "--cpu", "-o", "b.%04d.png", "--frames", "1"]);
+    assert!(ok, "{err}");
+    assert!(dir.join("b.0001.png").is_file());
+    std::fs::remove_file(dir.join("b.0001.png")).unwrap();
+    let args = [scene, "--cpu", "-o", "b.%04d.png", "--frames", "1-3"];
+    let (code, err) = render_code(&dir, &args);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("reyes render: frame 2: shot.rib:9: `Patch`"),
+        "{err}"
+    );
+    assert!(err.contains("frame 2 failed"), "{err}");
+    assert!(dir.join("b.0001.png").is_file() && dir.join("b.0003.png").is_file());
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains("0002") || n.starts_with('.'))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+    let t3 = mtime(&dir.join("b.0003.png"));
+    farm_scene(&dir, false);
+    let (code, err) = render_code(&dir, &args);
+    assert_eq!(code, 0, "{err}");
+    assert!(dir.join("b.0002.png").is_file());
+    assert_eq!(err.matches("wrote").count(), 1, "{err}");
+    assert_eq!(mtime(&dir.join("b.0003.png")), t3);
+    // Two frames writing one file: the later one fails.
+    std::fs::write(
+        dir.join("same.rib"),
+        "Format 8 6 1\nFrameBegin 1\nDisplay \"x.tif\" \"file\" \"rgba\"\nWorldBegin\nWorldEnd\nFrameEnd\n\
+         FrameBegin 2\nDisplay \"x.png\" \"file\" \"rgba\"\nWorldBegin\nWorldEnd\nFrameEnd\n",
+    )
+    .unwrap();
+    let (code, err) = render_code(&dir, &["same.rib", "--cpu"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("frame 2: frames 1 and 2 would both write x.png"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// A shadow-map frame is skipped with a warning; the others render.
 #[test]
 fn shadow_pass_frames_are_skipped_with_a_warning() {

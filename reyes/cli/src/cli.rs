@@ -14,8 +14,12 @@ use scheduler::StrategyKind;
 use std::path::PathBuf;
 
 const SEQUENCES: &str = "Frame sequences: a RIB file of several frames writes each frame's \
-Display name into -o's folder, or -o NAME.####.png (#### = the frame number, zero-padded; \
-also for --stats, --float, --depth, --exr, which need a #### when several frames are rendered).";
+Display name into -o's folder, or -o NAME.####.png or NAME.%04d.png (the frame number, \
+zero-padded; %d unpadded; also for --stats, --float, --depth, --exr, which need a pattern when \
+several frames are rendered). Frames are read and rendered one at a time. With --frames or \
+--frame, a frame whose outputs all exist is skipped (--overwrite renders it again), and a \
+frame that fails is named and the others still render; exit status 0: every selected frame \
+done, 1: some frame failed, 2: usage.";
 
 /// Renders RenderMan RIB, Newell and BPT scenes with the Reyes pipeline on the scheduler, and
 /// measures the result against the exact surfaces.
@@ -296,6 +300,15 @@ pub struct RenderCmd {
     #[arg(long, value_name = "N|A-B|A,B,..", value_parser = FrameRanges::parse)]
     pub frames: Option<FrameRanges>,
 
+    /// The one frame to render (the same as --frames N).
+    #[arg(long, value_name = "N", conflicts_with = "frames")]
+    pub frame: Option<u32>,
+
+    /// With --frames / --frame: render frames whose outputs already exist again (by default
+    /// they are skipped, so that a resubmitted farm task renders only what is missing).
+    #[arg(long)]
+    pub overwrite: bool,
+
     /// GPU frames to time (N > 1: after a warm-up; median ± MAD reported).
     #[arg(long, value_name = "N", default_value_t = 1, value_parser = value_parser!(u32).range(1..))]
     pub runs: u32,
@@ -310,6 +323,11 @@ pub struct RenderCmd {
 }
 
 impl RenderCmd {
+    /// The frames selected by `--frames` or `--frame`; `None`: every frame.
+    pub fn selection(&self) -> Option<FrameRanges> {
+        (self.frame.map(FrameRanges::one)).or_else(|| self.frames.clone())
+    }
+
     /// Whether this render asks for something only the GPU path gives: `--gpu`, a strategy,
     /// timed runs, stage times, statistics, float, depth or EXR output (what `--cpu` refuses).
     pub fn gpu_only(&self) -> bool {

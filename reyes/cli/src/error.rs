@@ -55,8 +55,16 @@ pub enum CliError {
         /// The file's frame numbers, comma-separated.
         numbers: String,
     },
+    /// Frames of the selection that failed (each reported on stderr as it failed).
+    #[error("{failed} failed; the other selected frames are done")]
+    FramesFailed {
+        /// The failed frames, e.g. "frame 2, frame 5".
+        failed: String,
+    },
     /// An output name without `#` when several frames are rendered.
-    #[error("{flag}: several frames are rendered; give a name with #### for the frame number")]
+    #[error(
+        "{flag}: several frames are rendered; give a name with #### or %04d for the frame number"
+    )]
     UnnumberedOutput {
         /// The output's flag, e.g. `--stats`.
         flag: &'static str,

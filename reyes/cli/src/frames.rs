@@ -1,19 +1,25 @@
-//! `reyes render` on frame sequences: which frames to render (`--frames`) and the files each
-//! writes. Pure functions of the sequence and the command line, so the naming rules are
-//! tested without rendering.
+//! `reyes render` on frame sequences: the files each frame writes, decided frame by frame as
+//! the frames stream in. Pure functions of the frame and the command line, so the naming
+//! rules are tested without rendering.
 //!
 //! Output names, per frame:
-//! - a name with a run of `#` (`-o out.####.png`, also `--stats`, `--float`, `--depth`, `--exr`): the
-//!   run becomes the frame number, zero-padded to its length;
-//! - a file of one frame: `-o` as given, else `SCENE.png` (as before sequences existed);
+//! - a name with a frame-number pattern (`-o out.####.png` or `out.%04d.png`, also `--stats`,
+//!   `--float`, `--depth`, `--exr`): the number, zero-padded to the run of `#` (to N for
+//!   `%0Nd`; `%d`: not padded);
+//! - a file of one frame, or one frame selected (`--frame N`): `-o` as given, else `SCENE.png`
+//!   (as before sequences existed);
 //! - a sequence: the frame's `Display` name in `-o`'s folder (its file name only: a scene
 //!   file does not choose folders), with the extension `.png`; without a `Display`,
 //!   `STEM.NNNN.png` where STEM is `-o`'s stem or the scene's.
 //!
-//! Frames the renderer cannot make (shadow-map passes) are skipped with a warning.
+//! Several frames are rendered when the file has several and the selection is not one frame
+//! number: then `--stats` (etc.) need a pattern. Two frames writing one file is an error of
+//! the later frame. Frames the renderer cannot make (shadow-map passes) are skipped with a
+//! warning.
 
 use crate::error::CliError;
-use reyes::scene::{FrameRanges, FrameSequence, SceneFrame};
+use reyes::scene::SceneFrame;
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 /// The files one frame writes.
@@ -24,6 +30,18 @@ pub struct Outputs {
     pub float: Option<PathBuf>,
     pub depth: Option<PathBuf>,
     pub exr: Option<PathBuf>,
+}
+
+impl Outputs {
+    /// Every file the frame writes: the image, and on the GPU path (`cpu` false) the others.
+    pub fn files(&self, cpu: bool) -> Vec<&Path> {
+        let mut v = vec![self.image.as_path()];
+        if !cpu {
+            let rest = [&self.stats, &self.float, &self.depth, &self.exr];
+            v.extend(rest.into_iter().flatten().map(PathBuf::as_path));
+        }
+        v
+    }
 }
 
 /// Where the command line says outputs go.
@@ -37,72 +55,78 @@ pub struct Requested<'a> {
     pub stem: &'a str,
 }
 
-/// The frames to render (indices into `seq.frames`) with their outputs, and warnings for the
-/// selected frames that are skipped.
-pub type Plan = (Vec<(usize, Outputs)>, Vec<String>);
+/// Names each frame's outputs as the frames come, remembering the images named so far.
+pub struct Namer<'a> {
+    req: &'a Requested<'a>,
+    /// The file has several frames.
+    sequence: bool,
+    /// Several frames may be rendered.
+    several: bool,
+    /// Images named so far, with their frame.
+    named: HashMap<PathBuf, u32>,
+    /// The output folders were checked (they are the same for every frame).
+    checked: bool,
+}
 
-/// The frames to render (indices into `seq.frames`) with their outputs, and warnings for the
-/// selected frames that are skipped ([`Plan`]). Errors: a selection that matches no frame, a `--stats`
-/// (etc.) name without `#` when several frames are rendered, two frames writing one file.
-pub fn plan(
-    seq: &FrameSequence,
-    selection: Option<&FrameRanges>,
-    req: &Requested,
-) -> Result<Plan, CliError> {
-    let selected: Vec<usize> = (0..seq.frames.len())
-        .filter(|&i| selection.is_none_or(|s| s.contains(seq.frames[i].number)))
-        .collect();
-    if selected.is_empty() {
-        let numbers: Vec<String> = seq.frames.iter().map(|f| f.number.to_string()).collect();
-        return Err(CliError::NoFrameSelected {
-            numbers: numbers.join(", "),
-        });
-    }
-    let mut warnings = Vec::new();
-    let mut jobs = Vec::new();
-    for i in selected {
-        let frame = &seq.frames[i];
-        match &frame.unsupported {
-            Some(why) => warnings.push(format!("skipped frame {}: {why}", frame.number)),
-            None => jobs.push(i),
-        }
-    }
-    let several = jobs.len() > 1;
-    let sequence = seq.frames.len() > 1;
-    let side =
-        |p: Option<&Path>, flag: &'static str, n: u32| -> Result<Option<PathBuf>, CliError> {
-            match p {
-                None => Ok(None),
-                Some(p) if has_pattern(p) => Ok(Some(numbered(p, n))),
-                Some(_) if several => Err(CliError::UnnumberedOutput { flag }),
-                Some(p) => Ok(Some(p.to_path_buf())),
+impl<'a> Namer<'a> {
+    /// The naming of a file of several frames (`sequence`) or one, of which several may be
+    /// rendered (`several`). Errors: a `--stats` (etc.) name without a pattern when several
+    /// are.
+    pub fn new(
+        req: &'a Requested<'a>,
+        sequence: bool,
+        several: bool,
+    ) -> Result<Namer<'a>, CliError> {
+        let sides = [
+            (req.stats, "--stats"),
+            (req.float, "--float"),
+            (req.depth, "--depth"),
+            (req.exr, "--exr"),
+        ];
+        for (p, flag) in sides {
+            if several && p.is_some_and(|p| !has_pattern(p)) {
+                return Err(CliError::UnnumberedOutput { flag });
             }
+        }
+        Ok(Namer {
+            req,
+            sequence,
+            several,
+            named: HashMap::new(),
+            checked: false,
+        })
+    }
+
+    /// The files `frame` writes. Errors: an output folder that does not exist (checked with
+    /// the first frame: every frame's outputs share their folders), an image an earlier
+    /// frame writes ([`CliError::SameOutput`]).
+    pub fn outputs(&mut self, frame: &SceneFrame) -> Result<Outputs, CliError> {
+        let (req, n) = (self.req, frame.number);
+        let side = |p: Option<&Path>| match p {
+            Some(p) if has_pattern(p) => Some(numbered(p, n)),
+            p => p.map(Path::to_path_buf),
         };
-    let mut out = Vec::new();
-    for i in jobs {
-        let frame = &seq.frames[i];
-        let n = frame.number;
         let outputs = Outputs {
-            image: image_path(frame, req, sequence, several),
-            stats: side(req.stats, "--stats", n)?,
-            float: side(req.float, "--float", n)?,
-            depth: side(req.depth, "--depth", n)?,
-            exr: side(req.exr, "--exr", n)?,
+            image: image_path(frame, req, self.sequence, self.several),
+            stats: side(req.stats),
+            float: side(req.float),
+            depth: side(req.depth),
+            exr: side(req.exr),
         };
-        if let Some((j, _)) = out
-            .iter()
-            .find(|(_, o): &&(usize, Outputs)| o.image == outputs.image)
-        {
+        if !self.checked {
+            check_folders(&outputs)?;
+            self.checked = true;
+        }
+        if let Some(&first) = self.named.get(&outputs.image) {
             return Err(CliError::SameOutput {
-                first: seq.frames[*j].number,
+                first,
                 second: n,
                 path: outputs.image,
             });
         }
-        check_folders(&outputs)?;
-        out.push((i, outputs));
+        self.named.insert(outputs.image.clone(), n);
+        Ok(outputs)
     }
-    Ok((out, warnings))
 }
 
 /// Every output's folder exists, so that a frame never fails after rendering (or after an
@@ -129,26 +153,47 @@ fn check_folders(o: &Outputs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// Whether the file name of `p` holds a `#` run.
-fn has_pattern(p: &Path) -> bool {
+/// Whether the file name of `p` holds a frame-number pattern: a run of `#`, `%d` or `%0Nd`.
+pub fn has_pattern(p: &Path) -> bool {
     p.file_name()
-        .is_some_and(|n| n.to_string_lossy().contains('#'))
+        .is_some_and(|n| pattern(&n.to_string_lossy()).is_some())
 }
 
-/// `p` with the first run of `#` in its file name replaced by `n`, zero-padded to the run's
-/// length (`out.####.png`, 7: `out.0007.png`).
+/// The first frame-number pattern of `name`: its byte range and padding (`####`: 4,
+/// `%04d`: 4, `%d`: 0).
+fn pattern(name: &str) -> Option<(usize, usize, usize)> {
+    let hash = name.find('#').map(|start| {
+        let len = name[start..].chars().take_while(|&c| c == '#').count();
+        (start, start + len, len)
+    });
+    let printf = name.match_indices('%').find_map(|(start, _)| {
+        let rest = &name[start + 1..];
+        let digits = rest.chars().take_while(char::is_ascii_digit).count();
+        if !rest[digits..].starts_with('d') || (digits > 0 && !rest.starts_with('0')) {
+            return None;
+        }
+        let pad = if digits > 0 {
+            rest[..digits].parse().ok()?
+        } else {
+            0
+        };
+        Some((start, start + 1 + digits + 1, pad))
+    });
+    match (hash, printf) {
+        (Some(h), Some(p)) => Some(if h.0 < p.0 { h } else { p }),
+        (h, p) => h.or(p),
+    }
+}
+
+/// `p` with the first frame-number pattern in its file name replaced by `n`, zero-padded to
+/// the pattern's width (`out.####.png` or `out.%04d.png`, 7: `out.0007.png`; `out.%d.png`:
+/// `out.7.png`).
 pub fn numbered(p: &Path, n: u32) -> PathBuf {
     let name = p.file_name().unwrap_or_default().to_string_lossy();
-    let Some(start) = name.find('#') else {
+    let Some((start, end, pad)) = pattern(&name) else {
         return p.to_path_buf();
     };
-    let len = name[start..].chars().take_while(|&c| c == '#').count();
-    let name = format!(
-        "{}{n:0len$}{}",
-        &name[..start],
-        &name[start + len..],
-        len = len
-    );
+    let name = format!("{}{n:0pad$}{}", &name[..start], &name[end..]);
     p.with_file_name(name)
 }
 
@@ -160,7 +205,7 @@ fn is_folder(p: &Path) -> bool {
         || p.is_dir()
 }
 
-/// The image of `frame`: `-o`'s #### pattern numbered; `-o`'s name when one frame is rendered;
+/// The image of `frame`: `-o`'s pattern numbered; `-o`'s name when one frame is rendered;
 /// else, in `-o`'s folder (`-o` itself when it names one), the frame's `Display` name or
 /// `<stem>.<frame>.png`.
 fn image_path(frame: &SceneFrame, req: &Requested, sequence: bool, several: bool) -> PathBuf {
@@ -210,7 +255,34 @@ fn as_png(name: &Path) -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use reyes::scene::{Display, Scene};
+    use reyes::scene::{Display, FrameRanges, FrameSequence, Scene};
+
+    /// The frames rendered (indices) with their outputs, and the skipped frames' warnings.
+    type Plan = (Vec<(usize, Outputs)>, Vec<String>);
+
+    /// What `reyes render` names for the frames of `seq` (selected by `selection`) as they
+    /// stream: the frames rendered with their outputs, the skipped frames' warnings; the first
+    /// error.
+    fn plan(
+        seq: &FrameSequence,
+        selection: Option<&FrameRanges>,
+        req: &Requested,
+    ) -> Result<Plan, CliError> {
+        let sequence = seq.frames.len() > 1;
+        let several = sequence && selection.is_none_or(|s| s.single().is_none());
+        let mut namer = Namer::new(req, sequence, several)?;
+        let (mut jobs, mut warnings) = (Vec::new(), Vec::new());
+        for (i, f) in seq.frames.iter().enumerate() {
+            if selection.is_some_and(|s| !s.contains(f.number)) {
+                continue;
+            }
+            match &f.unsupported {
+                Some(why) => warnings.push(format!("skipped frame {}: {why}", f.number)),
+                None => jobs.push((i, namer.outputs(f)?)),
+            }
+        }
+        Ok((jobs, warnings))
+    }
 
     fn seq(frames: &[(u32, Option<&str>, Option<&str>)]) -> FrameSequence {
         FrameSequence {
@@ -260,6 +332,19 @@ mod tests {
         );
         assert_eq!(numbered(Path::new("o#.png"), 12), Path::new("o12.png"));
         assert_eq!(numbered(Path::new("o.##.png"), 123), Path::new("o.123.png"));
+        assert_eq!(
+            numbered(Path::new("d/shot.%04d.png"), 7),
+            Path::new("d/shot.0007.png")
+        );
+        assert_eq!(numbered(Path::new("s.%d.png"), 12), Path::new("s.12.png"));
+        assert_eq!(
+            numbered(Path::new("s_%02d_#.png"), 3),
+            Path::new("s_03_#.png")
+        );
+        assert!(has_pattern(Path::new("a.%04d.exr")) && has_pattern(Path::new("a%d")));
+        for plain in ["a.png", "a%.png", "a.%4d.png", "a.%x.png", "d%04d/a.png"] {
+            assert!(!has_pattern(Path::new(plain)), "{plain}");
+        }
     }
 
     #[test]
@@ -321,9 +406,15 @@ mod tests {
             (1, Some("a.png"), Some("a shadow-map pass")),
             (2, Some("b.png"), None),
         ]);
-        let (jobs, warnings) = plan(&s, None, &req(None, Some("s.json"))).unwrap();
+        // A sequence: --stats needs a pattern unless one frame is selected.
+        let e = plan(&s, None, &req(None, Some("s.json"))).unwrap_err();
+        assert!(e.to_string().contains("--stats: several frames"), "{e}");
+        let two = FrameRanges::parse("2").unwrap();
+        let (jobs, warnings) = plan(&s, Some(&two), &req(None, Some("s.json"))).unwrap();
         assert_eq!(jobs.len(), 1);
         assert_eq!(jobs[0].1.stats.as_deref(), Some(Path::new("s.json")));
+        assert!(warnings.is_empty());
+        let (_, warnings) = plan(&s, None, &req(None, Some("s.#.json"))).unwrap();
         assert_eq!(warnings, ["skipped frame 1: a shadow-map pass"]);
         let two = seq(&[(1, None, None), (2, None, None)]);
         let e = plan(&two, None, &req(None, Some("s.json")))
@@ -332,14 +423,6 @@ mod tests {
         assert!(e.contains("--stats: several frames"), "{e}");
         let (jobs, _) = plan(&two, None, &req(None, Some("s.####.json"))).unwrap();
         assert_eq!(jobs[1].1.stats.as_deref(), Some(Path::new("s.0002.json")));
-        let sel = FrameRanges::parse("5").unwrap();
-        let e = plan(&two, Some(&sel), &req(None, None))
-            .unwrap_err()
-            .to_string();
-        assert!(
-            e.contains("selects none of the file's frames (1, 2)"),
-            "{e}"
-        );
         let same = seq(&[(1, Some("x.png"), None), (2, Some("x.tif"), None)]);
         let e = plan(&same, None, &req(None, None)).unwrap_err().to_string();
         assert_eq!(e, "frames 1 and 2 would both write x.png");

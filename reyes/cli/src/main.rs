@@ -24,10 +24,13 @@ use reyes::stats::{RunSummary, frame_stats};
 use scheduler::{Gpu, StrategyKind};
 use std::process::ExitCode;
 
-/// Renders every selected frame of the scene; the whole file is read (and every output name
-/// decided) before the first frame renders, so a bad file writes nothing.
+/// Renders every selected frame of the scene, reading the file a frame at a time: read a
+/// frame, render it (if selected), drop it, go on. A frame that fails (its input, its
+/// options, its render, its outputs) is reported naming it and the others still render;
+/// then the run fails ([`CliError::FramesFailed`], exit 1). With a selection (`--frames`,
+/// `--frame`), a frame whose outputs all exist is skipped unless `--overwrite`.
 fn run(a: RenderCmd) -> Result<(), CliError> {
-    let (seq, stem) = setup::load_sequence(a.scene.as_deref(), &a.render)?;
+    let (mut stream, stem) = setup::stream_sequence(a.scene.as_deref())?;
     // The reference of --compare-to, read before anything renders.
     let reference = match &a.compare_to {
         Some(p) => Some((
@@ -36,9 +39,6 @@ fn run(a: RenderCmd) -> Result<(), CliError> {
         )),
         None => None,
     };
-    for w in &seq.warnings {
-        log::warn!("{w}");
-    }
     let requested = frames::Requested {
         out: a.out.as_deref(),
         stats: a.stats.as_deref(),
@@ -47,66 +47,189 @@ fn run(a: RenderCmd) -> Result<(), CliError> {
         exr: a.exr.as_deref(),
         stem: &stem,
     };
-    let (jobs, skipped) = frames::plan(&seq, a.frames.as_ref(), &requested)?;
-    for w in &skipped {
-        log::warn!("{w}");
-    }
-    // Each frame's options are checked before any renders.
+    let selection = a.selection();
+    let selected = |n: u32| selection.as_ref().is_none_or(|s| s.contains(n));
+    let skip_existing = selection.is_some() && !a.overwrite;
     let options = a.render.options();
-    let data = jobs
-        .iter()
-        .map(|(i, _)| FrameData::new(&seq.frames[*i].scene, &options))
-        .collect::<Result<Vec<_>, _>>()?;
-    let gpu = match (a.cpu, jobs.is_empty()) {
-        (false, false) => {
-            // One program for every frame: compiled for what they need together.
-            let need = (data.iter()).fold(SceneFeatures::default(), |f, d| f.union(d.features()));
-            let gpu = setup::open_gpu()?;
-            match a.cpu_by_default(&gpu) {
-                true => None,
-                false => Some(gpu_renderer(&a, gpu, need)?),
-            }
-        }
-        _ => None,
-    };
-    // A bar over every frame rendered (with --runs N > 1: every timed frame) when there are
-    // several; nothing for one frame.
-    let per_frame = if gpu.is_some() { a.runs.max(1) } else { 1 };
-    let steps = jobs.len() as u64 * per_frame as u64;
-    let bar = if steps > 1 {
-        reyes_cli::progress::bar(steps, "")
+    // One frame read ahead: whether the file has several frames decides the names.
+    let mut file_warnings = Vec::new();
+    let mut ahead = stream.next();
+    let mut next = stream.next();
+    let sequence = next.is_some();
+    let several = sequence && selection.as_ref().is_none_or(|s| s.single().is_none());
+    let mut namer = frames::Namer::new(&requested, sequence, several)?;
+    let mut device = Device::Unopened;
+    // A bar over the frames rendered (with --runs N > 1: every timed frame) when several
+    // may be; it grows as frames come.
+    let bar = if several || a.runs > 1 {
+        reyes_cli::progress::bar(0, "")
     } else {
         indicatif::ProgressBar::hidden()
     };
-    for ((i, outputs), data) in jobs.iter().zip(&data) {
-        let number = seq.frames[*i].number;
-        if seq.frames.len() > 1 {
-            reyes_cli::progress::note(format!("frame {number}:"));
-            bar.set_message(format!("frame {number}"));
-        } else {
-            bar.set_message("timed frames");
+    let (mut numbers, mut failed, mut any) = (Vec::new(), Vec::new(), false);
+    while let Some(item) = ahead {
+        for w in stream.take_warnings() {
+            log::warn!("{w}");
+            file_warnings.push(w);
         }
-        render_frame(
-            &a,
-            &seq.frames[*i].scene,
-            &seq.warnings,
-            data,
-            outputs,
-            (gpu.as_ref(), reference.as_ref()),
-            &bar,
-        )?;
+        match item {
+            Err(e) => match e.number {
+                Some(n) if !selected(n) => {
+                    numbers.push(n);
+                    log::warn!("{e} (not selected: not rendered)");
+                }
+                None if numbers.is_empty() => return Err(e.error.into()),
+                n => {
+                    numbers.extend(n);
+                    any |= n.is_some();
+                    eprintln!("reyes render: {e}");
+                    failed.push(n.map_or("the file".into(), |n| format!("frame {n}")));
+                }
+            },
+            Ok(frame) if !selected(frame.number) => numbers.push(frame.number),
+            Ok(frame) => {
+                numbers.push(frame.number);
+                any = true;
+                match &frame.unsupported {
+                    Some(why) => log::warn!("skipped frame {}: {why}", frame.number),
+                    None => {
+                        let job = Job {
+                            frame,
+                            sequence,
+                            skip_existing,
+                            options: &options,
+                            file_warnings: &file_warnings,
+                            reference: reference.as_ref(),
+                        };
+                        match render_job(&a, job, &mut namer, &mut device, &bar) {
+                            Ok(()) => {}
+                            Err((None, e)) => return Err(e),
+                            Err((Some(n), e)) => {
+                                eprintln!("reyes render: frame {n}: {e}");
+                                failed.push(format!("frame {n}"));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        // The frame is dropped before the next one is read.
+        ahead = next.take().or_else(|| stream.next());
     }
     bar.finish_and_clear();
+    for w in stream.take_warnings() {
+        log::warn!("{w}");
+    }
+    if !any && failed.is_empty() {
+        let numbers: Vec<String> = numbers.iter().map(u32::to_string).collect();
+        return Err(CliError::NoFrameSelected {
+            numbers: numbers.join(", "),
+        });
+    }
+    if !failed.is_empty() {
+        return Err(CliError::FramesFailed {
+            failed: failed.join(", "),
+        });
+    }
     Ok(())
 }
 
-/// The GPU and its renderer, made once for all frames.
+/// Where frames render: not decided before the first frame to render (the GPU is opened
+/// then), the CPU twin, or the GPU with its renderer, compiled for what the frames so far
+/// need (and again, for the union, when a later frame needs more).
+enum Device {
+    Unopened,
+    Cpu,
+    Gpu(Box<Gpu>, Option<Box<(GpuRenderer, SceneFeatures)>>),
+}
+
+/// One frame to render and what it needs from the run.
+struct Job<'a> {
+    frame: reyes::scene::SceneFrame,
+    sequence: bool,
+    skip_existing: bool,
+    options: &'a reyes::frame::RenderOptions,
+    file_warnings: &'a [String],
+    reference: Option<&'a Reference>,
+}
+
+/// Names, checks and renders one frame (or skips it when its outputs exist and
+/// `skip_existing`); `bar` grows by the frame's steps. Errors: the frame's number (`None`:
+/// an error of the whole run, such as a missing output folder or no GPU) and the error.
+fn render_job(
+    a: &RenderCmd,
+    mut job: Job,
+    namer: &mut frames::Namer,
+    device: &mut Device,
+    bar: &indicatif::ProgressBar,
+) -> Result<(), (Option<u32>, CliError)> {
+    let number = job.frame.number;
+    let at = |e: CliError| (Some(number), e);
+    let outputs = namer.outputs(&job.frame).map_err(|e| match e {
+        CliError::MissingFolder { .. } => (None, e),
+        e => at(e),
+    })?;
+    let cpu = a.cpu || matches!(device, Device::Cpu);
+    if job.skip_existing && outputs.files(cpu).iter().all(|p| p.exists()) {
+        reyes_cli::progress::note(format!(
+            "frame {number}: skipped, {} exists (--overwrite renders it again)",
+            outputs.image.display()
+        ));
+        return Ok(());
+    }
+    a.render.change_scene(&mut job.frame.scene).map_err(at)?;
+    let data = FrameData::new(&job.frame.scene, job.options).map_err(|e| at(e.into()))?;
+    if let Device::Unopened = device {
+        *device = match a.cpu {
+            true => Device::Cpu,
+            false => {
+                let gpu = setup::open_gpu().map_err(|e| (None, e))?;
+                match a.cpu_by_default(&gpu) {
+                    true => Device::Cpu,
+                    false => Device::Gpu(Box::new(gpu), None),
+                }
+            }
+        };
+    }
+    let gpu = match device {
+        Device::Gpu(gpu, renderer) => {
+            let need = data.features();
+            let have = renderer.as_ref().map(|r| r.1);
+            if have.is_none_or(|h| h.union(need) != h) {
+                let all = have.map_or(need, |h| h.union(need));
+                *renderer = Some(Box::new((gpu_renderer(a, gpu, all).map_err(at)?, all)));
+            }
+            Some((&**gpu, &renderer.as_ref().expect("made above").0))
+        }
+        _ => None,
+    };
+    if job.sequence {
+        reyes_cli::progress::note(format!("frame {number}:"));
+        bar.set_message(format!("frame {number}"));
+    } else {
+        bar.set_message("timed frames");
+    }
+    let steps = if gpu.is_some() { a.runs.max(1) } else { 1 };
+    bar.set_length(bar.position() + steps as u64);
+    render_frame(
+        a,
+        &job.frame.scene,
+        job.file_warnings,
+        &data,
+        &outputs,
+        (gpu, job.reference),
+        bar,
+    )
+    .map_err(at)
+}
+
+/// The renderer for `features` on `gpu`.
 fn gpu_renderer(
     a: &RenderCmd,
-    gpu: Gpu,
+    gpu: &Gpu,
     features: SceneFeatures,
-) -> Result<(Gpu, GpuRenderer), CliError> {
-    let strategy = a.render.strategy_for(&gpu);
+) -> Result<GpuRenderer, CliError> {
+    let strategy = a.render.strategy_for(gpu);
     if a.stage_times && strategy == StrategyKind::Megakernel {
         log::warn!(
             "--stage-times: the megakernel's stages share one launch; only multipass times them apart"
@@ -115,8 +238,7 @@ fn gpu_renderer(
     let config = RendererConfig::new(strategy)
         .stage_timing(a.stage_times)
         .features(features);
-    let renderer = setup::renderer(&gpu, config)?;
-    Ok((gpu, renderer))
+    setup::renderer(gpu, config)
 }
 
 /// `--compare-to`'s file and image.
@@ -130,7 +252,7 @@ fn render_frame(
     file_warnings: &[String],
     data: &FrameData,
     out: &frames::Outputs,
-    (gpu, reference): (Option<&(Gpu, GpuRenderer)>, Option<&Reference>),
+    (gpu, reference): (Option<(&Gpu, &GpuRenderer)>, Option<&Reference>),
     progress: &indicatif::ProgressBar,
 ) -> Result<(), CliError> {
     let Some((gpu, renderer)) = gpu else {

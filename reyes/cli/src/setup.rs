@@ -8,7 +8,7 @@ use crate::cli::RenderArgs;
 use crate::error::CliError;
 use reyes::frame::{FrameData, RenderOptions};
 use reyes::gpu_render::{GpuRenderer, RendererConfig, required_features};
-use reyes::scene::{self, FrameSequence, Scene};
+use reyes::scene::{self, FrameStream, Scene};
 use scheduler::Gpu;
 use std::path::Path;
 
@@ -28,32 +28,26 @@ pub fn load_scene(path: Option<&Path>) -> Result<(Scene, String), CliError> {
     }
 }
 
-/// The scene file's frames (the built-in teapot: one) with `render`'s scene edits applied to
-/// each, and the file's stem for default output names. Errors: the file's, and the edits'.
-pub fn load_sequence(
-    path: Option<&Path>,
-    render: &RenderArgs,
-) -> Result<(FrameSequence, String), CliError> {
-    let (mut seq, stem) = match path {
+/// The scene file's frames (the built-in teapot: one) as a stream, read one at a time, and
+/// the file's stem for default output names. Errors: the file cannot be read (a Newell or
+/// BPT file's errors too); a RIB file's come with its frames.
+pub fn stream_sequence(path: Option<&Path>) -> Result<(FrameStream, String), CliError> {
+    Ok(match path {
         None => (
-            FrameSequence::single(scene::builtin_teapot()),
+            FrameStream::single(scene::builtin_teapot()),
             "teapot".into(),
         ),
         Some(p) if p.as_os_str() == "teapot" => (
-            FrameSequence::single(scene::builtin_teapot()),
+            FrameStream::single(scene::builtin_teapot()),
             "teapot".into(),
         ),
         Some(p) => (
-            scene::load_frames(p)?,
+            scene::stream_frames(p)?,
             p.file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or("out".into()),
         ),
-    };
-    for f in &mut seq.frames {
-        render.change_scene(&mut f.scene)?;
-    }
-    Ok((seq, stem))
+    })
 }
 
 /// One scene ready to render: loaded, edited by the flags, its warnings logged.

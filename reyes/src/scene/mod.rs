@@ -34,8 +34,8 @@ pub use displacement::{
 pub use newell::parse_newell;
 pub use primvars::{ColorField, Primvars};
 pub use rational::eval_rational_bezier;
-pub use rib::{load_rib, open_rib, parse_rib, parse_rib_frames};
-pub use sequence::{Display, FrameRanges, FrameSequence, SceneFrame};
+pub use rib::{RibFrames, load_rib, open_rib, parse_rib, parse_rib_frames, stream_rib};
+pub use sequence::{Display, FrameError, FrameRanges, FrameSequence, SceneFrame};
 pub use spin::spin;
 pub use teapot::{builtin_teapot, teapot_object_patches};
 
@@ -311,8 +311,23 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
 /// Loads every frame of a scene file. `.rib` is RIB and `.bpt` is BPT (also with `.gz`
 /// added); any other name is recognised by content (a count line followed by 16 indices:
 /// Newell; followed by "3 3": BPT; otherwise RIB). Gzip-compressed files are read
-/// decompressed, whatever their name. Newell and BPT files make one frame.
+/// decompressed, whatever their name. Newell and BPT files make one frame. The first error
+/// of any frame fails the load ([`stream_frames`] reads on past a broken frame).
 pub fn load_frames(path: &Path) -> Result<FrameSequence, SceneError> {
+    match stream_frames(path)? {
+        FrameStream(Stream::Rib(r)) => r.collect_sequence(),
+        FrameStream(Stream::One(frame, warnings)) => Ok(FrameSequence {
+            frames: frame.into_iter().map(|f| *f).collect(),
+            warnings,
+        }),
+    }
+}
+
+/// The frames of a scene file one at a time, as [`load_frames`] recognises it: a RIB file's
+/// frames as [`RibFrames`] reads them (one frame's scene held at a time; an error in a frame
+/// block is that frame's and the frames after it still come), a Newell or BPT file's one
+/// frame. Errors: the file cannot be read; a Newell or BPT file's errors.
+pub fn stream_frames(path: &Path) -> Result<FrameStream, SceneError> {
     let file = path.display().to_string();
     let cannot = |e: std::io::Error| SceneError::new(&file, 0, format!("cannot read file: {e}"));
     // The name without a `.gz`, and the first lines, decide the format.
@@ -327,7 +342,7 @@ pub fn load_frames(path: &Path) -> Result<FrameSequence, SceneError> {
     )
     .map_err(cannot)?;
     match detect_format(named, &String::from_utf8_lossy(&head)) {
-        InputFormat::Rib => load_rib(path),
+        InputFormat::Rib => Ok(FrameStream(Stream::Rib(Box::new(stream_rib(path)?)))),
         format => {
             let mut bytes = Vec::new();
             std::io::Read::read_to_end(&mut open_rib(path).map_err(cannot)?, &mut bytes)
@@ -338,7 +353,45 @@ pub fn load_frames(path: &Path) -> Result<FrameSequence, SceneError> {
             } else {
                 framed_scene(parse_bpt(&text, &file)?, false)
             };
-            Ok(FrameSequence::single(scene))
+            Ok(FrameStream::single(scene))
+        }
+    }
+}
+
+/// A scene file's frames one at a time ([`stream_frames`]): an iterator of each frame or the
+/// error that frame (or the file) has, in file order.
+pub struct FrameStream(Stream);
+
+enum Stream {
+    Rib(Box<RibFrames<'static>>),
+    One(Option<Box<SceneFrame>>, Vec<String>),
+}
+
+impl FrameStream {
+    /// The stream of the one frame of `scene` (frame 1, no `Display`); its warnings become
+    /// the stream's.
+    pub fn single(scene: Scene) -> FrameStream {
+        let mut seq = FrameSequence::single(scene);
+        let frame = seq.frames.pop().map(Box::new);
+        FrameStream(Stream::One(frame, seq.warnings))
+    }
+
+    /// The file's warnings given since the last call (one per kind of skipped input).
+    pub fn take_warnings(&mut self) -> Vec<String> {
+        match &mut self.0 {
+            Stream::Rib(r) => r.take_warnings(),
+            Stream::One(_, w) => std::mem::take(w),
+        }
+    }
+}
+
+impl Iterator for FrameStream {
+    type Item = Result<SceneFrame, FrameError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        match &mut self.0 {
+            Stream::Rib(r) => r.next(),
+            Stream::One(f, _) => f.take().map(|f| Ok(*f)),
         }
     }
 }

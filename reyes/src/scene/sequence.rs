@@ -2,7 +2,7 @@
 //! blocks) describes one image per world block, each with its frame number and `Display`.
 //! Every loader returns a [`FrameSequence`]; single-image formats give a one-frame sequence.
 
-use super::Scene;
+use super::{Scene, SceneError};
 use crate::Error;
 
 /// A frame's `Display name type mode` (RenderMan Interface Specification 3.2, §4.1.6).
@@ -95,6 +95,29 @@ impl FrameSequence {
     }
 }
 
+/// An error of one frame of a stream of frames (`rib::RibFrames`): the frame's number when
+/// the error lies inside its `FrameBegin` ... `FrameEnd` block (the frames after it are still
+/// read), `None` for an error of the file outside any frame block (which ends the stream).
+/// Shown as `frame N: file:line: message`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FrameError {
+    /// The frame the error belongs to, if any.
+    pub number: Option<u32>,
+    /// The input error, with its file and line.
+    pub error: SceneError,
+}
+
+impl std::fmt::Display for FrameError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.number {
+            Some(n) => write!(f, "frame {n}: {}", self.error),
+            None => write!(f, "{}", self.error),
+        }
+    }
+}
+
+impl std::error::Error for FrameError {}
+
 /// A `--frames` selection: frame numbers and inclusive ranges, e.g. `2`, `2-3`, `1,3-5`.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct FrameRanges(Vec<(u32, u32)>);
@@ -127,6 +150,17 @@ impl FrameRanges {
             out.push((a, b));
         }
         Ok(FrameRanges(out))
+    }
+
+    /// The one frame number selected, when the selection names a single frame.
+    pub fn single(&self) -> Option<u32> {
+        let (a, b) = *self.0.first()?;
+        (a == b && self.0.iter().all(|&r| r == (a, a))).then_some(a)
+    }
+
+    /// The selection of the one frame `n` (`--frame N`).
+    pub fn one(n: u32) -> FrameRanges {
+        FrameRanges(vec![(n, n)])
     }
 
     /// True when frame `n` lies in one of the ranges (ends included).

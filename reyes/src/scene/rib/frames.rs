@@ -12,7 +12,7 @@
 use super::lexer::shown;
 use super::state::{Block, Interp, OpenFrame};
 use super::syntax::{Args, Request};
-use crate::scene::{Display, FrameSequence, Scene, SceneError, SceneFrame};
+use crate::scene::{Display, Scene, SceneError, SceneFrame};
 
 /// Largest frame number accepted: eight digits keep `####` patterns and file names sane.
 pub(super) const MAX_FRAME_NUMBER: usize = 99_999_999;
@@ -165,14 +165,6 @@ impl Interp {
                 "MakeShadow",
                 "skipped unsupported request `MakeShadow`",
             ),
-        }
-    }
-
-    /// The frames read, once the input has ended with every block closed.
-    pub(super) fn finish(self) -> FrameSequence {
-        FrameSequence {
-            frames: self.frames,
-            warnings: self.warnings,
         }
     }
 }

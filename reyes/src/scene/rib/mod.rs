@@ -49,7 +49,7 @@ mod tests;
 
 pub use input::open_rib;
 
-use super::{FrameSequence, Scene, SceneError};
+use super::{FrameError, FrameSequence, Scene, SceneError, SceneFrame};
 use input::Reader;
 use state::Interp;
 use std::path::Path;
@@ -57,7 +57,7 @@ use std::path::Path;
 /// Parses RIB text into its frames. `file` names the input in errors and warnings; archives
 /// (`ReadArchive`) are looked up beside it, then in the current directory.
 pub fn parse_rib_frames(text: &str, file: &str) -> Result<FrameSequence, SceneError> {
-    read(Reader::new(Box::new(text.as_bytes()), file, None))
+    RibFrames::new(Reader::new(Box::new(text.as_bytes()), file, None)).collect_sequence()
 }
 
 /// Parses RIB text of one image: the first frame that can be rendered, with a warning when
@@ -69,60 +69,188 @@ pub fn parse_rib(text: &str, file: &str) -> Result<Scene, SceneError> {
 /// Reads a RIB file (gzip-compressed or not) into its frames, as a stream: the memory it
 /// needs is the scene's, not the file's. Errors name the file as `path` displays.
 pub fn load_rib(path: &Path) -> Result<FrameSequence, SceneError> {
+    stream_rib(path)?.collect_sequence()
+}
+
+/// The frames of a RIB file (gzip-compressed or not) one at a time ([`RibFrames`]). Errors:
+/// the file cannot be opened.
+pub fn stream_rib(path: &Path) -> Result<RibFrames<'static>, SceneError> {
     let file = path.display().to_string();
     let src =
         open_rib(path).map_err(|e| SceneError::new(&file, 0, format!("cannot read file: {e}")))?;
-    read(Reader::new(src, &file, Some(path)))
+    Ok(RibFrames::new(Reader::new(src, &file, Some(path))))
 }
 
-/// Runs the requests of `reader` to its end.
-fn read(mut reader: Reader) -> Result<FrameSequence, SceneError> {
-    let mut it = Interp::new();
-    while let Some(req) = reader.next_request()? {
-        if req.name == "ObjectBegin" {
-            it.warn_once(
-                &req,
-                "ObjectBegin",
-                "skipped `ObjectBegin` ... `ObjectEnd` (retained geometry is not supported)",
-            );
+/// A RIB stream read frame by frame, as RenderMan reads it: each item is the next frame (a
+/// world block, with the options and attributes in effect as RIB carries them over), built
+/// when its `WorldEnd` / `FrameEnd` is read and handed over, so the stream holds one frame's
+/// scene at a time whatever the file's length. An error inside a `FrameBegin` ... `FrameEnd`
+/// block is that frame's ([`FrameError::number`]): the rest of the block is skipped, the
+/// state the block saved is restored, and the frames after it are still delivered. An error
+/// outside a frame block (or one the lexer cannot read past) ends the stream.
+pub struct RibFrames<'a> {
+    reader: Reader<'a>,
+    it: Interp,
+    /// True once the stream has ended (the input's end, or an error that ends it).
+    done: bool,
+    /// True once a frame or an error has been handed over.
+    delivered: bool,
+}
+
+impl<'a> RibFrames<'a> {
+    fn new(reader: Reader<'a>) -> RibFrames<'a> {
+        RibFrames {
+            reader,
+            it: Interp::new(),
+            done: false,
+            delivered: false,
+        }
+    }
+
+    /// The warnings given since the last call (one per kind of skipped input in the file).
+    pub fn take_warnings(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.it.warnings)
+    }
+
+    /// The frames held, read but not yet handed over: at most one (a test of the streaming).
+    #[cfg(test)]
+    pub(crate) fn held(&self) -> usize {
+        self.it.frames.len()
+            + usize::from(self.it.frame.as_ref().is_some_and(|f| f.world.is_some()))
+    }
+
+    /// Every frame, stopping at the first error (as the whole file read at once).
+    pub fn collect_sequence(mut self) -> Result<FrameSequence, SceneError> {
+        let mut frames = Vec::new();
+        for f in self.by_ref() {
+            frames.push(f.map_err(|e| e.error)?);
+        }
+        Ok(FrameSequence {
+            frames,
+            warnings: self.take_warnings(),
+        })
+    }
+
+    /// Runs the next request. `Ok(false)` at the end of the input; an error comes with
+    /// whether its request was a `FrameEnd` (the end of the frame it belongs to).
+    fn step(&mut self) -> Result<bool, (SceneError, bool)> {
+        let req = match self.reader.next_request() {
+            Ok(Some(r)) => r,
+            Ok(None) => return Ok(false),
+            Err(e) => return Err((e, false)),
+        };
+        let frame_end = req.name == "FrameEnd";
+        let r = (|| {
+            let (reader, it) = (&mut self.reader, &mut self.it);
+            if req.name == "ObjectBegin" {
+                it.warn_once(
+                    &req,
+                    "ObjectBegin",
+                    "skipped `ObjectBegin` ... `ObjectEnd` (retained geometry is not supported)",
+                );
+                loop {
+                    match reader.next_request()? {
+                        Some(r) if r.name == "ObjectEnd" => break,
+                        Some(_) => {}
+                        None => {
+                            return Err(reader.eof_error(format!(
+                                "unexpected end of file inside `ObjectBegin` (line {})",
+                                req.line
+                            )));
+                        }
+                    }
+                }
+                return Ok(());
+            }
+            if it.motion.is_some() && req.name != "MotionEnd" && it.motion_request(&req)? {
+                return Ok(());
+            }
+            if req.name == "ReadArchive" {
+                return reader.read_archive(&req);
+            }
+            it.request(&req)
+        })();
+        r.map(|()| true).map_err(|e| (e, frame_end))
+    }
+
+    /// The checks at the end of the input: every block closed, some frame read.
+    fn end(&mut self) -> Option<FrameError> {
+        let number = self.it.frame.as_ref().map(|f| f.number);
+        let error = if let Some(m) = &self.it.motion {
+            self.reader.eof_error(format!(
+                "unexpected end of file inside `MotionBegin` (line {})",
+                m.line
+            ))
+        } else if let Some(open) = self.it.stack.last() {
+            self.reader.eof_error(format!(
+                "unexpected end of file inside `{}` ({})",
+                open.block.begin(),
+                open.place(&self.reader.file())
+            ))
+        } else if !self.delivered {
+            self.reader
+                .eof_error("no `WorldBegin` ... `WorldEnd` block in the file")
+        } else {
+            return None;
+        };
+        Some(FrameError { number, error })
+    }
+
+    /// After `error`: inside a frame block, skips to its `FrameEnd` (unless the error was
+    /// at it) and restores the state the block saved; elsewhere, ends the stream.
+    fn recover(&mut self, error: SceneError, at_frame_end: bool) -> FrameError {
+        let Some(number) = self.it.frame.as_ref().map(|f| f.number) else {
+            self.done = true;
+            return FrameError {
+                number: None,
+                error,
+            };
+        };
+        if !at_frame_end {
             loop {
-                match reader.next_request()? {
-                    Some(r) if r.name == "ObjectEnd" => break,
-                    Some(_) => {}
-                    None => {
-                        return Err(reader.eof_error(format!(
-                            "unexpected end of file inside `ObjectBegin` (line {})",
-                            req.line
-                        )));
+                match self.reader.next_request() {
+                    Ok(Some(r)) if r.name == "FrameEnd" => break,
+                    Ok(Some(_)) => {}
+                    Ok(None) | Err(_) => {
+                        self.done = true;
+                        break;
                     }
                 }
             }
-            continue;
         }
-        if it.motion.is_some() && req.name != "MotionEnd" && it.motion_request(&req)? {
-            continue;
+        self.it.abandon_frame(number);
+        FrameError {
+            number: Some(number),
+            error,
         }
-        if req.name == "ReadArchive" {
-            reader.read_archive(&req)?;
-            continue;
+    }
+}
+
+impl Iterator for RibFrames<'_> {
+    type Item = Result<SceneFrame, FrameError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        loop {
+            if !self.it.frames.is_empty() {
+                self.delivered = true;
+                return Some(Ok(self.it.frames.remove(0)));
+            }
+            if self.done {
+                return None;
+            }
+            match self.step() {
+                Ok(true) => {}
+                Ok(false) => {
+                    self.done = true;
+                    let e = self.end()?;
+                    self.delivered = true;
+                    return Some(Err(e));
+                }
+                Err((e, at_frame_end)) => {
+                    self.delivered = true;
+                    return Some(Err(self.recover(e, at_frame_end)));
+                }
+            }
         }
-        it.request(&req)?;
     }
-    if let Some(m) = &it.motion {
-        return Err(reader.eof_error(format!(
-            "unexpected end of file inside `MotionBegin` (line {})",
-            m.line
-        )));
-    }
-    if let Some(open) = it.stack.last() {
-        return Err(reader.eof_error(format!(
-            "unexpected end of file inside `{}` ({})",
-            open.block.begin(),
-            open.place(&reader.file())
-        )));
-    }
-    if it.frames.is_empty() {
-        return Err(reader.eof_error("no `WorldBegin` ... `WorldEnd` block in the file"));
-    }
-    Ok(it.finish())
 }

@@ -263,4 +263,24 @@ impl Interp {
         }
         Ok(())
     }
+
+    /// Leaves the frame block `number` after an error in it: the blocks opened inside it are
+    /// dropped, the state `FrameBegin` saved is restored, the world read so far is dropped.
+    pub(super) fn abandon_frame(&mut self, number: u32) {
+        if let Some(at) = (self.stack.iter()).rposition(|s| s.block == Block::FrameUniforms) {
+            self.stack.truncate(at + 1);
+            let saved = self.stack.pop().expect("the frame's block");
+            self.attrs = saved.attrs;
+            if let Some(options) = saved.options {
+                self.options = *options;
+            }
+        }
+        self.current_material = None;
+        self.world_to_camera = None;
+        self.scene = Scene::default();
+        self.materials.clear();
+        self.motion = None;
+        self.frame = None;
+        self.next_number = number.saturating_add(1);
+    }
 }

@@ -151,3 +151,104 @@ fn frame_errors() {
     );
     assert!(err("Display \"x\" \"file\" WorldBegin WorldEnd").contains("missing the display mode"));
 }
+
+/// The frames of `text` as a stream.
+fn stream(text: &str) -> crate::scene::RibFrames<'_> {
+    super::super::RibFrames::new(super::super::Reader::new(
+        Box::new(text.as_bytes()),
+        "t.rib",
+        None,
+    ))
+}
+
+const FARM_QUAD: &str = "Patch \"bilinear\" \"P\" [-1 -1 5  1 -1 5  -1 1 5  1 1 5]";
+
+/// An error inside a frame block is that frame's: the frames after it still come, with the
+/// options the file set before the frames (not those the broken frame set).
+#[test]
+fn a_frame_after_a_broken_one_is_still_delivered() {
+    let text = format!(
+        "Format 32 24 1\nFrameBegin 1\nWorldBegin\n{FARM_QUAD}\nWorldEnd\nFrameEnd\n\
+         FrameBegin 2\nFormat 64 48 1\nWorldBegin\nAttributeBegin\nPatch \"bilinear\" \"P\" [1 2]\n\
+         AttributeEnd\nWorldEnd\nFrameEnd\n\
+         FrameBegin 3\nWorldBegin\n{FARM_QUAD}\nWorldEnd\nFrameEnd\n"
+    );
+    let items: Vec<_> = stream(&text).collect();
+    assert_eq!(items.len(), 3);
+    let one = items[0].as_ref().unwrap();
+    assert_eq!((one.number, one.scene.patches.len()), (1, 1));
+    let e = items[1].as_ref().unwrap_err();
+    assert_eq!(e.number, Some(2));
+    assert_eq!(e.error.line, 11);
+    assert!(e.to_string().starts_with("frame 2: t.rib:11: "), "{e}");
+    let three = items[2].as_ref().unwrap();
+    assert_eq!(three.number, 3);
+    assert_eq!((three.scene.width, three.scene.height), (32, 24));
+    assert_eq!(three.scene.patches.len(), 1);
+    // The whole-sequence reader still fails on the first error.
+    let e = parse_rib_frames(&text, "t.rib").unwrap_err();
+    assert_eq!(e.line, 11);
+    // An error at `FrameEnd` itself skips nothing after it; one outside a frame block ends
+    // the stream.
+    let text = format!(
+        "FrameBegin 1\nWorldBegin\n{FARM_QUAD}\nFrameEnd\nFrameBegin 2\nWorldBegin\n{FARM_QUAD}\nWorldEnd\nFrameEnd\n"
+    );
+    let items: Vec<_> = stream(&text).collect();
+    assert_eq!(items[0].as_ref().unwrap_err().number, Some(1));
+    assert_eq!(items[1].as_ref().unwrap().number, 2);
+    let items: Vec<_> = stream(&format!(
+        "AttributeEnd\nWorldBegin\n{FARM_QUAD}\nWorldEnd\n"
+    ))
+    .collect();
+    assert_eq!(items.len(), 1);
+    assert_eq!(items[0].as_ref().unwrap_err().number, None);
+}
+
+/// A stream reads only as far as the frame it delivers and holds no frame once it has
+/// handed it over: the frames of an endless input come one by one, each dropped by the
+/// caller, however many are read.
+#[test]
+fn frames_stream_one_at_a_time() {
+    /// Frame after frame, without end.
+    struct Endless {
+        next: u32,
+        buf: Vec<u8>,
+        at: usize,
+    }
+    impl std::io::Read for Endless {
+        fn read(&mut self, out: &mut [u8]) -> std::io::Result<usize> {
+            if self.at == self.buf.len() {
+                self.next += 1;
+                self.buf = format!(
+                    "FrameBegin {}\nDisplay \"f.{:04}.tif\" \"file\" \"rgba\"\nWorldBegin\n{FARM_QUAD}\nWorldEnd\nFrameEnd\n",
+                    self.next, self.next
+                )
+                .into_bytes();
+                self.at = 0;
+            }
+            let n = out.len().min(self.buf.len() - self.at);
+            out[..n].copy_from_slice(&self.buf[self.at..self.at + n]);
+            self.at += n;
+            Ok(n)
+        }
+    }
+    let src = Endless {
+        next: 0,
+        buf: Vec::new(),
+        at: 0,
+    };
+    let mut s =
+        super::super::RibFrames::new(super::super::Reader::new(Box::new(src), "e.rib", None));
+    let selected = 500;
+    let mut kept = None;
+    for item in s.by_ref().take(selected as usize) {
+        let f = item.unwrap();
+        if f.number == selected {
+            kept = Some(f);
+        }
+    }
+    assert_eq!(s.held(), 0);
+    let f = kept.unwrap();
+    assert_eq!(f.display.unwrap().name, "f.0500.tif");
+    assert_eq!(f.scene.patches.len(), 1);
+}
