@@ -157,7 +157,7 @@ fn bad_options_are_clear_errors() {
         (
             &["--frames", "2"][..],
             "--frames selects none of the file's frames (1)",
-            1,
+            2,
         ),
     ] {
         let (got, err) = render_code(&dir, args);
@@ -1389,4 +1389,116 @@ fn output_through_links_and_into_fifos_never_replaces_them() {
         assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
         assert!(reader.join().unwrap().starts_with(b"\x89PNG"));
     }
+}
+
+/// `-o` writes PNG: a name with another image format's extension is a usage error naming the
+/// flag that writes that format (issue 24: PNG bytes were written under `out.exr`).
+#[test]
+fn output_names_of_another_format_are_usage_errors() {
+    let dir = scratch("out-format");
+    for (out, flag) in [
+        ("out.exr", "--exr"),
+        ("out.pfm", "--float"),
+        ("out.jpg", "PNG"),
+    ] {
+        let (code, err) = render_code(&dir, &["--cpu", "-o", out]);
+        assert_eq!(code, 2, "{out}: {err}");
+        assert!(
+            err.contains("-o writes PNG") && err.contains(flag),
+            "{out}: {err}"
+        );
+        assert!(!dir.join(out).exists());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// An output that is one of the scene's inputs (the scene file, an archive, a displacement
+/// map named by a frame's `Display`) is refused before the frame renders, naming both; the
+/// input is untouched and the other frames render (issue 24: the input was overwritten).
+#[test]
+fn outputs_never_overwrite_the_scenes_inputs() {
+    let dir = scratch("clobber");
+    let mut map = image::GrayImage::new(4, 4);
+    map.fill(128);
+    map.save(dir.join("bumps.png")).unwrap();
+    let quad = "Patch \"bilinear\" \"P\" [-1 -1 5  1 -1 5  -1 1 5  1 1 5]";
+    std::fs::write(dir.join("arch.rib"), format!("{quad}\n")).unwrap();
+    std::fs::write(
+        dir.join("s.rib"),
+        format!(
+            "Format 8 6 1\n\
+             FrameBegin 1\nDisplay \"bumps.tif\" \"file\" \"rgba\"\nWorldBegin\n\
+             Displacement \"mapped\" \"mapname\" \"bumps.png\" \"Km\" 0.1\n{quad}\n\
+             WorldEnd\nFrameEnd\n\
+             FrameBegin 2\nDisplay \"two.png\" \"file\" \"rgba\"\nWorldBegin\n\
+             ReadArchive \"arch.rib\"\nWorldEnd\nFrameEnd\n"
+        ),
+    )
+    .unwrap();
+    let before = |n: &str| std::fs::read(dir.join(n)).unwrap();
+    let (map0, scene0, arch0) = (before("bumps.png"), before("s.rib"), before("arch.rib"));
+    let (code, err) = render_code(&dir, &["s.rib", "--cpu"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("frame 1: bumps.png would overwrite")
+            && err.contains("bumps.png, an input of the scene"),
+        "{err}"
+    );
+    assert!(
+        dir.join("two.png").is_file(),
+        "frame 2 still renders: {err}"
+    );
+    assert_eq!(err.matches("wrote").count(), 1, "{err}");
+    for (out, frame) in [("s.rib", "1"), ("arch.rib", "2")] {
+        let (code, err) = render_code(&dir, &["s.rib", "--cpu", "--frame", frame, "-o", out]);
+        assert_eq!(code, 1, "{out}: {err}");
+        assert!(
+            err.contains(&format!("{out} would overwrite")),
+            "{out}: {err}"
+        );
+        assert!(!err.contains("wrote"), "{out}: {err}");
+    }
+    assert_eq!(before("bumps.png"), map0);
+    assert_eq!(before("s.rib"), scene0);
+    assert_eq!(before("arch.rib"), arch0);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A frame whose `Display` name the file system cannot hold (300 bytes, or a NUL) fails
+/// before it renders, naming the `Display` name; the other frames render (issue 24: frame 2
+/// was rendered, then failed with "File name too long").
+#[test]
+fn display_names_the_file_system_cannot_hold_fail_before_rendering() {
+    let dir = scratch("long-names");
+    let long = "d".repeat(300);
+    let frame = |n: u32, name: &str| {
+        format!(
+            "FrameBegin {n}\nDisplay \"{name}\" \"file\" \"rgba\"\nWorldBegin\n\
+             Patch \"bilinear\" \"P\" [-1 -1 5  1 -1 5  -1 1 5  1 1 5]\nWorldEnd\nFrameEnd\n"
+        )
+    };
+    std::fs::write(
+        dir.join("s.rib"),
+        format!(
+            "Format 8 6 1\n{}{}{}{}",
+            frame(1, "one.png"),
+            frame(2, &long),
+            frame(3, "nul\\000.png"),
+            frame(4, "four.png")
+        ),
+    )
+    .unwrap();
+    let (code, err) = render_code(&dir, &["s.rib", "--cpu"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("frame 2: the Display name \"dddd") && err.contains("more than the 255"),
+        "{err}"
+    );
+    assert!(
+        err.contains("frame 3: the Display name \"nul\\0.png\"") && err.contains("NUL byte"),
+        "{err}"
+    );
+    assert!(dir.join("one.png").is_file() && dir.join("four.png").is_file());
+    assert_eq!(err.matches("wrote").count(), 2, "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
 }

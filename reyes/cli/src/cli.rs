@@ -258,8 +258,10 @@ pub struct RenderCmd {
     #[arg(value_name = "SCENE")]
     pub scene: Option<PathBuf>,
 
-    /// Output PNG [default: SCENE's stem .png; for sequences see below].
-    #[arg(short = 'o', long = "output", value_name = "OUT.png")]
+    /// Output PNG [default: SCENE's stem .png; for sequences see below]. A name with another
+    /// image extension (.exr, .pfm, .jpg, .tif, ...) is refused: --exr and --float write
+    /// those formats.
+    #[arg(short = 'o', long = "output", value_name = "OUT.png", value_parser = png_path)]
     pub out: Option<PathBuf>,
 
     /// Write what the render did (counts, times, warnings) as JSON.
@@ -369,7 +371,7 @@ pub struct MeasureCmd {
     pub scene: Option<PathBuf>,
 
     /// Also write the GPU frame as PNG.
-    #[arg(short = 'o', long = "output", value_name = "OUT.png")]
+    #[arg(short = 'o', long = "output", value_name = "OUT.png", value_parser = png_path)]
     pub out: Option<PathBuf>,
 
     /// Samples per pixel axis of the f64 reference render on the exact surfaces (1..=64).
@@ -430,7 +432,7 @@ pub struct BenchCmd {
     pub json: bool,
 
     /// Write the last timed frame's angle once more as PNG (8-bit, converted on the GPU).
-    #[arg(short = 'o', long = "output", value_name = "OUT.png")]
+    #[arg(short = 'o', long = "output", value_name = "OUT.png", value_parser = png_path)]
     pub out: Option<PathBuf>,
 
     /// Also time a peer renderer on the same frames and report its image difference against
@@ -722,6 +724,29 @@ fn pfm_path(v: &str) -> Result<PathBuf, String> {
     Ok(p)
 }
 
+/// A PNG output's name (`-o`): any but one whose extension names another image format
+/// (`out.exr`, `out.jpg`), which would hold PNG bytes under that name; the error says which
+/// flag writes the format, where one does.
+fn png_path(v: &str) -> Result<PathBuf, String> {
+    let p = PathBuf::from(v);
+    let ext = p
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    let flag = match ext.as_deref() {
+        Some("exr") => Some("write OpenEXR with --exr"),
+        Some("pfm") => Some("write PFM with --float (colour) or --depth (depth)"),
+        Some(
+            "jpg" | "jpeg" | "tif" | "tiff" | "bmp" | "gif" | "webp" | "tga" | "hdr" | "ppm"
+            | "pgm" | "pbm" | "pnm" | "ico" | "dds" | "qoi" | "avif" | "ff",
+        ) => Some("no flag writes that format"),
+        _ => None,
+    };
+    match flag {
+        Some(flag) => Err(format!("`{v}`: -o writes PNG; name it .png ({flag})")),
+        None => Ok(p),
+    }
+}
+
 fn finite_f64(v: &str) -> Result<f64, String> {
     v.trim()
         .parse::<f64>()
@@ -854,6 +879,12 @@ mod tests {
             &["drift", "--height", "0"],
             &["render", "--float", "out.exr"],
             &["render", "--depth", "d.EXR"],
+            // PNG bytes were written under these names (issue 24).
+            &["render", "-o", "out.exr"],
+            &["render", "-o", "out.PFM"],
+            &["render", "-o", "out.####.jpg"],
+            &["measure", "-o", "m.tif"],
+            &["bench", "-o", "b.exr"],
             &["bench", "--frames", "0"],
             // Once aborted allocating 34 GB (issue 24).
             &["bench", "--frames", "4294967295"],
@@ -878,6 +909,23 @@ mod tests {
         assert_eq!(d.width, 7);
         // --cpu takes what the CPU twin uses.
         assert!(parse(&["render", "--cpu", "--memory-budget", "64K", "--frames", "2"]).is_ok());
+        // -o: PNG names, folders, patterns and names without an extension are taken; another
+        // format's extension names the flag that writes it.
+        for ok in [
+            "o.png",
+            "o.PNG",
+            "o",
+            "d/",
+            "o.####.png",
+            "o.%04d",
+            "o.0001",
+        ] {
+            assert!(parse(&["render", "-o", ok]).is_ok(), "{ok}");
+        }
+        let e = parse(&["render", "-o", "out.exr"]).map(|_| ()).unwrap_err();
+        assert!(e.to_string().contains("--exr"), "{e}");
+        let e = parse(&["render", "-o", "out.pfm"]).map(|_| ()).unwrap_err();
+        assert!(e.to_string().contains("--float"), "{e}");
     }
 
     #[test]

@@ -8,7 +8,8 @@ use scheduler::RunError;
 use std::path::PathBuf;
 
 /// What can make a `reyes` subcommand fail. [`CliError::Conflict`] is a usage error (exit 2,
-/// reported through clap); every other variant exits 1.
+/// reported through clap), and so is [`CliError::NoFrameSelected`] ([`CliError::exit_code`]);
+/// every other variant exits 1.
 #[derive(Debug, thiserror::Error)]
 pub enum CliError {
     /// Two options that cannot go together (`--raster nearest` with `--spin` or `--dof`).
@@ -78,6 +79,26 @@ pub enum CliError {
         second: u32,
         /// The image both would write.
         path: PathBuf,
+    },
+    /// An output that is one of the scene's inputs (the scene file, an archive, a map).
+    #[error(
+        "{} would overwrite {}, an input of the scene; write the output under another name",
+        output.display(), input.display()
+    )]
+    OutputIsInput {
+        /// The output file.
+        output: PathBuf,
+        /// The input it is, as the scene names it.
+        input: PathBuf,
+    },
+    /// An output name the file system cannot hold: a NUL, or a component longer than
+    /// [`crate::frames::MAX_NAME_BYTES`] bytes.
+    #[error("{what}: {why}")]
+    BadOutputName {
+        /// The output, e.g. "frame 2's Display name \"...\"" or "-o out.png".
+        what: String,
+        /// What is wrong with it.
+        why: String,
     },
     /// An output whose folder does not exist.
     #[error("{}: the folder {} does not exist", path.display(), folder.display())]
@@ -156,4 +177,15 @@ pub enum CliError {
     /// `reyes view`: a screenshot before the first frame.
     #[error("no frame yet")]
     NoFrame,
+}
+
+impl CliError {
+    /// The exit status of this error: 2 for a usage error (a `--frames` selection that names
+    /// none of the file's frames), 1 for the rest (bad input, a failed render or write).
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            CliError::Conflict { .. } | CliError::NoFrameSelected { .. } => 2,
+            _ => 1,
+        }
+    }
 }

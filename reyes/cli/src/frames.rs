@@ -113,6 +113,7 @@ impl<'a> Namer<'a> {
             depth: side(req.depth),
             exr: side(req.exr),
         };
+        check_names(frame, &outputs, self.sequence)?;
         if !self.checked {
             check_folders(&outputs)?;
             self.checked = true;
@@ -127,6 +128,76 @@ impl<'a> Namer<'a> {
         self.named.insert(outputs.image.clone(), n);
         Ok(outputs)
     }
+}
+
+/// The longest file name (one path component) written, in bytes: `NAME_MAX` of Linux's file
+/// systems (and of macOS's and Windows', in their units).
+pub const MAX_NAME_BYTES: usize = 255;
+
+/// The longest output path, in bytes (Linux's `PATH_MAX` less its NUL).
+pub const MAX_PATH_BYTES: usize = 4095;
+
+/// Every output's name is one the file system can hold: no NUL, no component longer than
+/// [`MAX_NAME_BYTES`], no path longer than [`MAX_PATH_BYTES`]; checked for each frame before it
+/// renders, so that no render is wasted on a name that cannot be written (issue 24: frame 2's
+/// 300-character `Display` name failed after rendering). An image named by the frame's
+/// `Display` is blamed on it.
+fn check_names(frame: &SceneFrame, o: &Outputs, sequence: bool) -> Result<(), CliError> {
+    let paths = [
+        Some(&o.image),
+        o.stats.as_ref(),
+        o.float.as_ref(),
+        o.depth.as_ref(),
+        o.exr.as_ref(),
+    ];
+    for (i, p) in paths.into_iter().flatten().enumerate() {
+        let Some(why) = bad_name(p) else { continue };
+        let display = frame.display.as_ref().filter(|_| sequence && i == 0);
+        let what = match display.filter(|d| bad_name(Path::new(&d.name)).is_some()) {
+            Some(d) => format!(
+                "the Display name \"{}\" ({} bytes)",
+                shown(&d.name),
+                d.name.len()
+            ),
+            None => format!("output {}", shown(&p.to_string_lossy())),
+        };
+        return Err(CliError::BadOutputName { what, why });
+    }
+    Ok(())
+}
+
+/// Why the file system cannot hold `p`, if it cannot.
+fn bad_name(p: &Path) -> Option<String> {
+    let bytes = p.as_os_str().as_encoded_bytes();
+    if bytes.contains(&0) {
+        return Some("a file name cannot hold a NUL byte".into());
+    }
+    if let Some(c) = p
+        .components()
+        .find(|c| c.as_os_str().len() > MAX_NAME_BYTES)
+    {
+        return Some(format!(
+            "the file name \"{}\" is {} bytes, more than the {MAX_NAME_BYTES} a file name may have",
+            shown(&c.as_os_str().to_string_lossy()),
+            c.as_os_str().len()
+        ));
+    }
+    if bytes.len() > MAX_PATH_BYTES {
+        return Some(format!(
+            "the path is {} bytes, more than the {MAX_PATH_BYTES} a path may have",
+            bytes.len()
+        ));
+    }
+    None
+}
+
+/// `s` as messages quote it: control characters escaped, cut after 40 characters.
+fn shown(s: &str) -> String {
+    let mut out: String = s.chars().take(40).flat_map(char::escape_debug).collect();
+    if s.chars().count() > 40 {
+        out.push_str("...");
+    }
+    out
 }
 
 /// Every output's folder exists, so that a frame never fails after rendering (or after an
@@ -423,6 +494,26 @@ mod tests {
         assert!(e.contains("--stats: several frames"), "{e}");
         let (jobs, _) = plan(&two, None, &req(None, Some("s.####.json"))).unwrap();
         assert_eq!(jobs[1].1.stats.as_deref(), Some(Path::new("s.0002.json")));
+        // Names the file system cannot hold fail their frame before it renders, blaming the
+        // Display name (issue 24: frame 2 rendered, then "File name too long").
+        let long = "d".repeat(300);
+        let bad = seq(&[(1, Some("a.png"), None), (2, Some(&long), None)]);
+        let r = req(None, None);
+        let mut namer = Namer::new(&r, true, true).unwrap();
+        assert!(namer.outputs(&bad.frames[0]).is_ok());
+        let e = namer.outputs(&bad.frames[1]).unwrap_err().to_string();
+        assert!(
+            e.starts_with("the Display name \"dddd") && e.contains("(300 bytes)"),
+            "{e}"
+        );
+        assert!(e.contains("304 bytes, more than the 255"), "{e}");
+        let nul = seq(&[(1, Some("a\0b.png"), None), (2, None, None)]);
+        let e = plan(&nul, None, &req(None, None)).unwrap_err().to_string();
+        assert!(e.contains("a\\0b.png") && e.contains("NUL"), "{e}");
+        let e = plan(&two, None, &req(Some(&format!("{long}.####.png")), None))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("output dddd"), "{e}");
         let same = seq(&[(1, Some("x.png"), None), (2, Some("x.tif"), None)]);
         let e = plan(&same, None, &req(None, None)).unwrap_err().to_string();
         assert_eq!(e, "frames 1 and 2 would both write x.png");

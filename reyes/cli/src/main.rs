@@ -8,6 +8,7 @@ mod drift;
 mod error;
 mod frames;
 mod holes;
+mod inputs;
 mod measure;
 mod setup;
 mod sweep;
@@ -27,7 +28,9 @@ use std::process::ExitCode;
 /// Renders every selected frame of the scene, reading the file a frame at a time: read a
 /// frame, render it (if selected), drop it, go on. A frame that fails (its input, its
 /// options, its render, its outputs) is reported naming it and the others still render;
-/// then the run fails ([`CliError::FramesFailed`], exit 1). With a selection (`--frames`,
+/// then the run fails ([`CliError::FramesFailed`], exit 1). A selection that names none of
+/// the file's frames is a usage error, found when the file has been read
+/// ([`CliError::NoFrameSelected`], exit 2). With a selection (`--frames`,
 /// `--frame`), a frame whose outputs all exist is skipped unless `--overwrite`.
 fn run(a: RenderCmd) -> Result<(), CliError> {
     let (mut stream, stem) = setup::stream_sequence(a.scene.as_deref())?;
@@ -59,6 +62,7 @@ fn run(a: RenderCmd) -> Result<(), CliError> {
     let several = sequence && selection.as_ref().is_none_or(|s| s.single().is_none());
     let mut namer = frames::Namer::new(&requested, sequence, several)?;
     let mut device = Device::Unopened;
+    let mut inputs = inputs::SceneInputs::new(a.scene.as_deref());
     // A bar over the frames rendered (with --runs N > 1: every timed frame) when several
     // may be; it grows as frames come.
     let bar = if several || a.runs > 1 {
@@ -101,7 +105,8 @@ fn run(a: RenderCmd) -> Result<(), CliError> {
                             file_warnings: &file_warnings,
                             reference: reference.as_ref(),
                         };
-                        match render_job(&a, job, &mut namer, &mut device, &bar) {
+                        let run = (&mut namer, &mut inputs, &mut device);
+                        match render_job(&a, job, run, &bar) {
                             Ok(()) => {}
                             Err((None, e)) => return Err(e),
                             Err((Some(n), e)) => {
@@ -153,14 +158,14 @@ struct Job<'a> {
     reference: Option<&'a Reference>,
 }
 
-/// Names, checks and renders one frame (or skips it when its outputs exist and
-/// `skip_existing`); `bar` grows by the frame's steps. Errors: the frame's number (`None`:
+/// Names, checks (names the file system holds, no output one of the scene's inputs) and
+/// renders one frame (or skips it when its outputs exist and `skip_existing`); `bar` grows
+/// by the frame's steps. Errors: the frame's number (`None`:
 /// an error of the whole run, such as a missing output folder or no GPU) and the error.
 fn render_job(
     a: &RenderCmd,
     mut job: Job,
-    namer: &mut frames::Namer,
-    device: &mut Device,
+    (namer, inputs, device): (&mut frames::Namer, &mut inputs::SceneInputs, &mut Device),
     bar: &indicatif::ProgressBar,
 ) -> Result<(), (Option<u32>, CliError)> {
     let number = job.frame.number;
@@ -170,6 +175,9 @@ fn render_job(
         e => at(e),
     })?;
     let cpu = a.cpu || matches!(device, Device::Cpu);
+    // Before anything renders (or is skipped as done): no output is the scene file, an
+    // archive or a map.
+    inputs.check(outputs.files(cpu)).map_err(at)?;
     if job.skip_existing && outputs.files(cpu).iter().all(|p| p.exists()) {
         reyes_cli::progress::note(format!(
             "frame {number}: skipped, {} exists (--overwrite renders it again)",
@@ -422,7 +430,7 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("reyes {name}: {e}");
-            ExitCode::FAILURE
+            ExitCode::from(e.exit_code())
         }
     }
 }
