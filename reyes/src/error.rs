@@ -33,6 +33,27 @@ pub enum Error {
         /// Why the `image` crate could not read it.
         source: image::ImageError,
     },
+    /// A displacement map named by a path that is not a regular file (a FIFO, a device, a
+    /// folder): reading one could block forever or never end.
+    #[error("the displacement map {} is not a regular file", path.display())]
+    DisplacementMapNotAFile {
+        /// The map's path.
+        path: PathBuf,
+    },
+    /// A displacement map with a NaN texel: it would displace points to NaN, which the
+    /// renderer drops without a word.
+    #[error(
+        "the displacement map {} has a NaN texel at ({x}, {y}) (texels must be numbers)",
+        path.display()
+    )]
+    DisplacementMapNaN {
+        /// The map's file.
+        path: PathBuf,
+        /// The first NaN texel's column.
+        x: u32,
+        /// Its row.
+        y: u32,
+    },
     /// A displacement map of a size the GPU table does not take.
     #[error(
         "the displacement map {} is {width}x{height}: each side must be 1..={max_side}",

@@ -45,8 +45,19 @@ pub struct DisplacementMap {
 impl DisplacementMap {
     /// Reads a PNG (8 or 16 bit, any channels) or OpenEXR image through the `image` crate and
     /// keeps its luminance (for EXR, clamped to [0, 1]). Errors name the file:
-    /// [`Error::DisplacementMapUnreadable`], [`Error::DisplacementMapSize`].
+    /// [`Error::DisplacementMapUnreadable`], [`Error::DisplacementMapSize`],
+    /// [`Error::DisplacementMapNotAFile`] (only regular files are read: a FIFO would block),
+    /// [`Error::DisplacementMapNaN`] (a NaN texel is refused, not taken as 0).
     pub fn load(path: &Path) -> Result<DisplacementMap, Error> {
+        // Only regular files: a FIFO or a device would block or never end (links are
+        // followed). A path that does not exist is left to `image::open`'s error.
+        if let Ok(m) = std::fs::metadata(path)
+            && !m.is_file()
+        {
+            return Err(Error::DisplacementMapNotAFile {
+                path: path.to_path_buf(),
+            });
+        }
         let img = image::open(path).map_err(|source| Error::DisplacementMapUnreadable {
             path: path.to_path_buf(),
             source,
@@ -61,6 +72,14 @@ impl DisplacementMap {
             });
         }
         let luma = img.to_luma32f();
+        if let Some(i) = luma.as_raw().iter().position(|x| x.is_nan()) {
+            let i = i as u32;
+            return Err(Error::DisplacementMapNaN {
+                path: path.to_path_buf(),
+                x: i % width,
+                y: i / width,
+            });
+        }
         let texels = luma
             .into_raw()
             .into_iter()

@@ -41,6 +41,8 @@ struct Input<'a> {
     canonical: Option<PathBuf>,
     /// The folder archives are looked up in first.
     dir: PathBuf,
+    /// Whether a request has been read from it (its first token is checked to be RIB).
+    started: bool,
 }
 
 impl Input<'_> {
@@ -75,6 +77,7 @@ impl<'a> Reader<'a> {
                 peeked: None,
                 canonical: std::fs::canonicalize(path).ok(),
                 dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+                started: false,
             }],
         }
     }
@@ -109,6 +112,22 @@ impl<'a> Reader<'a> {
                 None => return Ok(None),
             }
         };
+        // A file that is not RIB (`ReadArchive "/etc/shadow"`, whose first token is a whole
+        // line) is refused at its first token with one error that quotes none of it. Real
+        // RIB files start with a request, possibly one the reader skips (`set -x`).
+        if !std::mem::replace(&mut self.top().started, true)
+            && !matches!(&first.tok, Tok::Word(w) if is_identifier(w))
+        {
+            let file = self.top().lexer.file().clone();
+            return Err(self.err(
+                first.line,
+                format!(
+                    "{file} is not RIB: it does not start with a request name (a RIB file \
+                     starts with a request such as `version`, `Display` or `WorldBegin`, or a \
+                     `#` comment)"
+                ),
+            ));
+        }
         let name = match first.tok {
             Tok::Word(w) if is_identifier(&w) => w,
             Tok::Word(w) => {
@@ -245,6 +264,7 @@ impl<'a> Reader<'a> {
             peeked: None,
             canonical,
             dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+            started: false,
         });
         Ok(())
     }

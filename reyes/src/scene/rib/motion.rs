@@ -45,6 +45,12 @@ pub(super) struct MotionBlock {
     moving: bool,
 }
 
+/// The largest lens radius `DepthOfField` takes, in focal distances: the renderer's f32
+/// circle of confusion at the focal plane (a rounding error times focal length in pixels times
+/// this ratio) stays about 0.01 pixel per 1,000 pixels of focal length (real lenses are
+/// below 0.1).
+pub(crate) const MAX_LENS_RATIO: f64 = 100.0;
+
 impl Interp {
     /// `Shutter open close` and `DepthOfField fstop focallength focaldistance` (options).
     pub(super) fn lens_option(&mut self, req: &Request, a: &mut Args) -> Result<(), SceneError> {
@@ -85,11 +91,25 @@ impl Interp {
                 return Err(a.err(format!("the {name} must be positive and finite, found {v}")));
             }
         }
-        self.options.camera.depth_of_field = Some(DepthOfField {
+        let dof = DepthOfField {
             fstop,
             focal_length,
             focal_distance,
-        });
+        };
+        // The renderer's circle of confusion at depth z is focal_px x lens radius x (1 /
+        // focus - 1 / z) in f32: at the focal plane the difference is a rounding error, which
+        // the lens radius over the focal distance magnifies (1e14 made every pixel white).
+        // Computed in f64 here, before any f32 sees it.
+        let ratio = dof.lens_radius() / focal_distance;
+        if !(ratio <= MAX_LENS_RATIO && (dof.lens_radius() * 1e6) as f32 <= f32::MAX) {
+            return Err(a.err(format!(
+                "the lens radius (focal length / (2 f-stop) = {:e}) is {ratio:e} times the focal \
+                 distance: at most {MAX_LENS_RATIO} (beyond it f32 rounding blurs the focal \
+                 plane itself)",
+                dof.lens_radius()
+            )));
+        }
+        self.options.camera.depth_of_field = Some(dof);
         Ok(())
     }
 

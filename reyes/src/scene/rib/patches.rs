@@ -13,6 +13,10 @@ use crate::scene::rational::from_homogeneous;
 use crate::scene::{ColorField, Patch, PatchSource, Primvars, SceneError};
 use glam::{DMat4, DVec3, DVec4};
 
+/// The largest camera-space coordinate a control point may have: its cube, 1e36, is still
+/// finite in f32 (at most 3.4e38), as the renderer's bound arithmetic needs.
+pub(crate) const MAX_COORD: f64 = 1.0e12;
+
 impl Interp {
     pub(super) fn geometry_ctm(&self, a: &Args) -> Result<DMat4, SceneError> {
         if self.world_to_camera.is_none() {
@@ -70,14 +74,17 @@ impl Interp {
                 show_point(*p)
             )));
         }
-        // The renderer computes in f32: a point finite in f64 may not be there.
-        let beyond_f32 = |p: &DVec3| p.to_array().iter().any(|&x| !(x as f32).is_finite());
-        if let Some((k, p)) = cp.iter().enumerate().find(|(_, p)| beyond_f32(p)) {
+        // The renderer computes in f32, and its bound arithmetic squares coordinates (and
+        // cubes them: an edge cross product dotted with a point): a point finite in f32 may
+        // still make those infinite, and a patch whose bound is infinite splits forever
+        // (`Sphere 1e25` around the camera never finished).
+        let beyond = |p: &DVec3| p.to_array().iter().any(|&x| !(x.abs() <= MAX_COORD));
+        if let Some((k, p)) = cp.iter().enumerate().find(|(_, p)| beyond(p)) {
             return Err(a.err(format!(
                 "patch {index}: control point {k} is {} in camera space, beyond the f32 range \
-                 (±{:e}) the renderer computes in",
+                 the renderer computes in (coordinates at most ±{MAX_COORD:e}, so that their \
+                 squares and cubes stay finite)",
                 show_point(*p),
-                f32::MAX
             )));
         }
         let material = self.material();

@@ -38,6 +38,7 @@ pub(super) struct Request {
 
 pub(super) fn is_identifier(w: &str) -> bool {
     w.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_')
+        && w.bytes().all(|c| c.is_ascii_alphanumeric() || c == b'_')
 }
 
 /// A parameter of a request's parameter list: the name without its inline type declaration,

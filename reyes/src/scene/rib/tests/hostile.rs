@@ -42,16 +42,16 @@ fn values_beyond_f32_in_camera_space_name_the_patch_line() {
     assert!(e.contains("f32-overflow.rib:4: `Patch`: patch 0: control point 0 is [-1e200, -1e200, 5] in camera space, beyond the f32 range"), "{e}");
     // Just inside the range is accepted; the line is the primitive's.
     assert!(
-        parse(&world(&format!("Scale 1e37 1e37 1e37\n{QUAD}")))
+        parse(&world(&format!("Scale 1e12 1e12 1e12\n{QUAD}")))
             .patches
             .len()
             == 1
     );
     let e = err(&world(&format!(
-        "Scale 1e37 1e37 1e37\nScale 100 1 1\n\n{QUAD}"
+        "Scale 1e12 1e12 1e12\nScale 100 1 1\n\n{QUAD}"
     )));
     assert!(
-        e.starts_with("t.rib:5: `Patch`: patch 0: control point 2"),
+        e.starts_with("t.rib:5: `Patch`: patch 0: control point 1"),
         "{e}"
     );
     // Colours and lights go to the GPU as f32 too.
@@ -115,4 +115,147 @@ fn huge_tokens_are_quoted_short() {
         };
         assert!(msg.len() < 300 && msg.contains("bytes)"), "{msg}");
     }
+}
+
+/// `Sphere 1e25 -1e25 1e25 360` around the camera (and `Hyperboloid 1e30 ...`) passed the f32
+/// range check and never finished: the bound arithmetic squares and cubes coordinates. Now
+/// every camera-space coordinate is at most `MAX_COORD`, checked at the primitive's line.
+#[test]
+fn coordinates_whose_squares_overflow_are_refused_at_the_line() {
+    use crate::scene::rib::patches::MAX_COORD;
+    assert_eq!(MAX_COORD, 1e12);
+    assert!(((MAX_COORD * MAX_COORD * MAX_COORD * 3.0) as f32).is_finite());
+    let e = err(&world("Sphere 1e25 -1e25 1e25 360"));
+    assert!(
+        e.starts_with("t.rib:2: `Sphere`: patch 0: control point ")
+            && e.contains("coordinates at most ±1e12"),
+        "{e}"
+    );
+    let e = err(&world("\nHyperboloid 1e30 0 -1 1e30 0 1 360"));
+    assert!(e.starts_with("t.rib:3: `Hyperboloid`: patch 0:"), "{e}");
+    // A large sphere inside the limit is fine.
+    assert_eq!(parse(&world("Sphere 1e11 -1e11 1e11 360")).patches.len(), 8);
+}
+
+/// `DepthOfField 1e-15 1 5`: a lens radius of 5e14 made f32 rounding at the focal plane a
+/// circle of confusion over the whole image (every pixel white). Refused at its line.
+#[test]
+fn a_lens_wider_than_the_limit_is_refused_at_its_line() {
+    use crate::scene::rib::motion::MAX_LENS_RATIO;
+    let e = err(&format!("\nDepthOfField 1e-15 1 5\n{}", world(QUAD)));
+    assert!(
+        e.starts_with("t.rib:2: `DepthOfField`: the lens radius")
+            && e.contains(&format!("at most {MAX_LENS_RATIO}")),
+        "{e}"
+    );
+    // The limit itself is taken: a lens radius of 100 focal distances.
+    let s = parse(&format!("DepthOfField 0.005 1 1\n{}", world(QUAD)));
+    assert!(s.camera.depth_of_field.is_some());
+    assert!(err(&format!("DepthOfField 0.0049 1 1\n{}", world(QUAD))).contains("lens radius"));
+}
+
+/// A FIFO (or a folder) named as a displacement map blocked forever; only regular files are
+/// read, and the error names the map and the line.
+#[test]
+fn a_map_that_is_not_a_regular_file_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("folder.png")).unwrap();
+    let fifo = dir.path().join("fifo.png");
+    let made_fifo = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success());
+    let rib = dir.path().join("scene.rib");
+    let mut names = vec!["folder.png"];
+    if made_fifo {
+        names.push("fifo.png");
+    }
+    for name in names {
+        let text = world(&format!(
+            "Displacement \"mapped\" \"mapname\" \"{name}\"\n{QUAD}"
+        ));
+        let e = parse_rib(&text, rib.to_str().unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with(&format!("{}:2: `Displacement`:", rib.display()))
+                && e.contains(&format!("{name} is not a regular file")),
+            "{e}"
+        );
+    }
+}
+
+/// An EXR map with NaN texels drew 8 of ~1,500 pixels with no warning: it is refused, naming
+/// the map, the first NaN texel and the line.
+#[test]
+fn a_map_with_nan_texels_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("nan.exr");
+    let img = image::Rgb32FImage::from_fn(8, 8, |x, y| {
+        image::Rgb(
+            [if (x, y) == (3, 2) || y == 6 {
+                f32::NAN
+            } else {
+                0.5
+            }; 3],
+        )
+    });
+    img.save(&exr).unwrap();
+    let rib = dir.path().join("scene.rib");
+    let text = world(&format!(
+        "Displacement \"mapped\" \"mapname\" \"nan.exr\"\n{QUAD}"
+    ));
+    let e = parse_rib(&text, rib.to_str().unwrap())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with(&format!("{}:2: `Displacement`:", rib.display()))
+            && e.contains("nan.exr has a NaN texel at (3, 2)"),
+        "{e}"
+    );
+}
+
+/// `ReadArchive "/etc/shadow"` rendered and printed the start of every line as a warning. A
+/// file whose first token is not a request name is refused with one error quoting none of it;
+/// a skipped request is named alone, without its arguments.
+#[test]
+fn a_file_that_is_not_rib_is_refused_at_its_first_token() {
+    let dir = tempfile::tempdir().unwrap();
+    let secret = dir.path().join("shadow");
+    std::fs::write(
+        &secret,
+        "root:*:19000:0:99999:7:::\ndaemon:*:19000:0:99999:7:::\n",
+    )
+    .unwrap();
+    let rib = dir.path().join("scene.rib");
+    std::fs::write(&rib, world("ReadArchive \"shadow\"")).unwrap();
+    let e = load(&rib).unwrap_err().to_string();
+    assert_eq!(
+        e,
+        format!(
+            "{s}:1: {s} is not RIB: it does not start with a request name (a RIB file starts \
+             with a request such as `version`, `Display` or `WorldBegin`, or a `#` comment)",
+            s = secret.display()
+        )
+    );
+    assert!(!e.contains("root") && !e.contains("daemon"), "{e}");
+    // The scene file itself, and numbers or strings first, the same.
+    let e = load(&secret).unwrap_err().to_string();
+    assert!(e.contains("is not RIB") && !e.contains("root"), "{e}");
+    assert!(err("\"secret\" WorldBegin").starts_with("t.rib:1: t.rib is not RIB"));
+    // A request name is letters, digits and `_`: `a:b` is not one, anywhere.
+    let e = err("WorldBegin\nWorldEnd\nroot:x");
+    assert_eq!(
+        e,
+        "t.rib:3: `WorldEnd`: unexpected `root:x` (not a number or string)"
+    );
+    // An unknown request is named alone, not with its arguments or the rest of its line.
+    let s = parse(&format!(
+        "Frobnicate \"secret\" [1 2] -x junk:words\n{}",
+        world("")
+    ));
+    assert_eq!(
+        s.warnings,
+        vec!["t.rib:1: skipped unsupported request `Frobnicate`"]
+    );
 }
