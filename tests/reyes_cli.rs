@@ -1345,8 +1345,8 @@ fn nearest_rasterization_with_motion_or_depth_of_field_is_a_usage_error() {
 }
 
 /// `-o` naming a symbolic link writes the file it points to and keeps the link; naming a FIFO
-/// writes the PNG into it, in place (issue 24: both were replaced by a regular file, and as
-/// root `-o /dev/null` would have replaced /dev/null).
+/// writes the PNG into it, in place: neither becomes a regular file (as root, `-o /dev/null`
+/// must not replace /dev/null).
 #[cfg(unix)]
 #[test]
 fn output_through_links_and_into_fifos_never_replaces_them() {
@@ -1392,7 +1392,7 @@ fn output_through_links_and_into_fifos_never_replaces_them() {
 }
 
 /// `-o` writes PNG: a name with another image format's extension is a usage error naming the
-/// flag that writes that format (issue 24: PNG bytes were written under `out.exr`).
+/// flag that writes that format (PNG bytes under `out.exr` would mislead every reader).
 #[test]
 fn output_names_of_another_format_are_usage_errors() {
     let dir = scratch("out-format");
@@ -1414,7 +1414,7 @@ fn output_names_of_another_format_are_usage_errors() {
 
 /// An output that is one of the scene's inputs (the scene file, an archive, a displacement
 /// map named by a frame's `Display`) is refused before the frame renders, naming both; the
-/// input is untouched and the other frames render (issue 24: the input was overwritten).
+/// input is untouched and the other frames render.
 #[test]
 fn outputs_never_overwrite_the_scenes_inputs() {
     let dir = scratch("clobber");
@@ -1465,8 +1465,8 @@ fn outputs_never_overwrite_the_scenes_inputs() {
 }
 
 /// A frame whose `Display` name the file system cannot hold (300 bytes, or a NUL) fails
-/// before it renders, naming the `Display` name; the other frames render (issue 24: frame 2
-/// was rendered, then failed with "File name too long").
+/// before it renders, naming the `Display` name (not after rendering, with "File name too
+/// long"); the other frames render.
 #[test]
 fn display_names_the_file_system_cannot_hold_fail_before_rendering() {
     let dir = scratch("long-names");

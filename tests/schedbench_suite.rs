@@ -104,7 +104,7 @@ fn small_suite_verifies_every_run_and_writes_its_report() {
     }
 }
 
-/// Trees that aborted allocating, took 4 GB or never ended (issue 24) are refused before any
+/// Trees that would abort allocating, take 4 GB or never end are refused before any
 /// GPU work: exit 2, naming the flags that made them too large; `--help` states the limits.
 #[test]
 fn trees_too_large_to_run_are_refused_naming_their_flags() {

@@ -88,8 +88,8 @@ mod tests {
     use super::*;
     use clap::CommandFactory;
 
-    /// A queue overflow's advice names only options schedbench has (issue 24: it named "a
-    /// larger memory budget" and "the strategy's max_capacity", neither one of them).
+    /// A queue overflow's advice names only options schedbench has (not the library's "memory
+    /// budget" or "max_capacity", which are no schedbench flags).
     #[test]
     fn overflow_advice_names_existing_options() {
         let e = Error::Run(RunError::QueueOverflow {

@@ -168,7 +168,7 @@ mod tests {
 
     /// A symbolic link is followed (the file it points to written, the link kept); a FIFO and
     /// a character device are written in place, never replaced by a regular file; a
-    /// directory is refused (issue 24: `-o` replaced all three).
+    /// directory is refused (a special file must never become a regular one).
     #[cfg(unix)]
     #[test]
     fn special_targets_are_written_in_place_or_refused_never_replaced() {

@@ -19,9 +19,11 @@
 //! - `grid`: the screen position DiceShade computes (f32 `eval_patch`, f32 projection) on the
 //!   same grid, against the exact one: split drift plus the dicer's own rounding.
 
-use glam::{DVec2, DVec3, DVec4};
+use glam::{DVec2, DVec3};
 use reyes::frame::{FrameData, FrameUniforms, PatchItem};
-use reyes::reference::homogeneous::{HomNet, euclidean_net, eval_net, homogeneous};
+use reyes::reference::homogeneous::{
+    HomNet, euclidean_net, eval_net, homogeneous, split_u, split_v,
+};
 use reyes::scene::Scene;
 use reyes::stages::bound::{Decision, bound};
 use reyes::stages::dice_shade::eval_surface;
@@ -127,33 +129,12 @@ impl Pair {
     }
 }
 
-/// f64 de Casteljau half of a (homogeneous) cubic at t = 1/2.
-fn half_curve_f64(p: [DVec4; 4], second: bool) -> [DVec4; 4] {
-    let a = (p[0] + p[1]) * 0.5;
-    let b = (p[1] + p[2]) * 0.5;
-    let c = (p[2] + p[3]) * 0.5;
-    let d = (a + b) * 0.5;
-    let e = (b + c) * 0.5;
-    let m = (d + e) * 0.5;
-    if second {
-        [m, e, c, p[3]]
-    } else {
-        [p[0], a, d, m]
-    }
-}
-
-/// f64 reference of `stages::split::split_half` on a homogeneous control net `cp[4*v + u]`.
+/// f64 reference of `stages::split::split_half` on a homogeneous control net `cp[4*v + u]`:
+/// the first or `second` half along u or v ([`split_u`], [`split_v`], whose halving steps are
+/// the f32 split's in f64).
 pub fn split_half_f64(cp: &HomNet, along_u: bool, second: bool) -> HomNet {
-    let mut out = *cp;
-    let (step, across) = if along_u { (1, 4) } else { (4, 1) };
-    for r in 0..4 {
-        let o = r * across;
-        let row = [0, 1, 2, 3].map(|i| cp[o + i * step]);
-        for (i, p) in half_curve_f64(row, second).into_iter().enumerate() {
-            out[o + i * step] = p;
-        }
-    }
-    out
+    let (first, last) = if along_u { split_u(cp) } else { split_v(cp) };
+    if second { last } else { first }
 }
 
 /// Largest distances (pixels) of one sub-patch; NaN where no point could be projected.

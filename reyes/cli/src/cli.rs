@@ -879,14 +879,14 @@ mod tests {
             &["drift", "--height", "0"],
             &["render", "--float", "out.exr"],
             &["render", "--depth", "d.EXR"],
-            // PNG bytes were written under these names (issue 24).
+            // `-o` writes PNG bytes: these names would be lies.
             &["render", "-o", "out.exr"],
             &["render", "-o", "out.PFM"],
             &["render", "-o", "out.####.jpg"],
             &["measure", "-o", "m.tif"],
             &["bench", "-o", "b.exr"],
             &["bench", "--frames", "0"],
-            // Once aborted allocating 34 GB (issue 24).
+            // Up front, a frame count this large would allocate 34 GB.
             &["bench", "--frames", "4294967295"],
             &["bench", "--warmup", "4294967295"],
             &["bench", "--frames", "100001"],

@@ -139,18 +139,11 @@ pub const MAX_PATH_BYTES: usize = 4095;
 
 /// Every output's name is one the file system can hold: no NUL, no component longer than
 /// [`MAX_NAME_BYTES`], no path longer than [`MAX_PATH_BYTES`]; checked for each frame before it
-/// renders, so that no render is wasted on a name that cannot be written (issue 24: frame 2's
-/// 300-character `Display` name failed after rendering). An image named by the frame's
+/// renders, so that no render is wasted on a name that cannot be written (a 300-character
+/// `Display` name would fail only after rendering). An image named by the frame's
 /// `Display` is blamed on it.
 fn check_names(frame: &SceneFrame, o: &Outputs, sequence: bool) -> Result<(), CliError> {
-    let paths = [
-        Some(&o.image),
-        o.stats.as_ref(),
-        o.float.as_ref(),
-        o.depth.as_ref(),
-        o.exr.as_ref(),
-    ];
-    for (i, p) in paths.into_iter().flatten().enumerate() {
+    for (i, p) in o.files(false).into_iter().enumerate() {
         let Some(why) = bad_name(p) else { continue };
         let display = frame.display.as_ref().filter(|_| sequence && i == 0);
         let what = match display.filter(|d| bad_name(Path::new(&d.name)).is_some()) {
@@ -203,14 +196,7 @@ fn shown(s: &str) -> String {
 /// Every output's folder exists, so that a frame never fails after rendering (or after an
 /// earlier frame was written) for want of one.
 fn check_folders(o: &Outputs) -> Result<(), CliError> {
-    let paths = [
-        Some(&o.image),
-        o.stats.as_ref(),
-        o.float.as_ref(),
-        o.depth.as_ref(),
-        o.exr.as_ref(),
-    ];
-    for p in paths.into_iter().flatten() {
+    for p in o.files(false) {
         let dir = p.parent().filter(|d| !d.as_os_str().is_empty());
         if let Some(d) = dir
             && !d.is_dir()
@@ -495,7 +481,7 @@ mod tests {
         let (jobs, _) = plan(&two, None, &req(None, Some("s.####.json"))).unwrap();
         assert_eq!(jobs[1].1.stats.as_deref(), Some(Path::new("s.0002.json")));
         // Names the file system cannot hold fail their frame before it renders, blaming the
-        // Display name (issue 24: frame 2 rendered, then "File name too long").
+        // Display name, rather than rendering and then failing with "File name too long".
         let long = "d".repeat(300);
         let bad = seq(&[(1, Some("a.png"), None), (2, Some(&long), None)]);
         let r = req(None, None);

@@ -1,6 +1,6 @@
-//! The files a scene reads, so that no output overwrites one (issue 24: `-o SCENE.rib`, or a
-//! sequence whose `Display` name is one of its own displacement maps, replaced the input by
-//! an image). The scene's inputs are the scene file, the archives it reads (`ReadArchive`,
+//! The files a scene reads, so that no output overwrites one (`-o SCENE.rib`, or a sequence
+//! whose `Display` name is one of its own displacement maps, would replace the input by an
+//! image). The scene's inputs are the scene file, the archives it reads (`ReadArchive`,
 //! nested) and its displacement maps (`"mapname"`), looked up as the reader looks them up:
 //! beside the file that names them, then in the current directory.
 //!
