@@ -44,7 +44,10 @@ fn openjd_run(work: &Path, template: &str, out: &str, params: &[&str]) -> Output
 
 #[test]
 fn a_job_renders_the_frames_and_a_rerun_only_the_missing_ones() {
-    let tmp = tempfile::Builder::new().prefix("farm-openjd").tempdir().unwrap();
+    let tmp = tempfile::Builder::new()
+        .prefix("farm-openjd")
+        .tempdir()
+        .unwrap();
     let work = tmp.path();
     let out = work.join("out");
     std::fs::create_dir_all(&out).unwrap();

@@ -40,7 +40,9 @@ fn field_shot() -> PathBuf {
 pub fn write_shot(dir: &Path, broken_frame_2: bool) -> PathBuf {
     let mut text = std::fs::read_to_string(field_shot()).unwrap();
     if broken_frame_2 {
-        let frame2 = text.find("FrameBegin 2").expect("three-frames.rib has a frame 2");
+        let frame2 = text
+            .find("FrameBegin 2")
+            .expect("three-frames.rib has a frame 2");
         let world = frame2 + text[frame2..].find("WorldBegin\n").unwrap() + "WorldBegin\n".len();
         text.insert_str(world, "Patch \"bilinear\" \"P\" [0 0 5]\n");
     }
