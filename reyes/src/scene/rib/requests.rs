@@ -76,6 +76,7 @@ pub(super) const KNOWN: &[&str] = &[
     "DepthOfField",
     "ReadArchive",
     "MakeShadow",
+    "TrimCurve",
     "Declare",
 ];
 
@@ -154,6 +155,13 @@ impl Interp {
             "MotionBegin" => self.motion_begin(req, a),
             "MotionEnd" => self.motion_end(req),
             "Shutter" | "DepthOfField" => self.lens_option(req, a),
+            "TrimCurve" => {
+                let msg = "skipped unsupported request `TrimCurve`: the `NuPatch` surfaces \
+                           after it are drawn untrimmed (the regions its curves cut away are \
+                           filled)";
+                self.warn_once(req, "TrimCurve", msg);
+                Ok(())
+            }
             "MakeShadow" => {
                 self.make_shadow(req);
                 Ok(())

@@ -171,7 +171,9 @@ fn format_pixel_aspect_minus_one_is_one() {
     let s = load(&path).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!((s.width, s.height), (200, 150));
     assert!(
-        s.warnings.iter().any(|w| w.contains("TrimCurve")),
+        s.warnings
+            .iter()
+            .any(|w| w.contains("TrimCurve") && w.contains("untrimmed")),
         "{:?}",
         s.warnings
     );
