@@ -93,6 +93,9 @@ struct PatchInfo {
     // A moving patch's motion (PATCH_MOVING): 3 entries of `primvars`, the rows of the
     // camera-space affine map from shutter open to shutter close; 0 when still.
     motion: u32,
+    // Its "N" field (shading normal, camera space; entry << 2 | shape as cs), 0 for the
+    // surface's own normal; read for undisplaced patches only.
+    normal: u32,
 }
 
 @group(1) @binding(0) var<storage, read> frame: Frame;

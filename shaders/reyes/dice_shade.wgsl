@@ -133,7 +133,14 @@ fn shade_point(item: PatchItem, info: PatchInfo, at: u32, p: vec3<f32>, n: vec3<
         let q = original_uv(item, u, v);
         cs = color_field(info.cs, q.x, q.y);
     }
-    let c = shade(p, n, m, cs);
+    // A patch's "N" shades in place of its own normal; which side faces the eye stays the
+    // surface's (Sides 1).
+    var ns = n;
+    if SCENE_PRIMVARS && info.normal != 0u && (info.flags & PATCH_DISPLACED) == 0u {
+        let q = original_uv(item, u, v);
+        ns = color_field(info.normal, q.x, q.y);
+    }
+    let c = shade(p, ns, m, cs);
     let back = dot(n, p) > 0.0;
     let color = bitcast<f32>(pack_color(c, back));
     if (item.rates & NEAR_CLIP_GRID) != 0u {

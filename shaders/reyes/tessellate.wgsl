@@ -240,7 +240,11 @@ fn tess_points(@builtin(workgroup_id) wg: vec3<u32>,
     let n = patch_normal(&cp, &w, rational, e, u, v, flip);
     var cs = m.color;
     if SCENE_PRIMVARS && info.cs != 0u { cs = color_field(info.cs, u, v); }
-    let c = shade(e[0], n, m, cs);
+    var ns = n;
+    if SCENE_PRIMVARS && info.normal != 0u && (info.flags & PATCH_DISPLACED) == 0u {
+        ns = color_field(info.normal, u, v);
+    }
+    let c = shade(e[0], ns, m, cs);
     let back = dot(n, e[0]) > 0.0;
     let p = e[0];
     vertices[g.z + k] = RasterVertex(p.x * scale.x, p.y * scale.y, p.z / near,

@@ -262,7 +262,7 @@ impl FrameData {
         let os = self.patch_info.iter().any(|i| i.os != 0);
         SceneFeatures {
             rational: (self.patch_info.iter()).any(|i| i.flags & PATCH_RATIONAL != 0),
-            primvars: os || self.patch_info.iter().any(|i| i.cs != 0),
+            primvars: os || self.patch_info.iter().any(|i| i.cs != 0 || i.normal != 0),
             transparent: os || self.materials.iter().any(|m| m.opacity < 1.0),
             displacement: (self.patch_info.iter()).any(|i| i.flags & PATCH_DISPLACED != 0),
             nearest_raster: self.frame.raster == RASTER_NEAREST,
@@ -571,6 +571,7 @@ fn patch_info(
     let vars = p.primvars.as_deref();
     let cs = field(vars.and_then(|v| v.cs.as_ref()))?;
     let os = field(vars.and_then(|v| v.os.as_ref()))?;
+    let normal = field(vars.and_then(|v| v.n.as_ref()))?;
     let weights = if p.is_rational() {
         weights_ref(table, &homogeneous_points(p))?
     } else {
@@ -600,6 +601,7 @@ fn patch_info(
         weights,
         displacement,
         motion,
+        normal,
     })
 }
 
@@ -737,6 +739,7 @@ mod tests {
                 ("weights", offset_of!(PatchInfo, weights)),
                 ("displacement", offset_of!(PatchInfo, displacement)),
                 ("motion", offset_of!(PatchInfo, motion)),
+                ("normal", offset_of!(PatchInfo, normal)),
             ],
         );
     }
@@ -755,11 +758,13 @@ mod tests {
         scene.patches[3].primvars = Primvars {
             cs: Some(ColorField::Bilinear(corners)),
             os: Some(ColorField::Flat(DVec3::splat(0.5))),
+            n: None,
         }
         .boxed();
         scene.patches[7].primvars = Primvars {
             cs: None,
             os: Some(ColorField::Bezier([DVec3::splat(0.25); 16])),
+            n: None,
         }
         .boxed();
         let d = FrameData::new(&scene, &RenderOptions::default()).unwrap();

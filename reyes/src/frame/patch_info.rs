@@ -29,6 +29,9 @@ pub struct PatchInfo {
     /// [`FrameData::primvars`], the rows of the camera-space affine map from its points at
     /// shutter open to those at shutter close ([`motion_ref`]). 0 when it does not move.
     pub motion: u32,
+    /// The patch's `"N"` (shading normal, camera space) in [`FrameData::primvars`]
+    /// ([`field_ref`]), 0 for the surface's own normal. Used by an undisplaced patch only.
+    pub normal: u32,
 }
 
 /// Bit of [`PatchInfo::flags`] (`PATCH_MOVING` in common.wgsl): the patch moves over the

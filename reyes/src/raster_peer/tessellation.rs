@@ -223,7 +223,12 @@ pub fn tessellate_cpu(
         } else {
             Vec3::from(m.color)
         };
-        let c = stages::shade::shade(e[0], n, m, cs, &data.lights);
+        let ns = if info.normal != 0 && info.flags & crate::frame::PATCH_DISPLACED == 0 {
+            stages::dice_shade::color_field(&data.primvars, info.normal, u, v)
+        } else {
+            n
+        };
+        let c = stages::shade::shade(e[0], ns, m, cs, &data.lights);
         let back = n.dot(e[0]) > 0.0;
         out.push(RasterVertex {
             x: e[0].x * scale.x,

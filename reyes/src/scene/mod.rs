@@ -12,6 +12,7 @@ mod bpt;
 mod displacement;
 mod newell;
 mod nurbs;
+pub(crate) mod polygon;
 mod primvars;
 mod quadric;
 pub(crate) mod rational;

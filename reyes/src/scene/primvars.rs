@@ -1,5 +1,6 @@
 //! Primitive variables a patch carries to its shading: the surface colour `"Cs"` and opacity
-//! `"Os"`, each as a field over the patch's own parameter square.
+//! `"Os"` (and, for polygon meshes, the shading normal `"N"`), each as a field over the
+//! patch's own parameter square.
 //!
 //! The RIB reader turns every storage class of the RenderMan Interface (constant, uniform,
 //! varying, vertex; RI Specification 3.2, section 5) into one of three shapes over the
@@ -103,13 +104,18 @@ pub struct Primvars {
     /// `"Os"`: the surface opacity per channel; the renderer uses the mean of the three
     /// channels as the fraction of samples the surface covers (docs/reyes.md, Opacity).
     pub os: Option<ColorField>,
+    /// `"N"`: the shading normal in camera space (a field of vectors: polygon meshes' vertex
+    /// or face-varying normals), interpolated, then normalized by the shader; `None`: the
+    /// surface's own normal. Shading only: which side faces the eye (`Sides 1`) and the
+    /// direction of displacement stay the surface's.
+    pub n: Option<ColorField>,
 }
 
 impl Primvars {
     /// `Some` when at least one variable is given, else `None` (a patch without primitive
     /// variables costs nothing).
     pub fn boxed(self) -> Option<Box<Primvars>> {
-        (self.cs.is_some() || self.os.is_some()).then(|| Box::new(self))
+        (self.cs.is_some() || self.os.is_some() || self.n.is_some()).then(|| Box::new(self))
     }
 }
 

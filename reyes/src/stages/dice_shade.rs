@@ -314,7 +314,13 @@ fn shade_point(item: &PatchItem, data: &FrameData, p: Vec3, n: Vec3, u: f32, v: 
     } else {
         Vec3::from(m.color)
     };
-    let c = shade::shade(p, n, m, cs, &data.lights);
+    let ns = if info.normal != 0 && info.flags & PATCH_DISPLACED == 0 {
+        let (uo, vo) = original_uv(item, u, v);
+        color_field(&data.primvars, info.normal, uo, vo)
+    } else {
+        n
+    };
+    let c = shade::shade(p, ns, m, cs, &data.lights);
     let back = n.dot(p) > 0.0;
     let color = f32::from_bits(shade::pack_color(c, back));
     if item.rates & NEAR_CLIP_GRID != 0 {

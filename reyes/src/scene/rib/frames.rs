@@ -91,7 +91,7 @@ impl Interp {
         self.pop(Block::World, req)?;
         let world_to_camera = self.world_to_camera.take().unwrap_or_default();
         let o = &self.options;
-        let scene = Scene {
+        let mut scene = Scene {
             width: o.width,
             height: o.height,
             pixel_samples: o.pixel_samples,
@@ -101,9 +101,10 @@ impl Interp {
             },
             ..std::mem::take(&mut self.scene)
         };
+        self.frame_camera(req, &mut scene)?;
         self.materials.clear();
         self.current_material = None;
-        let display = o.display.clone();
+        let display = self.options.display.clone();
         let unsupported = display.as_ref().filter(|d| d.is_depth_pass()).map(|d| {
             format!(
                 "a depth-map pass (`Display` type \"{}\"), not an image",

@@ -30,14 +30,19 @@
 //! [`shading`] (surfaces, lights, the material table), [`patches`] (the patch primitives
 //! and their conversion to Bezier patches), [`displacement`] (`Displacement` and
 //! `"displacementbound"`), [`quadrics`] (the quadric primitives), [`motion`] (`Shutter`, `DepthOfField`, motion blocks) and
-//! [`primvars`] (`Declare` and the `"Cs"` / `"Os"` primitive variables of patches).
+//! [`primvars`] (`Declare` and the `"Cs"` / `"Os"` primitive variables of patches),
+//! [`polygons`] (the polygon requests), [`instance`] (`ObjectBegin` ... `ObjectInstance`) and
+//! [`camera`] (the window requests, orthographic projection, named coordinate systems).
 
+mod camera;
 mod displacement;
 mod frames;
 mod input;
+mod instance;
 mod lexer;
 mod motion;
 mod patches;
+mod polygons;
 mod primvars;
 mod quadrics;
 mod requests;
@@ -140,27 +145,20 @@ impl<'a> RibFrames<'a> {
             Err(e) => return Err((e, false)),
         };
         let frame_end = req.name == "FrameEnd";
+        if self.it.recording.is_some() && req.name != "ReadArchive" {
+            // Inside `ObjectBegin` ... `ObjectEnd`: kept for `ObjectInstance`.
+            return self
+                .it
+                .record(req)
+                .map(|()| true)
+                .map_err(|e| (e, frame_end));
+        }
         let r = (|| {
             let (reader, it) = (&mut self.reader, &mut self.it);
-            if req.name == "ObjectBegin" {
-                it.warn_once(
-                    &req,
-                    "ObjectBegin",
-                    "skipped `ObjectBegin` ... `ObjectEnd` (retained geometry is not supported)",
-                );
-                loop {
-                    match reader.next_request()? {
-                        Some(r) if r.name == "ObjectEnd" => break,
-                        Some(_) => {}
-                        None => {
-                            return Err(reader.eof_error(format!(
-                                "unexpected end of file inside `ObjectBegin` (line {})",
-                                req.line
-                            )));
-                        }
-                    }
-                }
-                return Ok(());
+            match req.name.as_str() {
+                "ObjectBegin" => return it.object_begin(&req),
+                "ObjectInstance" => return it.object_instance(&req),
+                _ => {}
             }
             if it.motion.is_some() && req.name != "MotionEnd" && it.motion_request(&req)? {
                 return Ok(());
@@ -176,7 +174,12 @@ impl<'a> RibFrames<'a> {
     /// The checks at the end of the input: every block closed, some frame read.
     fn end(&mut self) -> Option<FrameError> {
         let number = self.it.frame.as_ref().map(|f| f.number);
-        let error = if let Some(m) = &self.it.motion {
+        let error = if let Some(r) = &self.it.recording {
+            self.reader.eof_error(format!(
+                "unexpected end of file inside `ObjectBegin` (line {})",
+                r.line
+            ))
+        } else if let Some(m) = &self.it.motion {
             self.reader.eof_error(format!(
                 "unexpected end of file inside `MotionBegin` (line {})",
                 m.line

@@ -172,7 +172,9 @@ impl Interp {
                 let what = if in_world {
                     format!("motion of `{}` is not supported", req.name)
                 } else {
-                    "camera motion is not supported".to_string()
+                    "camera motion is not supported (the image has no blur from the camera \
+                     moving)"
+                        .to_string()
                 };
                 let key = format!("motion {what}");
                 self.warn_once(req, &key, &format!("{what}: using the first time sample"));

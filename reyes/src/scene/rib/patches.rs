@@ -108,7 +108,7 @@ impl Interp {
     }
 
     /// [`Self::emit`], then gives the new patch its primitive variables.
-    fn emit_with(
+    pub(super) fn emit_with(
         &mut self,
         a: &Args,
         ctm: &DMat4,
@@ -119,7 +119,7 @@ impl Interp {
     ) -> Result<(), SceneError> {
         self.emit(a, ctm, index, cp, w)?;
         if let Some(p) = self.scene.patches.last_mut() {
-            p.primvars = Primvars { cs, os }.boxed();
+            p.primvars = Primvars { cs, os, n: None }.boxed();
         }
         Ok(())
     }
@@ -133,6 +133,7 @@ impl Interp {
             uniform: 1,
             varying: 4,
             vertex: n,
+            facevarying: 4,
         };
         let vars = self.color_vars(a, &params, &counts)?;
         let ctm = self.geometry_ctm(a)?;
@@ -169,10 +170,12 @@ impl Interp {
         let nup = mesh_patches(a, "u", nu, uwrap, ustep, order)?;
         let nvp = mesh_patches(a, "v", nv, vwrap, vstep, order)?;
         let pts = self.positions(req, a, &params, nu * nv)?;
+        let varying = (nup + !uwrap as usize) * (nvp + !vwrap as usize);
         let counts = ClassCounts {
             uniform: nup * nvp,
-            varying: (nup + !uwrap as usize) * (nvp + !vwrap as usize),
+            varying,
             vertex: nu * nv,
+            facevarying: varying,
         };
         let vars = self.color_vars(a, &params, &counts)?;
         let ctm = self.geometry_ctm(a)?;
@@ -244,10 +247,12 @@ impl Interp {
         // Orders, knots and ranges first: their errors explain count mismatches best.
         nurbs::span_count(&surf).map_err(|m| a.err(m))?;
         let (values, dim) = self.position_values(req, a, &params, nu * nv)?;
+        let varying = (2 + nu - uorder) * (2 + nv - vorder);
         let counts = ClassCounts {
             uniform: (1 + nu - uorder) * (1 + nv - vorder),
-            varying: (2 + nu - uorder) * (2 + nv - vorder),
+            varying,
             vertex: nu * nv,
+            facevarying: varying,
         };
         let vars = self.color_vars(a, &params, &counts)?;
         let ctm = self.geometry_ctm(a)?;

@@ -32,7 +32,7 @@ pub(super) enum Class {
 }
 
 impl Class {
-    fn name(self) -> &'static str {
+    pub(super) fn name(self) -> &'static str {
         match self {
             Class::Constant => "constant",
             Class::Uniform => "uniform",
@@ -126,14 +126,18 @@ pub(super) struct ClassCounts {
     pub(super) uniform: usize,
     pub(super) varying: usize,
     pub(super) vertex: usize,
+    /// One per face corner: on patches the same as varying, on polygon meshes the sum of
+    /// the faces' vertex counts.
+    pub(super) facevarying: usize,
 }
 
 impl ClassCounts {
-    fn of(&self, class: Class) -> usize {
+    pub(super) fn of(&self, class: Class) -> usize {
         match class {
             Class::Constant => 1,
             Class::Uniform => self.uniform,
-            Class::Varying | Class::FaceVarying => self.varying,
+            Class::Varying => self.varying,
+            Class::FaceVarying => self.facevarying,
             Class::Vertex => self.vertex,
         }
     }

@@ -15,10 +15,17 @@ use crate::scene::{RI_EPSILON, SceneError};
 use glam::{DMat4, DVec3};
 
 /// Requests the interpreter understands; any other name is skipped with one warning.
-/// (`ReadArchive`, `ObjectBegin` and motion blocks are handled by the reading loop.)
+/// (`ReadArchive`, `ObjectBegin`, `ObjectInstance` and motion blocks are handled by the
+/// reading loop.)
 pub(super) const KNOWN: &[&str] = &[
     "Format",
     "PixelSamples",
+    "ScreenWindow",
+    "FrameAspectRatio",
+    "CropWindow",
+    "Imager",
+    "CoordinateSystem",
+    "CoordSysTransform",
     "Projection",
     "Clipping",
     "Display",
@@ -40,6 +47,10 @@ pub(super) const KNOWN: &[&str] = &[
     "Patch",
     "PatchMesh",
     "NuPatch",
+    "Polygon",
+    "GeneralPolygon",
+    "PointsPolygons",
+    "PointsGeneralPolygons",
     "Sphere",
     "Cylinder",
     "Cone",
@@ -58,14 +69,37 @@ pub(super) const KNOWN: &[&str] = &[
     "ReverseOrientation",
     "ObjectBegin",
     "ObjectEnd",
+    "ObjectInstance",
     "MotionBegin",
     "MotionEnd",
     "Shutter",
     "DepthOfField",
     "ReadArchive",
     "MakeShadow",
+    "TrimCurve",
     "Declare",
 ];
+
+/// A matrix's perspective terms (its last column in RIB's row-vector form) at most this
+/// fraction of its homogeneous scale are round-off (a Maya export writes 1e-12 there): the
+/// matrix is taken as affine. A point p then gets w = 1 + e.p with |e| <= 1e-9, which moves
+/// a point 1e3 units from the origin by at most 1e-6 of its distance.
+pub(super) const PROJECTIVE_ROUNDOFF: f64 = 1e-9;
+
+/// `m` with perspective terms within [`PROJECTIVE_ROUNDOFF`] set to exactly 0.
+pub(super) fn affine_within_roundoff(mut m: DMat4) -> DMat4 {
+    let s = m.w_axis.w.abs();
+    let tiny = |x: f64| x != 0.0 && x.abs() <= PROJECTIVE_ROUNDOFF * s;
+    if [m.x_axis.w, m.y_axis.w, m.z_axis.w]
+        .iter()
+        .all(|&x| x == 0.0 || tiny(x))
+    {
+        m.x_axis.w = 0.0;
+        m.y_axis.w = 0.0;
+        m.z_axis.w = 0.0;
+    }
+    m
+}
 
 impl Interp {
     pub(super) fn request(&mut self, req: &Request) -> Result<(), SceneError> {
@@ -74,6 +108,10 @@ impl Interp {
         match req.name.as_str() {
             "Format" | "PixelSamples" | "Projection" | "Clipping" => self.option(req, a),
             "Display" => self.display(req, a),
+            "ScreenWindow" | "FrameAspectRatio" | "CropWindow" | "Imager" => {
+                self.camera_request(req, a)
+            }
+            "CoordinateSystem" | "CoordSysTransform" => self.coordinate_system(req, a),
             "Identity" | "Transform" | "ConcatTransform" | "Translate" | "Rotate" | "Scale" => {
                 self.transform(req, a)
             }
@@ -109,11 +147,21 @@ impl Interp {
             "Patch" => self.patch(req, a),
             "PatchMesh" => self.patch_mesh(req, a),
             "NuPatch" => self.nu_patch(req, a),
+            "Polygon" | "GeneralPolygon" | "PointsPolygons" | "PointsGeneralPolygons" => {
+                self.polygon_request(req, a)
+            }
             name if QUADRICS.contains(&name) => self.quadric(req, a),
             "ObjectEnd" => Err(a.err("without a matching `ObjectBegin`")),
             "MotionBegin" => self.motion_begin(req, a),
             "MotionEnd" => self.motion_end(req),
             "Shutter" | "DepthOfField" => self.lens_option(req, a),
+            "TrimCurve" => {
+                let msg = "skipped unsupported request `TrimCurve`: the `NuPatch` surfaces \
+                           after it are drawn untrimmed (the regions its curves cut away are \
+                           filled)";
+                self.warn_once(req, "TrimCurve", msg);
+                Ok(())
+            }
             "MakeShadow" => {
                 self.make_shadow(req);
                 Ok(())
@@ -135,10 +183,19 @@ impl Interp {
                 let h = a.int("the y resolution", 1, side)?;
                 let aspect = a.num("the pixel aspect ratio")?;
                 a.done()?;
-                if aspect <= 0.0 {
+                // -1 means the default, 1, as other renderers read it.
+                if aspect <= 0.0 && aspect != -1.0 {
                     return Err(a.err(format!(
-                        "the pixel aspect ratio must be positive, found {aspect}"
+                        "the pixel aspect ratio must be positive (or -1: the default), found \
+                         {aspect}"
                     )));
+                }
+                if aspect > 0.0 && aspect != 1.0 {
+                    let msg = format!(
+                        "pixel aspect ratio {aspect} is rendered as 1 (square pixels): the \
+                         image is stretched by {aspect} horizontally against what was meant"
+                    );
+                    self.warn_once(req, "pixel aspect", &msg);
                 }
                 self.options.width = w as u32;
                 self.options.height = h as u32;
@@ -163,12 +220,14 @@ impl Interp {
                     return Err(a.err("not allowed inside `WorldBegin` ... `WorldEnd`"));
                 }
                 let name = a.string("the projection type")?;
-                if name != "perspective" {
+                if name != "perspective" && name != "orthographic" {
                     return Err(a.err(format!(
-                        "projection \"{}\" is not supported (only \"perspective\")",
+                        "projection \"{}\" is not supported (only \"perspective\" and \
+                         \"orthographic\")",
                         shown(name)
                     )));
                 }
+                self.options.framing.orthographic = name == "orthographic";
                 for p in a.params()? {
                     match p.name {
                         "fov" => {
@@ -214,7 +273,7 @@ impl Interp {
                 let v = a.fixed(16, "the matrix")?;
                 a.done()?;
                 // Row-major row-vector matrix == column-major column-vector matrix.
-                let m = DMat4::from_cols_slice(&v);
+                let m = affine_within_roundoff(DMat4::from_cols_slice(&v));
                 if req.name == "Transform" {
                     self.attrs.ctm_close = None;
                     self.set_ctm(self.world_to_camera.unwrap_or(DMat4::IDENTITY) * m);

@@ -70,6 +70,8 @@ pub(super) struct Options {
     pub(super) pixel_samples: (u32, u32),
     pub(super) camera: Camera,
     pub(super) display: Option<Display>,
+    /// `ScreenWindow`, `FrameAspectRatio`, `CropWindow`, orthographic projection.
+    pub(super) framing: super::camera::Framing,
 }
 
 impl Default for Options {
@@ -81,6 +83,7 @@ impl Default for Options {
             pixel_samples: s.pixel_samples,
             camera: s.camera,
             display: None,
+            framing: Default::default(),
         }
     }
 }
@@ -160,6 +163,14 @@ pub(super) struct Interp {
     pub(super) declared: HashMap<String, Decl>,
     /// Displacement maps read so far, by path (each file read once).
     pub(super) displacement_maps: HashMap<String, std::sync::Arc<crate::scene::DisplacementMap>>,
+    /// The object definition being recorded (`ObjectBegin` ... `ObjectEnd`).
+    pub(super) recording: Option<super::instance::Recording>,
+    /// Object definitions by handle (kept for the rest of the file, as RIB uses them).
+    pub(super) objects: HashMap<String, Rc<[Request]>>,
+    /// `ObjectInstance` replays under way (an object may instance another).
+    pub(super) instance_depth: usize,
+    /// `CoordinateSystem`s by name: the transform at shutter open and close.
+    pub(super) coordinate_systems: HashMap<String, (DMat4, Option<DMat4>)>,
 }
 
 impl Interp {
@@ -180,6 +191,10 @@ impl Interp {
             motion: None,
             declared: HashMap::new(),
             displacement_maps: HashMap::new(),
+            recording: None,
+            objects: HashMap::new(),
+            instance_depth: 0,
+            coordinate_systems: HashMap::new(),
         }
     }
 
@@ -280,6 +295,7 @@ impl Interp {
         self.scene = Scene::default();
         self.materials.clear();
         self.motion = None;
+        self.recording = None;
         self.frame = None;
         self.next_number = number.saturating_add(1);
     }

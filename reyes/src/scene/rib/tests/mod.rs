@@ -1,12 +1,15 @@
 //! Tests of the RIB interpreter, one file per concern like the interpreter's.
 
 mod archives;
+mod camera;
 mod displacement;
 mod frames;
 mod hostile;
 mod motion;
 mod nupatch;
+mod objects;
 mod patches;
+mod polygons;
 mod primvars;
 mod quadrics;
 mod shading;

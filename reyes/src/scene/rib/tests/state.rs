@@ -51,10 +51,10 @@ fn options() {
 
 #[test]
 fn option_errors() {
-    let e = err(&format!("\nProjection \"orthographic\"\n{}", world("")));
+    let e = err(&format!("\nProjection \"fisheye\"\n{}", world("")));
     assert_eq!(
         e,
-        "t.rib:2: `Projection`: projection \"orthographic\" is not supported (only \"perspective\")"
+        "t.rib:2: `Projection`: projection \"fisheye\" is not supported (only \"perspective\" and \"orthographic\")"
     );
     assert!(err("Projection \"perspective\" \"fov\" 0 WorldBegin WorldEnd").contains("fov 0"));
     assert!(
