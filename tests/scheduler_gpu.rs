@@ -516,6 +516,65 @@ fn a_queue_memory_budget_is_kept_or_reported_as_overflow() {
     }
 }
 
+/// The device-driven multi-pass records `1 + NQ` dispatches a round (the plan and one indirect
+/// dispatch per procedure: no scan or compaction passes), runs exactly the rounds the
+/// host-driven one needs, and a repeated run encodes as many rounds as the last one needed: one
+/// submission, no empty round. Results equal the CPU reference every time, also when the chunks
+/// are short enough that the first run needs several submissions.
+#[test]
+fn device_driven_multipass_counts_its_rounds_and_dispatches() {
+    let gpu = gpu();
+    let params = TreeParams {
+        max_depth: 7,
+        fanout: Fanout::Uniform(2),
+        ..small_tree(21)
+    };
+    let reference = params.reference();
+    let run = TreeRun::new(&gpu, params).unwrap();
+    let nq = run.program.queue_count() as u64;
+    let host = Scheduler::new(&gpu, &run.program, StrategyKind::MultipassHost, 1 << 12).unwrap();
+    let (base, result) = run.run(&gpu, &host).unwrap();
+    assert_eq!(result, reference);
+    let rounds = base.rounds;
+    assert!(rounds > 3, "{base:?}");
+    for chunk in [16, 2] {
+        let s = Scheduler::multipass(
+            &gpu,
+            &run.program,
+            MultipassConfig {
+                rounds_per_submit: chunk,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let (first, result) = run.run(&gpu, &s).unwrap();
+        assert_eq!(result, reference, "chunk {chunk}, first run");
+        assert_eq!(first.rounds, rounds, "{first:?}");
+        assert_eq!(first.queue_growths, 0, "{first:?}");
+        // Chunks of `chunk` rounds until one ends with no work left (no growth here): the
+        // last round with work leaves none, so the chunk that holds it is the last.
+        let chunks = rounds.div_ceil(chunk as u64);
+        assert_eq!(first.submits, chunks, "chunk {chunk}: {first:?}");
+        assert_eq!(
+            first.launches,
+            chunks * chunk as u64 * (1 + nq),
+            "{first:?}"
+        );
+        for k in 0..2 {
+            let (again, result) = run.run(&gpu, &s).unwrap();
+            assert_eq!(result, reference, "chunk {chunk}, run {k}");
+            assert_eq!(again.rounds, rounds, "{again:?}");
+            assert_eq!(again.submits, 1, "chunk {chunk}: {again:?}");
+            assert_eq!(
+                again.launches,
+                rounds * (1 + nq),
+                "chunk {chunk}: {again:?}"
+            );
+            assert_eq!(again.executed, first.executed);
+        }
+    }
+}
+
 #[test]
 fn multipass_stage_timing_keeps_results_and_splits_the_time_by_procedure() {
     let gpu = gpu();

@@ -1,8 +1,11 @@
-//! The multi-pass baseline (Patney & Owens 2008): rounds of one dispatch per procedure, then a
-//! scan/compact per target queue. Rounds are encoded in chunks and planned on the device; the
-//! host reads back only between chunks. A round whose outputs would not fit is refused on the
-//! device with its inputs intact; the host grows every queue that lacked room and resumes.
-//! [`host`] is the host-driven variant: exact direct dispatches, one read-back per round.
+//! The multi-pass baseline (Patney & Owens 2008), device-driven: rounds of one indirect
+//! dispatch per procedure, sized on the device by a one-thread plan from the previous round's
+//! counts; children are appended to the next round's inputs with one atomic add each
+//! (compaction fused into the producer, no scan). Rounds are encoded in chunks, the first as
+//! long as the previous run needed, so a repeated run is one submission; the host reads back
+//! only between chunks. A round whose outputs would not fit is refused on the device with its
+//! inputs intact; the host grows every queue that lacked room and resumes. [`host`] is the
+//! host-driven variant: exact direct dispatches, one read-back per round.
 
 pub mod host;
 pub(crate) mod layout;
@@ -26,8 +29,9 @@ use crate::timing::{PassTimer, StageTimer};
 /// Settings of [`Multipass::new`]; [`Default`] gives the documented defaults.
 #[derive(Debug, Clone)]
 pub struct MultipassConfig {
-    /// Rounds encoded per submission (default 16); the host checks for completion between
-    /// chunks.
+    /// Rounds encoded per submission after the first (default 16); the host checks for
+    /// completion between chunks. The first submission encodes as many rounds as the previous
+    /// run of this [`Multipass`] needed (at most [`MAX_LEARNED_ROUNDS`]), or this many.
     pub rounds_per_submit: u32,
     /// Rounds encoded per run, empty ones included, before it stops with
     /// [`RunError::NoProgress`] (default 100,000).
@@ -55,14 +59,20 @@ impl Default for MultipassConfig {
     }
 }
 
-/// A program compiled for the device-driven multi-pass strategy: one pipeline per procedure and
-/// per scan stage, buffers kept between runs. Usually reached through [`crate::Scheduler`].
+/// Most rounds the first submission of a run encodes from what the previous run needed.
+pub const MAX_LEARNED_ROUNDS: u32 = 1024;
+
+/// A program compiled for the device-driven multi-pass strategy: the plan's pipeline and one
+/// per procedure, buffers kept between runs. Usually reached through [`crate::Scheduler`].
 pub struct Multipass {
     program: Program,
     config: MultipassConfig,
     kernels: Kernels,
     /// Buffers of the last run, reused when the next run needs the same layout.
     cache: std::sync::Mutex<Option<DeviceRounds>>,
+    /// Rounds the last finished run executed (0 before the first): the next run's first
+    /// submission encodes that many.
+    learned_rounds: std::sync::atomic::AtomicU32,
 }
 
 struct DeviceRounds {
@@ -91,7 +101,7 @@ impl Multipass {
             ));
         }
         let source = wgsl::source(program);
-        let entries: Vec<_> = (0..7).map(|b| storage_entry(b, b == 6)).collect();
+        let entries: Vec<_> = (0..4).map(|b| storage_entry(b, b == 3)).collect();
         let eps = wgsl::entry_points(program);
         let eps: Vec<&str> = eps.iter().map(|s| s.as_str()).collect();
         let group2 = [storage_entry(0, false)];
@@ -109,6 +119,7 @@ impl Multipass {
             config,
             kernels,
             cache: Default::default(),
+            learned_rounds: Default::default(),
         })
     }
 
@@ -131,27 +142,19 @@ impl Multipass {
             gpu.storage_buffer("items a", layout.total_words)?,
             gpu.storage_buffer("items b", layout.total_words)?,
         ];
-        let emit = gpu.storage_buffer("emit", layout.total_words)?;
-        let emit_flags = gpu.storage_buffer("emit flags", layout.total_slots)?;
-        let mut params = vec![0u32; P_QUEUES + nq * P_QSTRIDE];
-        let mut sum_words = 0u32;
+        let mut params = vec![0u32; nq * P_QSTRIDE];
         for q in 0..nq {
-            let p = &mut params[P_QUEUES + q * P_QSTRIDE..];
+            let p = &mut params[q * P_QSTRIDE..];
             p[0] = layout.capacity[q];
             p[1] = layout.slot_base[q];
-            p[2] = layout.slot_base[q];
-            p[3] = layout.flag_base[q];
-            p[4] = sum_words;
-            p[5] = at_limit[q] as u32;
-            sum_words += layout.capacity[q].div_ceil(SCAN_BLOCK);
+            p[2] = at_limit[q] as u32;
         }
-        let sums = gpu.storage_buffer("block sums", sum_words as u64)?;
         let params_buf = gpu.storage_buffer("mp params", params.len() as u64)?;
         gpu.queue
             .write_buffer(&params_buf, 0, bytemuck::cast_slice(&params));
         let indirect = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("round dispatch args"),
-            size: (3 * 3 * nq * 4) as u64,
+            size: (3 * nq * 4) as u64,
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
             mapped_at_creation: false,
         });
@@ -162,10 +165,7 @@ impl Multipass {
                     (0, &ctrl),
                     (1, &items[par]),
                     (2, &items[1 - par]),
-                    (3, &emit),
-                    (4, &emit_flags),
-                    (5, &sums),
-                    (6, &params_buf),
+                    (3, &params_buf),
                 ],
             )
         });
@@ -237,9 +237,10 @@ impl Multipass {
         gpu.queue.submit([enc.finish()]);
     }
 
-    /// Encodes `rounds` rounds: plan, every procedure's items, then the scan and compaction of
-    /// what they emitted. With `stages`, each of those phases is its own timed pass (counted to
-    /// its procedure, or to the last stage for plan and compaction); else one pass.
+    /// Encodes `rounds` rounds: per round the plan (one thread, a direct dispatch), then one
+    /// indirect dispatch per procedure, `1 + NQ` dispatches in all. With `stages`, each
+    /// procedure's dispatch is its own timed pass and the plan is counted to the last stage;
+    /// else one pass.
     #[allow(clippy::too_many_arguments)]
     fn encode_rounds(
         &self,
@@ -271,17 +272,7 @@ impl Multipass {
             pass.set_bind_group(0, &d.bind[(first_round as usize + round) % 2], &[]);
             pass
         };
-        let args = |slot: usize| (slot * 12) as u64;
-        let encode_compaction = |pass: &mut wgpu::ComputePass| {
-            for t in 0..nq {
-                pass.set_pipeline(&p[1 + nq + t]);
-                pass.dispatch_workgroups_indirect(&d.indirect, args(nq + t));
-                pass.set_pipeline(&p[1 + 2 * nq + t]);
-                pass.dispatch_workgroups_indirect(&d.indirect, args(2 * nq + t));
-                pass.set_pipeline(&p[1 + 3 * nq + t]);
-                pass.dispatch_workgroups_indirect(&d.indirect, args(nq + t));
-            }
-        };
+        let args = |q: usize| (q * 12) as u64;
         if stages.is_some() {
             for r in 0..rounds as usize {
                 let mut pass = begin(enc, r, nq);
@@ -293,7 +284,6 @@ impl Multipass {
                     pass.set_pipeline(&p[1 + q]);
                     pass.dispatch_workgroups_indirect(&d.indirect, args(q));
                 }
-                encode_compaction(&mut begin(enc, r, nq));
             }
             return;
         }
@@ -306,7 +296,6 @@ impl Multipass {
                 pass.set_pipeline(&p[1 + q]);
                 pass.dispatch_workgroups_indirect(&d.indirect, args(q));
             }
-            encode_compaction(&mut pass);
         }
     }
 
@@ -323,7 +312,6 @@ impl Multipass {
         self.kernels.check_user_group(user)?;
         let start = Instant::now();
         let nq = self.program.queue_count();
-        // Reduce and scatter dispatch one workgroup per SCAN_BLOCK slots, at most 65,535.
         let RunStart {
             live,
             seeded,
@@ -332,9 +320,9 @@ impl Multipass {
             &self.program,
             seeds,
             gpu.max_binding_bytes(),
-            self.config.max_capacity.min(65_535 * SCAN_BLOCK),
+            self.config.max_capacity,
             max_queue_bytes,
-            3,
+            2,
         )?;
         // The first round's worst-case output is known here: queues too small for it grow
         // before the first submission rather than after a refused one.
@@ -359,8 +347,15 @@ impl Multipass {
             .collect();
         let mut anticipation = Anticipation::new(first_emits.iter().sum());
         let rounds_per_submit = self.config.rounds_per_submit.max(1);
-        // Rounds of the next submission: all of them, but fewer while queues grow.
-        let mut rounds = rounds_per_submit;
+        // Rounds of the next submission: as many as the last run needed (so a repeated run is
+        // one submission and no empty round), else a chunk; fewer while queues grow.
+        let learned = self
+            .learned_rounds
+            .load(std::sync::atomic::Ordering::Relaxed);
+        let mut rounds = match learned {
+            0 => rounds_per_submit,
+            n => n.min(MAX_LEARNED_ROUNDS),
+        };
         let mut stats = RunStats {
             strategy: "multipass".into(),
             item_layout: crate::ItemLayout::Interleaved.name().into(),
@@ -372,7 +367,7 @@ impl Multipass {
         let mut stage_timer = self
             .config
             .stage_timing
-            .then(|| StageTimer::new(gpu, nq + 1, rounds_per_submit * (nq as u32 + 2)));
+            .then(|| StageTimer::new(gpu, nq + 1, rounds.max(rounds_per_submit) * (nq as u32 + 1)));
         let mut encoded = 0u64;
         // Rounds encoded since the last upload: round r reads items[r % 2].
         let mut since_upload = 0u64;
@@ -405,7 +400,7 @@ impl Multipass {
             }
             gpu.queue.submit([enc.finish()]);
             stats.submits += 1;
-            stats.launches += rounds as u64 * (1 + 4 * nq as u64);
+            stats.launches += rounds as u64 * (1 + nq as u64);
             encoded += rounds as u64;
             since_upload += rounds as u64;
             let ctrl = gpu.read_words(&d.ctrl, 0, ctrl_words(nq) as u64)?;
@@ -422,6 +417,12 @@ impl Multipass {
                     target: self.program.procs[b as usize].proc.name.clone(),
                     declared: self.program.procs[a].emits[b as usize],
                 });
+            }
+            if error == ERR_ROOM {
+                return Err(RunError::Device(format!(
+                    "device-driven multi-pass: an append past the capacity the plan made room \
+                     for (queue {a}, slot {b})"
+                )));
             }
             let halted = error == ERR_OVERFLOW;
             let next: Vec<u32> = (0..nq).map(|q| ctrl[c(q, C_NEXT)]).collect();
@@ -450,8 +451,8 @@ impl Multipass {
                 }
                 let refused_grew = grown != capacity;
                 for t in 0..nq {
-                    // Per slot: its item in both parities and the emit buffer, and its flag.
-                    let slot_bytes = d.layout.words[t] as u64 * 12 + 4;
+                    // Per slot: its item in both parities.
+                    let slot_bytes = d.layout.words[t] as u64 * 8;
                     let extra = Anticipation::MAX_EXTRA_BYTES / slot_bytes / nq as u64;
                     let need = ((m[t] as f64 * factor) as u64).min(2 * m[t] + extra);
                     if need > grown[t] as u64 {
@@ -483,7 +484,11 @@ impl Multipass {
                 since_upload = 0;
             }
         }
-        stats.queue_bytes = d.layout.total_words * 4 * 3 + d.layout.total_slots * 4;
+        stats.queue_bytes = d.layout.total_words * 4 * 2;
+        self.learned_rounds.store(
+            stats.rounds.clamp(1, MAX_LEARNED_ROUNDS as u64) as u32,
+            std::sync::atomic::Ordering::Relaxed,
+        );
         stats.gpu_ms = timer.total_ms();
         if let Some(ms) = stage_timer.and_then(|st| st.stage_ms()) {
             stats.gpu_ms = Some(ms.iter().sum());

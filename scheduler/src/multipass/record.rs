@@ -36,10 +36,10 @@ impl Multipass {
             QueueLayout::capacity_limits(
                 &self.program,
                 gpu.max_binding_bytes(),
-                self.config.max_capacity.min(65_535 * SCAN_BLOCK),
+                self.config.max_capacity,
             ),
             max_queue_bytes,
-            3,
+            2,
         );
         QueueLayout::check_seeds(&self.program, seeded, &max_cap)?;
         let capacity: Vec<u32> = (0..seeded.len())
@@ -119,6 +119,12 @@ impl RecordedRounds {
                 declared: program.procs[a].emits[b as usize],
             });
         }
+        if error == ERR_ROOM {
+            return Err(RunError::Device(format!(
+                "device-driven multi-pass: an append past the capacity the plan made room for \
+                 (queue {a}, slot {b})"
+            )));
+        }
         if error == ERR_OVERFLOW {
             return Ok(Outcome::Incomplete(format!(
                 "a round refused: queue `{}` may receive {b} items, more than its {} slots",
@@ -138,8 +144,8 @@ impl RecordedRounds {
             executed: (0..nq).map(|q| ctrl[c(q, C_EXEC)] as u64).collect(),
             peak_occupancy: (0..nq).map(|q| ctrl[c(q, C_PEAK)] as u64).collect(),
             rounds: ctrl[g(nq, G_ROUNDS)] as u64,
-            launches: self.rounds as u64 * (1 + 4 * nq as u64),
-            queue_bytes: self.d.layout.total_words * 4 * 3 + self.d.layout.total_slots * 4,
+            launches: self.rounds as u64 * (1 + nq as u64),
+            queue_bytes: self.d.layout.total_words * 4 * 2,
             ..Default::default()
         }))
     }
