@@ -3,9 +3,11 @@
 // on the device. Compaction is fused into the producing pass, as in the host-driven variant
 // (`multipass_host.wgsl`): `enqueue_<t>` appends the item straight into queue t's region of the
 // next round's input buffer with one atomicAdd on t's count, so a round has no flags, no scan
-// and no scatter. A one-thread plan (`mp_plan`) before each round turns the previous round's
-// counts into this round's dispatch sizes; an empty queue gets 0 workgroups, an empty round 0
-// everywhere. Order within a queue is not kept.
+// and no scatter. The plan (`plan_round`) turns the previous round's counts into this round's
+// dispatch sizes: for a chunk's first round a one-thread dispatch (`mp_plan`), for every other
+// round the last workgroup of the round before, when it finishes. An empty queue gets 0
+// workgroups; an empty round is never planned, so it and every round after it in the chunk keep
+// the zeroed arguments the host cleared. Order within a queue is not kept.
 // Generated before this file: tables, procedures, `mp_in_*` / `mp_out_*` accessors,
 // `sched_execute`, `enqueue_*`, and the per-procedure entry points.
 
@@ -28,6 +30,10 @@ const G_ERR_B: u32 = 3u;
 const G_HALT: u32 = 4u;
 const G_PLANNED: u32 = 5u; // plans that let their round run, for the host's parity
 const G_PARTIAL: u32 = 6u; // partial rounds (scheduler/src/multipass/partial.rs)
+const G_DONE: u32 = 7u;    // workgroups of the current round that have finished
+const G_WGS: u32 = 8u;     // workgroups the current round dispatched, all procedures together
+const G_K: u32 = 9u;       // the current round's index within the chunk
+const G_CHUNK: u32 = 10u;  // rounds in the chunk (the host's): round G_CHUNK is not planned
 
 const ERR_EMIT: u32 = 1u;
 const ERR_OVERFLOW: u32 = 2u;
@@ -44,12 +50,15 @@ fn q_at_limit(q: u32) -> bool { return params[q * 4u + 2u] != 0u; }
 @group(0) @binding(1) var<storage, read_write> items_in: array<vec4<u32>>;
 @group(0) @binding(2) var<storage, read_write> items_out: array<vec4<u32>>;
 @group(0) @binding(3) var<storage, read> params: array<u32>;
-// Group 2: bound only to mp_plan, so no dispatch reads its own arguments as storage.
+// Group 2: the arguments of the rounds the bound dispatch may plan, round k's at slot
+// (k / 2) x NQ + q of buffer k % 2. Round k's dispatches read theirs from buffer k % 2 and have
+// buffer (k + 1) % 2 bound here, so no dispatch reads its own arguments as storage.
 @group(2) @binding(0) var<storage, read_write> indirect: array<u32>;
 
 // This round's inputs, inputs run, and workgroups of the dispatch, for procedure q.
 var<workgroup> wg_round: vec3<u32>;
 var<workgroup> wg_item_emits: array<atomic<u32>, 256u * NQ>;
+var<workgroup> wg_last: u32;
 var<private> sched_proc: u32;
 var<private> sched_slot: u32;
 var<private> sched_active: bool;
@@ -85,15 +94,19 @@ fn set_args(slot: u32, x: u32) {
     indirect[slot * 3u + 2u] = 1u;
 }
 
+// The first round of a chunk (its index 0): planned by one thread before it.
+@compute @workgroup_size(1)
+fn mp_plan() { plan_round(0u); }
+
 // One thread: takes the previous round's carried and appended counts as this round's inputs
 // and writes every dispatch size of the round (at most 65,535: grid-stride past that, so every
 // argument is valid with wgpu's indirect validation off). When a target cannot hold the
 // round's worst case: halts (nothing run, inputs intact) for the host to grow it, or, when it
 // is at its limit, runs only part of the inputs (partial.rs, the host twin) and carries the
 // rest; halts with ERR_OVERFLOW when not one input fits. A halted or empty round dispatches
-// nothing, and neither does any round after a halt.
-@compute @workgroup_size(1)
-fn mp_plan() {
+// nothing, so nothing plans the rounds after it: they keep their zeroed arguments. `k`: the
+// round's index within the chunk.
+fn plan_round(k: u32) {
     var total = 0u;
     var run: array<u32, NQ>;
     for (var q = 0u; q < NQ; q++) {
@@ -168,12 +181,14 @@ fn mp_plan() {
         }
     }
     // A halted round leaves the whole round's worst case in C_EMITS, for the host's growth.
+    var all_wgs = 0u;
     for (var q = 0u; q < NQ; q++) {
         let n = atomicLoad(&mp_ctrl[cw(q, C_COUNT)]);
         let per_step = 256u / THREADS[q];
         // Every input is visited: run, or copied to the front of the next round's inputs.
         let wgs = select(0u, min((n + per_step - 1u) / per_step, 65535u), ok);
-        set_args(q, wgs);
+        set_args((k / 2u) * NQ + q, wgs);
+        all_wgs += wgs;
         if ok {
             atomicStore(&mp_ctrl[cw(q, C_WGS)], wgs);
             atomicMax(&mp_ctrl[cw(q, C_PEAK)], n);
@@ -186,6 +201,28 @@ fn mp_plan() {
     }
     if ok { atomicAdd(&mp_ctrl[gw(G_PLANNED)], 1u); }
     if ok && total > 0u { atomicAdd(&mp_ctrl[gw(G_ROUNDS)], 1u); }
+    atomicStore(&mp_ctrl[gw(G_DONE)], 0u);
+    atomicStore(&mp_ctrl[gw(G_WGS)], all_wgs);
+    atomicStore(&mp_ctrl[gw(G_K)], k);
+}
+
+// After a workgroup's last step: the round's last workgroup to finish plans the next round,
+// unless the chunk ends here (the next submission's mp_plan plans it then). Every append of
+// the round precedes the plan: each workgroup's storageBarrier (naga: a device-scope
+// acquire-release fence on Vulkan) comes before its count of finished workgroups, and the last
+// one's after it (docs/scheduler.md 5.1).
+fn finish_workgroup(lid: u32) {
+    storageBarrier();
+    if lid == 0u {
+        let done = atomicAdd(&mp_ctrl[gw(G_DONE)], 1u) + 1u;
+        wg_last = select(0u, 1u, done == atomicLoad(&mp_ctrl[gw(G_WGS)]));
+    }
+    if workgroupUniformLoad(&wg_last) == 0u { return; }
+    storageBarrier();
+    if lid == 0u {
+        let k = atomicLoad(&mp_ctrl[gw(G_K)]) + 1u;
+        if k < atomicLoad(&mp_ctrl[gw(G_CHUNK)]) { plan_round(k); }
+    }
 }
 
 // Runs procedure q over this round's inputs, grid-stride, items_per_step items per step. The
@@ -223,4 +260,5 @@ fn run_procedure(q: u32, lid: u32, wid: u32) {
         sched_execute(q, q_base(q) + idx * WORDS[q], Invocation(thread, slot, live, THREADS[q]));
         workgroupBarrier();
     }
+    finish_workgroup(lid);
 }

@@ -516,8 +516,9 @@ fn a_queue_memory_budget_is_kept_or_reported_as_overflow() {
     }
 }
 
-/// The device-driven multi-pass records `1 + NQ` dispatches a round (the plan and one indirect
-/// dispatch per procedure: no scan or compaction passes), runs exactly the rounds the
+/// The device-driven multi-pass records one indirect dispatch per procedure a round and one plan
+/// per submission (the last workgroup of a round plans the next; no scan or compaction passes),
+/// runs exactly the rounds the
 /// host-driven one needs, and a repeated run encodes as many rounds as the last one needed: one
 /// submission, no empty round. Results equal the CPU reference every time, also when the chunks
 /// are short enough that the first run needs several submissions.
@@ -557,7 +558,7 @@ fn device_driven_multipass_counts_its_rounds_and_dispatches() {
         assert_eq!(first.submits, chunks, "chunk {chunk}: {first:?}");
         assert_eq!(
             first.launches,
-            chunks * chunk as u64 * (1 + nq),
+            chunks * (1 + chunk as u64 * nq),
             "{first:?}"
         );
         for k in 0..2 {
@@ -565,11 +566,7 @@ fn device_driven_multipass_counts_its_rounds_and_dispatches() {
             assert_eq!(result, reference, "chunk {chunk}, run {k}");
             assert_eq!(again.rounds, rounds, "{again:?}");
             assert_eq!(again.submits, 1, "chunk {chunk}: {again:?}");
-            assert_eq!(
-                again.launches,
-                rounds * (1 + nq),
-                "chunk {chunk}: {again:?}"
-            );
+            assert_eq!(again.launches, 1 + rounds * nq, "chunk {chunk}: {again:?}");
             assert_eq!(again.executed, first.executed);
         }
     }

@@ -17,6 +17,10 @@ pub const G_ERR_B: usize = 3;
 pub const G_HALT: usize = 4;
 pub const G_PLANNED: usize = 5;
 pub const G_PARTIAL: usize = 6;
+pub const G_DONE: usize = 7;
+pub const G_WGS: usize = 8;
+pub const G_K: usize = 9;
+pub const G_CHUNK: usize = 10;
 pub const ERR_EMIT: u32 = 1;
 pub const ERR_OVERFLOW: u32 = 2;
 pub const ERR_ROOM: u32 = 3;
@@ -24,7 +28,7 @@ pub const ERR_ROOM: u32 = 3;
 pub const P_QSTRIDE: usize = 4;
 
 pub fn ctrl_words(nq: usize) -> usize {
-    nq * CSTRIDE + 8
+    nq * CSTRIDE + 12
 }
 pub fn c(q: usize, i: usize) -> usize {
     q * CSTRIDE + i

@@ -61,6 +61,8 @@ impl Default for MultipassConfig {
 
 /// Most rounds the first submission of a run encodes from what the previous run needed.
 pub const MAX_LEARNED_ROUNDS: u32 = 1024;
+/// Most rounds one submission of a run encodes (the dispatch arguments' slots).
+const MAX_CHUNK: u32 = 1024;
 
 /// A program compiled for the device-driven multi-pass strategy: the plan's pipeline and one
 /// per procedure, buffers kept between runs. Usually reached through [`crate::Scheduler`].
@@ -80,8 +82,13 @@ struct DeviceRounds {
     at_limit: Vec<bool>,
     ctrl: wgpu::Buffer,
     items: [wgpu::Buffer; 2],
-    indirect: wgpu::Buffer,
-    plan_bind: wgpu::BindGroup,
+    /// Dispatch arguments: round k of a chunk reads its own from `args[k % 2]` (slot
+    /// `(k / 2) × NQ + q`) and may plan round k + 1 into `args[(k + 1) % 2]`.
+    args: [wgpu::Buffer; 2],
+    /// `args_bind[j]`: `args[j]` as storage (group 2).
+    args_bind: [wgpu::BindGroup; 2],
+    /// Rounds a chunk may hold (the arguments' slots).
+    max_chunk: u32,
     /// `bind[parity]`: round r reads `items[r % 2]` and writes `items[(r + 1) % 2]`.
     bind: [wgpu::BindGroup; 2],
 }
@@ -112,7 +119,7 @@ impl Multipass {
             &source,
             &entries,
             &eps,
-            Some((&group2, &["mp_plan"])),
+            Some((&group2, &eps)),
         )?;
         Ok(Multipass {
             program: program.clone(),
@@ -130,11 +137,13 @@ impl Multipass {
 
     /// Buffers of one layout; `at_limit[q]`: queue q cannot grow, so a round it cannot hold
     /// runs in part ([`partial`]) instead of halting for growth.
+    /// `max_chunk`: the most rounds one submission or record encodes.
     fn device_rounds(
         &self,
         gpu: &Gpu,
         layout: QueueLayout,
         at_limit: Vec<bool>,
+        max_chunk: u32,
     ) -> Result<DeviceRounds, RunError> {
         let nq = self.program.queue_count();
         let ctrl = gpu.storage_buffer("mp_ctrl", ctrl_words(nq) as u64)?;
@@ -152,11 +161,15 @@ impl Multipass {
         let params_buf = gpu.storage_buffer("mp params", params.len() as u64)?;
         gpu.queue
             .write_buffer(&params_buf, 0, bytemuck::cast_slice(&params));
-        let indirect = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("round dispatch args"),
-            size: (3 * nq * 4) as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
-            mapped_at_creation: false,
+        let args = [0, 1].map(|_| {
+            gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("round dispatch args"),
+                size: (max_chunk.div_ceil(2) as usize * nq * 12) as u64,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::INDIRECT
+                    | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
         });
         let bind = [0, 1].map(|par| {
             self.kernels.bind_group0(
@@ -169,21 +182,24 @@ impl Multipass {
                 ],
             )
         });
-        let plan_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("indirect args"),
-            layout: self.kernels.group2.as_ref().expect("multipass has group 2"),
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: indirect.as_entire_binding(),
-            }],
+        let args_bind = [0, 1].map(|j| {
+            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("round dispatch args"),
+                layout: self.kernels.group2.as_ref().expect("multipass has group 2"),
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: args[j].as_entire_binding(),
+                }],
+            })
         });
         Ok(DeviceRounds {
             layout,
             at_limit,
             ctrl,
             items,
-            indirect,
-            plan_bind,
+            args,
+            args_bind,
+            max_chunk,
             bind,
         })
     }
@@ -237,10 +253,12 @@ impl Multipass {
         gpu.queue.submit([enc.finish()]);
     }
 
-    /// Encodes `rounds` rounds: per round the plan (one thread, a direct dispatch), then one
-    /// indirect dispatch per procedure, `1 + NQ` dispatches in all. With `stages`, each
-    /// procedure's dispatch is its own timed pass and the plan is counted to the last stage;
-    /// else one pass.
+    /// Encodes a chunk of `rounds` rounds (at most `d.max_chunk`): the arguments cleared, the
+    /// first round's plan (one thread, a direct dispatch), then per round one indirect dispatch
+    /// per procedure; the last workgroup of each round plans the next (`shaders/multipass.wgsl`),
+    /// so the chunk is `1 + rounds × NQ` dispatches. `mp_ctrl`'s `G_CHUNK` must hold `rounds`.
+    /// With `stages`, each procedure's dispatches are timed as their own passes and the plan is
+    /// counted to the last stage; else one pass.
     #[allow(clippy::too_many_arguments)]
     fn encode_rounds(
         &self,
@@ -252,9 +270,13 @@ impl Multipass {
         stages: Option<&StageTimer>,
         user: Option<&wgpu::BindGroup>,
     ) {
+        debug_assert!(rounds <= d.max_chunk);
         let nq = self.program.queue_count();
         let p = &self.kernels.pipelines;
-        let begin = |enc: &mut wgpu::CommandEncoder, round: usize, stage: usize| {
+        for a in &d.args {
+            enc.clear_buffer(a, 0, None);
+        }
+        let begin = |enc: &mut wgpu::CommandEncoder, stage: usize| {
             let writes = match stages {
                 Some(st) => st.writes(stage),
                 None => timer.and_then(|t| t.writes()),
@@ -268,35 +290,48 @@ impl Multipass {
             if let Some(u) = user {
                 pass.set_bind_group(1, u, &[]);
             }
-            pass.set_bind_group(2, &d.plan_bind, &[]);
-            pass.set_bind_group(0, &d.bind[(first_round as usize + round) % 2], &[]);
             pass
         };
-        let args = |q: usize| (q * 12) as u64;
+        // Round k: its items' parity, the arguments it may plan, where its own are.
+        let round = |pass: &mut wgpu::ComputePass, k: usize| {
+            pass.set_bind_group(0, &d.bind[(first_round as usize + k) % 2], &[]);
+            pass.set_bind_group(2, &d.args_bind[(k + 1) % 2], &[]);
+        };
+        let args = |k: usize, q: usize| ((k / 2 * nq + q) * 12) as u64;
+        let plan = |pass: &mut wgpu::ComputePass| {
+            pass.set_bind_group(0, &d.bind[first_round as usize % 2], &[]);
+            pass.set_bind_group(2, &d.args_bind[0], &[]);
+            pass.set_pipeline(&p[0]);
+            pass.dispatch_workgroups(1, 1, 1);
+        };
         if stages.is_some() {
-            for r in 0..rounds as usize {
-                let mut pass = begin(enc, r, nq);
-                pass.set_pipeline(&p[0]);
-                pass.dispatch_workgroups(1, 1, 1);
-                drop(pass);
+            plan(&mut begin(enc, nq));
+            for k in 0..rounds as usize {
                 for q in 0..nq {
-                    let mut pass = begin(enc, r, q);
+                    let mut pass = begin(enc, q);
+                    round(&mut pass, k);
                     pass.set_pipeline(&p[1 + q]);
-                    pass.dispatch_workgroups_indirect(&d.indirect, args(q));
+                    pass.dispatch_workgroups_indirect(&d.args[k % 2], args(k, q));
                 }
             }
             return;
         }
-        let mut pass = begin(enc, 0, 0);
-        for r in 0..rounds as usize {
-            pass.set_bind_group(0, &d.bind[(first_round as usize + r) % 2], &[]);
-            pass.set_pipeline(&p[0]);
-            pass.dispatch_workgroups(1, 1, 1);
+        let mut pass = begin(enc, 0);
+        plan(&mut pass);
+        for k in 0..rounds as usize {
+            round(&mut pass, k);
             for q in 0..nq {
                 pass.set_pipeline(&p[1 + q]);
-                pass.dispatch_workgroups_indirect(&d.indirect, args(q));
+                pass.dispatch_workgroups_indirect(&d.args[k % 2], args(k, q));
             }
         }
+    }
+
+    /// Sets `G_CHUNK`, the rounds of the next chunk, before its submission.
+    fn set_chunk(&self, gpu: &Gpu, d: &DeviceRounds, rounds: u32) {
+        let at = g(self.program.queue_count(), G_CHUNK) as u64 * 4;
+        gpu.queue
+            .write_buffer(&d.ctrl, at, bytemuck::bytes_of(&rounds));
     }
 
     /// Runs the program to completion from `seeds`; `user` is bind group 1, if the program has
@@ -346,7 +381,7 @@ impl Multipass {
             })
             .collect();
         let mut anticipation = Anticipation::new(first_emits.iter().sum());
-        let rounds_per_submit = self.config.rounds_per_submit.max(1);
+        let rounds_per_submit = self.config.rounds_per_submit.clamp(1, MAX_CHUNK);
         // Rounds of the next submission: as many as the last run needed (so a repeated run is
         // one submission and no empty round), else a chunk; fewer while queues grow.
         let learned = self
@@ -367,7 +402,7 @@ impl Multipass {
         let mut stage_timer = self
             .config
             .stage_timing
-            .then(|| StageTimer::new(gpu, nq + 1, rounds.max(rounds_per_submit) * (nq as u32 + 1)));
+            .then(|| StageTimer::new(gpu, nq + 1, rounds.max(rounds_per_submit) * nq as u32 + 1));
         let mut encoded = 0u64;
         // Rounds encoded since the last upload: round r reads items[r % 2].
         let mut since_upload = 0u64;
@@ -375,7 +410,7 @@ impl Multipass {
         let at_limit = partial::at_limit(&capacity, &max_cap);
         let mut d = match self.cache.lock().unwrap().take() {
             Some(d) if d.layout == layout && d.at_limit == at_limit => d,
-            _ => self.device_rounds(gpu, layout, at_limit)?,
+            _ => self.device_rounds(gpu, layout, at_limit, MAX_CHUNK)?,
         };
         self.upload(gpu, &d, &live);
         loop {
@@ -385,6 +420,7 @@ impl Multipass {
                 )));
             }
             let mut enc = gpu.device.create_command_encoder(&Default::default());
+            self.set_chunk(gpu, &d, rounds);
             self.encode_rounds(
                 &mut enc,
                 &d,
@@ -400,7 +436,7 @@ impl Multipass {
             }
             gpu.queue.submit([enc.finish()]);
             stats.submits += 1;
-            stats.launches += rounds as u64 * (1 + nq as u64);
+            stats.launches += 1 + rounds as u64 * nq as u64;
             encoded += rounds as u64;
             since_upload += rounds as u64;
             let ctrl = gpu.read_words(&d.ctrl, 0, ctrl_words(nq) as u64)?;
@@ -478,6 +514,7 @@ impl Multipass {
                     gpu,
                     QueueLayout::new(&self.program, capacity.clone())?,
                     partial::at_limit(&capacity, &max_cap),
+                    MAX_CHUNK,
                 )?;
                 self.move_inputs(gpu, &d, parity, &new, &next);
                 d = new;

@@ -1,7 +1,7 @@
 //! The device-driven multi-pass's part of a [`crate::RecordedRun`]: a fixed number of rounds
 //! on queues of fixed capacity, seeded on the device, in one pass. A round that would not fit
-//! is refused on the device as in a run (inputs intact, every later round refused too), and an
-//! empty round costs only its plan and empty indirect dispatches.
+//! is refused on the device as in a run (inputs intact, no later round planned), and an empty
+//! round costs only its empty indirect dispatches.
 
 use super::Multipass;
 use super::layout::*;
@@ -47,18 +47,20 @@ impl Multipass {
             .collect();
         // No partial rounds: a recorded run has a fixed round count, so a round that does not
         // fit halts and the run reports itself incomplete (the caller re-renders that frame).
+        let rounds = rounds.max(1);
         let d = self.device_rounds(
             gpu,
             QueueLayout::new(&self.program, capacity.clone())?,
             vec![false; seeded.len()],
+            rounds,
         )?;
         let nq = seeded.len();
         let mut ctrl = vec![0u32; ctrl_words(nq)];
         for (q, &n) in seeded.iter().enumerate() {
             ctrl[c(q, C_NEXT)] = n;
         }
+        ctrl[g(nq, G_CHUNK)] = rounds;
         let ctrl_start = gpu.upload("mp_ctrl at start", &ctrl)?;
-        let rounds = rounds.max(1);
         Ok((
             RecordedRounds {
                 d,
@@ -144,7 +146,7 @@ impl RecordedRounds {
             executed: (0..nq).map(|q| ctrl[c(q, C_EXEC)] as u64).collect(),
             peak_occupancy: (0..nq).map(|q| ctrl[c(q, C_PEAK)] as u64).collect(),
             rounds: ctrl[g(nq, G_ROUNDS)] as u64,
-            launches: self.rounds as u64 * (1 + nq as u64),
+            launches: 1 + self.rounds as u64 * nq as u64,
             queue_bytes: self.d.layout.total_words * 4 * 2,
             ..Default::default()
         }))
