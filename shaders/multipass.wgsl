@@ -9,7 +9,9 @@
 // workgroups; an empty round is never planned, so it and every round after it in the chunk keep
 // the zeroed arguments the host cleared. Order within a queue is not kept.
 // Generated before this file: tables, procedures, `mp_in_*` / `mp_out_*` accessors,
-// `sched_execute`, `enqueue_*`, and the per-procedure entry points.
+// `sched_execute`, `mp_execute` (item i of queue q's region) and `mp_word_at` (word w of it),
+// both in the run's item layout (scheduler/src/item_layout.rs), `enqueue_*`, and the
+// per-procedure entry points.
 
 // ---- mp_ctrl layout; host twin: scheduler/src/multipass/layout.rs ----
 const CSTRIDE: u32 = 8u;
@@ -249,15 +251,17 @@ fn run_procedure(q: u32, lid: u32, wid: u32) {
         let idx = first + slot;
         let live = idx >= keep && idx < n;
         if idx < keep {
-            let at = q_base(q) + idx * WORDS[q];
-            for (var w = thread; w < WORDS[q]; w += THREADS[q]) { mp_out_store_word(at + w, mp_in_load_word(at + w)); }
+            for (var w = thread; w < WORDS[q]; w += THREADS[q]) {
+                let at = mp_word_at(q, idx, w);
+                mp_out_store_word(at, mp_in_load_word(at));
+            }
         }
         for (var t = thread; t < NQ; t += THREADS[q]) { atomicStore(&wg_item_emits[slot * NQ + t], 0u); }
         workgroupBarrier();
         sched_proc = q;
         sched_slot = slot;
         sched_active = live;
-        sched_execute(q, q_base(q) + idx * WORDS[q], Invocation(thread, slot, live, THREADS[q]));
+        mp_execute(q, idx, Invocation(thread, slot, live, THREADS[q]));
         workgroupBarrier();
     }
     finish_workgroup(lid);

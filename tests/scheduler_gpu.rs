@@ -211,6 +211,22 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
             Scheduler::new(&gpu, &tree.program, StrategyKind::MultipassHost, 1 << 12).unwrap(),
         ));
         schedulers.push((
+            // Planar items: carried inputs copied word by word, growth moves them plane by
+            // plane on the device.
+            "multipass, planar items, tiny queues".into(),
+            Scheduler::multipass(
+                &gpu,
+                &tree.program,
+                MultipassConfig {
+                    rounds_per_submit: 3,
+                    initial_capacity: 16,
+                    item_layout: Some(ItemLayout::Planar),
+                    ..Default::default()
+                },
+            )
+            .unwrap(),
+        ));
+        schedulers.push((
             "multipass-host, planar items, tiny queues".into(),
             Scheduler::multipass_host(
                 &gpu,
@@ -755,6 +771,17 @@ fn recorded_runs_finish_like_a_run_or_say_they_did_not() {
         megakernel(ItemLayout::Interleaved),
         megakernel(ItemLayout::Planar),
         Scheduler::new(&gpu, &program, StrategyKind::Multipass, 64).unwrap(),
+        // Planar: the seeds reach the round buffers' planes through the device scatter.
+        Scheduler::multipass(
+            &gpu,
+            &program,
+            MultipassConfig {
+                initial_capacity: 64,
+                item_layout: Some(ItemLayout::Planar),
+                ..Default::default()
+            },
+        )
+        .unwrap(),
     ] {
         let kind = s.kind();
         let full = s.run(&gpu, &[Seed::new("split", &roots)], None).unwrap();

@@ -20,6 +20,7 @@ use layout::*;
 use crate::error::RunError;
 use crate::gpu::Gpu;
 use crate::growth::{Anticipation, grow};
+use crate::item_layout::ItemLayout;
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
 use crate::queue_layout::{QueueLayout, RunStart};
@@ -45,6 +46,9 @@ pub struct MultipassConfig {
     /// Time each procedure's dispatches as their own passes ([`RunStats::stage_gpu_ms`]);
     /// the extra pass boundaries cost a little, so it is off for benchmarks of the whole.
     pub stage_timing: bool,
+    /// How the round buffers hold items; `None` (the default) picks
+    /// [`ItemLayout::for_program`], as the host-driven multi-pass does.
+    pub item_layout: Option<ItemLayout>,
 }
 
 impl Default for MultipassConfig {
@@ -55,6 +59,7 @@ impl Default for MultipassConfig {
             initial_capacity: 1 << 16,
             max_capacity: 1 << 26,
             stage_timing: false,
+            item_layout: None,
         }
     }
 }
@@ -100,14 +105,18 @@ impl Multipass {
     pub fn new(
         gpu: &Gpu,
         program: &Program,
-        config: MultipassConfig,
+        mut config: MultipassConfig,
     ) -> Result<Multipass, RunError> {
+        let items = config
+            .item_layout
+            .unwrap_or_else(|| ItemLayout::for_program(gpu, program));
+        config.item_layout = Some(items);
         if program.queue_count() > 16 {
             return Err(RunError::Program(
                 "the multi-pass strategy supports at most 16 procedures".into(),
             ));
         }
-        let source = wgsl::source(program);
+        let source = wgsl::source(program, items);
         let entries: Vec<_> = (0..4).map(|b| storage_entry(b, b == 3)).collect();
         let eps = wgsl::entry_points(program);
         let eps: Vec<&str> = eps.iter().map(|s| s.as_str()).collect();
@@ -133,6 +142,11 @@ impl Multipass {
     /// The program this multi-pass runs.
     pub fn program(&self) -> &Program {
         &self.program
+    }
+
+    /// How its round buffers hold items (the configured layout, or the adapter's).
+    pub fn item_layout(&self) -> ItemLayout {
+        self.config.item_layout.unwrap_or_default()
     }
 
     /// Buffers of one layout; `at_limit[q]`: queue q cannot grow, so a round it cannot hold
@@ -210,13 +224,8 @@ impl Multipass {
         let mut ctrl = vec![0u32; ctrl_words(nq)];
         for (q, items) in live.iter().enumerate() {
             ctrl[c(q, C_NEXT)] = (items.len() / d.layout.words[q] as usize) as u32;
-            if !items.is_empty() {
-                gpu.queue.write_buffer(
-                    &d.items[0],
-                    d.layout.slot_base[q] as u64 * 4,
-                    bytemuck::cast_slice(items),
-                );
-            }
+            self.item_layout()
+                .write_items(&gpu.queue, &d.items[0], &d.layout, q, items);
         }
         gpu.queue
             .write_buffer(&d.ctrl, 0, bytemuck::cast_slice(&ctrl));
@@ -237,16 +246,13 @@ impl Multipass {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         for (q, &n) in counts.iter().enumerate() {
             ctrl[c(q, C_NEXT)] = n;
-            let bytes = n as u64 * from.layout.words[q] as u64 * 4;
-            if bytes > 0 {
-                enc.copy_buffer_to_buffer(
-                    &from.items[parity],
-                    from.layout.slot_base[q] as u64 * 4,
-                    &to.items[0],
-                    to.layout.slot_base[q] as u64 * 4,
-                    bytes,
-                );
-            }
+            self.item_layout().encode_copy(
+                &mut enc,
+                (&from.items[parity], &from.layout),
+                (&to.items[0], &to.layout),
+                q,
+                n,
+            );
         }
         gpu.queue
             .write_buffer(&to.ctrl, 0, bytemuck::cast_slice(&ctrl));
@@ -393,7 +399,7 @@ impl Multipass {
         };
         let mut stats = RunStats {
             strategy: "multipass".into(),
-            item_layout: crate::ItemLayout::Interleaved.name().into(),
+            item_layout: self.item_layout().name().into(),
             executed: vec![0; nq],
             peak_occupancy: vec![0; nq],
             ..Default::default()

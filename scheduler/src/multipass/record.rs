@@ -7,6 +7,7 @@ use super::Multipass;
 use super::layout::*;
 use crate::error::RunError;
 use crate::gpu::Gpu;
+use crate::item_layout::{ItemLayout, PlanarScatter};
 use crate::program::Program;
 use crate::queue_layout::QueueLayout;
 use crate::stats::{Outcome, RunStats};
@@ -17,6 +18,9 @@ pub(crate) struct RecordedRounds {
     /// mp_ctrl at the start: the seed counts as the first round's inputs, all else 0.
     ctrl_start: wgpu::Buffer,
     rounds: u32,
+    /// Planar queues: the device copy of the seeds into their planes.
+    scatter: Option<PlanarScatter>,
+    item_layout: ItemLayout,
 }
 
 impl Multipass {
@@ -61,11 +65,17 @@ impl Multipass {
         }
         ctrl[g(nq, G_CHUNK)] = rounds;
         let ctrl_start = gpu.upload("mp_ctrl at start", &ctrl)?;
+        let scatter = match self.item_layout() {
+            ItemLayout::Interleaved => None,
+            ItemLayout::Planar => Some(PlanarScatter::new(gpu, &d.layout, seeded)?),
+        };
         Ok((
             RecordedRounds {
                 d,
                 ctrl_start,
                 rounds,
+                scatter,
+                item_layout: self.item_layout(),
             },
             capacity,
         ))
@@ -95,7 +105,10 @@ impl RecordedRounds {
     ) -> Result<(), RunError> {
         m.kernels.check_user_group(user)?;
         let d = &self.d;
-        d.layout.encode_seed_copies(enc, seeds, &d.items[0]);
+        match &self.scatter {
+            Some(s) => s.record(enc, seeds, &d.items[0]),
+            None => d.layout.encode_seed_copies(enc, seeds, &d.items[0]),
+        }
         enc.copy_buffer_to_buffer(&self.ctrl_start, 0, &d.ctrl, 0, d.ctrl.size());
         m.encode_rounds(enc, d, self.rounds, 0, None, None, user);
         enc.copy_buffer_to_buffer(&d.ctrl, 0, status, status_word * 4, d.ctrl.size());
@@ -142,7 +155,7 @@ impl RecordedRounds {
         }
         Ok(Outcome::Done(RunStats {
             strategy: "multipass".into(),
-            item_layout: crate::ItemLayout::Interleaved.name().into(),
+            item_layout: self.item_layout.name().into(),
             executed: (0..nq).map(|q| ctrl[c(q, C_EXEC)] as u64).collect(),
             peak_occupancy: (0..nq).map(|q| ctrl[c(q, C_PEAK)] as u64).collect(),
             rounds: ctrl[g(nq, G_ROUNDS)] as u64,
