@@ -1,19 +1,28 @@
-// Multi-pass baseline (Patney & Owens 2008): rounds of one dispatch per procedure with input;
-// each input item owns fixed output slots per target, flagged when used; a prefix sum over the
-// flags compacts them into the next round's inputs. Rounds are planned on the device (indirect
-// dispatch); an empty round dispatches zero workgroups.
-// Generated before this file: tables, procedures, `mp_in_*` / `mp_emit_*` accessors,
-// `sched_execute`, `enqueue_*`, and the per-procedure / per-target entry points.
+// Device-driven multi-pass (Patney & Owens 2008, without their read-back per round): rounds of
+// one indirect dispatch per procedure, every round of a submission recorded up front and sized
+// on the device. Compaction is fused into the producing pass, as in the host-driven variant
+// (`multipass_host.wgsl`): `enqueue_<t>` appends the item straight into queue t's region of the
+// next round's input buffer with one atomicAdd on t's count, so a round has no flags, no scan
+// and no scatter. The plan (`plan_round`) turns the previous round's counts into this round's
+// dispatch sizes: for a chunk's first round a one-thread dispatch (`mp_plan`), for every other
+// round the last workgroup of the round before, when it finishes. An empty queue gets 0
+// workgroups; an empty round is never planned, so it and every round after it in the chunk keep
+// the zeroed arguments the host cleared. Order within a queue is not kept.
+// Generated before this file: tables, procedures, `mp_in_*` / `mp_out_*` accessors,
+// `sched_execute`, `mp_execute` (item i of queue q's region) and `mp_word_at` (word w of it),
+// both in the run's item layout (scheduler/src/item_layout.rs), `enqueue_*`, and the
+// per-procedure entry points.
 
 // ---- mp_ctrl layout; host twin: scheduler/src/multipass/layout.rs ----
 const CSTRIDE: u32 = 8u;
 const C_COUNT: u32 = 0u;  // inputs of the current round
 const C_PEAK: u32 = 1u;
 const C_EXEC: u32 = 2u;
-const C_EMITS: u32 = 3u;  // output slots of this round for this target
-const C_NEXT: u32 = 4u;   // carried inputs + compacted outputs = inputs of the next round
+const C_EMITS: u32 = 3u;  // worst-case outputs of this round for this target
+const C_NEXT: u32 = 4u;   // carried inputs + appended outputs = inputs of the next round
 const C_RUN: u32 = 5u;    // inputs this round runs (all but in a partial round)
 const C_KEEP: u32 = 6u;   // inputs this round carries, unrun, to the front of the next
+const C_WGS: u32 = 7u;    // workgroups of this round's dispatch (num_workgroups, see mp_plan)
 fn cw(q: u32, i: u32) -> u32 { return q * CSTRIDE + i; }
 fn gw(i: u32) -> u32 { return NQ * CSTRIDE + i; }
 const G_ROUNDS: u32 = 0u;
@@ -23,40 +32,36 @@ const G_ERR_B: u32 = 3u;
 const G_HALT: u32 = 4u;
 const G_PLANNED: u32 = 5u; // plans that let their round run, for the host's parity
 const G_PARTIAL: u32 = 6u; // partial rounds (scheduler/src/multipass/partial.rs)
-fn off_w(p: u32, t: u32) -> u32 { return NQ * CSTRIDE + 8u + p * NQ + t; }
+const G_DONE: u32 = 7u;    // workgroups of the current round that have finished
+const G_WGS: u32 = 8u;     // workgroups the current round dispatched, all procedures together
+const G_K: u32 = 9u;       // the current round's index within the chunk
+const G_CHUNK: u32 = 10u;  // rounds in the chunk (the host's): round G_CHUNK is not planned
 
 const ERR_EMIT: u32 = 1u;
 const ERR_OVERFLOW: u32 = 2u;
+const ERR_ROOM: u32 = 3u; // an append past a capacity: the plan's room check failed (a bug)
 
-// ---- params; host twin: MultipassParams ----
-fn q_cap(q: u32) -> u32 { return params[8u + q * 8u]; }
-fn q_in_base(q: u32) -> u32 { return params[9u + q * 8u]; }
-fn q_emit_base(q: u32) -> u32 { return params[10u + q * 8u]; }
-fn q_eflag_base(q: u32) -> u32 { return params[11u + q * 8u]; }
-fn q_sum_base(q: u32) -> u32 { return params[12u + q * 8u]; }
+// ---- params; host twin: Multipass::device_rounds ----
+fn q_cap(q: u32) -> u32 { return params[q * 4u]; }
+fn q_base(q: u32) -> u32 { return params[q * 4u + 1u]; }
 // 1 when queue q is at its capacity limit: a round it cannot hold runs in part instead of
 // halting for growth.
-fn q_at_limit(q: u32) -> bool { return params[13u + q * 8u] != 0u; }
-
-const SCAN_BLOCK: u32 = 1024u; // flags per scan workgroup: 256 threads x 4
+fn q_at_limit(q: u32) -> bool { return params[q * 4u + 2u] != 0u; }
 
 @group(0) @binding(0) var<storage, read_write> mp_ctrl: array<atomic<u32>>;
 @group(0) @binding(1) var<storage, read_write> items_in: array<vec4<u32>>;
 @group(0) @binding(2) var<storage, read_write> items_out: array<vec4<u32>>;
-@group(0) @binding(3) var<storage, read_write> emit: array<vec4<u32>>;
-@group(0) @binding(4) var<storage, read_write> emit_flags: array<u32>;
-@group(0) @binding(5) var<storage, read_write> sums: array<u32>;
-@group(0) @binding(6) var<storage, read> params: array<u32>;
-// Group 2: bound only to mp_plan, so no dispatch reads its own arguments as storage.
+@group(0) @binding(3) var<storage, read> params: array<u32>;
+// Group 2: the arguments of the rounds the bound dispatch may plan, round k's at slot
+// (k / 2) x NQ + q of buffer k % 2. Round k's dispatches read theirs from buffer k % 2 and have
+// buffer (k + 1) % 2 bound here, so no dispatch reads its own arguments as storage.
 @group(2) @binding(0) var<storage, read_write> indirect: array<u32>;
 
-
-var<workgroup> wg_n: u32;
-var<workgroup> wg_k: u32;
+// This round's inputs, inputs run, and workgroups of the dispatch, for procedure q.
+var<workgroup> wg_round: vec3<u32>;
 var<workgroup> wg_item_emits: array<atomic<u32>, 256u * NQ>;
-var<workgroup> wg_sum: array<u32, 256>;
+var<workgroup> wg_last: u32;
 var<private> sched_proc: u32;
-var<private> sched_item: u32;
 var<private> sched_slot: u32;
 var<private> sched_active: bool;
 
@@ -68,15 +73,21 @@ fn sched_raise(code: u32, a: u32, b: u32) {
     atomicStore(&mp_ctrl[gw(G_HALT)], 1u);
 }
 
-// The output slot (index within target t's emit region) for this item's next item to t.
-fn sched_emit_slot(t: u32) -> u32 {
-    let e = EMITS[sched_proc * NQ + t];
+// The slot (index within queue t's region of items_out) of this item's next item to t, or
+// 0xffffffff after raising ERR_EMIT when the item emits more than it declared: the append is
+// refused, so the round's appends never pass its worst case, which the plan made room for.
+fn sched_append_slot(t: u32) -> u32 {
     let j = atomicAdd(&wg_item_emits[sched_slot * NQ + t], 1u);
-    if j >= e {
+    if j >= EMITS[sched_proc * NQ + t] {
         sched_raise(ERR_EMIT, sched_proc, t);
         return 0xffffffffu;
     }
-    return atomicLoad(&mp_ctrl[off_w(sched_proc, t)]) + sched_item * e + j;
+    let at = atomicAdd(&mp_ctrl[cw(t, C_NEXT)], 1u);
+    if at >= q_cap(t) {
+        sched_raise(ERR_ROOM, t, at);
+        return 0xffffffffu;
+    }
+    return at;
 }
 
 fn set_args(slot: u32, x: u32) {
@@ -85,13 +96,19 @@ fn set_args(slot: u32, x: u32) {
     indirect[slot * 3u + 2u] = 1u;
 }
 
-// One thread: takes the previous round's carried and compacted counts as this round's inputs,
-// lays out the output slots, and writes every dispatch size of the round. When a target cannot
-// hold the round's worst case: halts (nothing run, inputs intact) for the host to grow it, or,
-// when it is at its limit, runs only part of the inputs (partial.rs, the host twin) and carries
-// the rest; halts with ERR_OVERFLOW when not one input fits.
+// The first round of a chunk (its index 0): planned by one thread before it.
 @compute @workgroup_size(1)
-fn mp_plan() {
+fn mp_plan() { plan_round(0u); }
+
+// One thread: takes the previous round's carried and appended counts as this round's inputs
+// and writes every dispatch size of the round (at most 65,535: grid-stride past that, so every
+// argument is valid with wgpu's indirect validation off). When a target cannot hold the
+// round's worst case: halts (nothing run, inputs intact) for the host to grow it, or, when it
+// is at its limit, runs only part of the inputs (partial.rs, the host twin) and carries the
+// rest; halts with ERR_OVERFLOW when not one input fits. A halted or empty round dispatches
+// nothing, so nothing plans the rounds after it: they keep their zeroed arguments. `k`: the
+// round's index within the chunk.
+fn plan_round(k: u32) {
     var total = 0u;
     var run: array<u32, NQ>;
     for (var q = 0u; q < NQ; q++) {
@@ -158,140 +175,94 @@ fn mp_plan() {
             atomicStore(&mp_ctrl[gw(G_HALT)], 1u);
         }
     }
-    for (var t = 0u; t < NQ; t++) {
-        var m = 0u;
-        for (var p = 0u; p < NQ; p++) {
-            atomicStore(&mp_ctrl[off_w(p, t)], m);
-            m += run[p] * EMITS[p * NQ + t];
+    if ok {
+        for (var t = 0u; t < NQ; t++) {
+            var m = 0u;
+            for (var p = 0u; p < NQ; p++) { m += run[p] * EMITS[p * NQ + t]; }
+            atomicStore(&mp_ctrl[cw(t, C_EMITS)], m);
         }
-        // A halted round leaves the whole round's worst case here, for the host's growth.
-        if ok { atomicStore(&mp_ctrl[cw(t, C_EMITS)], m); }
     }
+    // A halted round leaves the whole round's worst case in C_EMITS, for the host's growth.
+    var all_wgs = 0u;
     for (var q = 0u; q < NQ; q++) {
         let n = atomicLoad(&mp_ctrl[cw(q, C_COUNT)]);
         let per_step = 256u / THREADS[q];
-        let m = atomicLoad(&mp_ctrl[cw(q, C_EMITS)]);
         // Every input is visited: run, or copied to the front of the next round's inputs.
-        set_args(q, select(0u, min((n + per_step - 1u) / per_step, 65535u), ok));
-        set_args(NQ + q, select(0u, (m + SCAN_BLOCK - 1u) / SCAN_BLOCK, ok));
-        set_args(2u * NQ + q, select(0u, 1u, ok && m > 0u));
+        let wgs = select(0u, min((n + per_step - 1u) / per_step, 65535u), ok);
+        set_args((k / 2u) * NQ + q, wgs);
+        all_wgs += wgs;
         if ok {
+            atomicStore(&mp_ctrl[cw(q, C_WGS)], wgs);
             atomicMax(&mp_ctrl[cw(q, C_PEAK)], n);
             atomicAdd(&mp_ctrl[cw(q, C_EXEC)], run[q]);
             atomicStore(&mp_ctrl[cw(q, C_RUN)], run[q]);
             atomicStore(&mp_ctrl[cw(q, C_KEEP)], n - run[q]);
-            // The carried inputs lead the next round; the scan of the round adds its outputs.
+            // The carried inputs lead the next round; the round's appends go after them.
             atomicStore(&mp_ctrl[cw(q, C_NEXT)], n - run[q]);
         }
     }
     if ok { atomicAdd(&mp_ctrl[gw(G_PLANNED)], 1u); }
     if ok && total > 0u { atomicAdd(&mp_ctrl[gw(G_ROUNDS)], 1u); }
+    atomicStore(&mp_ctrl[gw(G_DONE)], 0u);
+    atomicStore(&mp_ctrl[gw(G_WGS)], all_wgs);
+    atomicStore(&mp_ctrl[gw(G_K)], k);
 }
 
-// Runs procedure q over this round's inputs, grid-stride, items_per_step items per step.
-// Only the newest C_RUN inputs run (the outputs of the last rounds, so a partial round goes
-// depth first and its live work stays bounded); the older ones are copied, in place, to the
-// front of the next round's inputs.
-fn run_procedure(q: u32, lid: u32, wid: u32, nwg: u32) {
-    if lid == 0u { wg_n = atomicLoad(&mp_ctrl[cw(q, C_COUNT)]); }
-    let n = workgroupUniformLoad(&wg_n);
-    if lid == 0u { wg_k = atomicLoad(&mp_ctrl[cw(q, C_RUN)]); }
-    let k = workgroupUniformLoad(&wg_k);
+// After a workgroup's last step: the round's last workgroup to finish plans the next round,
+// unless the chunk ends here (the next submission's mp_plan plans it then). Every append of
+// the round precedes the plan: each workgroup's storageBarrier (naga: a device-scope
+// acquire-release fence on Vulkan) comes before its count of finished workgroups, and the last
+// one's after it (docs/scheduler.md 5.1).
+fn finish_workgroup(lid: u32) {
+    storageBarrier();
+    if lid == 0u {
+        let done = atomicAdd(&mp_ctrl[gw(G_DONE)], 1u) + 1u;
+        wg_last = select(0u, 1u, done == atomicLoad(&mp_ctrl[gw(G_WGS)]));
+    }
+    if workgroupUniformLoad(&wg_last) == 0u { return; }
+    storageBarrier();
+    if lid == 0u {
+        let k = atomicLoad(&mp_ctrl[gw(G_K)]) + 1u;
+        if k < atomicLoad(&mp_ctrl[gw(G_CHUNK)]) { plan_round(k); }
+    }
+}
+
+// Runs procedure q over this round's inputs, grid-stride, items_per_step items per step. The
+// workgroup count comes from mp_ctrl, not @builtin(num_workgroups), which D3D12 reports as 0
+// for indirect dispatches when wgpu's indirect validation is off. Only the newest C_RUN inputs
+// run (the outputs of the last rounds, so a partial round goes depth first and its live work
+// stays bounded); the older ones are copied, in place, to the front of the next round's inputs.
+fn run_procedure(q: u32, lid: u32, wid: u32) {
+    if lid == 0u {
+        wg_round = vec3<u32>(
+            atomicLoad(&mp_ctrl[cw(q, C_COUNT)]),
+            atomicLoad(&mp_ctrl[cw(q, C_RUN)]),
+            atomicLoad(&mp_ctrl[cw(q, C_WGS)]),
+        );
+    }
+    let round = workgroupUniformLoad(&wg_round);
+    let n = round.x;
+    let keep = n - round.y;
+    let nwg = max(round.z, 1u);
     let per_step = 256u / THREADS[q];
     let slot = lid / THREADS[q];
     let thread = lid % THREADS[q];
     for (var first = wid * per_step; first < n; first += nwg * per_step) {
         let idx = first + slot;
-        let keep = n - k;
         let live = idx >= keep && idx < n;
         if idx < keep {
-            let at = q_in_base(q) + idx * WORDS[q];
-            for (var w = thread; w < WORDS[q]; w += THREADS[q]) { mp_out_store_word(at + w, mp_in_load_word(at + w)); }
+            for (var w = thread; w < WORDS[q]; w += THREADS[q]) {
+                let at = mp_word_at(q, idx, w);
+                mp_out_store_word(at, mp_in_load_word(at));
+            }
         }
         for (var t = thread; t < NQ; t += THREADS[q]) { atomicStore(&wg_item_emits[slot * NQ + t], 0u); }
-        if live {
-            // Clear this item's output flags before anything is emitted.
-            for (var t = 0u; t < NQ; t++) {
-                let e = EMITS[q * NQ + t];
-                let first_slot = atomicLoad(&mp_ctrl[off_w(q, t)]) + (idx - keep) * e;
-                for (var j = thread; j < e; j += THREADS[q]) { emit_flags[q_eflag_base(t) + first_slot + j] = 0u; }
-            }
-        }
         workgroupBarrier();
-        storageBarrier();
         sched_proc = q;
-        sched_item = idx - keep;
         sched_slot = slot;
         sched_active = live;
-        sched_execute(q, q_in_base(q) + idx * WORDS[q], Invocation(thread, slot, live, THREADS[q]));
+        mp_execute(q, idx, Invocation(thread, slot, live, THREADS[q]));
         workgroupBarrier();
     }
-}
-
-// Exclusive-scan machinery over target t's output flags, in blocks of SCAN_BLOCK.
-fn flags4(t: u32, i: u32, m: u32) -> vec4<u32> {
-    var f = vec4<u32>(0u);
-    for (var k = 0u; k < 4u; k++) {
-        if i + k < m { f[k] = emit_flags[q_eflag_base(t) + i + k]; }
-    }
-    return f;
-}
-
-// Inclusive scan of wg_sum across the workgroup (Hillis-Steele); returns this thread's value.
-fn workgroup_inclusive_scan(lid: u32, v: u32) -> u32 {
-    wg_sum[lid] = v;
-    workgroupBarrier();
-    var acc = v;
-    for (var d = 1u; d < 256u; d <<= 1u) {
-        var add = 0u;
-        if lid >= d { add = wg_sum[lid - d]; }
-        workgroupBarrier();
-        acc += add;
-        wg_sum[lid] = acc;
-        workgroupBarrier();
-    }
-    return acc;
-}
-
-fn scan_reduce(t: u32, lid: u32, b: u32) {
-    let m = atomicLoad(&mp_ctrl[cw(t, C_EMITS)]);
-    let f = flags4(t, b * SCAN_BLOCK + lid * 4u, m);
-    let total = workgroup_inclusive_scan(lid, f.x + f.y + f.z + f.w);
-    if lid == 255u { sums[q_sum_base(t) + b] = total; }
-}
-
-fn scan_blocks(t: u32, lid: u32) {
-    let m = atomicLoad(&mp_ctrl[cw(t, C_EMITS)]);
-    let nb = (m + SCAN_BLOCK - 1u) / SCAN_BLOCK;
-    var carry = 0u;
-    for (var c = 0u; c < nb; c += 256u) {
-        var v = 0u;
-        if c + lid < nb { v = sums[q_sum_base(t) + c + lid]; }
-        let inc = workgroup_inclusive_scan(lid, v);
-        if c + lid < nb { sums[q_sum_base(t) + c + lid] = carry + inc - v; }
-        carry += wg_sum[255];
-        workgroupBarrier();
-    }
-    if lid == 0u { atomicStore(&mp_ctrl[cw(t, C_NEXT)], atomicLoad(&mp_ctrl[cw(t, C_KEEP)]) + carry); }
-}
-
-fn scan_scatter(t: u32, lid: u32, b: u32) {
-    let m = atomicLoad(&mp_ctrl[cw(t, C_EMITS)]);
-    let i = b * SCAN_BLOCK + lid * 4u;
-    let f = flags4(t, i, m);
-    let own = f.x + f.y + f.z + f.w;
-    let keep = atomicLoad(&mp_ctrl[cw(t, C_KEEP)]);
-    var dst = keep + sums[q_sum_base(t) + b] + workgroup_inclusive_scan(lid, own) - own;
-    for (var k = 0u; k < 4u; k++) {
-        if f[k] != 0u {
-            let src = q_emit_base(t) + (i + k) * WORDS[t];
-            let to = q_in_base(t) + dst * WORDS[t];
-            if WORDS[t] % 4u == 0u {
-                for (var w = 0u; w < WORDS[t]; w += 4u) { mp_out_store_vec4(to + w, mp_emit_load_vec4(src + w)); }
-            } else {
-                for (var w = 0u; w < WORDS[t]; w++) { mp_out_store_word(to + w, mp_emit_load_word(src + w)); }
-            }
-            dst += 1u;
-        }
-    }
+    finish_workgroup(lid);
 }

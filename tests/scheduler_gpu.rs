@@ -211,6 +211,22 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
             Scheduler::new(&gpu, &tree.program, StrategyKind::MultipassHost, 1 << 12).unwrap(),
         ));
         schedulers.push((
+            // Planar items: carried inputs copied word by word, growth moves them plane by
+            // plane on the device.
+            "multipass, planar items, tiny queues".into(),
+            Scheduler::multipass(
+                &gpu,
+                &tree.program,
+                MultipassConfig {
+                    rounds_per_submit: 3,
+                    initial_capacity: 16,
+                    item_layout: Some(ItemLayout::Planar),
+                    ..Default::default()
+                },
+            )
+            .unwrap(),
+        ));
+        schedulers.push((
             "multipass-host, planar items, tiny queues".into(),
             Scheduler::multipass_host(
                 &gpu,
@@ -516,6 +532,62 @@ fn a_queue_memory_budget_is_kept_or_reported_as_overflow() {
     }
 }
 
+/// The device-driven multi-pass records one indirect dispatch per procedure a round and one plan
+/// per submission (the last workgroup of a round plans the next; no scan or compaction passes),
+/// runs exactly the rounds the
+/// host-driven one needs, and a repeated run encodes as many rounds as the last one needed: one
+/// submission, no empty round. Results equal the CPU reference every time, also when the chunks
+/// are short enough that the first run needs several submissions.
+#[test]
+fn device_driven_multipass_counts_its_rounds_and_dispatches() {
+    let gpu = gpu();
+    let params = TreeParams {
+        max_depth: 7,
+        fanout: Fanout::Uniform(2),
+        ..small_tree(21)
+    };
+    let reference = params.reference();
+    let run = TreeRun::new(&gpu, params).unwrap();
+    let nq = run.program.queue_count() as u64;
+    let host = Scheduler::new(&gpu, &run.program, StrategyKind::MultipassHost, 1 << 12).unwrap();
+    let (base, result) = run.run(&gpu, &host).unwrap();
+    assert_eq!(result, reference);
+    let rounds = base.rounds;
+    assert!(rounds > 3, "{base:?}");
+    for chunk in [16, 2] {
+        let s = Scheduler::multipass(
+            &gpu,
+            &run.program,
+            MultipassConfig {
+                rounds_per_submit: chunk,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let (first, result) = run.run(&gpu, &s).unwrap();
+        assert_eq!(result, reference, "chunk {chunk}, first run");
+        assert_eq!(first.rounds, rounds, "{first:?}");
+        assert_eq!(first.queue_growths, 0, "{first:?}");
+        // Chunks of `chunk` rounds until one ends with no work left (no growth here): the
+        // last round with work leaves none, so the chunk that holds it is the last.
+        let chunks = rounds.div_ceil(chunk as u64);
+        assert_eq!(first.submits, chunks, "chunk {chunk}: {first:?}");
+        assert_eq!(
+            first.launches,
+            chunks * (1 + chunk as u64 * nq),
+            "{first:?}"
+        );
+        for k in 0..2 {
+            let (again, result) = run.run(&gpu, &s).unwrap();
+            assert_eq!(result, reference, "chunk {chunk}, run {k}");
+            assert_eq!(again.rounds, rounds, "{again:?}");
+            assert_eq!(again.submits, 1, "chunk {chunk}: {again:?}");
+            assert_eq!(again.launches, 1 + rounds * nq, "chunk {chunk}: {again:?}");
+            assert_eq!(again.executed, first.executed);
+        }
+    }
+}
+
 #[test]
 fn multipass_stage_timing_keeps_results_and_splits_the_time_by_procedure() {
     let gpu = gpu();
@@ -699,6 +771,17 @@ fn recorded_runs_finish_like_a_run_or_say_they_did_not() {
         megakernel(ItemLayout::Interleaved),
         megakernel(ItemLayout::Planar),
         Scheduler::new(&gpu, &program, StrategyKind::Multipass, 64).unwrap(),
+        // Planar: the seeds reach the round buffers' planes through the device scatter.
+        Scheduler::multipass(
+            &gpu,
+            &program,
+            MultipassConfig {
+                initial_capacity: 64,
+                item_layout: Some(ItemLayout::Planar),
+                ..Default::default()
+            },
+        )
+        .unwrap(),
     ] {
         let kind = s.kind();
         let full = s.run(&gpu, &[Seed::new("split", &roots)], None).unwrap();

@@ -51,11 +51,14 @@ impl Gpu {
     }
 
     /// The wgpu instance [`Gpu::from_env`] opens its adapter from: the backends of
-    /// `WGPU_BACKEND`, else the primary ones. A window's surface is made from it before
-    /// [`Gpu::from_env_for_surface`].
+    /// `WGPU_BACKEND`, else the primary ones, and wgpu's default flags as its environment
+    /// variables change them (`WGPU_VALIDATION_INDIRECT_CALL=0` turns off the validation
+    /// dispatch wgpu adds before every indirect dispatch; `docs/scheduler.md` 5.1 says when
+    /// that is safe). A window's surface is made from it before [`Gpu::from_env_for_surface`].
     pub fn instance_from_env() -> wgpu::Instance {
         wgpu::Instance::new(wgpu::InstanceDescriptor {
             backends: wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY),
+            flags: wgpu::InstanceFlags::from_env_or_default(),
             ..wgpu::InstanceDescriptor::new_without_display_handle()
         })
     }

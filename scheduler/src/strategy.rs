@@ -148,12 +148,11 @@ impl Scheduler {
         }
     }
 
-    /// How its queues hold items: as configured, or as [`ItemLayout::for_program`] chose; the
-    /// device-driven multi-pass always interleaves them.
+    /// How its queues hold items: as configured, or as [`ItemLayout::for_program`] chose.
     pub fn item_layout(&self) -> ItemLayout {
         match self {
             Scheduler::Megakernel(m) => m.item_layout(),
-            Scheduler::Multipass(_) => ItemLayout::Interleaved,
+            Scheduler::Multipass(m) => m.item_layout(),
             Scheduler::MultipassHost(m) => m.item_layout(),
         }
     }

@@ -9,6 +9,7 @@ pub const C_EMITS: usize = 3;
 pub const C_NEXT: usize = 4;
 pub const C_RUN: usize = 5;
 pub const C_KEEP: usize = 6;
+pub const C_WGS: usize = 7;
 pub const G_ROUNDS: usize = 0;
 pub const G_ERROR: usize = 1;
 pub const G_ERR_A: usize = 2;
@@ -16,14 +17,18 @@ pub const G_ERR_B: usize = 3;
 pub const G_HALT: usize = 4;
 pub const G_PLANNED: usize = 5;
 pub const G_PARTIAL: usize = 6;
+pub const G_DONE: usize = 7;
+pub const G_WGS: usize = 8;
+pub const G_K: usize = 9;
+pub const G_CHUNK: usize = 10;
 pub const ERR_EMIT: u32 = 1;
 pub const ERR_OVERFLOW: u32 = 2;
-pub const SCAN_BLOCK: u32 = 1024;
-pub const P_QUEUES: usize = 8;
-pub const P_QSTRIDE: usize = 8;
+pub const ERR_ROOM: u32 = 3;
+/// Words of params per queue: capacity, first word of its region, at its limit.
+pub const P_QSTRIDE: usize = 4;
 
 pub fn ctrl_words(nq: usize) -> usize {
-    nq * CSTRIDE + 8 + nq * nq
+    nq * CSTRIDE + 12
 }
 pub fn c(q: usize, i: usize) -> usize {
     q * CSTRIDE + i

@@ -1,8 +1,11 @@
-//! The multi-pass baseline (Patney & Owens 2008): rounds of one dispatch per procedure, then a
-//! scan/compact per target queue. Rounds are encoded in chunks and planned on the device; the
-//! host reads back only between chunks. A round whose outputs would not fit is refused on the
-//! device with its inputs intact; the host grows every queue that lacked room and resumes.
-//! [`host`] is the host-driven variant: exact direct dispatches, one read-back per round.
+//! The multi-pass baseline (Patney & Owens 2008), device-driven: rounds of one indirect
+//! dispatch per procedure, sized on the device by a one-thread plan from the previous round's
+//! counts; children are appended to the next round's inputs with one atomic add each
+//! (compaction fused into the producer, no scan). Rounds are encoded in chunks, the first as
+//! long as the previous run needed, so a repeated run is one submission; the host reads back
+//! only between chunks. A round whose outputs would not fit is refused on the device with its
+//! inputs intact; the host grows every queue that lacked room and resumes. [`host`] is the
+//! host-driven variant: exact direct dispatches, one read-back per round.
 
 pub mod host;
 pub(crate) mod layout;
@@ -17,6 +20,7 @@ use layout::*;
 use crate::error::RunError;
 use crate::gpu::Gpu;
 use crate::growth::{Anticipation, grow};
+use crate::item_layout::ItemLayout;
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
 use crate::queue_layout::{QueueLayout, RunStart};
@@ -26,8 +30,9 @@ use crate::timing::{PassTimer, StageTimer};
 /// Settings of [`Multipass::new`]; [`Default`] gives the documented defaults.
 #[derive(Debug, Clone)]
 pub struct MultipassConfig {
-    /// Rounds encoded per submission (default 16); the host checks for completion between
-    /// chunks.
+    /// Rounds encoded per submission after the first (default 16); the host checks for
+    /// completion between chunks. The first submission encodes as many rounds as the previous
+    /// run of this [`Multipass`] needed (at most [`MAX_LEARNED_ROUNDS`]), or this many.
     pub rounds_per_submit: u32,
     /// Rounds encoded per run, empty ones included, before it stops with
     /// [`RunError::NoProgress`] (default 100,000).
@@ -41,6 +46,9 @@ pub struct MultipassConfig {
     /// Time each procedure's dispatches as their own passes ([`RunStats::stage_gpu_ms`]);
     /// the extra pass boundaries cost a little, so it is off for benchmarks of the whole.
     pub stage_timing: bool,
+    /// How the round buffers hold items; `None` (the default) picks
+    /// [`ItemLayout::for_program`], as the host-driven multi-pass does.
+    pub item_layout: Option<ItemLayout>,
 }
 
 impl Default for MultipassConfig {
@@ -51,18 +59,27 @@ impl Default for MultipassConfig {
             initial_capacity: 1 << 16,
             max_capacity: 1 << 26,
             stage_timing: false,
+            item_layout: None,
         }
     }
 }
 
-/// A program compiled for the device-driven multi-pass strategy: one pipeline per procedure and
-/// per scan stage, buffers kept between runs. Usually reached through [`crate::Scheduler`].
+/// Most rounds the first submission of a run encodes from what the previous run needed.
+pub const MAX_LEARNED_ROUNDS: u32 = 1024;
+/// Most rounds one submission of a run encodes (the dispatch arguments' slots).
+const MAX_CHUNK: u32 = 1024;
+
+/// A program compiled for the device-driven multi-pass strategy: the plan's pipeline and one
+/// per procedure, buffers kept between runs. Usually reached through [`crate::Scheduler`].
 pub struct Multipass {
     program: Program,
     config: MultipassConfig,
     kernels: Kernels,
     /// Buffers of the last run, reused when the next run needs the same layout.
     cache: std::sync::Mutex<Option<DeviceRounds>>,
+    /// Rounds the last finished run executed (0 before the first): the next run's first
+    /// submission encodes that many.
+    learned_rounds: std::sync::atomic::AtomicU32,
 }
 
 struct DeviceRounds {
@@ -70,8 +87,13 @@ struct DeviceRounds {
     at_limit: Vec<bool>,
     ctrl: wgpu::Buffer,
     items: [wgpu::Buffer; 2],
-    indirect: wgpu::Buffer,
-    plan_bind: wgpu::BindGroup,
+    /// Dispatch arguments: round k of a chunk reads its own from `args[k % 2]` (slot
+    /// `(k / 2) × NQ + q`) and may plan round k + 1 into `args[(k + 1) % 2]`.
+    args: [wgpu::Buffer; 2],
+    /// `args_bind[j]`: `args[j]` as storage (group 2).
+    args_bind: [wgpu::BindGroup; 2],
+    /// Rounds a chunk may hold (the arguments' slots).
+    max_chunk: u32,
     /// `bind[parity]`: round r reads `items[r % 2]` and writes `items[(r + 1) % 2]`.
     bind: [wgpu::BindGroup; 2],
 }
@@ -83,15 +105,19 @@ impl Multipass {
     pub fn new(
         gpu: &Gpu,
         program: &Program,
-        config: MultipassConfig,
+        mut config: MultipassConfig,
     ) -> Result<Multipass, RunError> {
+        let items = config
+            .item_layout
+            .unwrap_or_else(|| ItemLayout::for_program(gpu, program));
+        config.item_layout = Some(items);
         if program.queue_count() > 16 {
             return Err(RunError::Program(
                 "the multi-pass strategy supports at most 16 procedures".into(),
             ));
         }
-        let source = wgsl::source(program);
-        let entries: Vec<_> = (0..7).map(|b| storage_entry(b, b == 6)).collect();
+        let source = wgsl::source(program, items);
+        let entries: Vec<_> = (0..4).map(|b| storage_entry(b, b == 3)).collect();
         let eps = wgsl::entry_points(program);
         let eps: Vec<&str> = eps.iter().map(|s| s.as_str()).collect();
         let group2 = [storage_entry(0, false)];
@@ -102,13 +128,14 @@ impl Multipass {
             &source,
             &entries,
             &eps,
-            Some((&group2, &["mp_plan"])),
+            Some((&group2, &eps)),
         )?;
         Ok(Multipass {
             program: program.clone(),
             config,
             kernels,
             cache: Default::default(),
+            learned_rounds: Default::default(),
         })
     }
 
@@ -117,13 +144,20 @@ impl Multipass {
         &self.program
     }
 
+    /// How its round buffers hold items (the configured layout, or the adapter's).
+    pub fn item_layout(&self) -> ItemLayout {
+        self.config.item_layout.unwrap_or_default()
+    }
+
     /// Buffers of one layout; `at_limit[q]`: queue q cannot grow, so a round it cannot hold
     /// runs in part ([`partial`]) instead of halting for growth.
+    /// `max_chunk`: the most rounds one submission or record encodes.
     fn device_rounds(
         &self,
         gpu: &Gpu,
         layout: QueueLayout,
         at_limit: Vec<bool>,
+        max_chunk: u32,
     ) -> Result<DeviceRounds, RunError> {
         let nq = self.program.queue_count();
         let ctrl = gpu.storage_buffer("mp_ctrl", ctrl_words(nq) as u64)?;
@@ -131,29 +165,25 @@ impl Multipass {
             gpu.storage_buffer("items a", layout.total_words)?,
             gpu.storage_buffer("items b", layout.total_words)?,
         ];
-        let emit = gpu.storage_buffer("emit", layout.total_words)?;
-        let emit_flags = gpu.storage_buffer("emit flags", layout.total_slots)?;
-        let mut params = vec![0u32; P_QUEUES + nq * P_QSTRIDE];
-        let mut sum_words = 0u32;
+        let mut params = vec![0u32; nq * P_QSTRIDE];
         for q in 0..nq {
-            let p = &mut params[P_QUEUES + q * P_QSTRIDE..];
+            let p = &mut params[q * P_QSTRIDE..];
             p[0] = layout.capacity[q];
             p[1] = layout.slot_base[q];
-            p[2] = layout.slot_base[q];
-            p[3] = layout.flag_base[q];
-            p[4] = sum_words;
-            p[5] = at_limit[q] as u32;
-            sum_words += layout.capacity[q].div_ceil(SCAN_BLOCK);
+            p[2] = at_limit[q] as u32;
         }
-        let sums = gpu.storage_buffer("block sums", sum_words as u64)?;
         let params_buf = gpu.storage_buffer("mp params", params.len() as u64)?;
         gpu.queue
             .write_buffer(&params_buf, 0, bytemuck::cast_slice(&params));
-        let indirect = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("round dispatch args"),
-            size: (3 * 3 * nq * 4) as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
-            mapped_at_creation: false,
+        let args = [0, 1].map(|_| {
+            gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("round dispatch args"),
+                size: (max_chunk.div_ceil(2) as usize * nq * 12) as u64,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::INDIRECT
+                    | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
         });
         let bind = [0, 1].map(|par| {
             self.kernels.bind_group0(
@@ -162,28 +192,28 @@ impl Multipass {
                     (0, &ctrl),
                     (1, &items[par]),
                     (2, &items[1 - par]),
-                    (3, &emit),
-                    (4, &emit_flags),
-                    (5, &sums),
-                    (6, &params_buf),
+                    (3, &params_buf),
                 ],
             )
         });
-        let plan_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("indirect args"),
-            layout: self.kernels.group2.as_ref().expect("multipass has group 2"),
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: indirect.as_entire_binding(),
-            }],
+        let args_bind = [0, 1].map(|j| {
+            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("round dispatch args"),
+                layout: self.kernels.group2.as_ref().expect("multipass has group 2"),
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: args[j].as_entire_binding(),
+                }],
+            })
         });
         Ok(DeviceRounds {
             layout,
             at_limit,
             ctrl,
             items,
-            indirect,
-            plan_bind,
+            args,
+            args_bind,
+            max_chunk,
             bind,
         })
     }
@@ -194,13 +224,8 @@ impl Multipass {
         let mut ctrl = vec![0u32; ctrl_words(nq)];
         for (q, items) in live.iter().enumerate() {
             ctrl[c(q, C_NEXT)] = (items.len() / d.layout.words[q] as usize) as u32;
-            if !items.is_empty() {
-                gpu.queue.write_buffer(
-                    &d.items[0],
-                    d.layout.slot_base[q] as u64 * 4,
-                    bytemuck::cast_slice(items),
-                );
-            }
+            self.item_layout()
+                .write_items(&gpu.queue, &d.items[0], &d.layout, q, items);
         }
         gpu.queue
             .write_buffer(&d.ctrl, 0, bytemuck::cast_slice(&ctrl));
@@ -221,25 +246,25 @@ impl Multipass {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         for (q, &n) in counts.iter().enumerate() {
             ctrl[c(q, C_NEXT)] = n;
-            let bytes = n as u64 * from.layout.words[q] as u64 * 4;
-            if bytes > 0 {
-                enc.copy_buffer_to_buffer(
-                    &from.items[parity],
-                    from.layout.slot_base[q] as u64 * 4,
-                    &to.items[0],
-                    to.layout.slot_base[q] as u64 * 4,
-                    bytes,
-                );
-            }
+            self.item_layout().encode_copy(
+                &mut enc,
+                (&from.items[parity], &from.layout),
+                (&to.items[0], &to.layout),
+                q,
+                n,
+            );
         }
         gpu.queue
             .write_buffer(&to.ctrl, 0, bytemuck::cast_slice(&ctrl));
         gpu.queue.submit([enc.finish()]);
     }
 
-    /// Encodes `rounds` rounds: plan, every procedure's items, then the scan and compaction of
-    /// what they emitted. With `stages`, each of those phases is its own timed pass (counted to
-    /// its procedure, or to the last stage for plan and compaction); else one pass.
+    /// Encodes a chunk of `rounds` rounds (at most `d.max_chunk`): the arguments cleared, the
+    /// first round's plan (one thread, a direct dispatch), then per round one indirect dispatch
+    /// per procedure; the last workgroup of each round plans the next (`shaders/multipass.wgsl`),
+    /// so the chunk is `1 + rounds × NQ` dispatches. `mp_ctrl`'s `G_CHUNK` must hold `rounds`.
+    /// With `stages`, each procedure's dispatches are timed as their own passes and the plan is
+    /// counted to the last stage; else one pass.
     #[allow(clippy::too_many_arguments)]
     fn encode_rounds(
         &self,
@@ -251,9 +276,13 @@ impl Multipass {
         stages: Option<&StageTimer>,
         user: Option<&wgpu::BindGroup>,
     ) {
+        debug_assert!(rounds <= d.max_chunk);
         let nq = self.program.queue_count();
         let p = &self.kernels.pipelines;
-        let begin = |enc: &mut wgpu::CommandEncoder, round: usize, stage: usize| {
+        for a in &d.args {
+            enc.clear_buffer(a, 0, None);
+        }
+        let begin = |enc: &mut wgpu::CommandEncoder, stage: usize| {
             let writes = match stages {
                 Some(st) => st.writes(stage),
                 None => timer.and_then(|t| t.writes()),
@@ -267,47 +296,48 @@ impl Multipass {
             if let Some(u) = user {
                 pass.set_bind_group(1, u, &[]);
             }
-            pass.set_bind_group(2, &d.plan_bind, &[]);
-            pass.set_bind_group(0, &d.bind[(first_round as usize + round) % 2], &[]);
             pass
         };
-        let args = |slot: usize| (slot * 12) as u64;
-        let encode_compaction = |pass: &mut wgpu::ComputePass| {
-            for t in 0..nq {
-                pass.set_pipeline(&p[1 + nq + t]);
-                pass.dispatch_workgroups_indirect(&d.indirect, args(nq + t));
-                pass.set_pipeline(&p[1 + 2 * nq + t]);
-                pass.dispatch_workgroups_indirect(&d.indirect, args(2 * nq + t));
-                pass.set_pipeline(&p[1 + 3 * nq + t]);
-                pass.dispatch_workgroups_indirect(&d.indirect, args(nq + t));
-            }
+        // Round k: its items' parity, the arguments it may plan, where its own are.
+        let round = |pass: &mut wgpu::ComputePass, k: usize| {
+            pass.set_bind_group(0, &d.bind[(first_round as usize + k) % 2], &[]);
+            pass.set_bind_group(2, &d.args_bind[(k + 1) % 2], &[]);
+        };
+        let args = |k: usize, q: usize| ((k / 2 * nq + q) * 12) as u64;
+        let plan = |pass: &mut wgpu::ComputePass| {
+            pass.set_bind_group(0, &d.bind[first_round as usize % 2], &[]);
+            pass.set_bind_group(2, &d.args_bind[0], &[]);
+            pass.set_pipeline(&p[0]);
+            pass.dispatch_workgroups(1, 1, 1);
         };
         if stages.is_some() {
-            for r in 0..rounds as usize {
-                let mut pass = begin(enc, r, nq);
-                pass.set_pipeline(&p[0]);
-                pass.dispatch_workgroups(1, 1, 1);
-                drop(pass);
+            plan(&mut begin(enc, nq));
+            for k in 0..rounds as usize {
                 for q in 0..nq {
-                    let mut pass = begin(enc, r, q);
+                    let mut pass = begin(enc, q);
+                    round(&mut pass, k);
                     pass.set_pipeline(&p[1 + q]);
-                    pass.dispatch_workgroups_indirect(&d.indirect, args(q));
+                    pass.dispatch_workgroups_indirect(&d.args[k % 2], args(k, q));
                 }
-                encode_compaction(&mut begin(enc, r, nq));
             }
             return;
         }
-        let mut pass = begin(enc, 0, 0);
-        for r in 0..rounds as usize {
-            pass.set_bind_group(0, &d.bind[(first_round as usize + r) % 2], &[]);
-            pass.set_pipeline(&p[0]);
-            pass.dispatch_workgroups(1, 1, 1);
+        let mut pass = begin(enc, 0);
+        plan(&mut pass);
+        for k in 0..rounds as usize {
+            round(&mut pass, k);
             for q in 0..nq {
                 pass.set_pipeline(&p[1 + q]);
-                pass.dispatch_workgroups_indirect(&d.indirect, args(q));
+                pass.dispatch_workgroups_indirect(&d.args[k % 2], args(k, q));
             }
-            encode_compaction(&mut pass);
         }
+    }
+
+    /// Sets `G_CHUNK`, the rounds of the next chunk, before its submission.
+    fn set_chunk(&self, gpu: &Gpu, d: &DeviceRounds, rounds: u32) {
+        let at = g(self.program.queue_count(), G_CHUNK) as u64 * 4;
+        gpu.queue
+            .write_buffer(&d.ctrl, at, bytemuck::bytes_of(&rounds));
     }
 
     /// Runs the program to completion from `seeds`; `user` is bind group 1, if the program has
@@ -323,7 +353,6 @@ impl Multipass {
         self.kernels.check_user_group(user)?;
         let start = Instant::now();
         let nq = self.program.queue_count();
-        // Reduce and scatter dispatch one workgroup per SCAN_BLOCK slots, at most 65,535.
         let RunStart {
             live,
             seeded,
@@ -332,9 +361,9 @@ impl Multipass {
             &self.program,
             seeds,
             gpu.max_binding_bytes(),
-            self.config.max_capacity.min(65_535 * SCAN_BLOCK),
+            self.config.max_capacity,
             max_queue_bytes,
-            3,
+            2,
         )?;
         // The first round's worst-case output is known here: queues too small for it grow
         // before the first submission rather than after a refused one.
@@ -358,12 +387,19 @@ impl Multipass {
             })
             .collect();
         let mut anticipation = Anticipation::new(first_emits.iter().sum());
-        let rounds_per_submit = self.config.rounds_per_submit.max(1);
-        // Rounds of the next submission: all of them, but fewer while queues grow.
-        let mut rounds = rounds_per_submit;
+        let rounds_per_submit = self.config.rounds_per_submit.clamp(1, MAX_CHUNK);
+        // Rounds of the next submission: as many as the last run needed (so a repeated run is
+        // one submission and no empty round), else a chunk; fewer while queues grow.
+        let learned = self
+            .learned_rounds
+            .load(std::sync::atomic::Ordering::Relaxed);
+        let mut rounds = match learned {
+            0 => rounds_per_submit,
+            n => n.min(MAX_LEARNED_ROUNDS),
+        };
         let mut stats = RunStats {
             strategy: "multipass".into(),
-            item_layout: crate::ItemLayout::Interleaved.name().into(),
+            item_layout: self.item_layout().name().into(),
             executed: vec![0; nq],
             peak_occupancy: vec![0; nq],
             ..Default::default()
@@ -372,7 +408,7 @@ impl Multipass {
         let mut stage_timer = self
             .config
             .stage_timing
-            .then(|| StageTimer::new(gpu, nq + 1, rounds_per_submit * (nq as u32 + 2)));
+            .then(|| StageTimer::new(gpu, nq + 1, rounds.max(rounds_per_submit) * nq as u32 + 1));
         let mut encoded = 0u64;
         // Rounds encoded since the last upload: round r reads items[r % 2].
         let mut since_upload = 0u64;
@@ -380,7 +416,7 @@ impl Multipass {
         let at_limit = partial::at_limit(&capacity, &max_cap);
         let mut d = match self.cache.lock().unwrap().take() {
             Some(d) if d.layout == layout && d.at_limit == at_limit => d,
-            _ => self.device_rounds(gpu, layout, at_limit)?,
+            _ => self.device_rounds(gpu, layout, at_limit, MAX_CHUNK)?,
         };
         self.upload(gpu, &d, &live);
         loop {
@@ -390,6 +426,7 @@ impl Multipass {
                 )));
             }
             let mut enc = gpu.device.create_command_encoder(&Default::default());
+            self.set_chunk(gpu, &d, rounds);
             self.encode_rounds(
                 &mut enc,
                 &d,
@@ -405,7 +442,7 @@ impl Multipass {
             }
             gpu.queue.submit([enc.finish()]);
             stats.submits += 1;
-            stats.launches += rounds as u64 * (1 + 4 * nq as u64);
+            stats.launches += 1 + rounds as u64 * nq as u64;
             encoded += rounds as u64;
             since_upload += rounds as u64;
             let ctrl = gpu.read_words(&d.ctrl, 0, ctrl_words(nq) as u64)?;
@@ -422,6 +459,12 @@ impl Multipass {
                     target: self.program.procs[b as usize].proc.name.clone(),
                     declared: self.program.procs[a].emits[b as usize],
                 });
+            }
+            if error == ERR_ROOM {
+                return Err(RunError::Device(format!(
+                    "device-driven multi-pass: an append past the capacity the plan made room \
+                     for (queue {a}, slot {b})"
+                )));
             }
             let halted = error == ERR_OVERFLOW;
             let next: Vec<u32> = (0..nq).map(|q| ctrl[c(q, C_NEXT)]).collect();
@@ -450,8 +493,8 @@ impl Multipass {
                 }
                 let refused_grew = grown != capacity;
                 for t in 0..nq {
-                    // Per slot: its item in both parities and the emit buffer, and its flag.
-                    let slot_bytes = d.layout.words[t] as u64 * 12 + 4;
+                    // Per slot: its item in both parities.
+                    let slot_bytes = d.layout.words[t] as u64 * 8;
                     let extra = Anticipation::MAX_EXTRA_BYTES / slot_bytes / nq as u64;
                     let need = ((m[t] as f64 * factor) as u64).min(2 * m[t] + extra);
                     if need > grown[t] as u64 {
@@ -477,13 +520,18 @@ impl Multipass {
                     gpu,
                     QueueLayout::new(&self.program, capacity.clone())?,
                     partial::at_limit(&capacity, &max_cap),
+                    MAX_CHUNK,
                 )?;
                 self.move_inputs(gpu, &d, parity, &new, &next);
                 d = new;
                 since_upload = 0;
             }
         }
-        stats.queue_bytes = d.layout.total_words * 4 * 3 + d.layout.total_slots * 4;
+        stats.queue_bytes = d.layout.total_words * 4 * 2;
+        self.learned_rounds.store(
+            stats.rounds.clamp(1, MAX_LEARNED_ROUNDS as u64) as u32,
+            std::sync::atomic::Ordering::Relaxed,
+        );
         stats.gpu_ms = timer.total_ms();
         if let Some(ms) = stage_timer.and_then(|st| st.stage_ms()) {
             stats.gpu_ms = Some(ms.iter().sum());

@@ -1,12 +1,13 @@
 //! The device-driven multi-pass's part of a [`crate::RecordedRun`]: a fixed number of rounds
 //! on queues of fixed capacity, seeded on the device, in one pass. A round that would not fit
-//! is refused on the device as in a run (inputs intact, every later round refused too), and an
-//! empty round costs only its plan and empty indirect dispatches.
+//! is refused on the device as in a run (inputs intact, no later round planned), and an empty
+//! round costs only its empty indirect dispatches.
 
 use super::Multipass;
 use super::layout::*;
 use crate::error::RunError;
 use crate::gpu::Gpu;
+use crate::item_layout::{ItemLayout, PlanarScatter};
 use crate::program::Program;
 use crate::queue_layout::QueueLayout;
 use crate::stats::{Outcome, RunStats};
@@ -17,6 +18,9 @@ pub(crate) struct RecordedRounds {
     /// mp_ctrl at the start: the seed counts as the first round's inputs, all else 0.
     ctrl_start: wgpu::Buffer,
     rounds: u32,
+    /// Planar queues: the device copy of the seeds into their planes.
+    scatter: Option<PlanarScatter>,
+    item_layout: ItemLayout,
 }
 
 impl Multipass {
@@ -36,10 +40,10 @@ impl Multipass {
             QueueLayout::capacity_limits(
                 &self.program,
                 gpu.max_binding_bytes(),
-                self.config.max_capacity.min(65_535 * SCAN_BLOCK),
+                self.config.max_capacity,
             ),
             max_queue_bytes,
-            3,
+            2,
         );
         QueueLayout::check_seeds(&self.program, seeded, &max_cap)?;
         let capacity: Vec<u32> = (0..seeded.len())
@@ -47,23 +51,31 @@ impl Multipass {
             .collect();
         // No partial rounds: a recorded run has a fixed round count, so a round that does not
         // fit halts and the run reports itself incomplete (the caller re-renders that frame).
+        let rounds = rounds.max(1);
         let d = self.device_rounds(
             gpu,
             QueueLayout::new(&self.program, capacity.clone())?,
             vec![false; seeded.len()],
+            rounds,
         )?;
         let nq = seeded.len();
         let mut ctrl = vec![0u32; ctrl_words(nq)];
         for (q, &n) in seeded.iter().enumerate() {
             ctrl[c(q, C_NEXT)] = n;
         }
+        ctrl[g(nq, G_CHUNK)] = rounds;
         let ctrl_start = gpu.upload("mp_ctrl at start", &ctrl)?;
-        let rounds = rounds.max(1);
+        let scatter = match self.item_layout() {
+            ItemLayout::Interleaved => None,
+            ItemLayout::Planar => Some(PlanarScatter::new(gpu, &d.layout, seeded)?),
+        };
         Ok((
             RecordedRounds {
                 d,
                 ctrl_start,
                 rounds,
+                scatter,
+                item_layout: self.item_layout(),
             },
             capacity,
         ))
@@ -93,7 +105,10 @@ impl RecordedRounds {
     ) -> Result<(), RunError> {
         m.kernels.check_user_group(user)?;
         let d = &self.d;
-        d.layout.encode_seed_copies(enc, seeds, &d.items[0]);
+        match &self.scatter {
+            Some(s) => s.record(enc, seeds, &d.items[0]),
+            None => d.layout.encode_seed_copies(enc, seeds, &d.items[0]),
+        }
         enc.copy_buffer_to_buffer(&self.ctrl_start, 0, &d.ctrl, 0, d.ctrl.size());
         m.encode_rounds(enc, d, self.rounds, 0, None, None, user);
         enc.copy_buffer_to_buffer(&d.ctrl, 0, status, status_word * 4, d.ctrl.size());
@@ -119,6 +134,12 @@ impl RecordedRounds {
                 declared: program.procs[a].emits[b as usize],
             });
         }
+        if error == ERR_ROOM {
+            return Err(RunError::Device(format!(
+                "device-driven multi-pass: an append past the capacity the plan made room for \
+                 (queue {a}, slot {b})"
+            )));
+        }
         if error == ERR_OVERFLOW {
             return Ok(Outcome::Incomplete(format!(
                 "a round refused: queue `{}` may receive {b} items, more than its {} slots",
@@ -134,12 +155,12 @@ impl RecordedRounds {
         }
         Ok(Outcome::Done(RunStats {
             strategy: "multipass".into(),
-            item_layout: crate::ItemLayout::Interleaved.name().into(),
+            item_layout: self.item_layout.name().into(),
             executed: (0..nq).map(|q| ctrl[c(q, C_EXEC)] as u64).collect(),
             peak_occupancy: (0..nq).map(|q| ctrl[c(q, C_PEAK)] as u64).collect(),
             rounds: ctrl[g(nq, G_ROUNDS)] as u64,
-            launches: self.rounds as u64 * (1 + 4 * nq as u64),
-            queue_bytes: self.d.layout.total_words * 4 * 3 + self.d.layout.total_slots * 4,
+            launches: 1 + self.rounds as u64 * nq as u64,
+            queue_bytes: self.d.layout.total_words * 4 * 2,
             ..Default::default()
         }))
     }

@@ -1,14 +1,14 @@
-//! Generates the multi-pass WGSL: the program's shared code, enqueue functions that write an
-//! item's fixed output slots, one entry point per procedure and per target's scan stage, and
-//! `shaders/multipass.wgsl`.
+//! Generates the device-driven multi-pass WGSL: the program's shared code, item accessors in
+//! the run's item layout, enqueue functions that append to the next round's inputs, one entry
+//! point per procedure, and `shaders/multipass.wgsl`.
 
+use crate::item_layout::{ItemLayout, planar_load_store_fns};
 use crate::program::Program;
 
 pub const TEMPLATE: &str = include_str!("../../../shaders/multipass.wgsl");
 
-/// Entry points in pipeline order: plan, procedures, then per target reduce, scan, scatter.
+/// Entry points in pipeline order: the plan, then the procedures.
 pub fn entry_points(program: &Program) -> Vec<String> {
-    let nq = program.queue_count();
     let mut e = vec!["mp_plan".to_string()];
     e.extend(
         program
@@ -16,40 +16,52 @@ pub fn entry_points(program: &Program) -> Vec<String> {
             .iter()
             .map(|p| format!("mp_proc_{}", p.proc.name)),
     );
-    for stage in ["reduce", "scanblocks", "scatter"] {
-        e.extend((0..nq).map(|t| format!("mp_{stage}_{t}")));
-    }
     e
 }
 
-pub fn source(program: &Program) -> String {
+/// The WGSL for `program` with its queues laid out as `items` (the same layout in the round
+/// buffers of every queue).
+pub fn source(program: &Program, items: ItemLayout) -> String {
     let mut s = program.tables_wgsl();
     s += &program.common_wgsl();
     s += &crate::wgsl::vec4_word_accessors("mp_in", "items_in");
     s += &crate::wgsl::vec4_word_accessors("mp_out", "items_out");
-    s += &crate::wgsl::vec4_word_accessors("mp_emit", "emit");
-    s += &crate::ItemLayout::Interleaved.execute_switch(program, "mp_in");
+    s += &items.execute_switch(program, "mp_in");
     let mut seen = Vec::new();
     for p in &program.procs {
         if !seen.contains(&p.layout.name) {
             seen.push(p.layout.name.clone());
-            s += &crate::wgsl::load_store_fns(&p.layout, "mp_emit");
+            s += &match items {
+                ItemLayout::Interleaved => crate::wgsl::load_store_fns(&p.layout, "mp_out"),
+                ItemLayout::Planar => planar_load_store_fns(&p.layout, "mp_out"),
+            };
         }
     }
-    let args = "@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>, \
-                @builtin(num_workgroups) nwg: vec3<u32>";
+    // Where item `at` of queue `t` starts, and (planar) the stride between its words; word `w`
+    // of that item (the carried inputs' copy).
+    let item_at = |t: &str| match items {
+        ItemLayout::Interleaved => format!("q_base({t}) + at * WORDS[{t}]"),
+        ItemLayout::Planar => format!("q_base({t}) + at, q_cap({t})"),
+    };
+    let word_at = match items {
+        ItemLayout::Interleaved => "q_base(t) + at * WORDS[t] + w",
+        ItemLayout::Planar => "q_base(t) + w * q_cap(t) + at",
+    };
+    s += &format!(
+        "fn mp_execute(t: u32, at: u32, inv: Invocation) {{ sched_execute(t, {}, inv); }}\n\
+         fn mp_word_at(t: u32, at: u32, w: u32) -> u32 {{ return {word_at}; }}\n",
+        item_at("t")
+    );
+    let args = "@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>";
     for (t, p) in program.procs.iter().enumerate() {
         s += &format!(
             "fn enqueue_{name}(item: {ty}) {{\n    if !sched_active {{ return; }}\n    \
-             let at = sched_emit_slot({t}u);\n    if at == 0xffffffffu {{ return; }}\n    \
-             mp_emit_store_{ty}(q_emit_base({t}u) + at * WORDS[{t}u], item);\n    \
-             emit_flags[q_eflag_base({t}u) + at] = 1u;\n}}\n\
-             @compute @workgroup_size(256) fn mp_proc_{name}({args}) {{ run_procedure({t}u, lid, wid.x, nwg.x); }}\n\
-             @compute @workgroup_size(256) fn mp_reduce_{t}({args}) {{ scan_reduce({t}u, lid, wid.x); }}\n\
-             @compute @workgroup_size(256) fn mp_scanblocks_{t}({args}) {{ scan_blocks({t}u, lid); }}\n\
-             @compute @workgroup_size(256) fn mp_scatter_{t}({args}) {{ scan_scatter({t}u, lid, wid.x); }}\n",
+             let at = sched_append_slot({t}u);\n    if at == 0xffffffffu {{ return; }}\n    \
+             mp_out_store_{ty}({store_at}, item);\n}}\n\
+             @compute @workgroup_size(256) fn mp_proc_{name}({args}) {{ run_procedure({t}u, lid, wid.x); }}\n",
             name = p.proc.name,
-            ty = p.layout.name
+            ty = p.layout.name,
+            store_at = item_at(&format!("{t}u")),
         );
     }
     s += TEMPLATE;
