@@ -3,11 +3,12 @@
 //! either strategy, then a resolve pass from sub-samples to pixels.
 
 use crate::buckets;
-use crate::frame::{FrameData, FrameUniforms, PatchItem, SceneFeatures};
+use crate::frame::{FrameData, FrameUniforms, PatchItem, SceneFeatures, Tile};
 use crate::gpu::{FrameTarget, Pipelines, SceneBuffers, scene_layout_entries};
 use crate::image::FrameImage;
 use crate::progress::Progress;
 use crate::shaders;
+use crate::stages::hiz::{OCCLUSION_OFF, OCCLUSION_TEST, front_items};
 use crate::stages::{C_MAX_DEPTH, COUNTERS};
 use scheduler::timing::PassTimer;
 use scheduler::{
@@ -330,6 +331,7 @@ impl GpuRenderer {
             counters,
             rgba,
             depth,
+            hiz,
             ..
         } = target;
         let mut out = GpuFrame {
@@ -358,6 +360,12 @@ impl GpuRenderer {
                     .copied()
                     .collect(),
             };
+            // Occlusion culling (stages::hiz): the items that may be nearest run first; the
+            // rest run after the depth pyramid of what those drew is built, tested against it.
+            let (items, first) = match f.occlusion != OCCLUSION_OFF {
+                true => front_first(data, &items, tile),
+                false => (items, usize::MAX),
+            };
             let tile_sample_bytes = tile.w as u64 * tile.h as u64 * per_pixel;
             let queue_budget = data
                 .memory_budget
@@ -374,11 +382,26 @@ impl GpuRenderer {
                 clippy::single_range_in_vec_init,
                 reason = "a stack of batches, each a range of items"
             )]
-            let mut batches = vec![0..items.len()];
+            let mut batches = match first < items.len() {
+                true => vec![first..items.len(), 0..first],
+                false => vec![0..items.len()],
+            };
             let mut recut = false;
             while let Some(batch) = batches.pop() {
                 let mut enc = gpu.device.create_command_encoder(&Default::default());
                 enc.clear_buffer(counters, 0, None);
+                // A batch of the second pass: the pyramid of everything drawn so far, and the
+                // test in Bound. (Halves of a first-pass batch stay ahead of it on the stack.)
+                if batch.start >= first {
+                    let test = FrameUniforms {
+                        occlusion: OCCLUSION_TEST,
+                        ..tile_frame
+                    };
+                    let hiz_passes = self.pipelines.hiz(gpu)?;
+                    if hiz_passes.record(gpu, &mut enc, &tile_frame, samples, hiz, pixels)? {
+                        scene.write_frame(gpu, &test);
+                    }
+                }
                 gpu.queue.submit([enc.finish()]);
                 let seeds = [Seed::new::<PatchItem>("bound", &items[batch.clone()])];
                 let run = match self
@@ -518,6 +541,23 @@ impl GpuRenderer {
         timer.collect(gpu)?;
         Ok(timer.total_ms())
     }
+}
+
+/// A bucket's items with those [`front_items`] picks first, and how many those are.
+fn front_first<'a>(
+    data: &FrameData,
+    items: &[PatchItem],
+    tile: Tile,
+) -> (std::borrow::Cow<'a, [PatchItem]>, usize) {
+    let front = front_items(data, items, tile);
+    let pick = |first: bool| {
+        (items.iter().zip(&front))
+            .filter(move |(_, f)| **f == first)
+            .map(|(i, _)| *i)
+    };
+    let ordered: Vec<PatchItem> = pick(true).chain(pick(false)).collect();
+    let n = front.iter().filter(|f| **f).count();
+    (ordered.into(), n)
 }
 
 /// Workgroups of a 1D pass of `threads` threads, `per_group` per workgroup, as a 2D dispatch
