@@ -62,26 +62,17 @@ pub fn render_cpu(data: &FrameData) -> CpuRender {
             }),
         };
         let mut samples = vec![0u64; tile.w as usize * tile.h as usize * spp as usize];
-        // With occlusion culling, as the GPU: the items that may be nearest first, then the
-        // depth pyramid of what they drew, then the rest tested against it.
+        // With occlusion culling, as the GPU: the passes of `hiz::passes`, each after the first
+        // tested against the depth pyramid of what the passes before it drew.
         let occlusion = bucket.frame.occlusion != hiz::OCCLUSION_OFF;
-        let front = match occlusion {
-            true => hiz::front_items(&bucket, &bucket.items, tile),
-            false => vec![true; bucket.items.len()],
+        let (items, starts) = match occlusion {
+            true => hiz::passes(&bucket, &bucket.items, tile),
+            false => (bucket.items.clone(), vec![0]),
         };
-        let pass = |first: bool| -> Vec<PatchItem> {
-            (bucket.items.iter().zip(&front))
-                .filter(|(_, f)| **f == first)
-                .map(|(i, _)| *i)
-                .collect()
-        };
-        let mut pyramid = None;
-        for first in [true, false] {
-            let items = pass(first);
-            if items.is_empty() {
-                continue;
-            }
-            let f = match &pyramid {
+        for (k, &start) in starts.iter().enumerate() {
+            let end = starts.get(k + 1).copied().unwrap_or(items.len());
+            let pyramid = (k > 0).then(|| hiz::build(&bucket.frame, &samples));
+            let f = match pyramid {
                 Some(_) => FrameUniforms {
                     occlusion: hiz::OCCLUSION_TEST,
                     ..bucket.frame
@@ -91,7 +82,7 @@ pub fn render_cpu(data: &FrameData) -> CpuRender {
             walk_items(
                 &bucket,
                 &f,
-                items,
+                items[start..end].to_vec(),
                 pyramid.as_ref(),
                 &mut counters,
                 &mut executed,
@@ -101,9 +92,6 @@ pub fn render_cpu(data: &FrameData) -> CpuRender {
                     counters[stages::C_BACKFACE] += culled as u64;
                 },
             );
-            if occlusion && first {
-                pyramid = Some(hiz::build(&bucket.frame, &samples));
-            }
         }
         let (rgba, depth) = stages::resolve::resolve(&samples, tile.w, tile.h, spp);
         for row in 0..tile.h as usize {

@@ -3,12 +3,12 @@
 //! either strategy, then a resolve pass from sub-samples to pixels.
 
 use crate::buckets;
-use crate::frame::{FrameData, FrameUniforms, PatchItem, SceneFeatures, Tile};
+use crate::frame::{FrameData, FrameUniforms, PatchItem, SceneFeatures};
 use crate::gpu::{FrameTarget, Pipelines, SceneBuffers, scene_layout_entries};
 use crate::image::FrameImage;
 use crate::progress::Progress;
 use crate::shaders;
-use crate::stages::hiz::{OCCLUSION_OFF, OCCLUSION_TEST, front_items};
+use crate::stages::hiz::{OCCLUSION_OFF, OCCLUSION_TEST, passes};
 use crate::stages::{C_MAX_DEPTH, COUNTERS};
 use scheduler::timing::PassTimer;
 use scheduler::{
@@ -362,10 +362,14 @@ impl GpuRenderer {
             };
             // Occlusion culling (stages::hiz): the items that may be nearest run first; the
             // rest run after the depth pyramid of what those drew is built, tested against it.
-            let (items, first) = match f.occlusion != OCCLUSION_OFF {
-                true => front_first(data, &items, tile),
-                false => (items, usize::MAX),
+            let (items, starts) = match f.occlusion != OCCLUSION_OFF {
+                true => {
+                    let (ordered, starts) = passes(data, &items, tile);
+                    (ordered.into(), starts)
+                }
+                false => (items, vec![0]),
             };
+            let first = starts.get(1).copied().unwrap_or(usize::MAX);
             let tile_sample_bytes = tile.w as u64 * tile.h as u64 * per_pixel;
             let queue_budget = data
                 .memory_budget
@@ -382,16 +386,17 @@ impl GpuRenderer {
                 clippy::single_range_in_vec_init,
                 reason = "a stack of batches, each a range of items"
             )]
-            let mut batches = match first < items.len() {
-                true => vec![first..items.len(), 0..first],
-                false => vec![0..items.len()],
-            };
+            // One batch per pass, the first on top of the stack.
+            let mut batches: Vec<std::ops::Range<usize>> = (starts.iter().enumerate())
+                .rev()
+                .map(|(k, &s)| s..starts.get(k + 1).copied().unwrap_or(items.len()))
+                .collect();
             let mut recut = false;
             while let Some(batch) = batches.pop() {
                 let mut enc = gpu.device.create_command_encoder(&Default::default());
                 enc.clear_buffer(counters, 0, None);
-                // A batch of the second pass: the pyramid of everything drawn so far, and the
-                // test in Bound. (Halves of a first-pass batch stay ahead of it on the stack.)
+                // A batch after the first pass: the pyramid of everything drawn so far, and the
+                // test in Bound. (Halves of a batch stay ahead of later passes on the stack.)
                 if batch.start >= first {
                     let test = FrameUniforms {
                         occlusion: OCCLUSION_TEST,
@@ -541,23 +546,6 @@ impl GpuRenderer {
         timer.collect(gpu)?;
         Ok(timer.total_ms())
     }
-}
-
-/// A bucket's items with those [`front_items`] picks first, and how many those are.
-fn front_first<'a>(
-    data: &FrameData,
-    items: &[PatchItem],
-    tile: Tile,
-) -> (std::borrow::Cow<'a, [PatchItem]>, usize) {
-    let front = front_items(data, items, tile);
-    let pick = |first: bool| {
-        (items.iter().zip(&front))
-            .filter(move |(_, f)| **f == first)
-            .map(|(i, _)| *i)
-    };
-    let ordered: Vec<PatchItem> = pick(true).chain(pick(false)).collect();
-    let n = front.iter().filter(|f| **f).count();
-    (ordered.into(), n)
 }
 
 /// Workgroups of a 1D pass of `threads` threads, `per_group` per workgroup, as a 2D dispatch

@@ -166,10 +166,9 @@ pub fn occluded(f: &FrameUniforms, hiz: &Hiz, lo: glam::Vec2, hi: glam::Vec2, z:
 }
 
 /// Which root items of a bucket are drawn in the first pass, before the pyramid is built: the
-/// items that may be nearest somewhere. The bucket is cut into a grid of cells (at most 16 x
-/// 16); in each, the nearest far depth of the items whose control points' bound reaches it is
-/// taken, and an item goes first if its near depth is at most that in some cell it reaches.
-/// Items crossing the near plane go first: Bound never culls them. A heuristic only (it looks
+/// nearest item of each cell. The bucket is cut into a grid of cells (at most 16 x 16); in
+/// each, of the items whose control points' bound reaches it, the one of the nearest near
+/// depth goes first. Items crossing the near plane go first too: Bound never culls them. A heuristic only (it looks
 /// at control points at shutter open, without displacement): either pass may hold any item
 /// without changing the image, only the work.
 pub fn front_items(data: &FrameData, items: &[PatchItem], tile: Tile) -> Vec<bool> {
@@ -216,20 +215,54 @@ pub fn front_items(data: &FrameData, items: &[PatchItem], tile: Tile) -> Vec<boo
             ))
         })
         .collect();
-    let mut far = vec![f32::MAX; nx * ny];
-    for (c, _, z1) in extents.iter().flatten() {
+    // Per cell, the item of the nearest near depth (the first on a tie).
+    let mut nearest = vec![(f32::MAX, usize::MAX); nx * ny];
+    for (k, e) in extents.iter().enumerate() {
+        let Some((c, z0, _)) = e else { continue };
         for y in c[1]..=c[3] {
             for x in c[0]..=c[2] {
-                far[y * nx + x] = far[y * nx + x].min(*z1);
+                if *z0 < nearest[y * nx + x].0 {
+                    nearest[y * nx + x] = (*z0, k);
+                }
             }
         }
     }
-    (extents.iter())
-        .map(|e| match e {
-            None => true,
-            Some((c, z0, _)) => (c[1]..=c[3]).any(|y| (c[0]..=c[2]).any(|x| *z0 <= far[y * nx + x])),
+    let mut first: Vec<bool> = extents.iter().map(|e| e.is_none()).collect();
+    for (_, k) in nearest {
+        if k != usize::MAX {
+            first[k] = true;
+        }
+    }
+    first
+}
+
+/// A bucket's items in the order the passes take them, and where each pass starts: first the
+/// [`front_items`], then the others by their nearest control point's depth, nearest first, in
+/// two passes (the nearer half, then the rest). Before each pass after the first the renderers
+/// build the pyramid of everything drawn so far and Bound tests against it, so each pass is
+/// culled against all the passes in front of it.
+pub fn passes(data: &FrameData, items: &[PatchItem], tile: Tile) -> (Vec<PatchItem>, Vec<usize>) {
+    let front = front_items(data, items, tile);
+    let mut ordered: Vec<PatchItem> = (items.iter().zip(&front))
+        .filter(|(_, f)| **f)
+        .map(|(i, _)| *i)
+        .collect();
+    let n = ordered.len();
+    let mut rest: Vec<(f32, PatchItem)> = (items.iter().zip(&front))
+        .filter(|(_, f)| !**f)
+        .map(|(i, _)| {
+            let zmin = (0..16)
+                .map(|k| cp_point(&i.cp, k).z)
+                .fold(f32::MAX, f32::min);
+            (zmin, *i)
         })
-        .collect()
+        .collect();
+    rest.sort_by(|a, b| a.0.total_cmp(&b.0));
+    ordered.extend(rest.iter().map(|r| r.1));
+    let mut starts = vec![0, n, n + rest.len() / 2];
+    starts.retain(|&s| s == 0 || s < ordered.len());
+    starts.dedup();
+    (ordered, starts)
 }
 
 #[cfg(test)]
