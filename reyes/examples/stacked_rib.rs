@@ -13,7 +13,9 @@ fn main() {
         .skip(1)
         .map(|a| {
             a.parse().unwrap_or_else(|_| {
-                eprintln!("usage: stacked_rib [LAYERS [PER_SIDE [WIDTH [HEIGHT]]]]: {a:?} is not a number");
+                eprintln!(
+                    "usage: stacked_rib [LAYERS [PER_SIDE [WIDTH [HEIGHT]]]]: {a:?} is not a number"
+                );
                 std::process::exit(2)
             })
         })

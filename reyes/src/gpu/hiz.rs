@@ -115,7 +115,11 @@ mod tests {
             ("dst_off", offset_of!(HizParams, dst_off)),
             ("dst_h", offset_of!(HizParams, dst_h)),
         ] {
-            let got = l.members.iter().find(|(n, _)| n == field).map(|m| m.1 as usize);
+            let got = l
+                .members
+                .iter()
+                .find(|(n, _)| n == field)
+                .map(|m| m.1 as usize);
             assert_eq!(got, Some(off), "HizParams.{field}");
         }
     }

@@ -46,7 +46,12 @@ pub fn stacked_rib(layers: u32, per_side: u32, width: u32, height: u32) -> Strin
         let z = FRONT_Z + k as f64 * LAYER_GAP;
         let (hx, hy) = (1.1 * z * t * ax, 1.1 * z * t * ay);
         let g = 0.3 + 0.6 * ((k * 37 % 101) as f64 / 100.0);
-        let _ = writeln!(out, "Color [{g:.3} {:.3} {:.3}]", 1.0 - g * 0.5, 0.5 + g * 0.3);
+        let _ = writeln!(
+            out,
+            "Color [{g:.3} {:.3} {:.3}]",
+            1.0 - g * 0.5,
+            0.5 + g * 0.3
+        );
         for pj in 0..n {
             for pi in 0..n {
                 let mut p = Vec::with_capacity(48);
@@ -57,7 +62,12 @@ pub fn stacked_rib(layers: u32, per_side: u32, width: u32, height: u32) -> Strin
                         // Inner control points bulge towards or away from the eye.
                         let inner = (1..3).contains(&i) && (1..3).contains(&j);
                         let bump = if inner {
-                            0.1 * LAYER_GAP * if (i + j + pi + pj + k) % 2 == 0 { 1.0 } else { -1.0 }
+                            0.1 * LAYER_GAP
+                                * if (i + j + pi + pj + k) % 2 == 0 {
+                                    1.0
+                                } else {
+                                    -1.0
+                                }
                         } else {
                             0.0
                         };

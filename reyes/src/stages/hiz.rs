@@ -134,8 +134,12 @@ pub fn occluded(f: &FrameUniforms, hiz: &Hiz, lo: glam::Vec2, hi: glam::Vec2, z:
     // Pixels of the bucket the bound reaches, as bucket coordinates.
     let x0 = (lo.x - CULL_MARGIN_PX).floor().max(f.tile_x0 as f32);
     let y0 = (lo.y - CULL_MARGIN_PX).floor().max(f.tile_y0 as f32);
-    let x1 = (hi.x + CULL_MARGIN_PX).floor().min((f.tile_x0 + f.tile_w - 1) as f32);
-    let y1 = (hi.y + CULL_MARGIN_PX).floor().min((f.tile_y0 + f.tile_h - 1) as f32);
+    let x1 = (hi.x + CULL_MARGIN_PX)
+        .floor()
+        .min((f.tile_x0 + f.tile_w - 1) as f32);
+    let y1 = (hi.y + CULL_MARGIN_PX)
+        .floor()
+        .min((f.tile_y0 + f.tile_h - 1) as f32);
     if !(x0 <= x1 && y0 <= y1) || !(z > 0.0) {
         return false;
     }
@@ -274,7 +278,15 @@ mod tests {
     /// tile, and each level halves the one below (rounding up).
     #[test]
     fn the_pyramid_fits_its_buffer() {
-        for (w, h) in [(1, 1), (1, 4096), (4096, 1), (7, 9), (1920, 1080), (16, 16), (33, 17)] {
+        for (w, h) in [
+            (1, 1),
+            (1, 4096),
+            (4096, 1),
+            (7, 9),
+            (1920, 1080),
+            (16, 16),
+            (33, 17),
+        ] {
             let l = levels(w, h);
             assert!(words(w, h) <= capacity(w as u64 * h as u64), "{w}x{h}");
             assert_eq!(&l.last().unwrap()[..2], &[1, 1]);
@@ -341,6 +353,9 @@ mod tests {
                 }
             }
         }
-        assert!(culled > 100, "only {culled} bounds culled: the test proves little");
+        assert!(
+            culled > 100,
+            "only {culled} bounds culled: the test proves little"
+        );
     }
 }
