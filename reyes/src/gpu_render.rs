@@ -360,8 +360,8 @@ impl GpuRenderer {
                     .copied()
                     .collect(),
             };
-            // Occlusion culling (stages::hiz): the items that may be nearest run first; the
-            // rest run after the depth pyramid of what those drew is built, tested against it.
+            // Occlusion culling (stages::hiz::passes): the nearest items first, then the rest
+            // in passes front to back, each tested against the depth pyramid of all drawn.
             let (items, starts) = match f.occlusion != OCCLUSION_OFF {
                 true => {
                     let (ordered, starts) = passes(data, &items, tile);
@@ -378,15 +378,11 @@ impl GpuRenderer {
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             enc.clear_buffer(samples, 0, Some(tile_sample_bytes));
             gpu.queue.submit([enc.finish()]);
-            // The bucket's patches go in as one batch; a batch whose work does not fit the
+            // Each pass's patches go in as one batch; a batch whose work does not fit the
             // queues is halved and each half run on its own. Samples keep the nearest key
             // (atomicMax), so batches, in any order and even a refused batch's partial work run
             // again, give the same image bit for bit; counters are read per finished batch.
-            #[allow(
-                clippy::single_range_in_vec_init,
-                reason = "a stack of batches, each a range of items"
-            )]
-            // One batch per pass, the first on top of the stack.
+            // One batch per pass (one without occlusion culling), the first on top.
             let mut batches: Vec<std::ops::Range<usize>> = (starts.iter().enumerate())
                 .rev()
                 .map(|(k, &s)| s..starts.get(k + 1).copied().unwrap_or(items.len()))

@@ -15,7 +15,9 @@ use std::sync::{Arc, Mutex, OnceLock};
 /// Layout entries of the scene bind group: 0-3 frame, materials, lights, patch info (read
 /// only); 4-5 samples, counters; 6 primitive variables, 7 the depth pyramid (read only).
 pub(crate) fn scene_layout_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
-    (0..8).map(|b| storage_entry(b, b < 4 || b >= 6)).collect()
+    (0..8)
+        .map(|b| storage_entry(b, !(4..6).contains(&b)))
+        .collect()
 }
 
 /// One device's pipelines of the renderers (see the module documentation).

@@ -140,7 +140,7 @@ pub fn occluded(f: &FrameUniforms, hiz: &Hiz, lo: glam::Vec2, hi: glam::Vec2, z:
     let y1 = (hi.y + CULL_MARGIN_PX)
         .floor()
         .min((f.tile_y0 + f.tile_h - 1) as f32);
-    if !(x0 <= x1 && y0 <= y1) || !(z > 0.0) {
+    if !(x0 <= x1 && y0 <= y1 && z > 0.0) {
         return false;
     }
     let mut t0 = [
