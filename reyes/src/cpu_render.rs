@@ -3,9 +3,9 @@
 //! keeps the maximum of its keys.
 
 use crate::buckets;
-use crate::frame::{FrameData, PatchItem};
+use crate::frame::{FrameData, FrameUniforms, PatchItem};
 use crate::image::FrameImage;
-use crate::stages::{self, bound::Cull, bound::Decision};
+use crate::stages::{self, bound::Cull, bound::Decision, hiz};
 
 /// The image plus what each stage did, in the GPU's terms (`stages::C_*` counters; executed
 /// items per procedure: bound, splitu, splitv, diceshade, dicesmall).
@@ -62,11 +62,37 @@ pub fn render_cpu(data: &FrameData) -> CpuRender {
             }),
         };
         let mut samples = vec![0u64; tile.w as usize * tile.h as usize * spp as usize];
-        walk(&bucket, &mut counters, &mut executed, |item, counters| {
-            let (mps, culled) = stages::dice_shade::dice_shade(item, &bucket, &mut samples);
-            counters[stages::C_MICROPOLYGONS] += mps as u64;
-            counters[stages::C_BACKFACE] += culled as u64;
-        });
+        // With occlusion culling, as the GPU: the passes of `hiz::passes`, each after the first
+        // tested against the depth pyramid of what the passes before it drew.
+        let occlusion = bucket.frame.occlusion != hiz::OCCLUSION_OFF;
+        let (items, starts) = match occlusion {
+            true => hiz::passes(&bucket, &bucket.items, tile),
+            false => (bucket.items.clone(), vec![0]),
+        };
+        for (k, &start) in starts.iter().enumerate() {
+            let end = starts.get(k + 1).copied().unwrap_or(items.len());
+            let pyramid = (k > 0).then(|| hiz::build(&bucket.frame, &samples));
+            let f = match pyramid {
+                Some(_) => FrameUniforms {
+                    occlusion: hiz::OCCLUSION_TEST,
+                    ..bucket.frame
+                },
+                None => bucket.frame,
+            };
+            walk_items(
+                &bucket,
+                &f,
+                items[start..end].to_vec(),
+                pyramid.as_ref(),
+                &mut counters,
+                &mut executed,
+                |item, counters| {
+                    let (mps, culled) = stages::dice_shade::dice_shade(item, &bucket, &mut samples);
+                    counters[stages::C_MICROPOLYGONS] += mps as u64;
+                    counters[stages::C_BACKFACE] += culled as u64;
+                },
+            );
+        }
         let (rgba, depth) = stages::resolve::resolve(&samples, tile.w, tile.h, spp);
         for row in 0..tile.h as usize {
             let (src, dst) = (
@@ -102,19 +128,34 @@ fn walk(
     data: &FrameData,
     counters: &mut [u64; stages::COUNTERS],
     executed: &mut [u64; 5],
+    dice: impl FnMut(&PatchItem, &mut [u64; stages::COUNTERS]),
+) {
+    let items = data.items.clone();
+    walk_items(data, &data.frame, items, None, counters, executed, dice)
+}
+
+/// [`walk`] from `items` under the uniforms `f` (`data`'s, perhaps with another
+/// `occlusion`), Bound testing against `hiz` when `f` asks for it.
+fn walk_items(
+    data: &FrameData,
+    f: &FrameUniforms,
+    items: Vec<PatchItem>,
+    hiz: Option<&hiz::Hiz>,
+    counters: &mut [u64; stages::COUNTERS],
+    executed: &mut [u64; 5],
     mut dice: impl FnMut(&PatchItem, &mut [u64; stages::COUNTERS]),
 ) {
-    let f = &data.frame;
-    let mut work: Vec<_> = data.items.clone();
+    let mut work = items;
     while let Some(item) = work.pop() {
         executed[0] += 1;
         let info = &data.patch_info[item.patch_id as usize];
-        match stages::bound::bound(&item, f, info, &data.primvars) {
+        match stages::bound::bound_against(&item, f, info, &data.primvars, hiz) {
             Decision::Cull(c) => {
                 counters[match c {
                     Cull::Clip => stages::C_CULL_CLIP,
                     Cull::Offscreen => stages::C_CULL_OFFSCREEN,
                     Cull::Backface => stages::C_CULL_BACKFACE,
+                    Cull::Occluded => stages::C_CULL_OCCLUDED,
                 }] += 1
             }
             Decision::Split { along_u, item, eye } => {

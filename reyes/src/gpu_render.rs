@@ -8,6 +8,7 @@ use crate::gpu::{FrameTarget, Pipelines, SceneBuffers, scene_layout_entries};
 use crate::image::FrameImage;
 use crate::progress::Progress;
 use crate::shaders;
+use crate::stages::hiz::{OCCLUSION_OFF, OCCLUSION_TEST, passes};
 use crate::stages::{C_MAX_DEPTH, COUNTERS};
 use scheduler::timing::PassTimer;
 use scheduler::{
@@ -330,6 +331,7 @@ impl GpuRenderer {
             counters,
             rgba,
             depth,
+            hiz,
             ..
         } = target;
         let mut out = GpuFrame {
@@ -358,6 +360,16 @@ impl GpuRenderer {
                     .copied()
                     .collect(),
             };
+            // Occlusion culling (stages::hiz::passes): the nearest items first, then the rest
+            // in passes front to back, each tested against the depth pyramid of all drawn.
+            let (items, starts) = match f.occlusion != OCCLUSION_OFF {
+                true => {
+                    let (ordered, starts) = passes(data, &items, tile);
+                    (ordered.into(), starts)
+                }
+                false => (items, vec![0]),
+            };
+            let first = starts.get(1).copied().unwrap_or(usize::MAX);
             let tile_sample_bytes = tile.w as u64 * tile.h as u64 * per_pixel;
             let queue_budget = data
                 .memory_budget
@@ -366,19 +378,31 @@ impl GpuRenderer {
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             enc.clear_buffer(samples, 0, Some(tile_sample_bytes));
             gpu.queue.submit([enc.finish()]);
-            // The bucket's patches go in as one batch; a batch whose work does not fit the
+            // Each pass's patches go in as one batch; a batch whose work does not fit the
             // queues is halved and each half run on its own. Samples keep the nearest key
             // (atomicMax), so batches, in any order and even a refused batch's partial work run
             // again, give the same image bit for bit; counters are read per finished batch.
-            #[allow(
-                clippy::single_range_in_vec_init,
-                reason = "a stack of batches, each a range of items"
-            )]
-            let mut batches = vec![0..items.len()];
+            // One batch per pass (one without occlusion culling), the first on top.
+            let mut batches: Vec<std::ops::Range<usize>> = (starts.iter().enumerate())
+                .rev()
+                .map(|(k, &s)| s..starts.get(k + 1).copied().unwrap_or(items.len()))
+                .collect();
             let mut recut = false;
             while let Some(batch) = batches.pop() {
                 let mut enc = gpu.device.create_command_encoder(&Default::default());
                 enc.clear_buffer(counters, 0, None);
+                // A batch after the first pass: the pyramid of everything drawn so far, and the
+                // test in Bound. (Halves of a batch stay ahead of later passes on the stack.)
+                if batch.start >= first {
+                    let test = FrameUniforms {
+                        occlusion: OCCLUSION_TEST,
+                        ..tile_frame
+                    };
+                    let hiz_passes = self.pipelines.hiz(gpu)?;
+                    if hiz_passes.record(gpu, &mut enc, &tile_frame, samples, hiz, pixels)? {
+                        scene.write_frame(gpu, &test);
+                    }
+                }
                 gpu.queue.submit([enc.finish()]);
                 let seeds = [Seed::new::<PatchItem>("bound", &items[batch.clone()])];
                 let run = match self

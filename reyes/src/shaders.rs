@@ -19,3 +19,5 @@ pub const PRESENT: &str = include_str!("../../shaders/reyes/present.wgsl");
 pub const TESSELLATE: &str = include_str!("../../shaders/reyes/tessellate.wgsl");
 pub const RASTER_DRAW: &str = include_str!("../../shaders/reyes/raster_draw.wgsl");
 pub const RASTER_RESOLVE: &str = include_str!("../../shaders/reyes/raster_resolve.wgsl");
+/// The depth pyramid of a bucket's samples (occlusion culling; twin: `stages::hiz`).
+pub const HIZ: &str = include_str!("../../shaders/reyes/hiz.wgsl");

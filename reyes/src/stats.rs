@@ -155,6 +155,8 @@ pub struct Culls {
     pub backface_patches: u64,
     /// Micropolygons of one-sided surfaces facing away.
     pub backface_micropolygons: u64,
+    /// Pieces hidden behind what was already drawn (occlusion culling in Bound).
+    pub occluded: u64,
 }
 
 /// Executions of each procedure (the names of `gpu_render::PROCEDURES`).
@@ -290,6 +292,7 @@ pub fn frame_stats(
             offscreen: c[s::C_CULL_OFFSCREEN],
             backface_patches: c[s::C_CULL_BACKFACE],
             backface_micropolygons: c[s::C_BACKFACE],
+            occluded: c[s::C_CULL_OCCLUDED],
         },
         depth_limited: c[s::C_DEPTH_LIMIT],
         near_clipped_grids: c[s::C_NEAR_CLIPPED],

@@ -160,6 +160,12 @@ fn bound_execute(item: PatchItem, inv: Invocation) {
         atomicAdd(&counters[C_CULL_OFFSCREEN], 1u);
         return;
     }
+    // Occlusion: hidden behind what the bucket's samples already hold (hiz_occluded), by the
+    // bound over the shutter and the lens (the screen bound and depths the culls above use).
+    if frame.occlusion == OCCLUSION_TEST && hiz_occluded(clo, chi, hiz_depth(uz.x, uz.y)) {
+        atomicAdd(&counters[C_CULL_OCCLUDED], 1u);
+        return;
+    }
     // Screen lengths of the control polygon along u and v bound the curves' lengths. (Chords
     // through a 4x4 grid of surface points made 1.5% fewer micropolygons on Killeroo but cost
     // more than that in Bound on the H100.)
@@ -388,6 +394,56 @@ fn backfacing_terms(cp: ptr<function, array<f32, 48>>, t: u32, flip: bool) -> bo
         for (var a = 0u; a < 16u; a++) {
             let p = cp_point(cp, a);
             if !(sgn * dot(p, n) > nl * length(p)) { return false; }
+        }
+    }
+    return true;
+}
+
+// Side of a level-0 tile of the depth pyramid, pixels; tiles per side Bound reads at most.
+// Rust twin: stages::hiz (HIZ_TILE_PX, HIZ_SPAN).
+const HIZ_TILE_PX: u32 = 8u;
+const HIZ_SPAN: u32 = 4u;
+// stages::hiz::DEPTH_MARGIN: relative margin off an item's nearest depth (f32 rounding of the
+// surface points DiceShade evaluates stays far below it).
+const HIZ_DEPTH_MARGIN: f32 = 1.0e-4;
+
+// The depth an item's occlusion test uses: its nearest depth less the margin.
+fn hiz_depth(zmin: f32, zmax: f32) -> f32 {
+    return zmin - HIZ_DEPTH_MARGIN * max(abs(zmax), abs(zmin));
+}
+
+// Whether every sub-sample of the bucket within the screen bound [lo, hi] grown by
+// CULL_MARGIN_PX (every sample a micropolygon of the item can write: its corners lie in the
+// bound, crack dilation reaches MAX_DILATE_PX beyond) holds a depth strictly nearer than z.
+// Then each key the item could write loses to the key already there (atomicMax on the
+// inverted depth bits), so culling it changes no sample. DiceShade's depths are at least z:
+// grid points lie in the control points' hull (up to rounding, which HIZ_DEPTH_MARGIN covers)
+// and sampling clamps interpolated depth to the micropolygon's corners (sample.wgsl).
+// Climbs the pyramid until the bound spans at most HIZ_SPAN tiles each way, reads them all.
+// Rust twin: stages::hiz::occluded.
+fn hiz_occluded(lo: vec2<f32>, hi: vec2<f32>, z: f32) -> bool {
+    let x0 = max(floor(lo.x - CULL_MARGIN_PX), f32(frame.tile_x0));
+    let y0 = max(floor(lo.y - CULL_MARGIN_PX), f32(frame.tile_y0));
+    let x1 = min(floor(hi.x + CULL_MARGIN_PX), f32(frame.tile_x0 + frame.tile_w - 1u));
+    let y1 = min(floor(hi.y + CULL_MARGIN_PX), f32(frame.tile_y0 + frame.tile_h - 1u));
+    if !(x0 <= x1 && y0 <= y1) || !(z > 0.0) { return false; }
+    var t0 = (vec2<u32>(vec2<f32>(x0, y0)) - vec2<u32>(frame.tile_x0, frame.tile_y0)) / HIZ_TILE_PX;
+    var t1 = (vec2<u32>(vec2<f32>(x1, y1)) - vec2<u32>(frame.tile_x0, frame.tile_y0)) / HIZ_TILE_PX;
+    // Level 0's size and each level's offset (stages::hiz::levels).
+    var lw = (frame.tile_w + HIZ_TILE_PX - 1u) / HIZ_TILE_PX;
+    var lh = (frame.tile_h + HIZ_TILE_PX - 1u) / HIZ_TILE_PX;
+    var off = 0u;
+    while t1.x - t0.x >= HIZ_SPAN || t1.y - t0.y >= HIZ_SPAN {
+        t0 = t0 / 2u;
+        t1 = t1 / 2u;
+        off += lw * lh;
+        lw = (lw + 1u) / 2u;
+        lh = (lh + 1u) / 2u;
+    }
+    let zb = bitcast<u32>(z);
+    for (var ty = t0.y; ty <= t1.y; ty++) {
+        for (var tx = t0.x; tx <= t1.x; tx++) {
+            if zb <= hiz[off + ty * lw + tx] { return false; }
         }
     }
     return true;

@@ -43,7 +43,14 @@ struct Frame {
     // coc_scale * (inv_focus - 1 / z) pixels (0 without depth of field).
     coc_scale: f32,
     inv_focus: f32,
+    // Occlusion culling in Bound: OCCLUSION_OFF, OCCLUSION_ON (no pyramid yet) or
+    // OCCLUSION_TEST (test items against the bucket's depth pyramid, hiz).
+    occlusion: u32,
 }
+
+const OCCLUSION_OFF: u32 = 0u;
+const OCCLUSION_ON: u32 = 1u;
+const OCCLUSION_TEST: u32 = 2u;
 
 const UVT_OFF: u32 = 0u;
 const UVT_SIMPLE: u32 = 1u;
@@ -110,6 +117,11 @@ struct PatchInfo {
 // patch's (u, v): one value, 4 bilinear corners or 16 bicubic Bezier coefficients; and the
 // weights of the rational patches (PatchInfo.weights).
 @group(1) @binding(6) var<storage, read> primvars: array<vec4<f32>>;
+// The bucket's depth pyramid (hiz.wgsl builds it between runs): level 0 holds, per tile of
+// HIZ_TILE_PX x HIZ_TILE_PX pixels, the largest depth bits of its sub-samples (u32::MAX where
+// one is empty); each level above the largest of up to 2x2 tiles below. Read by Bound only
+// when frame.occlusion == OCCLUSION_TEST.
+@group(1) @binding(7) var<storage, read> hiz: array<u32>;
 
 const FIELD_FLAT: u32 = 1u;
 const FIELD_BILINEAR: u32 = 2u;
@@ -124,6 +136,7 @@ const C_MAX_DEPTH: u32 = 5u;
 const C_EYE_SPLITS: u32 = 6u;
 const C_BACKFACE: u32 = 7u;        // micropolygons culled as back-facing (Sides 1)
 const C_CULL_BACKFACE: u32 = 8u;   // patches culled in Bound as back-facing everywhere
+const C_CULL_OCCLUDED: u32 = 9u;   // pieces culled in Bound as hidden by what is drawn (hiz)
 
 // Bound culls only what lies this far outside the bucket, so that a micropolygon grown by its
 // crack dilation (at most MAX_DILATE_PX) never reaches a sample of a bucket that culled it:

@@ -47,7 +47,11 @@ fn triangle_depth(t: Triangle, q: vec2<f32>) -> f32 {
     let wb = s * cross2(t.a.xy - t.c.xy, q - t.c.xy);
     let wc = s * cross2(t.b.xy - t.a.xy, q - t.a.xy);
     if wa < t.ga || wb < t.gb || wc < t.gc { return -1.0; }
-    return (wa * t.a.z + wb * t.b.z + wc * t.c.z) / abs(t.area);
+    // Clamped to the corners' depths: a sample the dilation reaches outside the triangle
+    // would extrapolate the plane, and rounding can leave the range even inside; Bound's
+    // occlusion test relies on no sample being nearer than the nearest corner.
+    let z = (wa * t.a.z + wb * t.b.z + wc * t.c.z) / abs(t.area);
+    return clamp(z, min(t.a.z, min(t.b.z, t.c.z)), max(t.a.z, max(t.b.z, t.c.z)));
 }
 
 fn average_color(a: u32, b: u32, c: u32, d: u32) -> u32 {

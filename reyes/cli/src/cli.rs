@@ -191,6 +191,12 @@ pub struct RenderArgs {
     #[arg(long, value_name = "DEG", value_parser = finite_f64)]
     pub spin: Option<f64>,
 
+    /// Occlusion culling in Bound: pieces hidden behind what is already drawn (a depth
+    /// pyramid of the samples after a first pass over the nearest patches) are not split or
+    /// diced. The image is the same either way; off only to compare.
+    #[arg(long, value_name = "ON|OFF", value_enum, default_value_t = OnOff::On)]
+    pub occlusion: OnOff,
+
     /// Depth of field: RenderMan's `DepthOfField fstop focallength focaldistance` (lengths in
     /// camera-space units), replacing the file's.
     #[arg(long, value_name = "FSTOP,FOCALLENGTH,DIST", value_parser = parse_dof)]
@@ -234,6 +240,7 @@ impl RenderArgs {
             sampling: self.sampling.into(),
             il_tile: self.il_tile,
             il_perms: self.il_perms,
+            occlusion: self.occlusion == OnOff::On,
             ..RenderOptions::default()
         }
     }
@@ -523,6 +530,15 @@ pub enum HoleReference {
     Exact,
     /// A bounding-box render of the same frame.
     Bbox,
+}
+
+/// A switch on the command line (`--occlusion`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum OnOff {
+    /// Switched on.
+    On,
+    /// Switched off.
+    Off,
 }
 
 /// `--raster`: [`RasterMode`] on the command line.

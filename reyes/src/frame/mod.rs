@@ -110,6 +110,10 @@ pub struct FrameUniforms {
     pub coc_scale: f32,
     /// 1 / the focal distance (camera space).
     pub inv_focus: f32,
+    /// Occlusion culling in Bound: `OCCLUSION_OFF`, `OCCLUSION_ON` (allowed; no depth
+    /// pyramid yet) or `OCCLUSION_TEST` (test against the bucket's pyramid), the constants of
+    /// [`crate::stages::hiz`].
+    pub occlusion: u32,
 }
 
 /// [`FrameUniforms::uvt`]: no time or lens sampling; the sampler of a still pinhole frame runs.
@@ -483,6 +487,11 @@ impl FrameData {
             il_perms: o.il_perms,
             coc_scale: 0.0,
             inv_focus: 0.0,
+            occlusion: if o.occlusion {
+                crate::stages::hiz::OCCLUSION_ON
+            } else {
+                crate::stages::hiz::OCCLUSION_OFF
+            },
         };
         let mut frame = frame;
         let moving = patch_info
@@ -708,6 +717,7 @@ mod tests {
                 ("il_perms", offset_of!(FrameUniforms, il_perms)),
                 ("coc_scale", offset_of!(FrameUniforms, coc_scale)),
                 ("inv_focus", offset_of!(FrameUniforms, inv_focus)),
+                ("occlusion", offset_of!(FrameUniforms, occlusion)),
             ],
         );
         check(

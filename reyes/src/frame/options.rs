@@ -43,6 +43,9 @@ pub struct RenderOptions {
     pub il_tile: u32,
     /// Interleave UVT's number of permutations P (1..=1024).
     pub il_perms: u32,
+    /// Occlusion culling in Bound against a depth pyramid of what is already drawn
+    /// (docs/reyes.md, *Occlusion culling*); the image is the same either way.
+    pub occlusion: bool,
 }
 
 /// How a micropolygon becomes samples (Sattler & Steinberger, "Reyes Rendering on the GPU",
@@ -111,6 +114,7 @@ impl Default for RenderOptions {
             sampling: Sampling::Simple,
             il_tile: 2,
             il_perms: 64,
+            occlusion: true,
         }
     }
 }

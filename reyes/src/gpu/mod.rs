@@ -10,6 +10,7 @@
 //! own and renders a frame again on them; the raster peer ([`crate::raster_peer`]) draws from
 //! the same scene tables.
 
+pub(crate) mod hiz;
 pub(crate) mod pipelines;
 mod scene;
 mod target;

@@ -13,9 +13,11 @@ use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
 /// Layout entries of the scene bind group: 0-3 frame, materials, lights, patch info (read
-/// only); 4-5 samples, counters; 6 primitive variables (read only).
+/// only); 4-5 samples, counters; 6 primitive variables, 7 the depth pyramid (read only).
 pub(crate) fn scene_layout_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
-    (0..7).map(|b| storage_entry(b, b < 4 || b == 6)).collect()
+    (0..8)
+        .map(|b| storage_entry(b, !(4..6).contains(&b)))
+        .collect()
 }
 
 /// One device's pipelines of the renderers (see the module documentation).
@@ -24,6 +26,7 @@ pub struct Pipelines {
     resolve: OnceLock<wgpu::ComputePipeline>,
     rgba8: OnceLock<wgpu::ComputePipeline>,
     roots: OnceLock<wgpu::ComputePipeline>,
+    hiz: OnceLock<super::hiz::HizPipelines>,
     /// The raster peer's, per feature set and MSAA sample count.
     raster: Mutex<HashMap<(SceneFeatures, u32), Arc<RasterPipelines>>>,
 }
@@ -54,6 +57,7 @@ impl Pipelines {
             resolve: OnceLock::new(),
             rgba8: OnceLock::new(),
             roots: OnceLock::new(),
+            hiz: OnceLock::new(),
             raster: Mutex::new(HashMap::new()),
         }
     }
@@ -86,6 +90,15 @@ impl Pipelines {
             let src = [shaders::PATCH_ITEM, shaders::ROOTS].concat();
             gpu.compute_pipeline("reyes roots", &src, "make_roots")
         })
+    }
+
+    /// The depth pyramid's passes (hiz.wgsl). Errors: as [`Pipelines::resolve`].
+    pub(crate) fn hiz(&self, gpu: &Gpu) -> Result<&super::hiz::HizPipelines, RunError> {
+        if let Some(p) = self.hiz.get() {
+            return Ok(p);
+        }
+        let p = super::hiz::HizPipelines::new(gpu)?;
+        Ok(self.hiz.get_or_init(|| p))
     }
 
     /// The raster peer's pipelines for scenes of `features` drawn with `samples` MSAA samples

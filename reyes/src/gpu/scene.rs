@@ -151,6 +151,7 @@ impl SceneBuffers {
                 &target.samples,
                 &target.counters,
                 &self.primvars.buffer,
+                &target.hiz,
             ],
         );
         self.bind = Some((target.id(), bind.clone()));

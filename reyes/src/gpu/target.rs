@@ -17,6 +17,9 @@ pub struct FrameTarget {
     pub(crate) rgba: wgpu::Buffer,
     /// Camera-space depth, one f32 a pixel.
     pub(crate) depth: wgpu::Buffer,
+    /// The depth pyramid of the bucket being rendered (`stages::hiz`, hiz.wgsl), sized for
+    /// any bucket of the image ([`crate::stages::hiz::capacity`]).
+    pub(crate) hiz: wgpu::Buffer,
     /// The 8-bit sRGB image (`rgba8.wgsl`), one u32 a pixel; only where asked for.
     pub(crate) rgba8: Option<wgpu::Buffer>,
 }
@@ -39,6 +42,7 @@ impl FrameTarget {
             counters: gpu.storage_buffer("counters", COUNTERS as u64)?,
             rgba: gpu.storage_buffer("rgba", pixels * 4)?,
             depth: gpu.storage_buffer("depth", pixels)?,
+            hiz: gpu.storage_buffer("hiz", crate::stages::hiz::capacity(pixels))?,
             rgba8: match rgba8 {
                 true => Some(gpu.storage_buffer("rgba8", pixels)?),
                 false => None,

@@ -216,7 +216,12 @@ impl RealtimeRenderer {
         strategy: StrategyKind,
         pixels: Pixels,
     ) -> Result<RealtimeRenderer, RunError> {
-        let base = FrameData::new(scene, options).map_err(|e| RunError::Program(e.to_string()))?;
+        let mut base =
+            FrameData::new(scene, options).map_err(|e| RunError::Program(e.to_string()))?;
+        // Pipelined frames run one pass, without occlusion culling (docs/reyes.md, *Occlusion
+        // culling*); the frame that sizes their queues and a frame rendered again must do the
+        // same work, or the sizes fall short of it.
+        base.frame.occlusion = crate::stages::hiz::OCCLUSION_OFF;
         let renderer =
             GpuRenderer::new(gpu, RendererConfig::new(strategy).features(base.features()))?;
         let f = base.frame;

@@ -19,6 +19,7 @@ pub(crate) mod rational;
 mod rib;
 mod sequence;
 mod spin;
+pub mod stacked;
 mod teapot;
 
 use glam::{DMat4, DVec3};

@@ -25,6 +25,9 @@ pub enum Cull {
     Offscreen,
     /// Back-facing at every point (one-sided surfaces only).
     Backface,
+    /// Behind what the bucket's samples already hold everywhere under its bound
+    /// ([`super::hiz::occluded`]).
+    Occluded,
 }
 
 /// What Bound does with an item ([`bound`]).
@@ -59,6 +62,18 @@ pub fn bound(
     f: &FrameUniforms,
     info: &PatchInfo,
     primvars: &[[f32; 4]],
+) -> Decision {
+    bound_against(item, f, info, primvars, None)
+}
+
+/// [`bound`] with the occlusion test against `hiz`, the bucket's depth pyramid, when the
+/// frame asks for it ([`super::hiz::OCCLUSION_TEST`]; `hiz_occluded` in bound.wgsl).
+pub fn bound_against(
+    item: &PatchItem,
+    f: &FrameUniforms,
+    info: &PatchInfo,
+    primvars: &[[f32; 4]],
+    hiz: Option<&super::hiz::Hiz>,
 ) -> Decision {
     // Each thread's weight is the same bits as thread 0's rational_weights (common.wgsl).
     let weights = item_weights(item, info, primvars);
@@ -170,6 +185,13 @@ pub fn bound(
     };
     if misses(clo, chi) {
         return Decision::Cull(Cull::Offscreen);
+    }
+    // Occlusion, by the bound over the shutter and the lens (see bound.wgsl).
+    if let Some(h) = hiz
+        && f.occlusion == super::hiz::OCCLUSION_TEST
+        && super::hiz::occluded(f, h, clo, chi, super::hiz::test_depth(uzmin, uzmax))
+    {
+        return Decision::Cull(Cull::Occluded);
     }
     let (mut lu, mut lv) = (0f32, 0f32);
     for r in 0..4 {

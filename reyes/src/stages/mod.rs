@@ -4,6 +4,7 @@
 
 pub mod bound;
 pub mod dice_shade;
+pub mod hiz;
 pub mod resolve;
 pub mod sample;
 pub mod sample_uvt;
@@ -31,6 +32,9 @@ pub const C_EYE_SPLITS: usize = 6;
 pub const C_BACKFACE: usize = 7;
 /// Items culled in Bound as back-facing at every point.
 pub const C_CULL_BACKFACE: usize = 8;
+/// Items culled in Bound as hidden behind what is already drawn (occlusion culling,
+/// [`hiz`]).
+pub const C_CULL_OCCLUDED: usize = 9;
 /// Words of the counter buffer (the `C_*` indices and room to spare).
 pub const COUNTERS: usize = 16;
 

@@ -84,7 +84,12 @@ pub(super) fn triangle_depth(t: &Triangle, q: Vec2) -> f32 {
     if wa < t.g[0] || wb < t.g[1] || wc < t.g[2] {
         return -1.0;
     }
-    (wa * t.a[2] + wb * t.b[2] + wc * t.c[2]) / t.area.abs()
+    // Clamped to the corners' depths (see sample.wgsl).
+    let z = (wa * t.a[2] + wb * t.b[2] + wc * t.c[2]) / t.area.abs();
+    z.clamp(
+        t.a[2].min(t.b[2].min(t.c[2])),
+        t.a[2].max(t.b[2].max(t.c[2])),
+    )
 }
 
 fn average_color(c: [u32; 4]) -> u32 {
