@@ -18,6 +18,7 @@ pub(crate) mod rational;
 mod rib;
 mod sequence;
 mod spin;
+pub mod subdiv;
 mod teapot;
 
 use glam::{DMat4, DVec3};

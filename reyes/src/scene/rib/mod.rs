@@ -43,6 +43,7 @@ mod quadrics;
 mod requests;
 mod shading;
 mod state;
+mod subdiv;
 mod syntax;
 #[cfg(test)]
 mod tests;

@@ -108,7 +108,7 @@ impl Interp {
     }
 
     /// [`Self::emit`], then gives the new patch its primitive variables.
-    fn emit_with(
+    pub(super) fn emit_with(
         &mut self,
         a: &Args,
         ctm: &DMat4,
