@@ -64,7 +64,11 @@ impl Interp {
                      is used)",
                     p.name
                 );
-                self.warn_once(req, &format!("SubdivisionMesh facevarying {}", p.name), &msg);
+                self.warn_once(
+                    req,
+                    &format!("SubdivisionMesh facevarying {}", p.name),
+                    &msg,
+                );
             }
             !drop
         });
@@ -234,7 +238,10 @@ mod tests {
         let e = err(&world(
             "SubdivisionMesh \"catmull-clark\" [3] [0 1 5] \"P\" [0 0 0 1 0 0 0 1 0]",
         ));
-        assert!(e.contains("t.rib:2") && e.contains("vertex 5 out of range"), "{e}");
+        assert!(
+            e.contains("t.rib:2") && e.contains("vertex 5 out of range"),
+            "{e}"
+        );
         let e = err(&world(
             "SubdivisionMesh \"catmull-clark\" [3 3] [0 1 2 0 1 2] \"P\" [0 0 0 1 0 0 0 1 0]",
         ));
@@ -243,7 +250,9 @@ mod tests {
             "SubdivisionMesh \"catmull-clark\" [2] [0 1] \"P\" [0 0 0 1 0 0]",
         ));
         assert!(e.contains("nvertices"), "{e}");
-        let s = parse(&world("SubdivisionMesh \"loop\" [3] [0 1 2] \"P\" [0 0 0 1 0 0 0 1 0]"));
+        let s = parse(&world(
+            "SubdivisionMesh \"loop\" [3] [0 1 2] \"P\" [0 0 0 1 0 0 0 1 0]",
+        ));
         assert!(s.patches.is_empty() && s.warnings[0].contains("\"loop\""));
     }
 }

@@ -60,7 +60,16 @@ fn grid16(mesh: &Mesh, topo: &Topology, f: u32) -> Option<[u32; 16]> {
             return None;
         }
         g[rotate(i, (1, 1))] = v;
-        let places = [(1, 2), (2, 2), (2, 1), (2, 0), (1, 0), (0, 0), (0, 1), (0, 2)];
+        let places = [
+            (1, 2),
+            (2, 2),
+            (2, 1),
+            (2, 0),
+            (1, 0),
+            (0, 0),
+            (0, 1),
+            (0, 2),
+        ];
         for k in 0..4 {
             g[rotate(i, places[2 * k])] = ring.edge[k];
             g[rotate(i, places[2 * k + 1])] = ring.diag[k];

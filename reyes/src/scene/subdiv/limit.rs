@@ -152,7 +152,12 @@ fn cross_offset(mesh: &Mesh, topo: &Topology, v: u32, w: u32, limit: &Stencil) -
 
 /// Interior Bezier point next to corner `v` of quad `face` (at position `k`).
 fn interior(lim: &VertexLimit, face: &[u32], k: usize) -> Stencil {
-    let (v, next, diag, prev) = (face[k], face[(k + 1) % 4], face[(k + 2) % 4], face[(k + 3) % 4]);
+    let (v, next, diag, prev) = (
+        face[k],
+        face[(k + 1) % 4],
+        face[(k + 2) % 4],
+        face[(k + 3) % 4],
+    );
     if let Some(r) = &lim.ring {
         let n = r.edge.len() as f64;
         let d = n + 5.0;
@@ -185,7 +190,9 @@ pub fn approximate_patch(
     let c = [face[0], face[1], face[2], face[3]];
     let edge = |a: u32, b: u32| position(a) + offset(a, b);
     let inner = |k: usize| {
-        let lim = limits[c[k] as usize].as_ref().expect("limit of a used vertex");
+        let lim = limits[c[k] as usize]
+            .as_ref()
+            .expect("limit of a used vertex");
         eval(&interior(lim, face, k))
     };
     [
@@ -221,7 +228,14 @@ mod tests {
         };
         // b10 - b00 of a bicubic B-spline patch: (4 (e0 - e2) + d0 + d3 - d1 - d2) / 36.
         let s = smooth_offset(&r, 0);
-        let want = [(1, 4.0), (3, -4.0), (5, 1.0), (8, 1.0), (6, -1.0), (7, -1.0)];
+        let want = [
+            (1, 4.0),
+            (3, -4.0),
+            (5, 1.0),
+            (8, 1.0),
+            (6, -1.0),
+            (7, -1.0),
+        ];
         for (i, w) in want {
             let got: f64 = s.iter().filter(|x| x.0 == i).map(|x| x.1).sum();
             assert!((got - w / 36.0).abs() < 1e-15, "{i}: {got}");

@@ -127,11 +127,7 @@ fn halstead_limit_of_the_control_mesh_is_where_deep_subdivision_converges() {
     let (lim, nrm) = halstead(&mesh, &p, 7);
     // Vertex points keep their index from level to level.
     let (fine, data) = uniform(&mesh, &[p.clone()], 6).unwrap();
-    assert!(
-        data[0][7].distance(lim) < 1e-3,
-        "{} vs {lim}",
-        data[0][7]
-    );
+    assert!(data[0][7].distance(lim) < 1e-3, "{} vs {lim}", data[0][7]);
     // The mask applied at any level gives the same point and normal (eigen-analysis).
     let (lim6, nrm6) = halstead(&fine, &data[0], 7);
     assert!(lim6.distance(lim) < 1e-12 && nrm6.distance(nrm) < 1e-9);
