@@ -31,6 +31,23 @@ use topology::{INFINITELY_SHARP, Mesh, SHARPNESS_CAP, Topology, edge_key};
 /// across (the tests' measured error there is under 0.2% of the object's size).
 pub const DEFAULT_MAX_LEVEL: u32 = 3;
 
+/// Control meshes of more faces than this get one adaptive level less per factor of 8 (at
+/// least 1): a mesh irregular everywhere (triangles from an exporter) makes up to 4^level
+/// patches per face, and the finer levels matter less on a mesh whose faces are already small.
+pub const FACES_FOR_FULL_DEPTH: usize = 20_000;
+
+/// The adaptive depth for a control mesh of `faces` faces: [`DEFAULT_MAX_LEVEL`], one less for
+/// each factor of 8 beyond [`FACES_FOR_FULL_DEPTH`], at least 1.
+pub fn max_level_for(faces: usize) -> u32 {
+    let mut level = DEFAULT_MAX_LEVEL;
+    let mut limit = FACES_FOR_FULL_DEPTH;
+    while faces > limit && level > 1 {
+        level -= 1;
+        limit = limit.saturating_mul(8);
+    }
+    level
+}
+
 /// `interpolateboundary` as RenderMan defines it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum BoundaryMode {
@@ -143,7 +160,7 @@ pub fn control_mesh(
 }
 
 /// The limit surface of a `SubdivisionMesh` as patches ([`control_mesh`], then
-/// [`limit_patches`] with [`DEFAULT_MAX_LEVEL`]); `data[0]` the positions.
+/// [`limit_patches`] to [`max_level_for`] its size); `data[0]` the positions.
 pub fn catmull_clark(
     sizes: &[usize],
     indices: &[u32],
@@ -151,5 +168,5 @@ pub fn catmull_clark(
     data: Vec<Vec<DVec3>>,
 ) -> Result<Vec<LimitPatch>, String> {
     let mesh = control_mesh(sizes, indices, data[0].len(), tags)?;
-    limit_patches(mesh, data, DEFAULT_MAX_LEVEL)
+    limit_patches(mesh, data, max_level_for(sizes.len()))
 }

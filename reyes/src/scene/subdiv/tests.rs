@@ -282,3 +282,14 @@ fn boundaries_holes_and_colours() {
     assert!(patches.iter().all(|p| p.origin != 4));
     assert!(patches.iter().any(|p| p.origin == 5));
 }
+
+#[test]
+fn large_meshes_subdivide_less_deep() {
+    assert_eq!(max_level_for(6), DEFAULT_MAX_LEVEL);
+    assert_eq!(max_level_for(FACES_FOR_FULL_DEPTH), DEFAULT_MAX_LEVEL);
+    assert_eq!(
+        max_level_for(FACES_FOR_FULL_DEPTH + 1),
+        DEFAULT_MAX_LEVEL - 1
+    );
+    assert_eq!(max_level_for(usize::MAX), 1);
+}
