@@ -226,8 +226,8 @@ mod tests {
         assert_eq!(q.len(), 9);
         assert_eq!(&q[..4], &p[..]);
         assert_eq!(q[8], DVec3::new(0.5, 0.5, 0.0));
-        for e in 4..8 {
-            assert!(q[e].x == 0.5 || q[e].y == 0.5);
+        for e in &q[4..8] {
+            assert!(e.x == 0.5 || e.y == 0.5);
         }
         // The boundary edges stay infinitely sharp, the inner edges are smooth.
         assert_eq!(c.edge_sharpness.len(), 8);

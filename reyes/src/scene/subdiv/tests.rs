@@ -126,7 +126,7 @@ fn halstead_limit_of_the_control_mesh_is_where_deep_subdivision_converges() {
     let mesh = mesh_of(&sizes, &idx, &p, &Tags::default());
     let (lim, nrm) = halstead(&mesh, &p, 7);
     // Vertex points keep their index from level to level.
-    let (fine, data) = uniform(&mesh, &[p.clone()], 6).unwrap();
+    let (fine, data) = uniform(&mesh, std::slice::from_ref(&p), 6).unwrap();
     assert!(data[0][7].distance(lim) < 1e-3, "{} vs {lim}", data[0][7]);
     // The mask applied at any level gives the same point and normal (eigen-analysis).
     let (lim6, nrm6) = halstead(&fine, &data[0], 7);
