@@ -20,6 +20,7 @@ mod rib;
 mod sequence;
 mod spin;
 pub mod stacked;
+pub mod subdiv;
 mod teapot;
 
 use glam::{DMat4, DVec3};

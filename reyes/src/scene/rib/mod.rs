@@ -48,6 +48,7 @@ mod quadrics;
 mod requests;
 mod shading;
 mod state;
+mod subdiv;
 mod syntax;
 #[cfg(test)]
 mod tests;

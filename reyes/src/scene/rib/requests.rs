@@ -51,6 +51,7 @@ pub(super) const KNOWN: &[&str] = &[
     "GeneralPolygon",
     "PointsPolygons",
     "PointsGeneralPolygons",
+    "SubdivisionMesh",
     "Sphere",
     "Cylinder",
     "Cone",
@@ -150,6 +151,7 @@ impl Interp {
             "Polygon" | "GeneralPolygon" | "PointsPolygons" | "PointsGeneralPolygons" => {
                 self.polygon_request(req, a)
             }
+            "SubdivisionMesh" => self.subdivision_mesh(req, a),
             name if QUADRICS.contains(&name) => self.quadric(req, a),
             "ObjectEnd" => Err(a.err("without a matching `ObjectBegin`")),
             "MotionBegin" => self.motion_begin(req, a),

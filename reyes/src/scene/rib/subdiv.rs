@@ -1,0 +1,258 @@
+//! `SubdivisionMesh "catmull-clark" nverts vertids [tags nargs intargs floatargs
+//! [stringargs]] parameterlist`: the mesh and its tags (`interpolateboundary`, `crease`,
+//! `corner`, `hole`; RenderMan Interface Specification 3.2, section 5.6) read here, the
+//! limit surface made by `scene::subdiv` and emitted as Bezier patches.
+//!
+//! Primitive variables: "P"; "Cs" and "Os" constant or uniform (one value per face, every
+//! patch of the face gets it), vertex or varying (subdivided with the positions: varying is
+//! smoothed like vertex, a choice). Facevarying colours are ignored with a warning.
+
+use super::lexer::shown;
+use super::patches::check_points;
+use super::primvars::{Class, ClassCounts, parse_decl};
+use super::state::Interp;
+use super::syntax::{Arg, Args, Request};
+use crate::scene::subdiv::{BoundaryMode, Tags, catmull_clark};
+use crate::scene::{ColorField, Patch, SceneError};
+
+/// Integers of a request's integer array (`what` names it in errors), each in `lo..=hi`.
+fn ints(a: &Args, v: &[f64], what: &str, lo: usize, hi: usize) -> Result<Vec<usize>, SceneError> {
+    v.iter()
+        .map(|&x| {
+            if x.fract() == 0.0 && x >= lo as f64 && x <= hi as f64 {
+                Ok(x as usize)
+            } else {
+                Err(a.err(format!("{what}: {x} is not an integer in {lo}..={hi}")))
+            }
+        })
+        .collect()
+}
+
+impl Interp {
+    pub(super) fn subdivision_mesh(
+        &mut self,
+        req: &Request,
+        a: &mut Args,
+    ) -> Result<(), SceneError> {
+        let scheme = a.string("the subdivision scheme")?;
+        if scheme != "catmull-clark" {
+            let msg = format!(
+                "skipped `SubdivisionMesh` of scheme \"{}\" (only \"catmull-clark\"): the \
+                 image lacks that mesh",
+                shown(scheme)
+            );
+            self.warn_once(req, &format!("SubdivisionMesh {scheme}"), &msg);
+            return Ok(());
+        }
+        const MAX: usize = 1 << 28;
+        let sizes = a.array("nvertices")?;
+        let sizes = ints(a, sizes, "nvertices", 3, MAX)?;
+        let ids = a.array("vertices")?;
+        let ids = ints(a, ids, "vertices", 0, MAX)?;
+        let tags = self.subdiv_tags(req, a)?;
+        let mut params = a.params()?;
+        // Facevarying colours need per-corner interpolation: not read.
+        params.retain(|p| {
+            let class = match p.decl {
+                Some(d) => parse_decl(d).ok().map(|d| d.class),
+                None => self.declared.get(p.name).map(|d| d.class),
+            };
+            let drop = matches!(p.name, "Cs" | "Os") && class == Some(Class::FaceVarying);
+            if drop {
+                let msg = format!(
+                    "ignored facevarying \"{}\" of `SubdivisionMesh` (the material's colour \
+                     is used)",
+                    p.name
+                );
+                self.warn_once(
+                    req,
+                    &format!("SubdivisionMesh facevarying {}", p.name),
+                    &msg,
+                );
+            }
+            !drop
+        });
+        let n = match params.iter().find(|p| p.name == "P" || p.name == "Pw") {
+            Some(p) => p.nums(a)?.len() / if p.name == "P" { 3 } else { 4 },
+            None => return Err(a.err("missing the \"P\" parameter")),
+        };
+        let pts = self.positions(req, a, &params, n)?;
+        let counts = ClassCounts {
+            uniform: sizes.len(),
+            varying: n,
+            vertex: n,
+        };
+        let vars = self.color_vars(a, &params, &counts)?;
+        let ctm = self.geometry_ctm(a)?;
+        check_points(a, 0, &pts, 0..n)?;
+        // Channels: positions, then each smoothly varying colour.
+        let mut data = vec![pts];
+        let mut slot = |v: &Option<super::primvars::ColorVar>| match v {
+            Some(c) if matches!(c.class, Class::Vertex | Class::Varying) => {
+                data.push(c.values.clone());
+                Some(data.len() - 1)
+            }
+            _ => None,
+        };
+        let (cs_ch, os_ch) = (slot(&vars.cs), slot(&vars.os));
+        let ids: Vec<u32> = ids.into_iter().map(|i| i as u32).collect();
+        let patches = catmull_clark(&sizes, &ids, &tags, data)
+            .map_err(|e| a.err(format!("SubdivisionMesh: {e}")))?;
+        for (k, p) in patches.into_iter().enumerate() {
+            let field = |v: &Option<super::primvars::ColorVar>, ch: Option<usize>| {
+                let v = v.as_ref()?;
+                Some(match (ch, v.class) {
+                    (Some(c), _) => ColorField::Bezier(p.channels[c]),
+                    (None, Class::Uniform) => ColorField::Flat(v.values[p.origin as usize]),
+                    (None, _) => ColorField::Flat(v.values[0]),
+                })
+            };
+            let fields = (field(&vars.cs, cs_ch), field(&vars.os, os_ch));
+            self.emit_with(a, &ctm, k, p.channels[0], Patch::POLYNOMIAL, fields)?;
+        }
+        Ok(())
+    }
+
+    /// The optional tag arrays: tags, nargs (two or three per tag), intargs, floatargs and,
+    /// with three counts per tag, stringargs. Unknown tags are skipped with a warning.
+    fn subdiv_tags(&mut self, req: &Request, a: &mut Args) -> Result<Tags, SceneError> {
+        let mut tags = Tags::default();
+        let names: Vec<String> = match a.peek() {
+            Some(Arg::Strs(v)) => v.clone(),
+            Some(Arg::Nums(v)) if v.is_empty() => Vec::new(),
+            _ => return Ok(tags),
+        };
+        a.pos += 1;
+        let nargs = a.array("nargs")?;
+        let per = if nargs.len() == 3 * names.len() && !names.is_empty() {
+            3
+        } else {
+            2
+        };
+        if nargs.len() != per * names.len() {
+            return Err(a.err(format!(
+                "nargs has {} numbers for {} tags (two per tag)",
+                nargs.len(),
+                names.len()
+            )));
+        }
+        let nargs = ints(a, nargs, "nargs", 0, 1 << 28)?;
+        let intargs = a.array("intargs")?;
+        let floatargs = a.array("floatargs")?;
+        if per == 3 {
+            match a.peek() {
+                Some(Arg::Strs(_)) | Some(Arg::Nums(_)) => a.pos += 1,
+                _ => return Err(a.err("missing stringargs (nargs gives three counts per tag)")),
+            }
+        }
+        let (ni, nf): (usize, usize) = (0..names.len())
+            .map(|t| (nargs[per * t], nargs[per * t + 1]))
+            .fold((0, 0), |(x, y), (i, f)| (x + i, y + f));
+        if ni != intargs.len() || nf != floatargs.len() {
+            return Err(a.err(format!(
+                "nargs asks for {ni} integer and {nf} float arguments, found {} and {}",
+                intargs.len(),
+                floatargs.len()
+            )));
+        }
+        let (mut io, mut fo) = (0, 0);
+        for (t, name) in names.iter().enumerate() {
+            let (ni, nf) = (nargs[per * t], nargs[per * t + 1]);
+            let iv = ints(a, &intargs[io..io + ni], name, 0, 1 << 28)?;
+            let fv = &floatargs[fo..fo + nf];
+            io += ni;
+            fo += nf;
+            if let Some(x) = fv.iter().find(|x| x.is_nan()) {
+                return Err(a.err(format!("tag \"{}\": sharpness {x}", shown(name))));
+            }
+            match name.as_str() {
+                "interpolateboundary" => {
+                    tags.boundary = match iv.first() {
+                        Some(0) => BoundaryMode::None,
+                        Some(2) => BoundaryMode::EdgesOnly,
+                        _ => BoundaryMode::EdgesAndCorners,
+                    }
+                }
+                "crease" if !fv.is_empty() && iv.len() >= 2 => {
+                    tags.creases
+                        .push((iv.iter().map(|&v| v as u32).collect(), fv[0]));
+                }
+                "corner" if !fv.is_empty() => {
+                    for (k, &v) in iv.iter().enumerate() {
+                        tags.corners.push((v as u32, fv[k.min(fv.len() - 1)]));
+                    }
+                }
+                "hole" => tags.holes.extend(iv.iter().map(|&f| f as u32)),
+                "crease" | "corner" => {
+                    return Err(a.err(format!(
+                        "tag \"{name}\" needs vertices and a sharpness, found {ni} integers \
+                         and {nf} floats"
+                    )));
+                }
+                other => {
+                    let msg = format!(
+                        "skipped tag \"{}\" of `SubdivisionMesh` (the surface is drawn \
+                         without it)",
+                        shown(other)
+                    );
+                    self.warn_once(req, &format!("SubdivisionMesh tag {other}"), &msg);
+                }
+            }
+        }
+        Ok(tags)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::{err, parse, world};
+
+    const TETRA: &str = "SubdivisionMesh \"catmull-clark\" [3 3 3 3] [0 1 3 1 2 3 2 0 3 2 1 0] \
+                         \"P\" [1 0 0  -0.5 0.866 0  -0.5 -0.866 0  0 0 1]";
+
+    #[test]
+    fn a_tetrahedron_is_read_as_limit_patches() {
+        let s = parse(&world(&format!("Translate 0 0 5\n{TETRA}")));
+        assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+        assert!(s.patches.len() > 100, "{}", s.patches.len());
+        assert!(s.patches.iter().all(|p| p.cp.iter().all(|c| c.z > 4.0)));
+    }
+
+    #[test]
+    fn tags_and_colours_are_read() {
+        let quad = "SubdivisionMesh \"catmull-clark\" [4] [0 1 2 3] \
+                    [\"interpolateboundary\" \"crease\" \"unknowntag\"] [0 0 2 1 0 0] [0 1] [10] \
+                    \"P\" [0 0 0 1 0 0 1 1 0 0 1 0] \"vertex color Cs\" [1 0 0 0 1 0 0 0 1 1 1 1] \
+                    \"uniform color Os\" [0.5 0.5 0.5] \"N\" [0 0 1 0 0 1 0 0 1 0 0 1]";
+        let s = parse(&world(quad));
+        assert!(!s.patches.is_empty());
+        let w = s.warnings.join("\n");
+        assert!(w.contains("unknowntag") && w.contains("\"N\""), "{w}");
+        let pv = s.patches[0].primvars.as_ref().unwrap();
+        assert!(matches!(pv.cs, Some(crate::scene::ColorField::Bezier(_))));
+        assert!(matches!(pv.os, Some(crate::scene::ColorField::Flat(_))));
+    }
+
+    #[test]
+    fn bad_meshes_name_their_fault() {
+        let e = err(&world(
+            "SubdivisionMesh \"catmull-clark\" [3] [0 1 5] \"P\" [0 0 0 1 0 0 0 1 0]",
+        ));
+        assert!(
+            e.contains("t.rib:2") && e.contains("vertex 5 out of range"),
+            "{e}"
+        );
+        let e = err(&world(
+            "SubdivisionMesh \"catmull-clark\" [3 3] [0 1 2 0 1 2] \"P\" [0 0 0 1 0 0 0 1 0]",
+        ));
+        assert!(e.contains("oriented manifold"), "{e}");
+        let e = err(&world(
+            "SubdivisionMesh \"catmull-clark\" [2] [0 1] \"P\" [0 0 0 1 0 0]",
+        ));
+        assert!(e.contains("nvertices"), "{e}");
+        let s = parse(&world(
+            "SubdivisionMesh \"loop\" [3] [0 1 2] \"P\" [0 0 0 1 0 0 0 1 0]",
+        ));
+        assert!(s.patches.is_empty() && s.warnings[0].contains("\"loop\""));
+    }
+}
