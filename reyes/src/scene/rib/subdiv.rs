@@ -81,6 +81,8 @@ impl Interp {
             uniform: sizes.len(),
             varying: n,
             vertex: n,
+            // One per face corner (facevarying values were dropped above with a warning).
+            facevarying: ids.len(),
         };
         let vars = self.color_vars(a, &params, &counts)?;
         let ctm = self.geometry_ctm(a)?;
