@@ -3,7 +3,9 @@
 mod archives;
 mod displacement;
 mod frames;
+mod fuzz;
 mod hostile;
+mod limits;
 mod motion;
 mod nupatch;
 mod patches;
