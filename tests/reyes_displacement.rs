@@ -219,3 +219,55 @@ fn a_uniform_map_displaces_the_sphere_to_a_larger_sphere() {
     );
     assert!(colour_off < 0.01, "mean colour difference {colour_off}");
 }
+
+/// A patch 5 units from the eye displaced by `"Km" 6` (or bounded by a huge
+/// `"displacementbound"`): every piece's grown bound reaches the eye however small the piece,
+/// and splitting by that bound once made 2^24 pieces (no end, CPU twin and GPU). A piece is
+/// split by what its undisplaced surface shows and its grids are clipped at the near plane:
+/// every strategy and the CPU twin agree, with a handful of eye splits, and the patch is drawn.
+#[test]
+fn a_displacement_reaching_the_eye_is_clipped_not_split_without_end() {
+    let patch = "Patch \"bicubic\" \"P\" [-1.5 -1.5 0 -0.5 -1.5 0 0.5 -1.5 0 1.5 -1.5 0 \
+                 -1.5 -0.5 0 -0.5 -0.5 0 0.5 -0.5 0 1.5 -0.5 0 -1.5 0.5 0 -0.5 0.5 0 0.5 0.5 0 \
+                 1.5 0.5 0 -1.5 1.5 0 -0.5 1.5 0 0.5 1.5 0 1.5 1.5 0]";
+    for displacement in [
+        "Displacement \"bumps\" \"Km\" 6",
+        "Attribute \"displacementbound\" \"sphere\" [1e30]\nDisplacement \"bumps\" \"Km\" 0.2",
+    ] {
+        // A small image: the bumps reach past the eye, so their clipped micropolygons cover
+        // the whole image and each is tested against every sample (seconds on lavapipe).
+        let text = format!(
+            "Format 16 12 1\nPixelSamples 1 1\nProjection \"perspective\" \"fov\" [40]\n\
+             Translate 0 0 5\nWorldBegin\nSurface \"matte\"\n{displacement}\n{patch}\nWorldEnd\n"
+        );
+        let s = scene::parse_rib(&text, "reaches-eye.rib").unwrap_or_else(|e| panic!("{e}"));
+        let d = data(&s, &RenderOptions::default());
+        let cpu = render_cpu(&d);
+        let eye = cpu.counters[reyes::stages::C_EYE_SPLITS];
+        assert!(eye <= 64, "{displacement}: {eye} eye splits");
+        assert!(
+            cpu.counters[reyes::stages::C_NEAR_CLIPPED] >= 1,
+            "{displacement}: no grid clipped at the near plane"
+        );
+        let image = render_everywhere(&d);
+        assert!(image.covered_pixels() > 0, "{displacement}: nothing drawn");
+    }
+    // --bound-px splits a displaced piece by its undisplaced extent: a patch clear of the eye
+    // whose grown screen box stays wider than bound_px at any split.
+    let text = format!(
+        "Format 64 48 1\nPixelSamples 2 2\nProjection \"perspective\" \"fov\" [40]\n\
+         Translate 0 0 5\nWorldBegin\nSurface \"matte\"\nDisplacement \"bumps\" \"Km\" 2\n\
+         {patch}\nWorldEnd\n"
+    );
+    let s = scene::parse_rib(&text, "bound-px.rib").unwrap();
+    let o = RenderOptions {
+        bound_px: Some(8.0),
+        ..RenderOptions::default()
+    };
+    let cpu = render_cpu(&data(&s, &o));
+    assert!(
+        cpu.executed[1] + cpu.executed[2] < 4096,
+        "{} splits",
+        cpu.executed[1] + cpu.executed[2]
+    );
+}

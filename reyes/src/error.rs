@@ -56,7 +56,8 @@ pub enum Error {
     },
     /// A displacement map of a size the GPU table does not take.
     #[error(
-        "the displacement map {} is {width}x{height}: each side must be 1..={max_side}",
+        "the displacement map {} is {width}x{height}: each side must be 1..={max_side} and \
+         the texels at most {max_texels} (4096x4096); sample it down",
         path.display()
     )]
     DisplacementMapSize {
@@ -68,6 +69,8 @@ pub enum Error {
         height: u32,
         /// The longest side taken ([`crate::scene::MAX_MAP_SIDE`]).
         max_side: u32,
+        /// The most texels taken ([`crate::scene::MAX_MAP_TEXELS`]).
+        max_texels: u64,
     },
     /// A turn of the scene about its vertical axis by an angle that is not finite.
     #[error("spin {degrees} degrees: must be finite")]
@@ -151,14 +154,14 @@ pub struct SceneError {
     /// The file as given (an archive's own name for errors inside it).
     pub file: String,
     /// The 1-based line of the request at fault, or 0 for the file as a whole.
-    pub line: u32,
+    pub line: u64,
     /// What is wrong, without the location.
     pub message: String,
 }
 
 impl SceneError {
     /// The error `message` at `line` of `file`.
-    pub fn new(file: &str, line: u32, message: impl Into<String>) -> SceneError {
+    pub fn new(file: &str, line: u64, message: impl Into<String>) -> SceneError {
         SceneError {
             file: file.to_string(),
             line,

@@ -83,7 +83,8 @@ fn bound_execute(item: PatchItem, inv: Invocation) {
     if zmin < frame.near {
         // Crossing the near plane: only the part in front can be seen, and its screen bound
         // decides whether anything of it reaches the bucket.
-        var vis = near_visible_bound(&cp);
+        let undisplaced = near_visible_bound(&cp);
+        var vis = undisplaced;
         // Displaced: a ball reaching the near plane reaches the whole image (and so may a
         // patch that moves or is blurred by the lens).
         if r > 0.0 || (SCENE_UVT && frame.uvt != UVT_OFF) {
@@ -96,8 +97,14 @@ fn bound_execute(item: PatchItem, inv: Invocation) {
         // Split while what can be seen of it spans more of the image than one finest grid
         // should: its micropolygons then stay small where they are seen. (The image, not the
         // bucket: decisions that do not depend on the bucket keep bucketed images exact.)
-        let seen = min(vis[1], vec2<f32>(f32(frame.width), f32(frame.height)) + CULL_MARGIN_PX)
-            - max(vis[0], vec2<f32>(-CULL_MARGIN_PX));
+        // A displaced piece splits by what its undisplaced surface shows: its grown bound
+        // keeps the radius r however small the piece, so it would reach the whole image at
+        // every split, and a patch whose balls all reach the eye (z = 5, "Km" 6) would split
+        // into 2^max_eye_splits pieces. Its grids are clipped at the near plane instead.
+        var split_vis = vis;
+        if r > 0.0 { split_vis = undisplaced; }
+        let seen = min(split_vis[1], vec2<f32>(f32(frame.width), f32(frame.height))
+            + CULL_MARGIN_PX) - max(split_vis[0], vec2<f32>(-CULL_MARGIN_PX));
         let grid_px = select(f32(frame.grid_max) * frame.mp_size, frame.bound_px,
             frame.bound_px > 0.0);
         if max(seen.x, seen.y) > grid_px && eye < frame.max_eye_splits && depth < frame.max_depth {
@@ -137,6 +144,9 @@ fn bound_execute(item: PatchItem, inv: Invocation) {
     var lo = pts[0].xy;
     var hi = pts[0].xy;
     for (var k = 1u; k < 16u; k++) { lo = min(lo, pts[k].xy); hi = max(hi, pts[k].xy); }
+    // The extent a split decides by (bound_px): the undisplaced one, which halves as the
+    // piece splits; the growth below does not (it would split to max_depth).
+    let extent = hi - lo;
     if r > 0.0 {
         // Every control point q has q.z >= zmin + r > r here. A point q + d, |d| <= r, projects
         // within focal r |q| / (q.z (q.z - r)) of q's projection along x and along y:
@@ -181,7 +191,7 @@ fn bound_execute(item: PatchItem, inv: Invocation) {
         lu = max(lu, su);
         lv = max(lv, sv);
     }
-    let d = dice_decision(lu, lv, hi - lo);
+    let d = dice_decision(lu, lv, extent);
     if d.x != 0u && depth < frame.max_depth {
         if d.x == 1u { enqueue_splitu(item); } else { enqueue_splitv(item); }
         return;

@@ -103,6 +103,26 @@ struct State {
     window: Arc<Window>,
 }
 
+/// The size frames are rendered at for a window of `window` pixels: the window's own, or,
+/// where that would not fit the device (its sub-samples, 8 bytes each, in one binding of
+/// `max_binding` bytes) or the renderer ([`reyes::frame::MAX_IMAGE_SIDE`] a side), the
+/// largest size of the window's aspect that does. The presenter scales it up to the window
+/// and the title says so: a window resized to 3000x3000 keeps running instead of failing
+/// on a buffer too large.
+fn render_size(window: (u32, u32), samples: (u32, u32), max_binding: u64) -> (u32, u32) {
+    let (w, h) = (window.0.max(1) as f64, window.1.max(1) as f64);
+    let per_pixel = 8.0 * samples.0.max(1) as f64 * samples.1.max(1) as f64;
+    let fits_memory = (max_binding as f64 / per_pixel / (w * h)).sqrt();
+    let side = reyes::frame::MAX_IMAGE_SIDE as f64;
+    let scale = fits_memory.min(side / w).min(side / h).min(1.0);
+    if scale >= 1.0 {
+        return window;
+    }
+    // Floors, so that the product stays within the bound.
+    let fit = |x: f64| ((x * scale).floor() as u32).max(1);
+    (fit(w), fit(h))
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Drag {
     Orbit,
@@ -201,7 +221,8 @@ impl Viewer {
         let Some(st) = self.state.as_mut() else {
             return Ok(false);
         };
-        let size = (st.config.width, st.config.height);
+        let window = (st.config.width, st.config.height);
+        let size = render_size(window, self.settings.samples, st.gpu.max_binding_bytes());
         if self.rebuild || st.renderer.is_none() {
             // Free the old buffers before the new ones are made.
             st.renderer = None;
@@ -254,7 +275,7 @@ impl Viewer {
             r.image_buffer(),
             (f.width, f.height),
             &view,
-            size,
+            window,
         );
         st.gpu.queue.submit([enc.finish()]);
         st.window.pre_present_notify();
@@ -268,7 +289,13 @@ impl Viewer {
         }
         self.last_shown = Some(now);
         self.shown += 1;
-        let title = self.title(&frame);
+        let mut title = self.title(&frame);
+        if size != window {
+            title += &format!(
+                " | rendered at {}x{}, scaled up to the window",
+                size.0, size.1
+            );
+        }
         let st = self.state.as_ref().expect("checked above");
         st.window.set_title(&title);
         if self.a.frames.is_some() {
@@ -518,5 +545,31 @@ impl ApplicationHandler for Viewer {
         } else {
             ControlFlow::Wait
         });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::render_size;
+
+    /// A window that fits is rendered at its size; a larger one at the largest size of its
+    /// aspect whose sub-samples fit one binding (and each side the renderer's limit).
+    #[test]
+    fn large_windows_render_at_a_size_that_fits() {
+        let mib = 1u64 << 20;
+        assert_eq!(render_size((640, 480), (2, 2), 128 * mib), (640, 480));
+        // 3000x3000 at 2x2 samples: 288 MB of sub-samples against a 128 MiB binding.
+        let (w, h) = render_size((3000, 3000), (2, 2), 128 * mib);
+        assert_eq!(w, h);
+        assert!(w as u64 * h as u64 * 4 * 8 <= 128 * mib, "{w}x{h}");
+        assert!(w > 1900, "{w}: more than needed was taken off");
+        // The aspect is kept (to the pixel), and sides stay within MAX_IMAGE_SIDE.
+        let (w, h) = render_size((4000, 1000), (4, 4), 64 * mib);
+        assert!((w as f64 / h as f64 - 4.0).abs() < 0.01, "{w}x{h}");
+        assert!(w as u64 * h as u64 * 16 * 8 <= 64 * mib);
+        let side = reyes::frame::MAX_IMAGE_SIDE;
+        let (w, _) = render_size((4 * side, 10), (1, 1), u64::MAX);
+        assert!(w <= side);
+        assert_eq!(render_size((0, 0), (1, 1), 1), (1, 1));
     }
 }

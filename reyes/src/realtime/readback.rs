@@ -89,8 +89,10 @@ pub(crate) fn await_mapped(
         gpu.wait_for(None, what)?;
     }
     // Another thread polling the same device (tests share one) may have taken the callbacks
-    // and be running them right now: give it a moment, bounded, before calling it an error.
-    let deadline = std::time::Instant::now() + gpu.timeout.min(std::time::Duration::from_secs(5));
+    // and be running them right now: give it the GPU's timeout, as every other wait, before
+    // calling it an error (a few seconds could run out on a loaded machine, where that thread
+    // may be descheduled; the wait ends as soon as the status is mapped).
+    let deadline = std::time::Instant::now() + gpu.timeout;
     while mapped.load(Ordering::Acquire) != n && std::time::Instant::now() < deadline {
         let _ = gpu.device.poll(wgpu::PollType::Poll);
         std::thread::sleep(std::time::Duration::from_millis(1));

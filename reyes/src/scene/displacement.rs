@@ -13,6 +13,12 @@ pub const DISPLACEMENT_NAMES: &[&str] = &["bumps", "mapped"];
 /// Most texels on a side of a displacement map (its size is packed in 16 bits per side).
 pub const MAX_MAP_SIDE: u32 = 16384;
 
+/// Most texels of a displacement map, 2^24 (4096 x 4096; 64 MiB in the frame's table, where
+/// they go 4 to a 16-byte entry): checked from the image's header before it is decoded, so a
+/// 16384 x 16384 map is refused at its `Displacement` line instead of taking 2.3 GB and then
+/// failing as a GPU buffer. Sample a larger map down to fit.
+pub const MAX_MAP_TEXELS: u64 = 1 << 24;
+
 /// The scalar field a displacement scales: values in [0, 1] over the original patch's (u, v).
 #[derive(Clone, Debug, PartialEq)]
 pub enum DisplacementPattern {
@@ -58,18 +64,34 @@ impl DisplacementMap {
                 path: path.to_path_buf(),
             });
         }
-        let img = image::open(path).map_err(|source| Error::DisplacementMapUnreadable {
+        let unreadable = |source| Error::DisplacementMapUnreadable {
             path: path.to_path_buf(),
             source,
-        })?;
+        };
+        let size_error = |(width, height)| Error::DisplacementMapSize {
+            path: path.to_path_buf(),
+            width,
+            height,
+            max_side: MAX_MAP_SIDE,
+            max_texels: MAX_MAP_TEXELS,
+        };
+        let fits = |(w, h): (u32, u32)| {
+            (1..=MAX_MAP_SIDE).contains(&w)
+                && (1..=MAX_MAP_SIDE).contains(&h)
+                && w as u64 * h as u64 <= MAX_MAP_TEXELS
+        };
+        // The size from the header first: nothing is decoded for a map that will not fit.
+        let reader = image::ImageReader::open(path)
+            .and_then(|r| r.with_guessed_format())
+            .map_err(|e| unreadable(image::ImageError::IoError(e)))?;
+        let size = reader.into_dimensions().map_err(unreadable)?;
+        if !fits(size) {
+            return Err(size_error(size));
+        }
+        let img = image::open(path).map_err(unreadable)?;
         let (width, height) = (img.width(), img.height());
-        if width == 0 || height == 0 || width > MAX_MAP_SIDE || height > MAX_MAP_SIDE {
-            return Err(Error::DisplacementMapSize {
-                path: path.to_path_buf(),
-                width,
-                height,
-                max_side: MAX_MAP_SIDE,
-            });
+        if !fits((width, height)) {
+            return Err(size_error((width, height)));
         }
         let luma = img.to_luma32f();
         if let Some(i) = luma.as_raw().iter().position(|x| x.is_nan()) {

@@ -32,7 +32,7 @@ pub use basis::Basis;
 pub use bpt::parse_bpt;
 pub use displacement::{
     DISPLACEMENT_NAMES, Displacement, DisplacementMap, DisplacementPattern, MAX_BUMPS_FREQUENCY,
-    MAX_MAP_SIDE,
+    MAX_MAP_SIDE, MAX_MAP_TEXELS,
 };
 pub use newell::parse_newell;
 pub use primvars::{ColorField, Primvars};
@@ -196,7 +196,7 @@ pub struct PatchSource {
     /// The scene file, as named to the loader.
     pub file: String,
     /// Line of the request in that file.
-    pub line: u32,
+    pub line: u64,
     /// Index of the patch within the request.
     pub index: u32,
 }

@@ -8,9 +8,9 @@ use glam::DVec3;
 /// Whitespace/comma separated fields with their line numbers, shared with the BPT reader.
 pub(crate) struct Fields<'a> {
     file: &'a str,
-    fields: Vec<(&'a str, u32)>,
+    fields: Vec<(&'a str, u64)>,
     pos: usize,
-    last_line: u32,
+    last_line: u64,
 }
 
 impl<'a> Fields<'a> {
@@ -18,7 +18,7 @@ impl<'a> Fields<'a> {
         let mut fields = Vec::new();
         let mut last_line = 1;
         for (n, line) in text.lines().enumerate() {
-            let line_no = n as u32 + 1;
+            let line_no = n as u64 + 1;
             last_line = line_no;
             let parts = line.split(|c: char| c.is_whitespace() || (commas && c == ','));
             fields.extend(parts.filter(|f| !f.is_empty()).map(|f| (f, line_no)));
@@ -31,11 +31,11 @@ impl<'a> Fields<'a> {
         }
     }
 
-    pub(crate) fn err(&self, line: u32, msg: impl Into<String>) -> SceneError {
+    pub(crate) fn err(&self, line: u64, msg: impl Into<String>) -> SceneError {
         SceneError::new(self.file, line, msg)
     }
 
-    fn next(&mut self, what: &str) -> Result<(&'a str, u32), SceneError> {
+    fn next(&mut self, what: &str) -> Result<(&'a str, u64), SceneError> {
         let f = self.fields.get(self.pos).copied().ok_or_else(|| {
             self.err(
                 self.last_line,
@@ -47,7 +47,7 @@ impl<'a> Fields<'a> {
     }
 
     /// A non-negative integer; returns it with its line.
-    pub(crate) fn int(&mut self, what: &str) -> Result<(u64, u32), SceneError> {
+    pub(crate) fn int(&mut self, what: &str) -> Result<(u64, u64), SceneError> {
         let (f, line) = self.next(what)?;
         let v = f
             .parse::<u64>()
@@ -56,7 +56,7 @@ impl<'a> Fields<'a> {
     }
 
     /// A finite number; returns it with its line.
-    pub(crate) fn float(&mut self, what: &str) -> Result<(f64, u32), SceneError> {
+    pub(crate) fn float(&mut self, what: &str) -> Result<(f64, u64), SceneError> {
         let (f, line) = self.next(what)?;
         let v = f
             .parse::<f64>()
@@ -67,7 +67,7 @@ impl<'a> Fields<'a> {
         Ok((v, line))
     }
 
-    pub(crate) fn point(&mut self, what: &str) -> Result<(DVec3, u32), SceneError> {
+    pub(crate) fn point(&mut self, what: &str) -> Result<(DVec3, u64), SceneError> {
         let (x, line) = self.float(what)?;
         let (y, _) = self.float(what)?;
         let (z, _) = self.float(what)?;

@@ -121,17 +121,21 @@ pub fn bound_against(
         Vec2::new((f.tile_x0 + f.tile_w) as f32, (f.tile_y0 + f.tile_h) as f32) + CULL_MARGIN_PX;
     let misses = |lo: Vec2, hi: Vec2| hi.x < t0.x || hi.y < t0.y || lo.x > t1.x || lo.y > t1.y;
     if zmin < f.near {
+        let undisplaced = near_visible_bound(f, cp);
         let (lo, hi) = if r > 0.0 || uvt.is_some() {
             (Vec2::splat(-3.0e38), Vec2::splat(3.0e38))
         } else {
-            near_visible_bound(f, cp)
+            undisplaced
         };
         if misses(lo, hi) {
             return Decision::Cull(Cull::Offscreen);
         }
+        // A displaced piece splits by what its undisplaced surface shows (its grown bound
+        // never shrinks: see bound.wgsl).
+        let (slo, shi) = if r > 0.0 { undisplaced } else { (lo, hi) };
         // The image, not the bucket: see bound.wgsl.
         let image = Vec2::new(f.width as f32, f.height as f32) + CULL_MARGIN_PX;
-        let seen = hi.min(image) - lo.max(Vec2::splat(-CULL_MARGIN_PX));
+        let seen = shi.min(image) - slo.max(Vec2::splat(-CULL_MARGIN_PX));
         let grid_px = if f.bound_px > 0.0 {
             f.bound_px
         } else {
@@ -167,6 +171,8 @@ pub fn bound_against(
     }
     let mut lo = pts.iter().fold(pts[0].0, |a, p| a.min(p.0));
     let mut hi = pts.iter().fold(pts[0].0, |a, p| a.max(p.0));
+    // bound_px splits by the undisplaced extent (see bound.wgsl).
+    let extent = hi - lo;
     if r > 0.0 {
         let mut g = 0f32;
         for k in 0..16 {
@@ -203,7 +209,7 @@ pub fn bound_against(
         lu = lu.max(su);
         lv = lv.max(sv);
     }
-    let (split, nu, nv) = dice_decision(f, lu, lv, hi - lo);
+    let (split, nu, nv) = dice_decision(f, lu, lv, extent);
     if split != 0 && depth < f.max_depth {
         return Decision::Split {
             along_u: split == 1,

@@ -19,6 +19,19 @@ use std::rc::Rc;
 /// Most inputs open at once: the scene file and 31 archives, each read by the one before.
 pub(super) const MAX_ARCHIVE_DEPTH: usize = 32;
 
+/// Most values (numbers, or strings) the arguments of one request may hold, counted over all
+/// its arrays and bare values: 2^24, 128 MiB of numbers, far beyond any hand-written request
+/// (a `PatchMesh` of 5 million points is 15 million numbers). A request past it is refused at
+/// the line where it crosses the limit, before more is held (a 1.2 MB gzip of one request of
+/// 600 million numbers once took 4 GB). An unknown request's arguments are read but never
+/// held, so they count against nothing.
+pub(crate) const MAX_REQUEST_VALUES: usize = 1 << 24;
+
+/// Most strings the arguments of one request may hold (each costs a heap allocation besides
+/// its bytes): 2^20. RIB string arrays name things (shaders, maps, parameters); 200 million
+/// one-character strings once took 4 GB.
+pub(crate) const MAX_REQUEST_STRINGS: usize = 1 << 20;
+
 /// The two bytes every gzip member starts with (RFC 1952, §2.3.1).
 const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
 
@@ -56,6 +69,35 @@ impl Input<'_> {
     fn next(&mut self) -> Result<Option<Token>, SceneError> {
         self.peek()?;
         Ok(self.peeked.take())
+    }
+}
+
+/// The values one request's arguments hold so far, against [`MAX_REQUEST_VALUES`] and
+/// [`MAX_REQUEST_STRINGS`].
+#[derive(Default)]
+struct Held {
+    values: usize,
+    strings: usize,
+}
+
+impl Held {
+    /// Counts one more value (a string if `is_str`); the error message when it is one too many.
+    fn add(&mut self, is_str: bool) -> Result<(), String> {
+        self.values += 1;
+        self.strings += usize::from(is_str);
+        if self.values > MAX_REQUEST_VALUES {
+            return Err(format!(
+                "more than {MAX_REQUEST_VALUES} values in one request's arguments (the limit \
+                 on array length)"
+            ));
+        }
+        if self.strings > MAX_REQUEST_STRINGS {
+            return Err(format!(
+                "more than {MAX_REQUEST_STRINGS} strings in one request's arguments (the limit \
+                 on string arrays)"
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -97,7 +139,7 @@ impl<'a> Reader<'a> {
         self.inputs.last_mut().expect("the scene file stays open")
     }
 
-    fn err(&mut self, line: u32, msg: impl Into<String>) -> SceneError {
+    fn err(&mut self, line: u64, msg: impl Into<String>) -> SceneError {
         SceneError::new(self.top().lexer.file(), line, msg)
     }
 
@@ -145,6 +187,8 @@ impl<'a> Reader<'a> {
         };
         let known = KNOWN.contains(&name.as_str());
         let mut args = Vec::new();
+        // Values held so far (numbers and strings; strings alone).
+        let mut held = Held::default();
         loop {
             let (line, stop) = match self.top().peek()? {
                 None => break,
@@ -168,12 +212,30 @@ impl<'a> Reader<'a> {
                 Some(Some(msg)) => return Err(self.err(line, msg)),
                 None => {}
             }
-            match self.top().next()?.map(|t| t.tok) {
-                Some(Tok::Num(v)) => args.push(Arg::Num(v)),
-                Some(Tok::Str(s)) => args.push(Arg::Str(s)),
-                Some(Tok::Open) => args.push(self.array(line)?),
-                _ => {} // junk words after an unknown request
+            let tok = self.top().next()?.map(|t| t.tok);
+            // An unknown request's arguments are read (their syntax checked) but not held:
+            // the request is skipped with a warning that names it alone.
+            if !known {
+                if let Some(Tok::Open) = tok {
+                    self.array(line, None)?;
+                }
+                continue;
             }
+            let arg = match tok {
+                Some(Tok::Num(v)) => Arg::Num(v),
+                Some(Tok::Str(s)) => Arg::Str(s),
+                Some(Tok::Open) => match self.array(line, Some((&mut held, name.as_str())))? {
+                    Some(a) => a,
+                    None => continue,
+                },
+                _ => continue,
+            };
+            if matches!(arg, Arg::Num(_) | Arg::Str(_)) {
+                let is_str = matches!(arg, Arg::Str(_));
+                held.add(is_str)
+                    .map_err(|msg| self.err(line, format!("`{name}`: {msg}")))?;
+            }
+            args.push(arg);
         }
         Ok(Some(Request {
             name,
@@ -183,7 +245,14 @@ impl<'a> Reader<'a> {
         }))
     }
 
-    fn array(&mut self, open_line: u32) -> Result<Arg, SceneError> {
+    /// The rest of an array opened at `open_line`: counted into `held` (with the request's
+    /// name for errors) and returned, or with `held` `None` (an unknown request's) read
+    /// through and dropped.
+    fn array(
+        &mut self,
+        open_line: u64,
+        mut held: Option<(&mut Held, &str)>,
+    ) -> Result<Option<Arg>, SceneError> {
         let mut nums = Vec::new();
         let mut strs = Vec::new();
         loop {
@@ -194,8 +263,16 @@ impl<'a> Reader<'a> {
                     format!("unexpected end of file inside the array opened at line {open_line}"),
                 ));
             };
+            if let (Some((h, name)), Tok::Num(_) | Tok::Str(_)) = (held.as_mut(), &t.tok) {
+                let name = *name;
+                h.add(matches!(t.tok, Tok::Str(_))).map_err(|msg| {
+                    let msg = format!("`{name}`: {msg} (in the array opened at line {open_line})");
+                    self.err(t.line, msg)
+                })?;
+            }
             match t.tok {
                 Tok::Close => break,
+                Tok::Num(_) | Tok::Str(_) if held.is_none() => {}
                 Tok::Num(v) => nums.push(v),
                 Tok::Str(s) => strs.push(s),
                 Tok::Open => return Err(self.err(t.line, "unexpected `[` inside an array")),
@@ -211,11 +288,13 @@ impl<'a> Reader<'a> {
                 return Err(self.err(t.line, "array mixes numbers and strings"));
             }
         }
-        Ok(if strs.is_empty() {
-            Arg::Nums(nums)
-        } else {
-            Arg::Strs(strs)
-        })
+        Ok(held.map(|_| {
+            if strs.is_empty() {
+                Arg::Nums(nums)
+            } else {
+                Arg::Strs(strs)
+            }
+        }))
     }
 
     /// `ReadArchive "name"`: opens the archive; its requests come next.

@@ -26,7 +26,7 @@ pub(super) enum Tok {
 #[derive(Clone, Debug, PartialEq)]
 pub(super) struct Token {
     pub(super) tok: Tok,
-    pub(super) line: u32,
+    pub(super) line: u64,
 }
 
 /// Longest token (string or bare word) the lexer accepts, in bytes: far beyond any real RIB
@@ -62,8 +62,8 @@ pub(super) struct Lexer<'a> {
     buf: Box<[u8]>,
     pos: usize,
     len: usize,
-    /// The current line (1-based).
-    line: u32,
+    /// The current line (1-based; 64 bits: a file of more than 2^32 lines must not wrap).
+    line: u64,
     /// Whether the last byte consumed was a newline (for the end-of-file line).
     after_newline: bool,
 }
@@ -81,13 +81,22 @@ impl<'a> Lexer<'a> {
         }
     }
 
+    /// A lexer whose input starts at line `line` (a test of line numbers past 2^32).
+    #[cfg(test)]
+    pub(super) fn starting_at(src: Box<dyn Read + 'a>, line: u64) -> Lexer<'a> {
+        Lexer {
+            line,
+            ..Lexer::new(src, "t".into())
+        }
+    }
+
     pub(super) fn file(&self) -> &Rc<str> {
         &self.file
     }
 
     /// The line an end-of-file error names: the last line that has any text (1 for an empty
     /// input), as `str::lines` counts them.
-    pub(super) fn eof_line(&self) -> u32 {
+    pub(super) fn eof_line(&self) -> u64 {
         if self.after_newline && self.line > 1 {
             self.line - 1
         } else {
@@ -95,7 +104,7 @@ impl<'a> Lexer<'a> {
         }
     }
 
-    fn err(&self, line: u32, msg: impl Into<String>) -> SceneError {
+    fn err(&self, line: u64, msg: impl Into<String>) -> SceneError {
         SceneError::new(&self.file, line, msg)
     }
 
@@ -129,7 +138,7 @@ impl<'a> Lexer<'a> {
         Ok(b)
     }
 
-    fn too_long(&self, line: u32, what: &[u8]) -> SceneError {
+    fn too_long(&self, line: u64, what: &[u8]) -> SceneError {
         let start = String::from_utf8_lossy(&what[..QUOTE_CHARS.min(what.len())]).into_owned();
         self.err(
             line,
@@ -178,7 +187,7 @@ impl<'a> Lexer<'a> {
     }
 
     /// The rest of a string whose opening quote (on `start_line`) has been consumed.
-    fn string(&mut self, start_line: u32) -> Result<String, SceneError> {
+    fn string(&mut self, start_line: u64) -> Result<String, SceneError> {
         let mut s = Vec::new();
         let unterminated = |l: &Self| l.err(start_line, "unterminated string");
         loop {
@@ -224,7 +233,7 @@ impl<'a> Lexer<'a> {
     }
 
     /// A bare word: a number, a request name or junk.
-    fn word(&mut self, line: u32) -> Result<Tok, SceneError> {
+    fn word(&mut self, line: u64) -> Result<Tok, SceneError> {
         let mut w = Vec::new();
         while let Some(c) = self.peek()? {
             if is_delim(c) {
@@ -263,7 +272,7 @@ pub(super) fn tokenize(src: &[u8], file: &str) -> Result<Vec<Token>, SceneError>
 mod tests {
     use super::*;
 
-    fn toks(s: &str) -> Vec<(Tok, u32)> {
+    fn toks(s: &str) -> Vec<(Tok, u64)> {
         tokenize(s.as_bytes(), "t")
             .unwrap()
             .into_iter()
@@ -339,9 +348,9 @@ mod tests {
         let mut want = Vec::new();
         for k in 0..20_000 {
             text += &format!("Word{k} \"s{k}\"\n{k}.5 ");
-            want.push((Tok::Word(format!("Word{k}")), k + 1));
-            want.push((Tok::Str(format!("s{k}")), k + 1));
-            want.push((Tok::Num(k as f64 + 0.5), k + 2));
+            want.push((Tok::Word(format!("Word{k}")), k as u64 + 1));
+            want.push((Tok::Str(format!("s{k}")), k as u64 + 1));
+            want.push((Tok::Num(k as f64 + 0.5), k as u64 + 2));
         }
         assert!(text.len() > 4 * (64 << 10));
         let got = toks(&text);
@@ -358,10 +367,23 @@ mod tests {
             while lx.next_token().unwrap().is_some() {}
             assert_eq!(
                 lx.eof_line(),
-                text.lines().count().max(1) as u32,
+                text.lines().count().max(1) as u64,
                 "{text:?}"
             );
         }
+    }
+
+    /// Line numbers are 64-bit: a file of more than 2^32 lines (4.4e9 once wrapped the
+    /// counter) names its lines past it.
+    #[test]
+    fn line_numbers_go_past_two_to_the_32() {
+        let start = u32::MAX as u64 - 1;
+        let mut lx = Lexer::starting_at(Box::new(&b"A\n\nB\n\"x\n"[..]), start);
+        assert_eq!(lx.next_token().unwrap().unwrap().line, start);
+        assert_eq!(lx.next_token().unwrap().unwrap().line, start + 2);
+        let e = lx.next_token().unwrap_err();
+        assert_eq!(e.line, u32::MAX as u64 + 2);
+        assert_eq!(e.to_string(), "t:4294967297: unterminated string");
     }
 
     #[test]

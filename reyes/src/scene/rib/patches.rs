@@ -17,6 +17,33 @@ use glam::{DMat4, DVec3, DVec4};
 /// finite in f32 (at most 3.4e38), as the renderer's bound arithmetic needs.
 pub(crate) const MAX_COORD: f64 = 1.0e12;
 
+/// Most patches one frame may hold, 2^22 (4,194,304): a `Patch` is about 600 bytes on the host
+/// (16 f64 points and weights, its source), so a frame at the limit holds about 2.5 GB before
+/// the GPU tables. The patch past it is refused at its request's line (10 million identical
+/// bilinear patches in a 1.6 MB gzip once took 4 GB and never finished). Frames stream: the
+/// limit is per frame, not per file.
+pub(crate) const MAX_FRAME_PATCHES: usize = 1 << 22;
+
+#[cfg(test)]
+thread_local! {
+    /// The limit [`max_frame_patches`] gives in this thread's tests (a test lowers it rather
+    /// than parse 4 million patches).
+    pub(super) static TEST_MAX_FRAME_PATCHES: std::cell::Cell<usize> =
+        const { std::cell::Cell::new(MAX_FRAME_PATCHES) };
+}
+
+/// [`MAX_FRAME_PATCHES`].
+#[cfg(not(test))]
+fn max_frame_patches() -> usize {
+    MAX_FRAME_PATCHES
+}
+
+/// [`MAX_FRAME_PATCHES`], or what a test of this thread lowered it to.
+#[cfg(test)]
+fn max_frame_patches() -> usize {
+    TEST_MAX_FRAME_PATCHES.with(|m| m.get())
+}
+
 impl Interp {
     pub(super) fn geometry_ctm(&self, a: &Args) -> Result<DMat4, SceneError> {
         if self.world_to_camera.is_none() {
@@ -45,6 +72,14 @@ impl Interp {
         cp: [DVec3; 16],
         w: [f64; 16],
     ) -> Result<(), SceneError> {
+        let max = max_frame_patches();
+        if self.scene.patches.len() >= max {
+            return Err(a.err(format!(
+                "patch {index}: more than {max} patches in one frame (the limit \
+                 on scene size: each holds about 600 bytes on the host; split the scene into \
+                 frames or coarser patches)"
+            )));
+        }
         let bad = |p: &DVec3| {
             if p.is_nan() { "NaN" } else { "infinite" }
         };

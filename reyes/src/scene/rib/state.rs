@@ -111,7 +111,7 @@ impl Block {
 pub(super) struct Saved {
     pub(super) block: Block,
     pub(super) file: Rc<str>,
-    pub(super) line: u32,
+    pub(super) line: u64,
     pub(super) attrs: Attributes,
     /// The options, saved by `FrameBegin` only.
     pub(super) options: Option<Box<Options>>,
@@ -131,7 +131,7 @@ impl Saved {
 /// The frame block being read.
 pub(super) struct OpenFrame {
     pub(super) number: u32,
-    pub(super) line: u32,
+    pub(super) line: u64,
     /// Set by `MakeShadow`: the frame is a shadow-map pass.
     pub(super) unsupported: Option<String>,
     /// The frame's world, once its `WorldEnd` has been read.

@@ -32,7 +32,7 @@ pub(super) struct Request {
     pub(super) name: String,
     /// The file (or archive) the request is in, as errors name it.
     pub(super) file: Rc<str>,
-    pub(super) line: u32,
+    pub(super) line: u64,
     pub(super) args: Vec<Arg>,
 }
 

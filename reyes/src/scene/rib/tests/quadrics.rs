@@ -148,7 +148,7 @@ fn field_airplane_quadrics_become_patches() {
         let first = line.split_whitespace().next().unwrap_or("");
         if names.contains(&first) {
             quadrics += 1;
-            let line_no = i as u32 + 1;
+            let line_no = i as u64 + 1;
             let n = s
                 .patches
                 .iter()
