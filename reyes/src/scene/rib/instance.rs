@@ -21,7 +21,7 @@ const MAX_INSTANCE_DEPTH: usize = 64;
 /// The definition being recorded.
 pub(super) struct Recording {
     pub(super) handle: String,
-    pub(super) line: u32,
+    pub(super) line: u64,
     pub(super) requests: Vec<Request>,
 }
 
