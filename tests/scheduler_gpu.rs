@@ -448,7 +448,7 @@ fn a_run_started_at_capacity_16_grows_geometrically_and_stays_exact() {
         assert_eq!(result, reference, "{kind:?} roomy");
         assert_eq!(base.queue_growths, 0, "{kind:?}: {base:?}");
         let tiny = Scheduler::new(&gpu, &run.program, kind, 16).unwrap();
-        for _ in 0..2 {
+        for again in [false, true] {
             let (stats, result) = run.run(&gpu, &tiny).unwrap();
             eprintln!(
                 "{kind:?}: {} launches, {} submits, {} growths, {} rounds (roomy: {} launches, \
@@ -463,6 +463,11 @@ fn a_run_started_at_capacity_16_grows_geometrically_and_stays_exact() {
             );
             assert_eq!(result, reference, "{kind:?}");
             let growths = stats.queue_growths;
+            if again && kind == StrategyKind::Megakernel {
+                // The megakernel starts a run with the room its last run needed.
+                assert_eq!(growths, 0, "{stats:?}");
+                continue;
+            }
             assert!(growths >= 1, "{kind:?} never grew from 16: {stats:?}");
             assert!(growths <= growth_bound(&stats), "{kind:?}: {stats:?}");
             match kind {
@@ -493,6 +498,50 @@ fn a_run_started_at_capacity_16_grows_geometrically_and_stays_exact() {
             }
         }
     }
+}
+
+/// A megakernel run whose queues had to grow (each growth a relaunch after a host round trip)
+/// teaches its scheduler the room the work needs: the next run, memory allowing, is one launch
+/// with no growth. One workgroup, so no slot waits on another workgroup (an abandoned wait would
+/// also end a launch) and the work fits lavapipe's bounded launch.
+#[test]
+fn a_megakernel_run_after_one_that_grew_needs_exactly_one_launch() {
+    let gpu = gpu();
+    let params = TreeParams {
+        roots: 4,
+        max_depth: 9,
+        fanout: Fanout::Uniform(2),
+        work: 1,
+        payload_words: 2,
+        seed: 5,
+    };
+    let reference = params.reference();
+    let run = TreeRun::new(&gpu, params).unwrap();
+    let mk = Scheduler::megakernel(
+        &gpu,
+        &run.program,
+        MegakernelConfig {
+            workgroups: Workgroups::Fixed(1),
+            initial_capacity: 16,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let (first, result) = run.run(&gpu, &mk).unwrap();
+    assert_eq!(result, reference);
+    assert!(first.queue_growths >= 1 && first.launches >= 2, "{first:?}");
+    for _ in 0..2 {
+        let (next, result) = run.run(&gpu, &mk).unwrap();
+        assert_eq!(result, reference);
+        assert_eq!((next.launches, next.queue_growths), (1, 0), "{next:?}");
+        assert_eq!(next.submits, 1, "{next:?}");
+    }
+    // A memory budget below that room still bounds the queues (the remembered room is only a
+    // start): the first run's final queues, smaller than the room with every batch's promise.
+    let budget = first.queue_bytes;
+    let (tight, result) = run.run_within(&gpu, &mk, Some(budget)).unwrap();
+    assert_eq!(result, reference);
+    assert!(tight.queue_bytes <= budget, "{tight:?} within {budget}");
 }
 
 #[test]

@@ -134,6 +134,8 @@ pub struct GpuConfig {
     pub direct_enqueue: Option<bool>,
     /// Queue slots at the start of a run; `None` lets the workload choose from its size.
     pub capacity: Option<u32>,
+    /// `MegakernelConfig::turn_anatomy`.
+    pub turn_anatomy: bool,
 }
 
 impl Default for GpuConfig {
@@ -145,6 +147,7 @@ impl Default for GpuConfig {
             item_layout: None,
             direct_enqueue: None,
             capacity: None,
+            turn_anatomy: false,
         }
     }
 }
@@ -175,6 +178,7 @@ pub fn compile(
                 idle_backoff: config.idle_backoff,
                 item_layout: config.item_layout,
                 direct_enqueue: config.direct_enqueue,
+                turn_anatomy: config.turn_anatomy,
                 initial_capacity: capacity,
                 ..Default::default()
             },

@@ -11,16 +11,19 @@ pub const TEMPLATE: &str = include_str!("../../../shaders/megakernel.wgsl");
 /// The megakernel's WGSL for `program`, with `slots` read through `@coherent` loads where the
 /// device has them, and queues and outboxes holding items as `items` says. `direct`: enqueue
 /// straight into the slots, with the longest ticket list of a batch and each (source, target)
-/// part's offset in it (`MegakernelConfig::direct_enqueue`).
+/// part's offset in it (`MegakernelConfig::direct_enqueue`). `anatomy`: count each turn's
+/// phases (`MegakernelConfig::turn_anatomy`).
 pub fn source(
     program: &Program,
     coherent: bool,
     items: ItemLayout,
     direct: Option<(u32, &[u32])>,
+    anatomy: bool,
 ) -> String {
     let planar = items == ItemLayout::Planar;
     let mut s = program.tables_wgsl();
     s += &format!("const ITEMS_PLANAR: bool = {planar};\n");
+    s += &format!("const TURN_ANATOMY: bool = {anatomy};\n");
     let (slots, offsets) = direct.unwrap_or((1, &[]));
     let nq = program.queue_count();
     let es: Vec<String> = (0..nq * nq)
@@ -121,7 +124,7 @@ mod tests {
             .body("fn sink_execute(item: Word, inv: Invocation) {}");
         let two = Procedure::new("two", word, 2).execute_of("one");
         let p = Program::new(vec![one, sink, two], UserBindings::none()).unwrap();
-        let src = super::source(&p, false, ItemLayout::Interleaved, None);
+        let src = super::source(&p, false, ItemLayout::Interleaved, None, false);
         assert_eq!(src.matches("one_execute(it, inv)").count(), 1, "{src}");
         assert!(src.contains("case 0u, 2u:"), "{src}");
     }
