@@ -131,9 +131,14 @@ fn sched_raise(code: u32, a: u32, b: u32) {
     atomicStore(&ctrl[gw(G_STOP)], 1u);
 }
 
+// Generated before this file: `sched_take(t, direct) -> vec2<u32>`, the index j of this emit
+// among the batch's emits to t and, for direct enqueue, its ticket of queue t (taken only for
+// emits within the batch's declared limit): one lane's atomics, or on adapters with subgroups one
+// atomic per subgroup (scheduler/src/megakernel/wgsl.rs, MegakernelConfig::subgroups).
+
 // Where enqueue_<t> puts the j-th item emitted to queue t in this batch, or a raised error.
 fn sched_outbox_slot(t: u32) -> u32 {
-    let j = atomicAdd(&wg_emit_count[t], 1u);
+    let j = sched_take(t, false).x;
     if j >= sched_batch_n * EMITS[sched_proc * NQ + t] {
         sched_raise(ERR_EMIT, sched_proc, t);
         return 0xffffffffu;
@@ -145,12 +150,13 @@ fn sched_outbox_slot(t: u32) -> u32 {
 // publishing, or a raised error. The claim reserved the batch's worst case in t's budget, so the
 // ticket is below t's capacity.
 fn sched_direct_slot(t: u32) -> u32 {
-    let j = atomicAdd(&wg_emit_count[t], 1u);
+    let js = sched_take(t, true);
+    let j = js.x;
     if j >= sched_batch_n * EMITS[sched_proc * NQ + t] {
         sched_raise(ERR_EMIT, sched_proc, t);
         return 0xffffffffu;
     }
-    let s = atomicAdd(&ctrl[t * QSTRIDE + Q_RESERVE], 1u);
+    let s = js.y;
     wg_emit_slot[ES_OFF[sched_proc * NQ + t] + j] = s;
     return s;
 }

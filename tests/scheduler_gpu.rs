@@ -50,7 +50,12 @@ impl Lcg {
 }
 
 fn stress_configs() -> Vec<(&'static str, MegakernelConfig)> {
-    let base = MegakernelConfig::default();
+    // Every run starts at its initial capacity, so the tiny queues grow run after run (except
+    // "oversubscribed" and "probed", which keep the room of the runs before).
+    let base = MegakernelConfig {
+        size_from_last_run: false,
+        ..Default::default()
+    };
     vec![
         (
             "one workgroup",
@@ -125,12 +130,39 @@ fn stress_configs() -> Vec<(&'static str, MegakernelConfig)> {
             },
         ),
         (
+            // The per-item ticket path where the adapter has subgroups (the default takes
+            // tickets once per subgroup there), both ways of enqueueing.
+            "no subgroups, direct enqueue, tiny queues, impatient waits",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(3),
+                max_iterations: 24,
+                spin_limit: 1,
+                initial_capacity: 16,
+                direct_enqueue: Some(true),
+                subgroups: Some(false),
+                ..base.clone()
+            },
+        ),
+        (
+            "no subgroups, outbox, tiny queues, impatient waits",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(3),
+                max_iterations: 24,
+                spin_limit: 1,
+                initial_capacity: 16,
+                direct_enqueue: Some(false),
+                subgroups: Some(false),
+                ..base.clone()
+            },
+        ),
+        (
             "oversubscribed",
             MegakernelConfig {
                 workgroups: Workgroups::Fixed(24),
                 batch_steps: 4,
                 max_iterations: 200,
                 initial_capacity: 64,
+                size_from_last_run: true,
                 ..base.clone()
             },
         ),
@@ -139,6 +171,7 @@ fn stress_configs() -> Vec<(&'static str, MegakernelConfig)> {
             MegakernelConfig {
                 policy: QueuePolicy::Fifo,
                 initial_capacity: 256,
+                size_from_last_run: true,
                 ..base
             },
         ),
@@ -185,6 +218,17 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
             direct.contains(&true) && direct.contains(&false),
             "{direct:?}"
         );
+        // And both ways of taking tickets: per subgroup (lavapipe has subgroups of 8) and per
+        // item.
+        let subgroups: Vec<bool> = (schedulers.iter())
+            .filter_map(|(_, s)| match s {
+                Scheduler::Megakernel(m) => Some(m.subgroups()),
+                _ => None,
+            })
+            .collect();
+        assert!(gpu.subgroups || !gpu.is_lavapipe(), "lavapipe without subgroups");
+        assert!(subgroups.contains(&false), "{subgroups:?}");
+        assert_eq!(subgroups.contains(&true), gpu.subgroups, "{subgroups:?}");
         schedulers.push((
             "multipass, tiny queues".into(),
             Scheduler::multipass(

@@ -154,6 +154,11 @@ pub struct Cli {
     /// reserve, copy, publish) and print the table after the runs (`MegakernelConfig::turn_anatomy`).
     #[arg(long, help_heading = "Scheduler")]
     pub turn_anatomy: bool,
+
+    /// The megakernel takes enqueue tickets one atomic per item even where the adapter has
+    /// subgroups (by default one per subgroup there: `MegakernelConfig::subgroups`).
+    #[arg(long, help_heading = "Scheduler")]
+    pub no_subgroups: bool,
 }
 
 /// `--enqueue`: how megakernel items reach their queue.
@@ -294,6 +299,7 @@ impl Cli {
             idle_backoff: self.idle_backoff,
             capacity: self.capacity,
             turn_anatomy: self.turn_anatomy,
+            subgroups: self.no_subgroups.then_some(false),
             item_layout: self.item_layout,
             direct_enqueue: self.enqueue.map(|e| e == Enqueue::Direct),
         }

@@ -136,6 +136,8 @@ pub struct GpuConfig {
     pub capacity: Option<u32>,
     /// `MegakernelConfig::turn_anatomy`.
     pub turn_anatomy: bool,
+    /// `MegakernelConfig::subgroups`; `None`: where the adapter has them.
+    pub subgroups: Option<bool>,
 }
 
 impl Default for GpuConfig {
@@ -148,6 +150,7 @@ impl Default for GpuConfig {
             direct_enqueue: None,
             capacity: None,
             turn_anatomy: false,
+            subgroups: None,
         }
     }
 }
@@ -179,6 +182,7 @@ pub fn compile(
                 item_layout: config.item_layout,
                 direct_enqueue: config.direct_enqueue,
                 turn_anatomy: config.turn_anatomy,
+                subgroups: config.subgroups,
                 initial_capacity: capacity,
                 ..Default::default()
             },

@@ -108,6 +108,16 @@ pub struct MegakernelConfig {
     /// atomic per counter per workgroup at exit. Off by default; when off the counters are
     /// compiled out.
     pub turn_anatomy: bool,
+    /// Take enqueue tickets once per subgroup (one atomic for all lanes of a subgroup that emit
+    /// to a queue at once) with wgpu's `SUBGROUP` operations, instead of one atomic per item.
+    /// `None` (the default): where the device has them ([`Gpu::subgroups`]); `Some(false)` forces
+    /// the per-item path; `Some(true)` on a device without them is an error.
+    pub subgroups: Option<bool>,
+    /// Start a run with the room the largest earlier run of this megakernel needed to finish in
+    /// one launch (default `true`): queues that had to grow (each growth a relaunch after a host
+    /// round trip) are not shrunk back to `initial_capacity`. `false` starts every run at
+    /// `initial_capacity` (tests use it to exercise growth run after run).
+    pub size_from_last_run: bool,
 }
 
 /// Most tickets one batch may list for direct enqueue (`MegakernelConfig::direct_enqueue`):
@@ -133,6 +143,8 @@ impl Default for MegakernelConfig {
             item_layout: None,
             direct_enqueue: None,
             turn_anatomy: false,
+            subgroups: None,
+            size_from_last_run: true,
         }
     }
 }
@@ -256,7 +268,22 @@ impl Megakernel {
             .unwrap_or_else(|| ItemLayout::for_program(gpu, program));
         config.item_layout = Some(items);
         let direct = direct.then_some((emit_slots, es_off.as_slice()));
-        let source = wgsl::source(program, gpu.coherent, items, direct, config.turn_anatomy);
+        if config.subgroups == Some(true) && !gpu.subgroups {
+            return Err(RunError::Program(format!(
+                "subgroups asked for, but {} lacks wgpu's SUBGROUP feature",
+                gpu.adapter_name()
+            )));
+        }
+        let subgroups = config.subgroups.unwrap_or(gpu.subgroups);
+        config.subgroups = Some(subgroups);
+        let source = wgsl::source(
+            program,
+            gpu.coherent,
+            items,
+            direct,
+            config.turn_anatomy,
+            subgroups,
+        );
         let entries = [
             storage_entry(0, false),
             storage_entry(1, false),
@@ -301,6 +328,11 @@ impl Megakernel {
     /// and the batch's worst case within [`MAX_DIRECT_EMITS`]) or through the outbox.
     pub fn direct_enqueue(&self) -> bool {
         self.config.direct_enqueue == Some(true)
+    }
+
+    /// Whether enqueue tickets are taken once per subgroup (`MegakernelConfig::subgroups`).
+    pub fn subgroups(&self) -> bool {
+        self.config.subgroups == Some(true)
     }
 
     fn enqueue_name(&self) -> &'static str {
@@ -492,7 +524,10 @@ impl Megakernel {
         // A queue holds every ticket of a launch, so a run grows its queues (each growth a
         // relaunch with a host round trip) unless they start with room for all it appends. What
         // an earlier run of this program needed is the best estimate the host has: start there.
-        let known = self.one_launch_need.lock().unwrap().clone();
+        let known = match self.config.size_from_last_run {
+            true => self.one_launch_need.lock().unwrap().clone(),
+            false => vec![0; nq],
+        };
         let mut capacity: Vec<u32> = (0..nq)
             .map(|q| {
                 let n = seeded[q];
