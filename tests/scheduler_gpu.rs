@@ -226,7 +226,10 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
                 _ => None,
             })
             .collect();
-        assert!(gpu.subgroups || !gpu.is_lavapipe(), "lavapipe without subgroups");
+        assert!(
+            gpu.subgroups || !gpu.is_lavapipe(),
+            "lavapipe without subgroups"
+        );
         assert!(subgroups.contains(&false), "{subgroups:?}");
         assert_eq!(subgroups.contains(&true), gpu.subgroups, "{subgroups:?}");
         schedulers.push((

@@ -151,7 +151,10 @@ mod tests {
         assert_eq!(a.turns, 20);
         assert_eq!(a.claim, 80);
         let t = a.table(16, 2, Some(1.0));
-        assert!(t.contains("claim    global atomics             80       5.00       4.00"), "{t}");
+        assert!(
+            t.contains("claim    global atomics             80       5.00       4.00"),
+            "{t}"
+        );
         // 1 ms x 2 workgroups over 20 turns.
         assert!(t.contains("mean turn: 100.00 us"), "{t}");
         assert!(a.table(0, 1, None).contains("n/a"));

@@ -543,10 +543,7 @@ impl Megakernel {
             executed: vec![0; nq],
             peak_occupancy: vec![0; nq],
             workgroups,
-            turn_anatomy: self
-                .config
-                .turn_anatomy
-                .then(anatomy::TurnAnatomy::default),
+            turn_anatomy: self.config.turn_anatomy.then(anatomy::TurnAnatomy::default),
             ..Default::default()
         };
         let mut timer = RunTimer::new(gpu, 64);
