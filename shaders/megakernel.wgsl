@@ -32,6 +32,19 @@ const G_PROBE_FINISHED: u32 = 9u;
 const G_PROBE_RESIDENT: u32 = 10u;
 const G_ITER_EXITS: u32 = 11u;
 // G_LOST = 12: written only by the device compaction (megakernel_compact.wgsl)
+// Turn anatomy (TURN_ANATOMY; host twin: scheduler/src/megakernel/anatomy.rs): per phase, the
+// leader's (lane 0's) count of global memory operations or loop trips on the turn's critical
+// path, kept in lane 0's registers and added once when the workgroup leaves its loop.
+const G_AN: u32 = 16u;
+const AN_TURNS: u32 = 0u;    // loop turns (batches, idle turns and the exit turn)
+const AN_CLAIM: u32 = 1u;    // global atomics of the claim (every turn, idle ones included)
+const AN_WAIT: u32 = 2u;     // flag polls of the slowest lane, summed over batches
+const AN_EXEC: u32 = 3u;     // workgroup steps of the bodies
+const AN_ENQUEUE: u32 = 4u;  // direct enqueue: per-item ticket atomics (all lanes)
+const AN_RESERVE: u32 = 5u;  // global atomics after the batch, before the copy
+const AN_COPY: u32 = 6u;     // copy loop trips of a lane
+const AN_PUBLISH: u32 = 7u;  // flag-store trips of a lane + the leader's global atomics
+const AN_WORDS: u32 = 8u;
 
 const ERR_EMIT: u32 = 1u;
 
@@ -76,6 +89,12 @@ var<workgroup> wg_emit_count: array<atomic<u32>, NQ>;
 var<workgroup> wg_emit_base: array<u32, NQ>;
 var<workgroup> wg_emit_n: array<u32, NQ>;
 var<workgroup> wg_abandoned: atomic<u32>;
+var<workgroup> wg_emitted: atomic<u32>;
+// The turn's probe, read by lanes in parallel before the leader decides: Q_COUNT of prio(i) in
+// wg_avail[i], G_STOP and G_PENDING.
+var<workgroup> wg_avail: array<i32, NQ>;
+var<workgroup> wg_stop: u32;
+var<workgroup> wg_pending: u32;
 // Direct enqueue: the tickets this batch took, per target from ES_OFF[q * NQ + t].
 var<workgroup> wg_emit_slot: array<u32, EMIT_SLOTS>;
 
@@ -85,6 +104,16 @@ var<private> sched_batch_n: u32;
 var<private> sched_outbox: u32;
 var<private> sched_blocked: bool;
 var<private> sched_pause_sink: u32;
+// Statistics of the lane's own queue (lane t < NQ: queue t), added to ctrl once at exit.
+var<private> st_peak: u32;
+var<private> st_executed: u32;
+var<private> st_batches: u32;
+var<private> an: array<u32, AN_WORDS>;
+var<workgroup> wg_an_wait: atomic<u32>;
+
+fn an_add(k: u32, v: u32) {
+    if TURN_ANATOMY { an[k] += v; }
+}
 
 // An idle workgroup's pause before it polls again: a loop of `trips` dependent multiply-adds,
 // touching no memory, so idle workgroups do not crowd the L2 lines every claim needs.
@@ -102,9 +131,14 @@ fn sched_raise(code: u32, a: u32, b: u32) {
     atomicStore(&ctrl[gw(G_STOP)], 1u);
 }
 
+// Generated before this file: `sched_take(t, direct) -> vec2<u32>`, the index j of this emit
+// among the batch's emits to t and, for direct enqueue, its ticket of queue t (taken only for
+// emits within the batch's declared limit): one lane's atomics, or on adapters with subgroups one
+// atomic per subgroup (scheduler/src/megakernel/wgsl.rs, MegakernelConfig::subgroups).
+
 // Where enqueue_<t> puts the j-th item emitted to queue t in this batch, or a raised error.
 fn sched_outbox_slot(t: u32) -> u32 {
-    let j = atomicAdd(&wg_emit_count[t], 1u);
+    let j = sched_take(t, false).x;
     if j >= sched_batch_n * EMITS[sched_proc * NQ + t] {
         sched_raise(ERR_EMIT, sched_proc, t);
         return 0xffffffffu;
@@ -116,12 +150,13 @@ fn sched_outbox_slot(t: u32) -> u32 {
 // publishing, or a raised error. The claim reserved the batch's worst case in t's budget, so the
 // ticket is below t's capacity.
 fn sched_direct_slot(t: u32) -> u32 {
-    let j = atomicAdd(&wg_emit_count[t], 1u);
+    let js = sched_take(t, true);
+    let j = js.x;
     if j >= sched_batch_n * EMITS[sched_proc * NQ + t] {
         sched_raise(ERR_EMIT, sched_proc, t);
         return 0xffffffffu;
     }
-    let s = atomicAdd(&ctrl[t * QSTRIDE + Q_RESERVE], 1u);
+    let s = js.y;
     wg_emit_slot[ES_OFF[sched_proc * NQ + t] + j] = s;
     return s;
 }
@@ -139,6 +174,7 @@ fn reserve_budget(q: u32, n: u32) -> bool {
         let e = EMITS[q * NQ + t];
         if e == 0u { continue; }
         let need = n * e;
+        an_add(AN_CLAIM, 1u);
         let old = atomicAdd(&ctrl[t * QSTRIDE + Q_BUDGET], need);
         if old + need > q_cap(t) {
             atomicSub(&ctrl[t * QSTRIDE + Q_BUDGET], need);
@@ -156,23 +192,26 @@ fn reserve_budget(q: u32, n: u32) -> bool {
     return true;
 }
 
-// Leader only. Claims up to a batch of written items of q: an optimistic decrement of the count
-// (undone in part if it overshot), then tickets from head. Claimed tickets were all reserved
+// Leader only. Claims up to a batch of written items of q, of which `avail` were seen
+// (Q_COUNT, read by the turn's probe): an optimistic decrement of the count (undone in part if
+// it overshot, as when the probe's read is stale), then tickets from head. Claimed tickets were all reserved
 // before, since the count only grows after items are written.
-fn try_claim(q: u32) -> bool {
-    let avail = bitcast<i32>(atomicLoad(&ctrl[q * QSTRIDE + Q_COUNT]));
+fn try_claim(q: u32, avail: i32) -> bool {
     if avail <= 0 { return false; }
     let want = min(u32(avail), batch_max(q));
     if !reserve_budget(q, want) { return false; }
+    an_add(AN_CLAIM, 1u);
     let old = bitcast<i32>(atomicSub(&ctrl[q * QSTRIDE + Q_COUNT], want));
     let got = u32(clamp(old, 0, i32(want)));
     if got < want {
+        an_add(AN_CLAIM, 2u);
         atomicAdd(&ctrl[q * QSTRIDE + Q_COUNT], want - got);
         release_budget(q, want - got, NQ);
     }
     if got == 0u { return false; }
     wg_q = q;
     wg_n = got;
+    an_add(AN_CLAIM, 1u);
     wg_h = atomicAdd(&ctrl[q * QSTRIDE + Q_HEAD], got);
     return true;
 }
@@ -182,7 +221,9 @@ fn fifo_pick() -> u32 {
     var best = NQ;
     var best_stamp = CONSUMED;
     for (var q = 0u; q < NQ; q++) {
+        an_add(AN_CLAIM, 1u);
         if bitcast<i32>(atomicLoad(&ctrl[q * QSTRIDE + Q_COUNT])) <= 0 { continue; }
+        an_add(AN_CLAIM, 2u);
         let h = atomicLoad(&ctrl[q * QSTRIDE + Q_HEAD]);
         if h >= q_cap(q) { continue; }
         let f = atomicLoad(&flags[q_flag_base(q) + h]);
@@ -192,18 +233,26 @@ fn fifo_pick() -> u32 {
 }
 
 fn leader_decide() -> u32 {
-    if atomicLoad(&ctrl[gw(G_STOP)]) != 0u { return CMD_EXIT; }
+    an_add(AN_TURNS, 1u);
+    an_add(AN_CLAIM, 1u); // the probe: one round of parallel loads
+    if wg_stop != 0u { return CMD_EXIT; }
     sched_blocked = false;
     if params[P_POLICY] == 1u {
         let q = fifo_pick();
-        if q < NQ && try_claim(q) { return CMD_RUN; }
+        if q < NQ {
+            an_add(AN_CLAIM, 1u);
+            if try_claim(q, bitcast<i32>(atomicLoad(&ctrl[q * QSTRIDE + Q_COUNT]))) { return CMD_RUN; }
+        }
     }
+    // The probe read every count at once; only queues seen with work cost atomics.
     for (var i = 0u; i < NQ; i++) {
-        if try_claim(prio(i)) { return CMD_RUN; }
+        if try_claim(prio(i), wg_avail[i]) { return CMD_RUN; }
     }
     // Nothing claimable. Pending counts every item still to run in this launch, including
-    // those being produced right now, so zero means this launch is finished.
-    if atomicLoad(&ctrl[gw(G_PENDING)]) == 0u { return CMD_EXIT; }
+    // those being produced right now, so zero means this launch is finished. Zero is final (only
+    // a running batch adds to it, and a running batch's items are pending), so the probe's read,
+    // taken before the claims, decides as well as a fresh one.
+    if wg_pending == 0u { return CMD_EXIT; }
     if sched_blocked {
         // Work waits for room that only compaction between launches can give: end the launch.
         atomicStore(&ctrl[gw(G_STOP)], 1u);
@@ -239,9 +288,19 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
     var iter = 0u;
     // Bounded far below lavapipe's silent 65,535-iteration cut; the host relaunches if needed.
     for (; iter < params[P_MAX_ITERS]; iter++) {
+        // The probe: lanes read every queue's count, the stop and pending words in parallel
+        // (one round trip instead of one per queue, in turn, on the leader).
+        if lid < NQ {
+            wg_avail[lid] = bitcast<i32>(atomicLoad(&ctrl[prio(lid) * QSTRIDE + Q_COUNT]));
+        }
+        if lid == 255u { wg_stop = atomicLoad(&ctrl[gw(G_STOP)]); }
+        if lid == 254u { wg_pending = atomicLoad(&ctrl[gw(G_PENDING)]); }
+        workgroupBarrier();
         if lid == 0u {
             wg_cmd = leader_decide();
             atomicStore(&wg_abandoned, 0u);
+            atomicStore(&wg_emitted, 0u);
+            if TURN_ANATOMY { atomicStore(&wg_an_wait, 0u); }
         }
         if lid < NQ { atomicStore(&wg_emit_count[lid], 0u); }
         let cmd = workgroupUniformLoad(&wg_cmd);
@@ -259,14 +318,18 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
 
         // 1. Wait, bounded, for each claimed slot's producer to publish it. A slot whose wait
         //    runs out is abandoned to the compaction between launches: never lost.
+        var polls = 0u;
         for (var i = lid; i < n; i += 256u) {
             var ok = 0u;
-            for (var s = 0u; s < params[P_SPIN]; s++) {
+            var s = 0u;
+            for (; s < params[P_SPIN]; s++) {
                 if atomicLoad(&flags[q_flag_base(q) + h + i]) != EMPTY { ok = 1u; break; }
             }
+            polls += min(s + 1u, params[P_SPIN]);
             wg_ready[i] = ok;
             if ok == 0u { atomicAdd(&wg_abandoned, 1u); }
         }
+        if TURN_ANATOMY && polls > 0u { atomicMax(&wg_an_wait, polls); }
         storageBarrier(); // acquire: flags seen before the payload is read
         // wg_ready is workgroup memory, which storageBarrier does not order: lanes other than the
         // one that waited read it when threads_per_item > 1.
@@ -286,37 +349,77 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         }
         storageBarrier(); // outbox writes visible to the whole workgroup
 
-        // 3. Reserve tickets for what was emitted, one atomic per target queue.
-        if lid == 0u {
-            let abandoned = atomicLoad(&wg_abandoned);
-            var emitted = 0u;
-            for (var t = 0u; t < NQ; t++) {
-                let k = min(atomicLoad(&wg_emit_count[t]), n * EMITS[q * NQ + t]);
-                wg_emit_n[t] = k;
-                emitted += k;
-                if k > 0u {
-                    // Direct enqueue took its tickets item by item; else take k now.
-                    var end = atomicLoad(&ctrl[t * QSTRIDE + Q_RESERVE]);
-                    if !DIRECT_ENQUEUE {
-                        let base = atomicAdd(&ctrl[t * QSTRIDE + Q_RESERVE], k);
-                        wg_emit_base[t] = base;
-                        end = base + k;
-                    }
-                    let waiting = end - min(atomicLoad(&ctrl[t * QSTRIDE + Q_HEAD]), end);
-                    atomicMax(&ctrl[t * QSTRIDE + Q_PEAK], waiting);
+        // 3. Reserve tickets for what was emitted: lane t for target queue t, all in parallel;
+        //    lane q counts the batch in its statistics (registers, added to ctrl at exit).
+        let abandoned = atomicLoad(&wg_abandoned);
+        if lid < NQ {
+            let t = lid;
+            let promised = n * EMITS[q * NQ + t];
+            let k = min(atomicLoad(&wg_emit_count[t]), promised);
+            wg_emit_n[t] = k;
+            if k > 0u {
+                // Direct enqueue took its tickets item by item; else take k now.
+                var end = 0u;
+                if DIRECT_ENQUEUE {
+                    end = atomicLoad(&ctrl[t * QSTRIDE + Q_RESERVE]);
+                } else {
+                    let base = atomicAdd(&ctrl[t * QSTRIDE + Q_RESERVE], k);
+                    wg_emit_base[t] = base;
+                    end = base + k;
                 }
-                // Unused promised room goes back.
-                let promised = n * EMITS[q * NQ + t];
-                if promised > k { atomicSub(&ctrl[t * QSTRIDE + Q_BUDGET], promised - k); }
+                st_peak = max(st_peak, end - min(atomicLoad(&ctrl[t * QSTRIDE + Q_HEAD]), end));
+                atomicAdd(&wg_emitted, k);
             }
-            // Children are pending before their parent stops being pending.
-            if emitted > 0u { atomicAdd(&ctrl[gw(G_PENDING)], emitted); }
-            wg_stamp = atomicAdd(&ctrl[gw(G_SEQ)], 1u) + 2u;
-            atomicAdd(&ctrl[q * QSTRIDE + Q_EXECUTED], n - abandoned);
-            atomicAdd(&ctrl[q * QSTRIDE + Q_BATCHES], 1u);
+            // Unused promised room goes back.
+            if promised > k { atomicSub(&ctrl[t * QSTRIDE + Q_BUDGET], promised - k); }
+            if t == q {
+                st_executed += n - abandoned;
+                st_batches += 1u;
+            }
+        }
+        if lid == 0u {
+            // A stamp that orders batches only where the FIFO policy compares them.
+            wg_stamp = 2u;
+            if params[P_POLICY] == 1u { wg_stamp = atomicAdd(&ctrl[gw(G_SEQ)], 1u) + 2u; }
             if abandoned > 0u { atomicAdd(&ctrl[gw(G_ABANDONED)], abandoned); }
         }
         workgroupBarrier();
+        if lid == 0u {
+            // Pending: + the children, - this batch, in one atomic. The children are counted
+            // before they are published (the count adds below, after a storageBarrier), so
+            // pending stays above zero until they run; without children it may reach zero now,
+            // which is right: nothing of this launch is left to run.
+            let emitted = atomicLoad(&wg_emitted);
+            if emitted > n {
+                atomicAdd(&ctrl[gw(G_PENDING)], emitted - n);
+            } else if emitted < n {
+                atomicSub(&ctrl[gw(G_PENDING)], n - emitted);
+            }
+            if TURN_ANATOMY {
+                an_add(AN_WAIT, atomicLoad(&wg_an_wait));
+                an_add(AN_EXEC, (n + per_step - 1u) / per_step);
+                // The longest lane's chain; then the pending atomic and, under FIFO, the stamp.
+                var chain = 0u;
+                for (var t = 0u; t < NQ; t++) {
+                    let k = wg_emit_n[t];
+                    chain = max(chain, 3u * u32(k > 0u) + u32(n * EMITS[q * NQ + t] > k));
+                    if DIRECT_ENQUEUE { an_add(AN_ENQUEUE, k); }
+                    if !DIRECT_ENQUEUE {
+                        if ITEMS_PLANAR {
+                            an_add(AN_COPY, ((k + 255u) / 256u) * WORDS[t]);
+                        } else if WORDS[t] % 4u == 0u {
+                            an_add(AN_COPY, (k * WORDS[t] + 1023u) / 1024u);
+                        } else {
+                            an_add(AN_COPY, (k * WORDS[t] + 255u) / 256u);
+                        }
+                    }
+                    an_add(AN_PUBLISH, (k + 255u) / 256u);
+                }
+                an_add(AN_RESERVE, chain + u32(emitted != n) + params[P_POLICY] + u32(abandoned > 0u));
+                // Flag stores of the inputs, then one round of parallel count adds.
+                an_add(AN_PUBLISH, (n + 255u) / 256u + 1u);
+            }
+        }
 
         // 4. Copy the payloads into the reserved slots, coalesced: planar items a plane at a
         //    time; interleaved ones 16 bytes per thread where the item is a whole number of vec4s
@@ -373,17 +476,27 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
             if wg_ready[i] != 0u { atomicStore(&flags[q_flag_base(q) + h + i], CONSUMED); }
         }
         storageBarrier();
-        if lid == 0u {
-            for (var t = 0u; t < NQ; t++) {
-                if wg_emit_n[t] > 0u { atomicAdd(&ctrl[t * QSTRIDE + Q_COUNT], wg_emit_n[t]); }
-            }
-            atomicSub(&ctrl[gw(G_PENDING)], n);
+        // The new items become claimable: lane t adds target t's, all in parallel.
+        if lid < NQ && wg_emit_n[lid] > 0u {
+            atomicAdd(&ctrl[lid * QSTRIDE + Q_COUNT], wg_emit_n[lid]);
         }
+    }
+    // Statistics, once per workgroup and launch. Every exit of the loop passes here, lavapipe's
+    // silent loop cut included, so the host's accounting (executed per queue) stays exact.
+    if lid < NQ {
+        if st_executed > 0u { atomicAdd(&ctrl[lid * QSTRIDE + Q_EXECUTED], st_executed); }
+        if st_batches > 0u { atomicAdd(&ctrl[lid * QSTRIDE + Q_BATCHES], st_batches); }
+        if st_peak > 0u { atomicMax(&ctrl[lid * QSTRIDE + Q_PEAK], st_peak); }
     }
     if lid == 0u {
         if idle > 0u { atomicAdd(&ctrl[gw(G_IDLE)], idle); }
         if iter >= params[P_MAX_ITERS] { atomicAdd(&ctrl[gw(G_ITER_EXITS)], 1u); }
         // Keeps the pauses from being optimised away (never true in practice).
         if sched_pause_sink == 0x9e3779b9u { atomicAdd(&ctrl[gw(G_IDLE)], 1u); }
+        if TURN_ANATOMY {
+            for (var k = 0u; k < AN_WORDS; k++) {
+                if an[k] > 0u { atomicAdd(&ctrl[gw(G_AN + k)], an[k]); }
+            }
+        }
     }
 }

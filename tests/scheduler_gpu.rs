@@ -50,7 +50,12 @@ impl Lcg {
 }
 
 fn stress_configs() -> Vec<(&'static str, MegakernelConfig)> {
-    let base = MegakernelConfig::default();
+    // Every run starts at its initial capacity, so the tiny queues grow run after run (except
+    // "oversubscribed" and "probed", which keep the room of the runs before).
+    let base = MegakernelConfig {
+        size_from_last_run: false,
+        ..Default::default()
+    };
     vec![
         (
             "one workgroup",
@@ -125,12 +130,39 @@ fn stress_configs() -> Vec<(&'static str, MegakernelConfig)> {
             },
         ),
         (
+            // The per-item ticket path where the adapter has subgroups (the default takes
+            // tickets once per subgroup there), both ways of enqueueing.
+            "no subgroups, direct enqueue, tiny queues, impatient waits",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(3),
+                max_iterations: 24,
+                spin_limit: 1,
+                initial_capacity: 16,
+                direct_enqueue: Some(true),
+                subgroups: Some(false),
+                ..base.clone()
+            },
+        ),
+        (
+            "no subgroups, outbox, tiny queues, impatient waits",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(3),
+                max_iterations: 24,
+                spin_limit: 1,
+                initial_capacity: 16,
+                direct_enqueue: Some(false),
+                subgroups: Some(false),
+                ..base.clone()
+            },
+        ),
+        (
             "oversubscribed",
             MegakernelConfig {
                 workgroups: Workgroups::Fixed(24),
                 batch_steps: 4,
                 max_iterations: 200,
                 initial_capacity: 64,
+                size_from_last_run: true,
                 ..base.clone()
             },
         ),
@@ -139,6 +171,7 @@ fn stress_configs() -> Vec<(&'static str, MegakernelConfig)> {
             MegakernelConfig {
                 policy: QueuePolicy::Fifo,
                 initial_capacity: 256,
+                size_from_last_run: true,
                 ..base
             },
         ),
@@ -185,6 +218,20 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
             direct.contains(&true) && direct.contains(&false),
             "{direct:?}"
         );
+        // And both ways of taking tickets: per subgroup (lavapipe has subgroups of 8) and per
+        // item.
+        let subgroups: Vec<bool> = (schedulers.iter())
+            .filter_map(|(_, s)| match s {
+                Scheduler::Megakernel(m) => Some(m.subgroups()),
+                _ => None,
+            })
+            .collect();
+        assert!(
+            gpu.subgroups || !gpu.is_lavapipe(),
+            "lavapipe without subgroups"
+        );
+        assert!(subgroups.contains(&false), "{subgroups:?}");
+        assert_eq!(subgroups.contains(&true), gpu.subgroups, "{subgroups:?}");
         schedulers.push((
             "multipass, tiny queues".into(),
             Scheduler::multipass(
@@ -464,7 +511,7 @@ fn a_run_started_at_capacity_16_grows_geometrically_and_stays_exact() {
         assert_eq!(result, reference, "{kind:?} roomy");
         assert_eq!(base.queue_growths, 0, "{kind:?}: {base:?}");
         let tiny = Scheduler::new(&gpu, &run.program, kind, 16).unwrap();
-        for _ in 0..2 {
+        for again in [false, true] {
             let (stats, result) = run.run(&gpu, &tiny).unwrap();
             eprintln!(
                 "{kind:?}: {} launches, {} submits, {} growths, {} rounds (roomy: {} launches, \
@@ -479,6 +526,11 @@ fn a_run_started_at_capacity_16_grows_geometrically_and_stays_exact() {
             );
             assert_eq!(result, reference, "{kind:?}");
             let growths = stats.queue_growths;
+            if again && kind == StrategyKind::Megakernel {
+                // The megakernel starts a run with the room its last run needed.
+                assert_eq!(growths, 0, "{stats:?}");
+                continue;
+            }
             assert!(growths >= 1, "{kind:?} never grew from 16: {stats:?}");
             assert!(growths <= growth_bound(&stats), "{kind:?}: {stats:?}");
             match kind {
@@ -509,6 +561,50 @@ fn a_run_started_at_capacity_16_grows_geometrically_and_stays_exact() {
             }
         }
     }
+}
+
+/// A megakernel run whose queues had to grow (each growth a relaunch after a host round trip)
+/// teaches its scheduler the room the work needs: the next run, memory allowing, is one launch
+/// with no growth. One workgroup, so no slot waits on another workgroup (an abandoned wait would
+/// also end a launch) and the work fits lavapipe's bounded launch.
+#[test]
+fn a_megakernel_run_after_one_that_grew_needs_exactly_one_launch() {
+    let gpu = gpu();
+    let params = TreeParams {
+        roots: 4,
+        max_depth: 9,
+        fanout: Fanout::Uniform(2),
+        work: 1,
+        payload_words: 2,
+        seed: 5,
+    };
+    let reference = params.reference();
+    let run = TreeRun::new(&gpu, params).unwrap();
+    let mk = Scheduler::megakernel(
+        &gpu,
+        &run.program,
+        MegakernelConfig {
+            workgroups: Workgroups::Fixed(1),
+            initial_capacity: 16,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let (first, result) = run.run(&gpu, &mk).unwrap();
+    assert_eq!(result, reference);
+    assert!(first.queue_growths >= 1 && first.launches >= 2, "{first:?}");
+    for _ in 0..2 {
+        let (next, result) = run.run(&gpu, &mk).unwrap();
+        assert_eq!(result, reference);
+        assert_eq!((next.launches, next.queue_growths), (1, 0), "{next:?}");
+        assert_eq!(next.submits, 1, "{next:?}");
+    }
+    // A memory budget below that room still bounds the queues (the remembered room is only a
+    // start): the first run's final queues, smaller than the room with every batch's promise.
+    let budget = first.queue_bytes;
+    let (tight, result) = run.run_within(&gpu, &mk, Some(budget)).unwrap();
+    assert_eq!(result, reference);
+    assert!(tight.queue_bytes <= budget, "{tight:?} within {budget}");
 }
 
 #[test]

@@ -149,6 +149,16 @@ pub struct Cli {
     #[arg(long, value_name = "SLOTS", value_parser = value_parser!(u32).range(1..),
           help_heading = "Scheduler")]
     pub capacity: Option<u32>,
+
+    /// Count what the megakernel's loop turns spend per phase (claim, wait for flags, execute,
+    /// reserve, copy, publish) and print the table after the runs (`MegakernelConfig::turn_anatomy`).
+    #[arg(long, help_heading = "Scheduler")]
+    pub turn_anatomy: bool,
+
+    /// The megakernel takes enqueue tickets one atomic per item even where the adapter has
+    /// subgroups (by default one per subgroup there: `MegakernelConfig::subgroups`).
+    #[arg(long, help_heading = "Scheduler")]
+    pub no_subgroups: bool,
 }
 
 /// `--enqueue`: how megakernel items reach their queue.
@@ -288,6 +298,8 @@ impl Cli {
             batch_steps: self.batch_steps,
             idle_backoff: self.idle_backoff,
             capacity: self.capacity,
+            turn_anatomy: self.turn_anatomy,
+            subgroups: self.no_subgroups.then_some(false),
             item_layout: self.item_layout,
             direct_enqueue: self.enqueue.map(|e| e == Enqueue::Direct),
         }

@@ -235,6 +235,7 @@ mod tests {
             peak_occupancy: vec![],
             queue_bytes: 0,
             workgroups: 0,
+            turn_anatomy: Vec::new(),
         };
         let records = vec![
             rec("a", 1000, 1.0),

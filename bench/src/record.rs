@@ -58,6 +58,10 @@ pub struct RunRecord {
     pub peak_occupancy: Vec<u64>,
     pub queue_bytes: u64,
     pub workgroups: u32,
+    /// Megakernel with `--turn-anatomy`: per phase (claim, wait, ...), its count over the run
+    /// (`scheduler::megakernel::anatomy::TurnAnatomy::phases`), then `turns`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub turn_anatomy: Vec<(String, u64)>,
 }
 
 /// Which run of what: the fields every record of one (workload, size, strategy) shares.
@@ -95,6 +99,12 @@ impl RunRecord {
             peak_occupancy: s.peak_occupancy,
             queue_bytes: s.queue_bytes,
             workgroups: s.workgroups,
+            turn_anatomy: s.turn_anatomy.as_ref().map_or(Vec::new(), |a| {
+                let mut v: Vec<(String, u64)> =
+                    a.phases().iter().map(|p| (p.0.to_string(), p.2)).collect();
+                v.push(("turns".into(), a.turns));
+                v
+            }),
             item_layout: (!s.item_layout.is_empty()).then(|| s.item_layout.clone()),
             enqueue: (!s.enqueue.is_empty()).then(|| s.enqueue.clone()),
             ..Self::failed(k, String::new())
@@ -132,6 +142,7 @@ impl RunRecord {
             peak_occupancy: Vec::new(),
             queue_bytes: 0,
             workgroups: 0,
+            turn_anatomy: Vec::new(),
         }
     }
 }

@@ -190,6 +190,7 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
             );
         }
     }
+    print_turn_anatomy(records);
     let refs: Vec<_> = cs.iter().collect();
     if let Some(best) = best_baseline(&refs) {
         for c in cs.iter().filter(|c| c.megakernel) {
@@ -201,6 +202,33 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
                     w.0 / best.wall.unwrap().0
                 );
             }
+        }
+    }
+}
+
+/// `--turn-anatomy`: per megakernel strategy, the table of its run with the median GPU time
+/// (wall time without one).
+fn print_turn_anatomy(records: &[RunRecord]) {
+    let mut names: Vec<&str> = Vec::new();
+    for r in records.iter().filter(|r| !r.turn_anatomy.is_empty()) {
+        if !names.contains(&r.strategy.as_str()) {
+            names.push(&r.strategy);
+        }
+    }
+    for name in names {
+        let mut runs: Vec<&RunRecord> = records
+            .iter()
+            .filter(|r| r.strategy == name && !r.turn_anatomy.is_empty())
+            .collect();
+        runs.sort_by(|a, b| {
+            let t = |r: &RunRecord| r.gpu_ms.or(r.wall_ms).unwrap_or(0.0);
+            t(a).total_cmp(&t(b))
+        });
+        let r = runs[runs.len() / 2];
+        let pairs = r.turn_anatomy.iter().map(|(n, c)| (n.as_str(), *c));
+        if let Some(a) = scheduler::megakernel::anatomy::TurnAnatomy::from_named(pairs) {
+            println!("{name}, run {} (median time):", r.run);
+            print!("{}", a.table(r.batches, r.workgroups, r.gpu_ms));
         }
     }
 }

@@ -134,6 +134,10 @@ pub struct GpuConfig {
     pub direct_enqueue: Option<bool>,
     /// Queue slots at the start of a run; `None` lets the workload choose from its size.
     pub capacity: Option<u32>,
+    /// `MegakernelConfig::turn_anatomy`.
+    pub turn_anatomy: bool,
+    /// `MegakernelConfig::subgroups`; `None`: where the adapter has them.
+    pub subgroups: Option<bool>,
 }
 
 impl Default for GpuConfig {
@@ -145,6 +149,8 @@ impl Default for GpuConfig {
             item_layout: None,
             direct_enqueue: None,
             capacity: None,
+            turn_anatomy: false,
+            subgroups: None,
         }
     }
 }
@@ -175,6 +181,8 @@ pub fn compile(
                 idle_backoff: config.idle_backoff,
                 item_layout: config.item_layout,
                 direct_enqueue: config.direct_enqueue,
+                turn_anatomy: config.turn_anatomy,
+                subgroups: config.subgroups,
                 initial_capacity: capacity,
                 ..Default::default()
             },

@@ -28,6 +28,9 @@ pub struct Gpu {
     pub coherent: bool,
     /// Timestamp queries at pass boundaries are available: runs report GPU time.
     pub timestamps: bool,
+    /// Subgroup operations (wgpu's `SUBGROUP`) are available: the megakernel aggregates its
+    /// enqueue tickets per subgroup (`MegakernelConfig::subgroups`).
+    pub subgroups: bool,
     /// Bound of every wait for the GPU ([`DEFAULT_GPU_TIMEOUT`] unless changed): a wait that
     /// runs out is a [`RunError::Timeout`].
     pub timeout: Duration,
@@ -98,7 +101,7 @@ impl Gpu {
 
     /// Opens a device on `adapter` with `required` features plus those the scheduler benefits
     /// from when present (`MEMORY_DECORATION_COHERENT`, `TIMESTAMP_QUERY`,
-    /// `TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES`), the adapter's
+    /// `TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES`, `SUBGROUP`), the adapter's
     /// storage and workgroup-memory limits, and 256 invocations per workgroup. Errors:
     /// [`RunError::NoAdapter`] when the adapter lacks `required` or `request_device` fails.
     pub fn from_adapter(adapter: wgpu::Adapter, required: wgpu::Features) -> Result<Gpu, RunError> {
@@ -115,7 +118,8 @@ impl Gpu {
         // adapter supports beyond WebGPU's 1 and 4 (reyes's raster peer: 8 or 16 MSAA samples).
         let wanted = wgpu::Features::MEMORY_DECORATION_COHERENT
             | wgpu::Features::TIMESTAMP_QUERY
-            | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES;
+            | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES
+            | wgpu::Features::SUBGROUP;
         let features = (available & wanted) | required;
         let alimits = adapter.limits();
         let limits = wgpu::Limits {
@@ -147,6 +151,7 @@ impl Gpu {
             uncaptured,
             coherent: features.contains(wgpu::Features::MEMORY_DECORATION_COHERENT),
             timestamps: features.contains(wgpu::Features::TIMESTAMP_QUERY),
+            subgroups: features.contains(wgpu::Features::SUBGROUP),
             adapter,
             device,
             queue,

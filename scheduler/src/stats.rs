@@ -48,6 +48,8 @@ pub struct RunStats {
     pub stage_gpu_ms: Vec<f64>,
     /// Host wall time: upload, all submissions, read-backs.
     pub wall_ms: f64,
+    /// Megakernel with `MegakernelConfig::turn_anatomy`: what its loop turns spent per phase.
+    pub turn_anatomy: Option<crate::megakernel::anatomy::TurnAnatomy>,
 }
 
 impl RunStats {
@@ -80,6 +82,11 @@ impl RunStats {
         self.workgroups = self.workgroups.max(o.workgroups);
         self.gpu_ms = self.gpu_ms.zip(o.gpu_ms).map(|(a, b)| a + b);
         self.wall_ms += o.wall_ms;
+        match (&mut self.turn_anatomy, &o.turn_anatomy) {
+            (Some(a), Some(b)) => a.absorb(b),
+            (None, Some(b)) => self.turn_anatomy = Some(b.clone()),
+            _ => {}
+        }
     }
 }
 

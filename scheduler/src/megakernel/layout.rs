@@ -30,7 +30,10 @@ pub const G_PROBE_RESIDENT: usize = 10;
 pub const G_ITER_EXITS: usize = 11;
 /// Slots the device compaction found reserved but unpublished, or could not place.
 pub const G_LOST: usize = 12;
-pub const GLOBAL_WORDS: usize = 16;
+/// First of the turn anatomy's counters (`anatomy::TurnAnatomy`, `AN_*` in the shader).
+pub const G_AN: usize = 16;
+pub const AN_WORDS: usize = 8;
+pub const GLOBAL_WORDS: usize = G_AN + AN_WORDS;
 
 pub const ERR_EMIT: u32 = 1;
 
@@ -94,6 +97,8 @@ mod tests {
             ("G_ABANDONED", G_ABANDONED),
             ("G_PROBE_RESIDENT", G_PROBE_RESIDENT),
             ("G_ITER_EXITS", G_ITER_EXITS),
+            ("G_AN", G_AN),
+            ("AN_WORDS", AN_WORDS),
             ("P_MAX_ITERS", P_MAX_ITERS),
             ("P_BATCH_STEPS", P_BATCH_STEPS),
             ("P_IDLE_BACKOFF", P_IDLE_BACKOFF),

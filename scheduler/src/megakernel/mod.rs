@@ -3,6 +3,7 @@
 //! with work left, the host compacts the queues (dropping consumed slots, keeping every live item),
 //! grows a queue that lacked room, and launches again. Protocol: `docs/scheduler.md`.
 
+pub mod anatomy;
 mod compact;
 pub(crate) mod layout;
 pub(crate) mod record;
@@ -102,6 +103,21 @@ pub struct MegakernelConfig {
     /// enqueue in the megakernel"):
     /// 64-word items 1.17 -> 0.80 ms, Reyes frames 1-4% faster; 3-word items 6-25% slower.
     pub direct_enqueue: Option<bool>,
+    /// Count what each loop turn spends per phase (claim, wait for flags, execute, reserve,
+    /// copy, publish) and report it in [`RunStats::turn_anatomy`]: a few registers and one
+    /// atomic per counter per workgroup at exit. Off by default; when off the counters are
+    /// compiled out.
+    pub turn_anatomy: bool,
+    /// Take enqueue tickets once per subgroup (one atomic for all lanes of a subgroup that emit
+    /// to a queue at once) with wgpu's `SUBGROUP` operations, instead of one atomic per item.
+    /// `None` (the default): where the device has them ([`Gpu::subgroups`]); `Some(false)` forces
+    /// the per-item path; `Some(true)` on a device without them is an error.
+    pub subgroups: Option<bool>,
+    /// Start a run with the room the largest earlier run of this megakernel needed to finish in
+    /// one launch (default `true`): queues that had to grow (each growth a relaunch after a host
+    /// round trip) are not shrunk back to `initial_capacity`. `false` starts every run at
+    /// `initial_capacity` (tests use it to exercise growth run after run).
+    pub size_from_last_run: bool,
 }
 
 /// Most tickets one batch may list for direct enqueue (`MegakernelConfig::direct_enqueue`):
@@ -126,6 +142,9 @@ impl Default for MegakernelConfig {
             max_launches: 10_000,
             item_layout: None,
             direct_enqueue: None,
+            turn_anatomy: false,
+            subgroups: None,
+            size_from_last_run: true,
         }
     }
 }
@@ -147,6 +166,9 @@ pub struct Megakernel {
     /// The mapped buffer ctrl is read back through after each launch, kept between runs.
     readback: std::sync::Mutex<Option<Readback>>,
     compaction: DeviceCompaction,
+    /// Slots per queue that the largest run so far needed to finish in one launch (see
+    /// [`Megakernel::run`]); the next run starts with at least this much, within its limits.
+    one_launch_need: std::sync::Mutex<Vec<u64>>,
 }
 
 /// Buffers of one queue layout.
@@ -246,7 +268,22 @@ impl Megakernel {
             .unwrap_or_else(|| ItemLayout::for_program(gpu, program));
         config.item_layout = Some(items);
         let direct = direct.then_some((emit_slots, es_off.as_slice()));
-        let source = wgsl::source(program, gpu.coherent, items, direct);
+        if config.subgroups == Some(true) && !gpu.subgroups {
+            return Err(RunError::Program(format!(
+                "subgroups asked for, but {} lacks wgpu's SUBGROUP feature",
+                gpu.adapter_name()
+            )));
+        }
+        let subgroups = config.subgroups.unwrap_or(gpu.subgroups);
+        config.subgroups = Some(subgroups);
+        let source = wgsl::source(
+            program,
+            gpu.coherent,
+            items,
+            direct,
+            config.turn_anatomy,
+            subgroups,
+        );
         let entries = [
             storage_entry(0, false),
             storage_entry(1, false),
@@ -278,6 +315,7 @@ impl Megakernel {
             cache: Default::default(),
             readback: Default::default(),
             compaction: DeviceCompaction::new(gpu)?,
+            one_launch_need: std::sync::Mutex::new(vec![0; nq]),
         })
     }
 
@@ -290,6 +328,11 @@ impl Megakernel {
     /// and the batch's worst case within [`MAX_DIRECT_EMITS`]) or through the outbox.
     pub fn direct_enqueue(&self) -> bool {
         self.config.direct_enqueue == Some(true)
+    }
+
+    /// Whether enqueue tickets are taken once per subgroup (`MegakernelConfig::subgroups`).
+    pub fn subgroups(&self) -> bool {
+        self.config.subgroups == Some(true)
     }
 
     fn enqueue_name(&self) -> &'static str {
@@ -478,10 +521,18 @@ impl Megakernel {
             max_queue_bytes,
             1,
         )?;
+        // A queue holds every ticket of a launch, so a run grows its queues (each growth a
+        // relaunch with a host round trip) unless they start with room for all it appends. What
+        // an earlier run of this program needed is the best estimate the host has: start there.
+        let known = match self.config.size_from_last_run {
+            true => self.one_launch_need.lock().unwrap().clone(),
+            false => vec![0; nq],
+        };
         let mut capacity: Vec<u32> = (0..nq)
             .map(|q| {
                 let n = seeded[q];
                 let want = self.config.initial_capacity.max(n.saturating_mul(2)).max(1);
+                let want = want.max(known[q].min(u32::MAX as u64) as u32);
                 want.min(max_cap[q]).max(n)
             })
             .collect();
@@ -492,6 +543,7 @@ impl Megakernel {
             executed: vec![0; nq],
             peak_occupancy: vec![0; nq],
             workgroups,
+            turn_anatomy: self.config.turn_anatomy.then(anatomy::TurnAnatomy::default),
             ..Default::default()
         };
         let mut timer = RunTimer::new(gpu, 64);
@@ -581,6 +633,9 @@ impl Megakernel {
                     stats.peak_occupancy[q].max(ctrl[layout::q(q, Q_PEAK)] as u64);
             }
             stats.idle_polls += ctrl[g(nq, G_IDLE)] as u64;
+            if let Some(a) = stats.turn_anatomy.as_mut() {
+                a.add_launch(&ctrl[g(nq, G_AN)..g(nq, G_AN) + AN_WORDS]);
+            }
             stats.abandoned += ctrl[g(nq, G_ABANDONED)] as u64;
             if ctrl[g(nq, G_PENDING)] == 0 && ctrl[g(nq, G_ABANDONED)] == 0 {
                 break;
@@ -667,6 +722,22 @@ impl Megakernel {
                     self.item_layout(),
                 )?)
             };
+        }
+        // Room for one launch of this run: every item it appended to a queue (the executed ones:
+        // all ran) plus the worst case that running batches may have promised at once.
+        {
+            let mut known = self.one_launch_need.lock().unwrap();
+            for (t, need) in known.iter_mut().enumerate() {
+                let promised: u64 = (0..nq)
+                    .map(|q| {
+                        let p = &self.program.procs[q];
+                        let batch = (p.items_per_step * self.config.batch_steps.max(1))
+                            .min(MAX_BATCH) as u64;
+                        workgroups as u64 * batch * p.emits[t] as u64
+                    })
+                    .sum();
+                *need = (*need).max(stats.executed[t] + promised);
+            }
         }
         stats.queue_bytes = dq
             .as_ref()

@@ -11,16 +11,21 @@ pub const TEMPLATE: &str = include_str!("../../../shaders/megakernel.wgsl");
 /// The megakernel's WGSL for `program`, with `slots` read through `@coherent` loads where the
 /// device has them, and queues and outboxes holding items as `items` says. `direct`: enqueue
 /// straight into the slots, with the longest ticket list of a batch and each (source, target)
-/// part's offset in it (`MegakernelConfig::direct_enqueue`).
+/// part's offset in it (`MegakernelConfig::direct_enqueue`). `anatomy`: count each turn's
+/// phases (`MegakernelConfig::turn_anatomy`). `subgroups`: take enqueue tickets once per
+/// subgroup (`MegakernelConfig::subgroups`; the device must have wgpu's `SUBGROUP`).
 pub fn source(
     program: &Program,
     coherent: bool,
     items: ItemLayout,
     direct: Option<(u32, &[u32])>,
+    anatomy: bool,
+    subgroups: bool,
 ) -> String {
     let planar = items == ItemLayout::Planar;
     let mut s = program.tables_wgsl();
     s += &format!("const ITEMS_PLANAR: bool = {planar};\n");
+    s += &format!("const TURN_ANATOMY: bool = {anatomy};\n");
     let (slots, offsets) = direct.unwrap_or((1, &[]));
     let nq = program.queue_count();
     let es: Vec<String> = (0..nq * nq)
@@ -49,6 +54,7 @@ pub fn source(
                   for (var k = 0u; k < 4u; k++) { atomicStore(&slots[i + k], v[k]); }\n}\n";
     }
     s += &crate::wgsl::vec4_word_accessors("sched_ob", "outbox");
+    s += if subgroups { TAKE_SUBGROUP } else { TAKE_ONE };
     s += &items.execute_switch(program, "sched_slot");
     // Where item `s` of queue `q`'s slots starts (planar: and its stride).
     let slot_at = |q: &str| {
@@ -108,6 +114,41 @@ pub fn source(
     s
 }
 
+/// `sched_take` (see `shaders/megakernel.wgsl`): every emitting lane takes its own index and
+/// ticket.
+const TAKE_ONE: &str = "\
+fn sched_take(t: u32, direct: bool) -> vec2<u32> {
+    let j = atomicAdd(&wg_emit_count[t], 1u);
+    var s = 0u;
+    if direct && j < sched_batch_n * EMITS[sched_proc * NQ + t] {
+        s = atomicAdd(&ctrl[t * QSTRIDE + Q_RESERVE], 1u);
+    }
+    return vec2<u32>(j, s);
+}
+";
+
+/// `sched_take` with subgroups: the lanes of a subgroup that emit to `t` at the same call take
+/// consecutive indices and tickets with one atomic each (the first such lane's), as
+/// Whippletree's warp-aggregated enqueue does with ballot and popc.
+const TAKE_SUBGROUP: &str = "\
+fn sched_take(t: u32, direct: bool) -> vec2<u32> {
+    let rank = subgroupExclusiveAdd(1u);
+    let n = subgroupAdd(1u);
+    var base = vec2<u32>(0u, 0u);
+    if rank == 0u {
+        base.x = atomicAdd(&wg_emit_count[t], n);
+        if direct {
+            // Tickets only for the emits within the batch's declared limit.
+            let limit = sched_batch_n * EMITS[sched_proc * NQ + t];
+            let within = min(n, limit - min(limit, base.x));
+            if within > 0u { base.y = atomicAdd(&ctrl[t * QSTRIDE + Q_RESERVE], within); }
+        }
+    }
+    base = subgroupBroadcastFirst(base);
+    return base + vec2<u32>(rank, rank);
+}
+";
+
 #[cfg(test)]
 mod tests {
     use crate::{ItemLayout, ItemType, Procedure, Program, UserBindings};
@@ -121,7 +162,7 @@ mod tests {
             .body("fn sink_execute(item: Word, inv: Invocation) {}");
         let two = Procedure::new("two", word, 2).execute_of("one");
         let p = Program::new(vec![one, sink, two], UserBindings::none()).unwrap();
-        let src = super::source(&p, false, ItemLayout::Interleaved, None);
+        let src = super::source(&p, false, ItemLayout::Interleaved, None, false, false);
         assert_eq!(src.matches("one_execute(it, inv)").count(), 1, "{src}");
         assert!(src.contains("case 0u, 2u:"), "{src}");
     }
