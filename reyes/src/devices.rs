@@ -298,8 +298,7 @@ pub fn render_split(
     };
     let mut shares = Vec::new();
     let mut frame: Option<GpuFrame> = None;
-    for ((d, (name, _, _)), (part, pixels, wall_ms)) in devices.iter().enumerate().zip(done) {
-        let _ = d;
+    for ((name, _, _), (part, pixels, wall_ms)) in devices.iter().zip(done) {
         for p in &pixels {
             place(&mut image, p);
         }
