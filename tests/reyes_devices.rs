@@ -67,7 +67,11 @@ fn devices_lists_the_adapter_that_can_render() {
     let dir = scratch("list");
     let (code, out, err) = reyes(&dir, &["devices"]);
     assert_eq!(code, 0, "{err}");
-    assert!(out.lines().any(|l| l.starts_with("0: ") && l.ends_with("can render")), "{out}");
+    assert!(
+        out.lines()
+            .any(|l| l.starts_with("0: ") && l.ends_with("can render")),
+        "{out}"
+    );
     assert!(out.contains("--devices all: "), "{out}");
     let (code, _, err) = reyes(&dir, &["render", "--devices", "0,x"]);
     assert_eq!(code, 2, "{err}");
@@ -89,17 +93,31 @@ fn a_sequence_on_two_devices_equals_one_device_and_uses_both() {
     let (code, _, err) = reyes(&dir, &[&["render"][..], &one].concat());
     assert_eq!(code, 0, "{err}");
     let two = [
-        "render", scene, "--devices", "0,0", "-o", "two.####.png", "--stats", "two.####.json",
+        "render",
+        scene,
+        "--devices",
+        "0,0",
+        "-o",
+        "two.####.png",
+        "--stats",
+        "two.####.json",
     ];
     let (code, _, err) = reyes(&dir, &two);
     assert_eq!(code, 0, "{err}");
     let mut slots = Vec::new();
     for n in 1..=4 {
         let name = |s: &str, ext: &str| dir.join(format!("{s}.000{n}.{ext}"));
-        assert!(bytes(&name("one", "png")) == bytes(&name("two", "png")), "frame {n}");
+        assert!(
+            bytes(&name("one", "png")) == bytes(&name("two", "png")),
+            "frame {n}"
+        );
         let stats = json(&name("two", "json"));
         let devices = stats["devices"].as_array().expect("devices in --stats");
-        assert_eq!(devices.len(), 1, "frame {n}: one device renders a frame of a sequence");
+        assert_eq!(
+            devices.len(),
+            1,
+            "frame {n}: one device renders a frame of a sequence"
+        );
         assert_eq!(devices[0]["frames"], 1);
         slots.push(devices[0]["slot"].as_u64().unwrap());
     }
@@ -120,11 +138,26 @@ fn a_sequence_on_two_devices_equals_one_device_and_uses_both() {
 fn a_frame_split_over_two_devices_equals_one_device() {
     let dir = scratch("split");
     let size = ["--width", "160", "--height", "120"];
-    let one = [&["render", "teapot", "--gpu", "-o", "one.png", "--exr", "one.exr"][..], &size].concat();
+    let one = [
+        &[
+            "render", "teapot", "--gpu", "-o", "one.png", "--exr", "one.exr",
+        ][..],
+        &size,
+    ]
+    .concat();
     let (code, _, err) = reyes(&dir, &one);
     assert_eq!(code, 0, "{err}");
     let two = [
-        &["render", "teapot", "--devices", "0,0", "-o", "two.png", "--exr", "two.exr"][..],
+        &[
+            "render",
+            "teapot",
+            "--devices",
+            "0,0",
+            "-o",
+            "two.png",
+            "--exr",
+            "two.exr",
+        ][..],
         &["--stats", "two.json"],
         &size,
     ]
@@ -136,9 +169,18 @@ fn a_frame_split_over_two_devices_equals_one_device() {
     let stats = json(&dir.join("two.json"));
     let devices = stats["devices"].as_array().expect("devices in --stats");
     assert_eq!(devices.len(), 2);
-    let buckets: Vec<u64> = devices.iter().map(|d| d["buckets"].as_u64().unwrap()).collect();
-    assert!(buckets.iter().all(|&b| b > 0), "both devices rendered buckets: {buckets:?}");
-    assert_eq!(buckets.iter().sum::<u64>(), stats["buckets"].as_u64().unwrap());
+    let buckets: Vec<u64> = devices
+        .iter()
+        .map(|d| d["buckets"].as_u64().unwrap())
+        .collect();
+    assert!(
+        buckets.iter().all(|&b| b > 0),
+        "both devices rendered buckets: {buckets:?}"
+    );
+    assert_eq!(
+        buckets.iter().sum::<u64>(),
+        stats["buckets"].as_u64().unwrap()
+    );
     // 120 rows in strips of 16 (four per device wanted: 15 rows, rounded up to 16): 8.
     assert_eq!(stats["buckets"], 8);
     std::fs::remove_dir_all(&dir).unwrap();
@@ -149,8 +191,20 @@ fn a_frame_split_over_two_devices_equals_one_device() {
 fn bench_on_two_devices_reports_each_device() {
     let dir = scratch("bench");
     let args = [
-        "bench", "teapot", "--devices", "0,0", "--frames", "8", "--warmup", "1", "--turntable",
-        "--width", "64", "--height", "48", "--json",
+        "bench",
+        "teapot",
+        "--devices",
+        "0,0",
+        "--frames",
+        "8",
+        "--warmup",
+        "1",
+        "--turntable",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--json",
     ];
     let (code, out, err) = reyes(&dir, &args);
     assert_eq!(code, 0, "{err}");
@@ -165,6 +219,9 @@ fn bench_on_two_devices_reports_each_device() {
         .map(|f| f["angle_deg"].as_f64().unwrap())
         .collect();
     let want: Vec<f64> = (0..8).map(|i| 45.0 * i as f64).collect();
-    assert!(angles.iter().zip(&want).all(|(a, b)| (a - b).abs() < 1e-9), "{angles:?}");
+    assert!(
+        angles.iter().zip(&want).all(|(a, b)| (a - b).abs() < 1e-9),
+        "{angles:?}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
