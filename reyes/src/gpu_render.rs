@@ -3,7 +3,7 @@
 //! either strategy, then a resolve pass from sub-samples to pixels.
 
 use crate::buckets;
-use crate::frame::{FrameData, FrameUniforms, PatchItem, SceneFeatures};
+use crate::frame::{FrameData, FrameUniforms, PatchItem, SceneFeatures, Tile};
 use crate::gpu::{FrameTarget, Pipelines, SceneBuffers, scene_layout_entries};
 use crate::image::FrameImage;
 use crate::progress::Progress;
@@ -269,6 +269,31 @@ impl GpuRenderer {
     /// frame's differ; the target is reused while the size stays. Errors: a frame needing
     /// features the program was not compiled for ([`RunError::Program`]), and those of a run.
     pub fn render(&self, gpu: &Gpu, data: &FrameData) -> Result<GpuFrame, RunError> {
+        let f = &data.frame;
+        let mut todo = buckets::plan(f, data.memory_budget);
+        let largest = todo.iter().map(|t| t.w as u64 * t.h as u64).max().unwrap();
+        todo.reverse();
+        let (frame, _) = self.render_tiles(gpu, data, largest, &mut || todo.pop(), false)?;
+        Ok(frame)
+    }
+
+    /// Renders the buckets that `next` hands out, one at a time until it returns `None`, on
+    /// the renderer's cached scene and target (as [`GpuRenderer::render`]); `largest`: pixels
+    /// of the largest bucket `next` may give, for the sample buffer. A bucket `next` gives
+    /// renders as a bucket of [`GpuRenderer::render`] does (patches that cannot reach it left
+    /// out on the host, recut in four under a memory budget when its queues overflow), so
+    /// each of its pixels is bit for bit the whole frame's. With `tiles_only`, the returned
+    /// frame's image is left empty and the buckets come back with their pixels, read from
+    /// the device (for [`crate::devices`], which assembles them); else the whole image is
+    /// read back and the list is empty. Errors: as [`GpuRenderer::render`].
+    pub fn render_tiles(
+        &self,
+        gpu: &Gpu,
+        data: &FrameData,
+        largest: u64,
+        next: &mut dyn FnMut() -> Option<Tile>,
+        tiles_only: bool,
+    ) -> Result<(GpuFrame, Vec<TilePixels>), RunError> {
         self.check_features(data)?;
         let start = Instant::now();
         let f = &data.frame;
@@ -278,10 +303,6 @@ impl GpuRenderer {
             None => *cache = Some((SceneBuffers::new(gpu, data)?, None)),
         }
         let (scene, target) = cache.as_mut().unwrap();
-        let largest = (buckets::plan(f, data.memory_budget).iter())
-            .map(|t| t.w as u64 * t.h as u64)
-            .max()
-            .unwrap();
         let pixels = f.width as u64 * f.height as u64;
         let size = (largest * buckets::sample_bytes_per_pixel(f) / 4, pixels);
         if target.as_ref().is_none_or(|t| t.size() != size) {
@@ -292,7 +313,35 @@ impl GpuRenderer {
         }
         let target = target.as_ref().unwrap();
         let bind = scene.bind_group(gpu, self.pipelines.scene_layout(), target);
-        self.render_on(gpu, scene, target, &bind, data, start)
+        // A bucket beyond the sample buffer is the caller's error, refused before it renders.
+        let mut checked = || match next() {
+            Some(t) if t.w as u64 * t.h as u64 > largest => Some(Err(t)),
+            t => t.map(Ok),
+        };
+        let mut too_large = None;
+        let mut next = || match checked()? {
+            Ok(t) => Some(t),
+            Err(t) => {
+                too_large = Some(t);
+                None
+            }
+        };
+        let r = self.render_buckets_on(
+            gpu,
+            (scene, target, &bind),
+            (data, largest),
+            start,
+            &mut next,
+            tiles_only,
+        )?;
+        if let Some(t) = too_large {
+            return Err(RunError::Program(format!(
+                "a {}x{} px bucket is larger than the {largest} pixels the sample buffer was \
+                 sized for",
+                t.w, t.h
+            )));
+        }
+        Ok(r)
     }
 
     /// Refuses a frame that needs features the program was not compiled for.
@@ -319,13 +368,39 @@ impl GpuRenderer {
         data: &FrameData,
         start: Instant,
     ) -> Result<GpuFrame, RunError> {
+        let mut todo = buckets::plan(&data.frame, data.memory_budget);
+        let largest = todo.iter().map(|t| t.w as u64 * t.h as u64).max().unwrap();
+        todo.reverse();
+        let (frame, _) = self.render_buckets_on(
+            gpu,
+            (scene, target, bind),
+            (data, largest),
+            start,
+            &mut || todo.pop(),
+            false,
+        )?;
+        Ok(frame)
+    }
+
+    /// The core of [`GpuRenderer::render_on`] and [`GpuRenderer::render_tiles`]: the buckets
+    /// `next` gives (and their quarters, when recut), rendered one after another.
+    fn render_buckets_on(
+        &self,
+        gpu: &Gpu,
+        (scene, target, bind): (&SceneBuffers, &FrameTarget, &wgpu::BindGroup),
+        (data, largest): (&FrameData, u64),
+        start: Instant,
+        next: &mut dyn FnMut() -> Option<Tile>,
+        tiles_only: bool,
+    ) -> Result<(GpuFrame, Vec<TilePixels>), RunError> {
         self.check_features(data)?;
         let f = &data.frame;
-        let mut todo = buckets::plan(f, data.memory_budget);
-        todo.reverse();
+        let whole = f.whole_image();
         let per_pixel = buckets::sample_bytes_per_pixel(f);
-        let largest = todo.iter().map(|t| t.w as u64 * t.h as u64).max().unwrap();
         let pixels = f.width as u64 * f.height as u64;
+        // Quarters of recut buckets, rendered before the next bucket of `next`.
+        let mut todo: Vec<Tile> = Vec::new();
+        let mut done: Vec<Tile> = Vec::new();
         let FrameTarget {
             samples,
             counters,
@@ -347,11 +422,13 @@ impl GpuRenderer {
             peak_working_bytes: 0,
             wall_ms: 0.0,
         };
-        while let Some(tile) = todo.pop() {
+        while let Some(tile) = todo.pop().or_else(&mut *next) {
             let tile_frame = f.with_tile(tile);
-            let items: std::borrow::Cow<[PatchItem]> = match data.memory_budget {
-                None => (&data.items[..]).into(),
-                Some(_) => (data.items.iter())
+            // A bucket smaller than the image (under a budget, or one of several devices'
+            // buckets) renders only the patches that may reach it.
+            let items: std::borrow::Cow<[PatchItem]> = match tile == whole {
+                true => (&data.items[..]).into(),
+                false => (data.items.iter())
                     .filter(|i| {
                         let info = &data.patch_info[i.patch_id as usize];
                         let w = crate::stages::item_weights(i, info, &data.primvars);
@@ -469,6 +546,14 @@ impl GpuRenderer {
             let resolve_ms = self.resolve(gpu, &tile_frame, samples, rgba, depth)?;
             out.resolve_gpu_ms = out.resolve_gpu_ms.zip(resolve_ms).map(|(a, b)| a + b);
             out.buckets += 1;
+            done.push(tile);
+        }
+        if tiles_only {
+            let tiles = (done.into_iter())
+                .map(|t| TilePixels::read(gpu, f.width, t, rgba, depth))
+                .collect::<Result<_, _>>()?;
+            out.wall_ms = start.elapsed().as_secs_f64() * 1e3;
+            return Ok((out, tiles));
         }
         let words = gpu.read_words(rgba, 0, pixels * 4)?;
         let z = gpu.read_words(depth, 0, pixels)?;
@@ -480,7 +565,7 @@ impl GpuRenderer {
             depth: z.into_iter().map(f32::from_bits).collect(),
         };
         out.wall_ms = start.elapsed().as_secs_f64() * 1e3;
-        Ok(out)
+        Ok((out, Vec::new()))
     }
 
     /// Renders one frame (it compiles pipelines and sizes the queues), raises the GPU's clocks
@@ -570,4 +655,47 @@ pub(crate) fn resolve_params(f: &FrameUniforms) -> ([u32; 8], (u32, u32)) {
         0,
     ];
     (params, (gx, gy))
+}
+
+/// One bucket's resolved pixels, read from a device ([`GpuRenderer::render_tiles`]).
+pub struct TilePixels {
+    /// The bucket.
+    pub tile: Tile,
+    /// Its linear RGBA, row by row (`tile.w * tile.h`).
+    pub rgba: Vec<[f32; 4]>,
+    /// Its depth, row by row.
+    pub depth: Vec<f32>,
+}
+
+impl TilePixels {
+    /// Reads `tile`'s pixels from the image buffers of a frame `width` pixels wide: the
+    /// rows it spans, whole (one read each for colour and depth), of which its columns are
+    /// kept.
+    fn read(
+        gpu: &Gpu,
+        width: u32,
+        tile: Tile,
+        rgba: &wgpu::Buffer,
+        depth: &wgpu::Buffer,
+    ) -> Result<TilePixels, RunError> {
+        let (row0, rows) = (tile.y0 as u64 * width as u64, tile.h as u64 * width as u64);
+        let words = gpu.read_words(rgba, row0 * 4, rows * 4)?;
+        let z = gpu.read_words(depth, row0, rows)?;
+        let floats: &[f32] = bytemuck::cast_slice(&words);
+        let cols = tile.x0 as usize..(tile.x0 + tile.w) as usize;
+        let (mut c, mut d) = (Vec::new(), Vec::new());
+        for y in 0..tile.h as usize {
+            let row = y * width as usize;
+            for x in cols.clone() {
+                let p = &floats[(row + x) * 4..(row + x) * 4 + 4];
+                c.push([p[0], p[1], p[2], p[3]]);
+                d.push(f32::from_bits(z[row + x]));
+            }
+        }
+        Ok(TilePixels {
+            tile,
+            rgba: c,
+            depth: d,
+        })
+    }
 }

@@ -32,6 +32,7 @@
 pub mod buckets;
 pub mod camera;
 pub mod cpu_render;
+pub mod devices;
 pub mod driver_env;
 pub mod error;
 pub mod frame;

@@ -115,6 +115,29 @@ pub struct FrameStats {
     /// `reyes render --compare-to`: the image error against the reference; absent elsewhere.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub image_error: Option<ImageErrorStats>,
+    /// `reyes render --devices`: the device that rendered this frame of a sequence (each
+    /// frame on one device), or the frame's buckets split over the devices (one entry each);
+    /// absent without `--devices`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub devices: Option<Vec<DeviceStats>>,
+}
+
+/// One device's part in a frame (`reyes render --devices`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DeviceStats {
+    /// Its position in the `--devices` list (0, 1, ...).
+    pub slot: usize,
+    /// `#N name (backend)`: N its adapter's index (`reyes devices`).
+    pub device: String,
+    /// Frames it rendered (1 for the device of a frame of a sequence; 1 for each device of
+    /// a split frame, which each rendered a part of).
+    pub frames: u32,
+    /// Screen buckets it rendered.
+    pub buckets: u32,
+    /// Its GPU ms (scheduler runs and resolves), when timestamps exist.
+    pub gpu_ms: Option<f64>,
+    /// Its host ms: from the frame's start to its last bucket read back.
+    pub wall_ms: f64,
 }
 
 /// How a frame with motion blur or depth of field sampled time and the lens.
@@ -344,6 +367,7 @@ pub fn frame_stats(
         peak_working_bytes: g.peak_working_bytes,
         warnings: warnings.to_vec(),
         runs: None,
+        devices: None,
     }
 }
 

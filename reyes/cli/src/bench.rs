@@ -93,6 +93,10 @@ pub struct BenchReport {
     /// `--peer`: the peer's timing and image difference; absent without it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub peer: Option<PeerReport>,
+    /// `--devices`: each device's frames and rate (`fps` above is then over all devices:
+    /// timed frames over the wall time from the first to the last); absent without it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub devices: Option<Vec<crate::bench_devices::DeviceBench>>,
 }
 
 /// Steps (of 255, in the 8-bit sRGB image) a pixel of the peer may differ from Reyes's without
@@ -152,6 +156,9 @@ pub struct PeerRow {
 }
 
 pub fn main(a: BenchCmd) -> Result<(), CliError> {
+    if a.devices.is_some() {
+        return crate::bench_devices::main(a);
+    }
     let crate::setup::Setup {
         scene,
         name,
@@ -275,7 +282,7 @@ fn raster_peer(
 }
 
 #[allow(clippy::too_many_arguments)]
-fn report(
+pub(crate) fn report(
     a: &BenchCmd,
     name: &str,
     gpu: &Gpu,
@@ -322,10 +329,11 @@ fn report(
             })
             .collect(),
         peer: None,
+        devices: None,
     }
 }
 
-fn print_table(r: &BenchReport) {
+pub(crate) fn print_table(r: &BenchReport) {
     println!(
         "reyes bench: {} {}x{} ({}x{} samples), {}, {} frames{}, {}",
         r.scene,
@@ -372,6 +380,16 @@ fn print_table(r: &BenchReport) {
     }
     if let Some(p) = &r.peer {
         print_peer(p);
+    }
+    for d in r.devices.iter().flatten() {
+        let gpu = d
+            .gpu_ms
+            .as_ref()
+            .map_or("n/a".into(), |g| format!("{:.3}", g.median));
+        println!(
+            "device {} ({}): {} frames, {:.1} fps, busy {:.1} ms, median GPU {gpu} ms",
+            d.slot, d.device, d.frames, d.fps, d.busy_ms
+        );
     }
 }
 

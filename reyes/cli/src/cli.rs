@@ -6,6 +6,7 @@
 
 use crate::error::CliError;
 use clap::{Args, Parser, Subcommand, ValueEnum, value_parser};
+use reyes::devices::DeviceSelection;
 use reyes::frame::{DisplacementNormals, RasterMode, RenderOptions, Sampling};
 use reyes::scene::{DepthOfField, FrameRanges, Scene};
 use reyes_accuracy::drift::PathOptions;
@@ -60,6 +61,9 @@ pub enum Command {
     /// quality, frame times in the title, S saves a screenshot (`reyes view --help` lists the controls).
     #[command(after_help = VIEW_CONTROLS, allow_negative_numbers = true, args_override_self = true)]
     View(ViewCmd),
+    /// List the adapters wgpu finds (WGPU_BACKEND narrows the backends), each with the index
+    /// that --devices takes, and whether it can render (64-bit atomic min/max) or is skipped.
+    Devices,
 }
 
 const VIEW_CONTROLS: &str = "Controls: left drag orbits about the scene's centre; right or \
@@ -80,6 +84,7 @@ impl Command {
             Command::Drift(_) => "drift",
             Command::Bench(_) => "bench",
             Command::View(_) => "view",
+            Command::Devices => "devices",
         }
     }
 
@@ -91,7 +96,7 @@ impl Command {
             Command::Holes(c) => Some(&c.render),
             Command::Bench(c) => Some(&c.render),
             Command::View(c) => Some(&c.render),
-            Command::Sweep(_) | Command::Drift(_) => None,
+            Command::Sweep(_) | Command::Drift(_) | Command::Devices => None,
         }
     }
 
@@ -304,6 +309,16 @@ pub struct RenderCmd {
     #[arg(long, conflicts_with = "cpu")]
     pub gpu: bool,
 
+    /// Render on several devices: `all` (every adapter that can render, with 64-bit atomic
+    /// min/max; only the GPUs when there are any), or adapter indices as `reyes devices`
+    /// lists them, e.g. `0,1` (an index given twice, `0,0`, opens two logical devices on
+    /// one adapter, each its own device and queue). The frames of a sequence go to the
+    /// devices from one queue (each device takes the next frame); one frame alone is split
+    /// into screen buckets over them and its image assembled, identical bit for bit to one
+    /// device's. Renders on the adapters even when they are CPUs (as --gpu).
+    #[arg(long, value_name = "all|N,M", conflicts_with = "cpu")]
+    pub devices: Option<DeviceSelection>,
+
     /// Frames of a sequence to render: N, A-B or a comma list of them (2-3, 2, 1,3)
     /// [default: all].
     #[arg(long, value_name = "N|A-B|A,B,..", value_parser = FrameRanges::parse)]
@@ -341,6 +356,7 @@ impl RenderCmd {
     /// timed runs, stage times, statistics, float, depth or EXR output (what `--cpu` refuses).
     pub fn gpu_only(&self) -> bool {
         self.gpu
+            || self.devices.is_some()
             || self.render.strategy.is_some()
             || self.runs > 1
             || self.stage_times
@@ -448,6 +464,14 @@ pub struct BenchCmd {
     /// (`reyes::raster_peer`; docs/reyes.md).
     #[arg(long, value_name = "PEER")]
     pub peer: Option<Peer>,
+
+    /// Time the frames on several devices: `all` or adapter indices (`0,1`; `0,0`: two
+    /// logical devices on adapter 0), as for `reyes render --devices`. Each device warms up
+    /// on its own, then the timed frames go to the devices from one queue, a few frames at a
+    /// time (each device pipelines its frames); reports frames per second over all devices
+    /// (timed frames over the wall time from the start to the last frame) and per device.
+    #[arg(long, value_name = "all|N,M", conflicts_with = "peer")]
+    pub devices: Option<DeviceSelection>,
 
     #[command(flatten)]
     pub render: RenderArgs,

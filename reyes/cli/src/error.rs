@@ -31,6 +31,10 @@ pub enum CliError {
     /// A GPU run that failed (no adapter, a device error, a timeout, a queue overflow).
     #[error(transparent)]
     Run(#[from] RunError),
+    /// A device of `--devices` that failed while rendering its part of a split frame (the
+    /// device and bucket named).
+    #[error(transparent)]
+    Device(#[from] reyes::devices::DeviceError),
     /// `--spin` that cannot turn the scene.
     #[error("--spin: {0}")]
     Spin(#[source] reyes::Error),

@@ -3,6 +3,7 @@
 //! the scheduler and writes a PNG; `--stats` writes what it did as JSON.
 
 mod bench;
+mod bench_devices;
 mod cli;
 mod drift;
 mod error;
@@ -10,6 +11,7 @@ mod frames;
 mod holes;
 mod inputs;
 mod measure;
+mod multi;
 mod setup;
 mod sweep;
 mod view;
@@ -71,56 +73,77 @@ fn run(a: RenderCmd) -> Result<(), CliError> {
         indicatif::ProgressBar::hidden()
     };
     let (mut numbers, mut failed, mut any) = (Vec::new(), Vec::new(), false);
-    while let Some(item) = ahead {
-        for w in stream.take_warnings() {
-            log::warn!("{w}");
-            file_warnings.push(w);
-        }
-        match item {
-            Err(e) => match e.number {
-                Some(n) if !selected(n) => {
-                    numbers.push(n);
-                    log::warn!("{e} (not selected: not rendered)");
-                }
-                None if numbers.is_empty() => return Err(e.error.into()),
-                n => {
-                    numbers.extend(n);
-                    any |= n.is_some();
-                    eprintln!("reyes render: {e}");
-                    failed.push(n.map_or("the file".into(), |n| format!("frame {n}")));
-                }
-            },
-            Ok(frame) if !selected(frame.number) => numbers.push(frame.number),
-            Ok(frame) => {
-                numbers.push(frame.number);
-                any = true;
-                match &frame.unsupported {
-                    Some(why) => log::warn!("skipped frame {}: {why}", frame.number),
-                    None => {
-                        let job = Job {
-                            frame,
-                            sequence,
-                            skip_existing,
-                            options: &options,
-                            file_warnings: &file_warnings,
-                            reference: reference.as_ref(),
-                        };
-                        let run = (&mut namer, &mut inputs, &mut device);
-                        match render_job(&a, job, run, &bar) {
-                            Ok(()) => {}
-                            Err((None, e)) => return Err(e),
-                            Err((Some(n), e)) => {
-                                eprintln!("reyes render: frame {n}: {e}");
-                                failed.push(format!("frame {n}"));
+    // --devices: frames go to the devices' threads (a sequence) or are split over them (one
+    // frame); they report failed frames here.
+    let device_failures = std::sync::Mutex::new(Vec::new());
+    let shared = multi::Shared {
+        a: &a,
+        bar: &bar,
+        reference: reference.as_ref(),
+        failed: &device_failures,
+    };
+    std::thread::scope(|scope| -> Result<(), CliError> {
+        let mut pool = (a.devices.clone()).map(|d| multi::Pool::new(d, several, scope, &shared));
+        while let Some(item) = ahead {
+            for w in stream.take_warnings() {
+                log::warn!("{w}");
+                file_warnings.push(w);
+            }
+            match item {
+                Err(e) => match e.number {
+                    Some(n) if !selected(n) => {
+                        numbers.push(n);
+                        log::warn!("{e} (not selected: not rendered)");
+                    }
+                    None if numbers.is_empty() => return Err(e.error.into()),
+                    n => {
+                        numbers.extend(n);
+                        any |= n.is_some();
+                        eprintln!("reyes render: {e}");
+                        failed.push(n.map_or("the file".into(), |n| format!("frame {n}")));
+                    }
+                },
+                Ok(frame) if !selected(frame.number) => numbers.push(frame.number),
+                Ok(frame) => {
+                    numbers.push(frame.number);
+                    any = true;
+                    match &frame.unsupported {
+                        Some(why) => log::warn!("skipped frame {}: {why}", frame.number),
+                        None => {
+                            let job = Job {
+                                frame,
+                                sequence,
+                                skip_existing,
+                                options: &options,
+                                file_warnings: &file_warnings,
+                                reference: reference.as_ref(),
+                            };
+                            let run = (&mut namer, &mut inputs, &mut device);
+                            match render_job(&a, job, run, &bar, pool.as_mut()) {
+                                Ok(()) => {}
+                                Err((None, e)) => return Err(e),
+                                Err((Some(n), e)) => {
+                                    eprintln!("reyes render: frame {n}: {e}");
+                                    failed.push(format!("frame {n}"));
+                                }
                             }
                         }
                     }
                 }
             }
+            // The frame is dropped before the next one is read.
+            ahead = next.take().or_else(|| stream.next());
         }
-        // The frame is dropped before the next one is read.
-        ahead = next.take().or_else(|| stream.next());
-    }
+        if let Some(pool) = pool {
+            pool.finish();
+        }
+        Ok(())
+    })?;
+    failed.extend(
+        device_failures
+            .into_inner()
+            .unwrap_or_else(|p| p.into_inner()),
+    );
     bar.finish_and_clear();
     for w in stream.take_warnings() {
         log::warn!("{w}");
@@ -167,6 +190,7 @@ fn render_job(
     mut job: Job,
     (namer, inputs, device): (&mut frames::Namer, &mut inputs::SceneInputs, &mut Device),
     bar: &indicatif::ProgressBar,
+    pool: Option<&mut multi::Pool>,
 ) -> Result<(), (Option<u32>, CliError)> {
     let number = job.frame.number;
     let at = |e: CliError| (Some(number), e);
@@ -187,6 +211,17 @@ fn render_job(
     }
     a.render.change_scene(&mut job.frame.scene).map_err(at)?;
     let data = FrameData::new(&job.frame.scene, job.options).map_err(|e| at(e.into()))?;
+    if let Some(pool) = pool {
+        let frame = multi::Prepared {
+            number,
+            sequence: job.sequence,
+            scene: job.frame.scene,
+            data,
+            outputs,
+            file_warnings: job.file_warnings.to_vec(),
+        };
+        return pool.dispatch(frame);
+    }
     if let Device::Unopened = device {
         *device = match a.cpu {
             true => Device::Cpu,
@@ -285,9 +320,32 @@ fn render_frame(
         ));
         return Ok(());
     };
-    // One frame makes the image; with --runs N > 1, N frames are timed after a warm-up
-    // (GpuRenderer::timed_frames).
-    let (frame, times) = if a.runs > 1 {
+    let (frame, times) = gpu_frame(a, gpu, renderer, data, progress)?;
+    let adapter = gpu.adapter_name();
+    write_frame(
+        (scene, file_warnings, data),
+        out,
+        frame,
+        times,
+        &adapter,
+        reference,
+        None,
+    )
+}
+
+/// One GPU frame's times: its GPU ms (when timestamps exist) and wall ms.
+type Times = Vec<(Option<f64>, f64)>;
+
+/// Renders `data` on `gpu`: one frame, or with --runs N > 1 N frames timed after a warm-up
+/// (GpuRenderer::timed_frames), each printed; the (last) frame and the times.
+fn gpu_frame(
+    a: &RenderCmd,
+    gpu: &Gpu,
+    renderer: &GpuRenderer,
+    data: &FrameData,
+    progress: &indicatif::ProgressBar,
+) -> Result<(reyes::gpu_render::GpuFrame, Times), CliError> {
+    Ok(if a.runs > 1 {
         let t = renderer.timed_frames(gpu, data, a.runs, &|n| progress.inc(n))?;
         for (i, (g, w)) in t.gpu_ms.iter().zip(&t.wall_ms).enumerate() {
             let g = g.map_or("n/a".into(), |g| format!("{g:.3}"));
@@ -306,7 +364,21 @@ fn render_frame(
         let gpu_ms = f.run.gpu_ms.zip(f.resolve_gpu_ms).map(|(x, y)| x + y);
         let wall_ms = f.wall_ms;
         (f, vec![(gpu_ms, wall_ms)])
-    };
+    })
+}
+
+/// Writes a GPU frame's outputs (image, --float, --depth, --exr, --stats with the times and,
+/// with --devices, each device's part) and prints what it did; with a `reference`
+/// (`--compare-to`), reports the image error against it.
+fn write_frame(
+    (scene, file_warnings, data): (&Scene, &[String], &FrameData),
+    out: &frames::Outputs,
+    frame: reyes::gpu_render::GpuFrame,
+    times: Times,
+    adapter: &str,
+    reference: Option<&Reference>,
+    devices: Option<Vec<reyes::stats::DeviceStats>>,
+) -> Result<(), CliError> {
     // Where the renderer gave up on something (near-plane culls, split limit, nothing drawn).
     let frame_warnings = reyes::warnings::frame_warnings(data, &frame.counters);
     for w in &frame_warnings {
@@ -318,8 +390,9 @@ fn render_frame(
         .chain(&frame_warnings)
         .cloned()
         .collect();
-    let mut stats = frame_stats(data, &frame, &gpu.adapter_name(), &all_warnings);
+    let mut stats = frame_stats(data, &frame, adapter, &all_warnings);
     stats.runs = Some(RunSummary::of(&times));
+    stats.devices = devices;
     if let Some(reference) = reference {
         stats.image_error = Some(compare_to(reference, &frame.image)?);
     }
@@ -425,6 +498,7 @@ fn main() -> ExitCode {
         Command::Drift(a) => drift::main(a),
         Command::Bench(a) => bench::main(a),
         Command::View(a) => view::main(a),
+        Command::Devices => multi::list_devices(),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
