@@ -19,6 +19,10 @@ fn load(rel: &str) -> Scene {
 }
 
 fn with(o: &RenderOptions, occlusion: bool) -> RenderOptions {
+    let occlusion = match occlusion {
+        true => reyes::frame::Occlusion::On,
+        false => reyes::frame::Occlusion::Off,
+    };
     RenderOptions {
         occlusion,
         ..o.clone()
@@ -125,4 +129,39 @@ fn nothing_is_culled_where_nothing_overlaps() {
         .render(gpu(), &FrameData::new(&one, &o).unwrap())
         .unwrap();
     assert_eq!(g.counters[C_CULL_OCCLUDED], 0);
+}
+
+/// `--occlusion auto` (the default) renders in passes only where patches lie deep over each
+/// other: the teapot and Killeroo (depth complexity about 1-2) in one pass, nothing culled,
+/// the same micropolygons as with culling off; the 16-layer stack in passes, every hidden root
+/// culled. CPU twin (the GPU follows the same `hiz::passes`, checked above).
+#[test]
+fn auto_culls_only_where_layers_are_deep() {
+    use reyes::frame::Occlusion;
+    let mode = |o: &RenderOptions, occlusion| RenderOptions {
+        occlusion,
+        ..o.clone()
+    };
+    let o = small(96, 62);
+    assert_eq!(o.occlusion, Occlusion::Auto, "auto is the default");
+    for (name, s) in [
+        ("teapot", scene::builtin_teapot()),
+        ("killeroo", load("rib/killeroo.rib")),
+    ] {
+        let auto = render_cpu(&FrameData::new(&s, &mode(&o, Occlusion::Auto)).unwrap());
+        let off = render_cpu(&FrameData::new(&s, &mode(&o, Occlusion::Off)).unwrap());
+        assert_eq!(auto.counters[C_CULL_OCCLUDED], 0, "{name}: one pass");
+        assert_eq!(
+            auto.counters[C_MICROPOLYGONS], off.counters[C_MICROPOLYGONS],
+            "{name}"
+        );
+    }
+    let o = small(48, 36);
+    let stack = scene::parse_rib(&stacked_rib(16, 2, 48, 36), "stacked.rib").unwrap();
+    let auto = render_cpu(&FrameData::new(&stack, &mode(&o, Occlusion::Auto)).unwrap());
+    assert_eq!(
+        auto.counters[C_CULL_OCCLUDED],
+        15 * 2 * 2,
+        "every hidden root culled"
+    );
 }

@@ -130,28 +130,28 @@ fn stress_configs() -> Vec<(&'static str, MegakernelConfig)> {
             },
         ),
         (
-            // The per-item ticket path where the adapter has subgroups (the default takes
-            // tickets once per subgroup there), both ways of enqueueing.
-            "no subgroups, direct enqueue, tiny queues, impatient waits",
+            // Tickets once per subgroup where the adapter has them (the default takes one
+            // per item), both ways of enqueueing.
+            "subgroups, direct enqueue, tiny queues, impatient waits",
             MegakernelConfig {
                 workgroups: Workgroups::Fixed(3),
                 max_iterations: 24,
                 spin_limit: 1,
                 initial_capacity: 16,
                 direct_enqueue: Some(true),
-                subgroups: Some(false),
+                subgroups: None,
                 ..base.clone()
             },
         ),
         (
-            "no subgroups, outbox, tiny queues, impatient waits",
+            "subgroups, outbox, tiny queues, impatient waits",
             MegakernelConfig {
                 workgroups: Workgroups::Fixed(3),
                 max_iterations: 24,
                 spin_limit: 1,
                 initial_capacity: 16,
                 direct_enqueue: Some(false),
-                subgroups: Some(false),
+                subgroups: None,
                 ..base.clone()
             },
         ),

@@ -155,10 +155,10 @@ pub struct Cli {
     #[arg(long, help_heading = "Scheduler")]
     pub turn_anatomy: bool,
 
-    /// The megakernel takes enqueue tickets one atomic per item even where the adapter has
-    /// subgroups (by default one per subgroup there: `MegakernelConfig::subgroups`).
+    /// The megakernel takes enqueue tickets once per subgroup where the adapter has wgpu's
+    /// `SUBGROUP` operations (by default one atomic per item: `MegakernelConfig::subgroups`).
     #[arg(long, help_heading = "Scheduler")]
-    pub no_subgroups: bool,
+    pub subgroups: bool,
 }
 
 /// `--enqueue`: how megakernel items reach their queue.
@@ -299,7 +299,10 @@ impl Cli {
             idle_backoff: self.idle_backoff,
             capacity: self.capacity,
             turn_anatomy: self.turn_anatomy,
-            subgroups: self.no_subgroups.then_some(false),
+            subgroups: match self.subgroups {
+                true => None,
+                false => Some(false),
+            },
             item_layout: self.item_layout,
             direct_enqueue: self.enqueue.map(|e| e == Enqueue::Direct),
         }

@@ -136,7 +136,7 @@ pub struct GpuConfig {
     pub capacity: Option<u32>,
     /// `MegakernelConfig::turn_anatomy`.
     pub turn_anatomy: bool,
-    /// `MegakernelConfig::subgroups`; `None`: where the adapter has them.
+    /// `MegakernelConfig::subgroups`; `None`: where the adapter has them; default `Some(false)`.
     pub subgroups: Option<bool>,
 }
 
@@ -150,7 +150,7 @@ impl Default for GpuConfig {
             direct_enqueue: None,
             capacity: None,
             turn_anatomy: false,
-            subgroups: None,
+            subgroups: Some(false),
         }
     }
 }

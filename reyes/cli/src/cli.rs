@@ -198,9 +198,11 @@ pub struct RenderArgs {
 
     /// Occlusion culling in Bound: pieces hidden behind what is already drawn (a depth
     /// pyramid of the samples after a first pass over the nearest patches) are not split or
-    /// diced. The image is the same either way; off only to compare.
-    #[arg(long, value_name = "ON|OFF", value_enum, default_value_t = OnOff::On)]
-    pub occlusion: OnOff,
+    /// diced. The image is the same in every mode. `auto`: passes only in buckets whose
+    /// patches lie about 4 deep or more over the screen they reach (each pass costs a
+    /// scheduler run); `on`: always; `off`: never.
+    #[arg(long, value_name = "AUTO|ON|OFF", value_enum, default_value_t = OcclusionArg::Auto)]
+    pub occlusion: OcclusionArg,
 
     /// Depth of field: RenderMan's `DepthOfField fstop focallength focaldistance` (lengths in
     /// camera-space units), replacing the file's.
@@ -245,7 +247,11 @@ impl RenderArgs {
             sampling: self.sampling.into(),
             il_tile: self.il_tile,
             il_perms: self.il_perms,
-            occlusion: self.occlusion == OnOff::On,
+            occlusion: match self.occlusion {
+                OcclusionArg::Auto => reyes::frame::Occlusion::Auto,
+                OcclusionArg::On => reyes::frame::Occlusion::On,
+                OcclusionArg::Off => reyes::frame::Occlusion::Off,
+            },
             ..RenderOptions::default()
         }
     }
@@ -556,12 +562,14 @@ pub enum HoleReference {
     Bbox,
 }
 
-/// A switch on the command line (`--occlusion`).
+/// `--occlusion`: [`reyes::frame::Occlusion`] on the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum OnOff {
-    /// Switched on.
+pub enum OcclusionArg {
+    /// Passes where the patches lie deep over each other.
+    Auto,
+    /// Passes in every bucket.
     On,
-    /// Switched off.
+    /// One pass, nothing culled.
     Off,
 }
 

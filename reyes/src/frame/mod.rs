@@ -487,10 +487,10 @@ impl FrameData {
             il_perms: o.il_perms,
             coc_scale: 0.0,
             inv_focus: 0.0,
-            occlusion: if o.occlusion {
-                crate::stages::hiz::OCCLUSION_ON
-            } else {
-                crate::stages::hiz::OCCLUSION_OFF
+            occlusion: match o.occlusion {
+                Occlusion::Off => crate::stages::hiz::OCCLUSION_OFF,
+                Occlusion::Auto => crate::stages::hiz::OCCLUSION_AUTO,
+                Occlusion::On => crate::stages::hiz::OCCLUSION_ON,
             },
         };
         let mut frame = frame;

@@ -30,6 +30,15 @@ pub const OCCLUSION_ON: u32 = 1;
 /// `FrameUniforms::occlusion`: Bound tests items against the bucket's pyramid (the second
 /// pass). Set by the renderers only, for the runs after the pyramid is built.
 pub const OCCLUSION_TEST: u32 = 2;
+/// `FrameUniforms::occlusion`: as [`OCCLUSION_ON`] in a bucket whose [`depth_complexity`] is
+/// at least [`AUTO_MIN_DEPTH_COMPLEXITY`], else as [`OCCLUSION_OFF`] (`--occlusion auto`).
+/// Bound reads only [`OCCLUSION_TEST`].
+pub const OCCLUSION_AUTO: u32 = 3;
+
+/// The [`depth_complexity`] from which `--occlusion auto` renders a bucket in passes. Killeroo
+/// and the teapot (about 1-2) stay in one pass, where the extra passes cost more than they
+/// save on an H200; a stack of screen-filling layers (its layer count) is culled.
+pub const AUTO_MIN_DEPTH_COMPLEXITY: f32 = 4.0;
 
 /// Relative margin taken off an item's nearest depth before the test: the f32 rounding of a
 /// surface point evaluated from its control points (a convex combination, a few operations)
@@ -176,47 +185,12 @@ pub fn occluded(f: &FrameUniforms, hiz: &Hiz, lo: glam::Vec2, hi: glam::Vec2, z:
 /// at control points at shutter open, without displacement): either pass may hold any item
 /// without changing the image, only the work.
 pub fn front_items(data: &FrameData, items: &[PatchItem], tile: Tile) -> Vec<bool> {
-    let f = &data.frame;
-    const CELLS: u32 = 16;
-    let (cw, ch) = (
-        tile.w.div_ceil(CELLS).max(1) as f32,
-        tile.h.div_ceil(CELLS).max(1) as f32,
-    );
-    let (nx, ny) = (
-        (tile.w as f32 / cw).ceil() as usize,
-        (tile.h as f32 / ch).ceil() as usize,
-    );
-    // Per item: cell range and depth range, or None (goes first).
+    let grid = CellGrid::of(tile);
+    let (nx, ny) = (grid.nx, grid.ny);
     let extents: Vec<Option<([usize; 4], f32, f32)>> = (items.iter())
         .map(|item| {
-            let info = &data.patch_info[item.patch_id as usize];
-            let w = item_weights(item, info, &data.primvars);
-            let (mut lo, mut hi) = (glam::Vec2::splat(f32::MAX), glam::Vec2::splat(f32::MIN));
-            let (mut z0, mut z1) = (f32::MAX, f32::MIN);
-            for k in 0..16 {
-                let p = cp_point(&item.cp, k) / w.map_or(1.0, |w| w[k]);
-                if !(p.z >= f.near) {
-                    return None;
-                }
-                let s = glam::Vec2::from(project(f, p));
-                lo = lo.min(s);
-                hi = hi.max(s);
-                z0 = z0.min(p.z);
-                z1 = z1.max(p.z);
-            }
-            let cell = |v: f32, o: u32, c: f32, n: usize| {
-                (((v - o as f32) / c).floor().max(0.0) as usize).min(n - 1)
-            };
-            Some((
-                [
-                    cell(lo.x, tile.x0, cw, nx),
-                    cell(lo.y, tile.y0, ch, ny),
-                    cell(hi.x, tile.x0, cw, nx),
-                    cell(hi.y, tile.y0, ch, ny),
-                ],
-                z0,
-                z1,
-            ))
+            let (lo, hi, z0, z1) = screen_extent(data, item)?;
+            Some((grid.cells(lo, hi), z0, z1))
         })
         .collect();
     // Per cell, the item of the nearest near depth (the first on a tie).
@@ -240,12 +214,120 @@ pub fn front_items(data: &FrameData, items: &[PatchItem], tile: Tile) -> Vec<boo
     first
 }
 
-/// A bucket's items in the order the passes take them, and where each pass starts: first the
+/// How many times over a bucket's root items cover the screen cells they reach: the sum of
+/// their screen bounds' areas (clipped to the bucket) over the area of the cells of the
+/// [`front_items`] grid that some bound reaches. About 1-2 for one object seen from outside,
+/// the layer count for stacked layers; infinite when an item crosses the near plane (its bound
+/// is unknown). Control points at shutter open, without displacement: a heuristic for
+/// `--occlusion auto`, never for what may be culled.
+pub fn depth_complexity(data: &FrameData, items: &[PatchItem], tile: Tile) -> f32 {
+    let grid = CellGrid::of(tile);
+    let mut reached = vec![false; grid.nx * grid.ny];
+    let (x0, y0) = (tile.x0 as f32, tile.y0 as f32);
+    let (x1, y1) = (x0 + tile.w as f32, y0 + tile.h as f32);
+    let mut area = 0.0f64;
+    for item in items {
+        let Some((lo, hi, _, _)) = screen_extent(data, item) else {
+            return f32::INFINITY;
+        };
+        let w = (hi.x.min(x1) - lo.x.max(x0)).max(0.0);
+        let h = (hi.y.min(y1) - lo.y.max(y0)).max(0.0);
+        if w * h <= 0.0 {
+            continue;
+        }
+        area += (w * h) as f64;
+        let c = grid.cells(lo, hi);
+        for y in c[1]..=c[3] {
+            for x in c[0]..=c[2] {
+                reached[y * grid.nx + x] = true;
+            }
+        }
+    }
+    let cells = reached.iter().filter(|r| **r).count() as f64;
+    match cells > 0.0 {
+        true => (area / (cells * grid.cw as f64 * grid.ch as f64)) as f32,
+        false => 0.0,
+    }
+}
+
+/// An item's screen bound and depth range from its control points at shutter open (`None`
+/// when one is not in front of the near plane).
+fn screen_extent(data: &FrameData, item: &PatchItem) -> Option<(glam::Vec2, glam::Vec2, f32, f32)> {
+    let f = &data.frame;
+    let info = &data.patch_info[item.patch_id as usize];
+    let w = item_weights(item, info, &data.primvars);
+    let (mut lo, mut hi) = (glam::Vec2::splat(f32::MAX), glam::Vec2::splat(f32::MIN));
+    let (mut z0, mut z1) = (f32::MAX, f32::MIN);
+    for k in 0..16 {
+        let p = cp_point(&item.cp, k) / w.map_or(1.0, |w| w[k]);
+        if !(p.z >= f.near) {
+            return None;
+        }
+        let s = glam::Vec2::from(project(f, p));
+        lo = lo.min(s);
+        hi = hi.max(s);
+        z0 = z0.min(p.z);
+        z1 = z1.max(p.z);
+    }
+    Some((lo, hi, z0, z1))
+}
+
+/// The grid of at most 16 x 16 cells a bucket is cut into by [`front_items`].
+struct CellGrid {
+    tile: Tile,
+    cw: f32,
+    ch: f32,
+    nx: usize,
+    ny: usize,
+}
+
+impl CellGrid {
+    fn of(tile: Tile) -> Self {
+        const CELLS: u32 = 16;
+        let (cw, ch) = (
+            tile.w.div_ceil(CELLS).max(1) as f32,
+            tile.h.div_ceil(CELLS).max(1) as f32,
+        );
+        let (nx, ny) = (
+            (tile.w as f32 / cw).ceil() as usize,
+            (tile.h as f32 / ch).ceil() as usize,
+        );
+        CellGrid {
+            tile,
+            cw,
+            ch,
+            nx,
+            ny,
+        }
+    }
+
+    /// The cells `[x0, y0, x1, y1]` (inclusive) a screen bound reaches, clamped to the grid.
+    fn cells(&self, lo: glam::Vec2, hi: glam::Vec2) -> [usize; 4] {
+        let cell = |v: f32, o: u32, c: f32, n: usize| {
+            (((v - o as f32) / c).floor().max(0.0) as usize).min(n - 1)
+        };
+        [
+            cell(lo.x, self.tile.x0, self.cw, self.nx),
+            cell(lo.y, self.tile.y0, self.ch, self.ny),
+            cell(hi.x, self.tile.x0, self.cw, self.nx),
+            cell(hi.y, self.tile.y0, self.ch, self.ny),
+        ]
+    }
+}
+
+/// A bucket's items in the order the passes take them, and where each pass starts (one pass,
+/// the items as given, under `--occlusion auto` when [`depth_complexity`] is below
+/// [`AUTO_MIN_DEPTH_COMPLEXITY`]): first the
 /// [`front_items`], then the others by their nearest control point's depth, nearest first, in
 /// two passes (the nearer half, then the rest). Before each pass after the first the renderers
 /// build the pyramid of everything drawn so far and Bound tests against it, so each pass is
 /// culled against all the passes in front of it.
 pub fn passes(data: &FrameData, items: &[PatchItem], tile: Tile) -> (Vec<PatchItem>, Vec<usize>) {
+    if data.frame.occlusion == OCCLUSION_AUTO
+        && depth_complexity(data, items, tile) < AUTO_MIN_DEPTH_COMPLEXITY
+    {
+        return (items.to_vec(), vec![0]);
+    }
     let front = front_items(data, items, tile);
     let mut ordered: Vec<PatchItem> = (items.iter().zip(&front))
         .filter(|(_, f)| **f)

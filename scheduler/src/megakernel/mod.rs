@@ -110,8 +110,11 @@ pub struct MegakernelConfig {
     pub turn_anatomy: bool,
     /// Take enqueue tickets once per subgroup (one atomic for all lanes of a subgroup that emit
     /// to a queue at once) with wgpu's `SUBGROUP` operations, instead of one atomic per item.
-    /// `None` (the default): where the device has them ([`Gpu::subgroups`]); `Some(false)` forces
-    /// the per-item path; `Some(true)` on a device without them is an error.
+    /// `Some(false)` (the default): one atomic per item; measured on the H200 the subgroup path
+    /// was slower on the trees (binary 0.254 against 0.233 ms, large-payload 0.748 against
+    /// 0.730; docs/results.md, 2026-12-02), where a batch's lanes rarely emit to one queue at
+    /// once. `None`: where the device has them ([`Gpu::subgroups`]); `Some(true)` on a device
+    /// without them is an error.
     pub subgroups: Option<bool>,
     /// Start a run with the room the largest earlier run of this megakernel needed to finish in
     /// one launch (default `true`): queues that had to grow (each growth a relaunch after a host
@@ -143,7 +146,7 @@ impl Default for MegakernelConfig {
             item_layout: None,
             direct_enqueue: None,
             turn_anatomy: false,
-            subgroups: None,
+            subgroups: Some(false),
             size_from_last_run: true,
         }
     }
