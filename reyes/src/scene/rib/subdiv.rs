@@ -99,7 +99,7 @@ impl Interp {
         let (cs_ch, os_ch) = (slot(&vars.cs), slot(&vars.os));
         let ids: Vec<u32> = ids.into_iter().map(|i| i as u32).collect();
         let patches = catmull_clark(&sizes, &ids, &tags, data)
-            .map_err(|e| a.err(format!("SubdivisionMesh: {e}")))?;
+            .map_err(|e| a.err(format!("{e} (faces and vertices count from 0)")))?;
         for (k, p) in patches.into_iter().enumerate() {
             let field = |v: &Option<super::primvars::ColorVar>, ch: Option<usize>| {
                 let v = v.as_ref()?;
