@@ -11,7 +11,7 @@ use std::time::Instant;
 use crate::error::RunError;
 use crate::gpu::Gpu;
 use crate::growth::grow;
-use crate::item_layout::{ItemLayout, planar_load_store_fns};
+use crate::item_layout::ItemLayout;
 use crate::multipass::partial::{at_limit, needs_partial, partial_round};
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
@@ -91,45 +91,9 @@ struct HostRounds {
 /// a queue's region), append-style enqueue functions, one entry point per procedure
 /// (`mp_host_<name>`), then the template.
 pub(crate) fn source(program: &Program, items: ItemLayout) -> String {
-    let mut s = program.tables_wgsl();
-    s += &program.common_wgsl();
-    s += &crate::wgsl::vec4_word_accessors("mp_in", "items_in");
-    s += &crate::wgsl::vec4_word_accessors("mp_out", "items_out");
-    s += &items.execute_switch(program, "mp_in");
-    let mut seen = Vec::new();
-    for p in &program.procs {
-        if !seen.contains(&p.layout.name) {
-            seen.push(p.layout.name.clone());
-            s += &match items {
-                ItemLayout::Interleaved => crate::wgsl::load_store_fns(&p.layout, "mp_out"),
-                ItemLayout::Planar => planar_load_store_fns(&p.layout, "mp_out"),
-            };
-        }
-    }
-    // Where item `at` of queue `t` starts, and (planar) the stride between its words.
-    let item_at = |t: &str| match items {
-        ItemLayout::Interleaved => format!("q_base({t}) + at * WORDS[{t}]"),
-        ItemLayout::Planar => format!("q_base({t}) + at, q_cap({t})"),
-    };
-    s += &format!(
-        "fn mp_execute(t: u32, at: u32, inv: Invocation) {{ sched_execute(t, {}, inv); }}\n",
-        item_at("t")
-    );
     let args = "@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>, \
                 @builtin(num_workgroups) nwg: vec3<u32>";
-    for (t, p) in program.procs.iter().enumerate() {
-        s += &format!(
-            "fn enqueue_{name}(item: {ty}) {{\n    if !sched_active {{ return; }}\n    \
-             let at = sched_append_slot({t}u);\n    if at == 0xffffffffu {{ return; }}\n    \
-             mp_out_store_{ty}({store_at}, item);\n}}\n\
-             @compute @workgroup_size(256) fn mp_host_{name}({args}) {{ run_procedure({t}u, lid, wid.x, nwg.x); }}\n",
-            name = p.proc.name,
-            ty = p.layout.name,
-            store_at = item_at(&format!("{t}u")),
-        );
-    }
-    s += TEMPLATE;
-    s
+    super::wgsl::rounds_source(program, items, "mp_host", args, "lid, wid.x, nwg.x") + TEMPLATE
 }
 
 impl HostMultipass {

@@ -22,6 +22,30 @@ pub fn entry_points(program: &Program) -> Vec<String> {
 /// The WGSL for `program` with its queues laid out as `items` (the same layout in the round
 /// buffers of every queue).
 pub fn source(program: &Program, items: ItemLayout) -> String {
+    let args = "@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>";
+    let mut s = rounds_source(program, items, "mp_proc", args, "lid, wid.x");
+    // Word `w` of item `at` of queue `t` (the carried inputs' copy).
+    let word_at = match items {
+        ItemLayout::Interleaved => "q_base(t) + at * WORDS[t] + w",
+        ItemLayout::Planar => "q_base(t) + w * q_cap(t) + at",
+    };
+    s += &format!("fn mp_word_at(t: u32, at: u32, w: u32) -> u32 {{ return {word_at}; }}\n");
+    s += TEMPLATE;
+    s
+}
+
+/// The WGSL both multi-passes share (the device-driven one above, the host-driven one in
+/// `host.rs`), before their templates: the program's code, accessors of the round buffers
+/// `mp_in`/`mp_out` in the layout `items`, `mp_execute` (runs item `at` of queue `t`'s
+/// inputs), and per procedure an append-style `enqueue_<name>` and the entry point
+/// `{entry}_<name>({args})`, which calls `run_procedure(t, {call})`.
+pub(super) fn rounds_source(
+    program: &Program,
+    items: ItemLayout,
+    entry: &str,
+    args: &str,
+    call: &str,
+) -> String {
     let mut s = program.tables_wgsl();
     s += &program.common_wgsl();
     s += &crate::wgsl::vec4_word_accessors("mp_in", "items_in");
@@ -37,33 +61,25 @@ pub fn source(program: &Program, items: ItemLayout) -> String {
             };
         }
     }
-    // Where item `at` of queue `t` starts, and (planar) the stride between its words; word `w`
-    // of that item (the carried inputs' copy).
+    // Where item `at` of queue `t` starts, and (planar) the stride between its words.
     let item_at = |t: &str| match items {
         ItemLayout::Interleaved => format!("q_base({t}) + at * WORDS[{t}]"),
         ItemLayout::Planar => format!("q_base({t}) + at, q_cap({t})"),
     };
-    let word_at = match items {
-        ItemLayout::Interleaved => "q_base(t) + at * WORDS[t] + w",
-        ItemLayout::Planar => "q_base(t) + w * q_cap(t) + at",
-    };
     s += &format!(
-        "fn mp_execute(t: u32, at: u32, inv: Invocation) {{ sched_execute(t, {}, inv); }}\n\
-         fn mp_word_at(t: u32, at: u32, w: u32) -> u32 {{ return {word_at}; }}\n",
+        "fn mp_execute(t: u32, at: u32, inv: Invocation) {{ sched_execute(t, {}, inv); }}\n",
         item_at("t")
     );
-    let args = "@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>";
     for (t, p) in program.procs.iter().enumerate() {
         s += &format!(
             "fn enqueue_{name}(item: {ty}) {{\n    if !sched_active {{ return; }}\n    \
              let at = sched_append_slot({t}u);\n    if at == 0xffffffffu {{ return; }}\n    \
              mp_out_store_{ty}({store_at}, item);\n}}\n\
-             @compute @workgroup_size(256) fn mp_proc_{name}({args}) {{ run_procedure({t}u, lid, wid.x); }}\n",
+             @compute @workgroup_size(256) fn {entry}_{name}({args}) {{ run_procedure({t}u, {call}); }}\n",
             name = p.proc.name,
             ty = p.layout.name,
             store_at = item_at(&format!("{t}u")),
         );
     }
-    s += TEMPLATE;
     s
 }
