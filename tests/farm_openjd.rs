@@ -7,6 +7,7 @@
 //! `openjd` is found on PATH, or as the environment's `OPENJD`; `./run-tests` installs it
 //! (scripts/ensure-openjd.sh). A missing runner is a failure, never a skip.
 
+mod cli;
 mod farm;
 
 use farm::{

@@ -9,6 +9,7 @@
 //! prints the daemons' logs, never a skip. The daemons are stopped when the test ends, passed
 //! or failed.
 
+mod cli;
 mod farm;
 
 use farm::{

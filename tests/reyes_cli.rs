@@ -2,28 +2,14 @@
 //! failing exit status (2 for usage errors, 1 for the others), and no output file left behind.
 //! No GPU is needed: these fail first. Also its help and version.
 
+mod cli;
+
+use cli::{mtime, png, reyes_in as reyes_any};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("reyes-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// Runs `reyes ARGS` in `dir`; returns (exit code, stdout, stderr).
-fn reyes_any(dir: &Path, args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_reyes"))
-        .args(args)
-        .current_dir(dir)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .unwrap();
-    (
-        out.status.code().expect("killed by a signal"),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    cli::scratch("cli", name)
 }
 
 /// Runs `reyes render ARGS` in `dir`; returns (exit code, stderr).
@@ -405,12 +391,6 @@ fn field(name: &str) -> String {
     p.to_str().unwrap().to_string()
 }
 
-fn png(p: &Path) -> image::RgbaImage {
-    image::open(p)
-        .unwrap_or_else(|e| panic!("{}: {e}", p.display()))
-        .to_rgba8()
-}
-
 fn covered(img: &image::RgbaImage) -> usize {
     img.pixels().filter(|p| p[3] > 0).count()
 }
@@ -519,12 +499,6 @@ fn farm_scene(dir: &Path, broken: bool) -> &'static str {
     )
     .unwrap();
     "shot.rib"
-}
-
-fn mtime(p: &Path) -> std::time::SystemTime {
-    std::fs::metadata(p)
-        .and_then(|m| m.modified())
-        .unwrap_or_else(|e| panic!("{}: {e}", p.display()))
 }
 
 /// `-o` with a printf-style frame number: `%04d` zero-padded, `%d` not; `--frame N` is

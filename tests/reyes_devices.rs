@@ -5,28 +5,13 @@
 //! equal 8-bit pixels; the float EXR is compared too for the split frame), and the
 //! statistics must show that both devices rendered (per-device frame and bucket counts).
 
+mod cli;
+
+use cli::reyes_in as reyes;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("reyes-devices-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// Runs `reyes ARGS` in `dir`; returns (exit code, stdout, stderr).
-fn reyes(dir: &Path, args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_reyes"))
-        .args(args)
-        .current_dir(dir)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .unwrap();
-    (
-        out.status.code().expect("killed by a signal"),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    cli::scratch("devices", name)
 }
 
 fn json(p: &Path) -> serde_json::Value {

@@ -11,7 +11,9 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
-use std::time::{Duration, Instant, SystemTime};
+
+pub use crate::cli::{mtime, png};
+use std::time::{Duration, Instant};
 
 /// The repository's root (the job script and template are found from it).
 pub fn repo_root() -> PathBuf {
@@ -112,20 +114,6 @@ pub fn reference_images(dir: &Path, shot: &Path) -> Vec<image::RgbaImage> {
     (1..=3)
         .map(|n| png(&dir.join(format!("ref.{n:04}.png"))))
         .collect()
-}
-
-/// The decoded image at `p`.
-pub fn png(p: &Path) -> image::RgbaImage {
-    image::open(p)
-        .unwrap_or_else(|e| panic!("{}: {e}", p.display()))
-        .to_rgba8()
-}
-
-/// The modification time of `p`.
-pub fn mtime(p: &Path) -> SystemTime {
-    std::fs::metadata(p)
-        .and_then(|m| m.modified())
-        .unwrap_or_else(|e| panic!("{}: {e}", p.display()))
 }
 
 /// Asserts that `dir/PREFIX.000N.png` holds exactly the reference image N for N in `frames`
