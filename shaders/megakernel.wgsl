@@ -18,6 +18,7 @@ const Q_BATCHES: u32 = 6u;
 const Q_BLOCKED: u32 = 7u;   // 1 when a batch was refused for lack of room in this queue
 const Q_DEMAND: u32 = 8u;    // largest worst-case output to this queue of a batch refused for room
 // Q_KEPT = 9: written only by the device compaction (megakernel_compact.wgsl)
+const Q_LOCAL: u32 = 10u;    // items run from the workgroup's local queue (never ticketed)
 fn gw(i: u32) -> u32 { return NQ * QSTRIDE + i; }
 const G_PENDING: u32 = 0u;   // items appended and neither processed nor abandoned in this launch
 const G_STOP: u32 = 1u;
@@ -32,6 +33,7 @@ const G_PROBE_FINISHED: u32 = 9u;
 const G_PROBE_RESIDENT: u32 = 10u;
 const G_ITER_EXITS: u32 = 11u;
 // G_LOST = 12: written only by the device compaction (megakernel_compact.wgsl)
+const G_IDLE_NOW: u32 = 13u; // workgroups idle right now (LOCAL only)
 // Turn anatomy (TURN_ANATOMY; host twin: scheduler/src/megakernel/anatomy.rs): per phase, the
 // leader's (lane 0's) count of global memory operations or loop trips on the turn's critical
 // path, kept in lane 0's registers and added once when the workgroup leaves its loop.
@@ -73,6 +75,7 @@ const CONSUMED: u32 = 0xffffffffu; // slot flag: processed; any other value: rea
 const CMD_IDLE: u32 = 0u;
 const CMD_RUN: u32 = 1u;
 const CMD_EXIT: u32 = 2u;
+const CMD_LOCAL: u32 = 3u;   // run the items of local queue wg_q held in the workgroup
 
 @group(0) @binding(0) var<storage, read_write> ctrl: array<atomic<u32>>;
 @group(0) @binding(2) var<storage, read_write> flags: array<atomic<u32>>;
@@ -97,6 +100,16 @@ var<workgroup> wg_stop: u32;
 var<workgroup> wg_pending: u32;
 // Direct enqueue: the tickets this batch took, per target from ES_OFF[q * NQ + t].
 var<workgroup> wg_emit_slot: array<u32, EMIT_SLOTS>;
+// Local queues (LOCAL; sizes and regions: scheduler/src/megakernel/local.rs). Region t of
+// wg_local_out holds wg_local_n[t] items of queue t, kept by earlier batches; while a batch runs,
+// its emits to t may fill it up to wg_local_lim[t] (the count may pass the limit: the emits past
+// it went to the global queue, and the count is cut back after the batch). Every held item is
+// pending and insured: its room stays reserved in t's budget, so a spill never lacks a ticket.
+var<workgroup> wg_local_n: array<atomic<u32>, NQ>;
+var<workgroup> wg_local_lim: array<u32, NQ>;
+var<workgroup> wg_local_held: array<u32, NQ>;
+var<workgroup> wg_idle_now: u32;
+var<workgroup> wg_local_fail: atomic<u32>;
 
 var<private> sched_proc: u32;
 var<private> sched_active: bool;
@@ -108,6 +121,11 @@ var<private> sched_pause_sink: u32;
 var<private> st_peak: u32;
 var<private> st_executed: u32;
 var<private> st_batches: u32;
+var<private> st_local: u32;
+// The running batch reads its items from wg_local_in (a local batch).
+var<private> sched_from_local: bool;
+// The leader counts itself in G_IDLE_NOW.
+var<private> sched_idle_reg: bool;
 var<private> an: array<u32, AN_WORDS>;
 var<workgroup> wg_an_wait: atomic<u32>;
 
@@ -237,6 +255,16 @@ fn leader_decide() -> u32 {
     an_add(AN_CLAIM, 1u); // the probe: one round of parallel loads
     if wg_stop != 0u { return CMD_EXIT; }
     sched_blocked = false;
+    // Work held in the workgroup runs first, in priority order: no global atomic to claim it.
+    for (var i = 0u; i < NQ && LOCAL; i++) {
+        let m = atomicLoad(&wg_local_n[prio(i)]);
+        if m > 0u {
+            wg_q = prio(i);
+            wg_n = m;
+            wg_h = 0u;
+            return CMD_LOCAL;
+        }
+    }
     if params[P_POLICY] == 1u {
         let q = fifo_pick();
         if q < NQ {
@@ -261,6 +289,50 @@ fn leader_decide() -> u32 {
     return CMD_IDLE;
 }
 
+// Moves every item held in the workgroup's local queues to the global queues (tickets, copy,
+// flags, counts), all lanes together: when the launch ends for this workgroup, or when a local
+// batch finds no room for its output. The tickets are below capacity: the held items' room was
+// reserved in each queue's budget when they were kept (the insurance above).
+fn spill_local(lid: u32) {
+    workgroupBarrier();
+    if lid < NQ {
+        let m = atomicLoad(&wg_local_n[lid]);
+        wg_emit_n[lid] = m;
+        if m > 0u { wg_emit_base[lid] = atomicAdd(&ctrl[lid * QSTRIDE + Q_RESERVE], m); }
+    }
+    if lid == 0u {
+        wg_stamp = 2u;
+        if params[P_POLICY] == 1u { wg_stamp = atomicAdd(&ctrl[gw(G_SEQ)], 1u) + 2u; }
+    }
+    workgroupBarrier();
+    for (var t = 0u; t < NQ; t++) {
+        let m = wg_emit_n[t];
+        let base = wg_emit_base[t];
+        for (var i = lid; i < m * WORDS[t]; i += 256u) {
+            if ITEMS_PLANAR {
+                let plane = i / m;
+                let j = i % m;
+                sched_slot_store_word(q_slot_base(t) + plane * q_cap(t) + base + j,
+                    wg_local_out[LOCAL_OFF[t] + plane * LOCAL_CAP[t] + j]);
+            } else {
+                sched_slot_store_word(q_slot_base(t) + base * WORDS[t] + i, wg_local_out[LOCAL_OFF[t] + i]);
+            }
+        }
+    }
+    storageBarrier();
+    for (var t = 0u; t < NQ; t++) {
+        for (var j = lid; j < wg_emit_n[t]; j += 256u) {
+            atomicStore(&flags[q_flag_base(t) + wg_emit_base[t] + j], wg_stamp);
+        }
+    }
+    storageBarrier();
+    if lid < NQ && wg_emit_n[lid] > 0u {
+        atomicAdd(&ctrl[lid * QSTRIDE + Q_COUNT], wg_emit_n[lid]);
+        atomicStore(&wg_local_n[lid], 0u);
+    }
+    workgroupBarrier();
+}
+
 // Co-residency probe: a workgroup that starts before any workgroup has finished runs at the
 // same time as every workgroup that started before it.
 fn probe(lid: u32) {
@@ -283,6 +355,7 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         return;
     }
     sched_outbox = wid.x * params[P_OUTBOX_STRIDE];
+    if LOCAL && lid < NQ { atomicStore(&wg_local_n[lid], 0u); } // ordered by the probe's barrier
     var idle = 0u;
     var streak = 0u;
     var iter = 0u;
@@ -295,9 +368,19 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         }
         if lid == 255u { wg_stop = atomicLoad(&ctrl[gw(G_STOP)]); }
         if lid == 254u { wg_pending = atomicLoad(&ctrl[gw(G_PENDING)]); }
+        if LOCAL && lid == 253u { wg_idle_now = atomicLoad(&ctrl[gw(G_IDLE_NOW)]); }
         workgroupBarrier();
         if lid == 0u {
             wg_cmd = leader_decide();
+            if LOCAL {
+                // Idle right now, for workgroups deciding how much to keep: only changes cost.
+                let idle_now = wg_cmd == CMD_IDLE;
+                if idle_now != sched_idle_reg {
+                    if idle_now { atomicAdd(&ctrl[gw(G_IDLE_NOW)], 1u); } else { atomicSub(&ctrl[gw(G_IDLE_NOW)], 1u); }
+                    sched_idle_reg = idle_now;
+                }
+                atomicStore(&wg_local_fail, 0u);
+            }
             atomicStore(&wg_abandoned, 0u);
             atomicStore(&wg_emitted, 0u);
             if TURN_ANATOMY { atomicStore(&wg_an_wait, 0u); }
@@ -315,11 +398,58 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         let q = workgroupUniformLoad(&wg_q);
         let h = workgroupUniformLoad(&wg_h);
         let n = workgroupUniformLoad(&wg_n);
+        let from_local = LOCAL && cmd == CMD_LOCAL;
+        sched_from_local = from_local;
+        if from_local {
+            // 0. A local batch: reserve its worst-case output in every target, lanes in
+            //    parallel; without room, spill what the workgroup holds and claim as usual.
+            var need = 0u;
+            if lid < NQ { need = n * EMITS[q * NQ + lid]; }
+            var old = 0u;
+            if need > 0u {
+                old = atomicAdd(&ctrl[lid * QSTRIDE + Q_BUDGET], need);
+                if old + need > q_cap(lid) { atomicStore(&wg_local_fail, 1u); }
+            }
+            workgroupBarrier();
+            if lid == 0u { wg_cmd = atomicLoad(&wg_local_fail); }
+            if workgroupUniformLoad(&wg_cmd) != 0u {
+                if need > 0u { atomicSub(&ctrl[lid * QSTRIDE + Q_BUDGET], need); }
+                spill_local(lid);
+                continue;
+            }
+            // The batch moves to wg_local_in (same layout), freeing its region for new emits.
+            let words = n * WORDS[q];
+            for (var i = lid; i < words; i += 256u) {
+                var at = LOCAL_OFF[q] + i;
+                if ITEMS_PLANAR { at = LOCAL_OFF[q] + (i / n) * LOCAL_CAP[q] + i % n; }
+                var to = i;
+                if ITEMS_PLANAR { to = (i / n) * LOCAL_CAP[q] + i % n; }
+                wg_local_in[to] = wg_local_out[at];
+            }
+            for (var i = lid; i < n; i += 256u) { wg_ready[i] = 1u; }
+            workgroupBarrier();
+            if lid == 0u { atomicStore(&wg_local_n[q], 0u); }
+            workgroupBarrier();
+        }
+        if LOCAL && lid < NQ {
+            // How many items of lid this batch may keep: a full region while every workgroup is
+            // busy; one step's worth while some are idle (one step runs them as fast as many
+            // workgroups would), the rest shared through the global queue.
+            let held = atomicLoad(&wg_local_n[lid]);
+            wg_local_held[lid] = held;
+            var lim = held;
+            if LOCAL_EDGE[q * NQ + lid] != 0u {
+                var want = LOCAL_CAP[lid];
+                if wg_idle_now != 0u { want = min(want, 256u / THREADS[lid]); }
+                lim = max(held, want);
+            }
+            wg_local_lim[lid] = lim;
+        }
 
         // 1. Wait, bounded, for each claimed slot's producer to publish it. A slot whose wait
         //    runs out is abandoned to the compaction between launches: never lost.
         var polls = 0u;
-        for (var i = lid; i < n; i += 256u) {
+        for (var i = lid; i < n && !from_local; i += 256u) {
             var ok = 0u;
             var s = 0u;
             for (; s < params[P_SPIN]; s++) {
@@ -355,7 +485,16 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         if lid < NQ {
             let t = lid;
             let promised = n * EMITS[q * NQ + t];
-            let k = min(atomicLoad(&wg_emit_count[t]), promised);
+            // Local emits: the count cut back to the limit; what was kept stays insured.
+            var kept_new = 0u;
+            if LOCAL {
+                let kept = min(atomicLoad(&wg_local_n[t]), wg_local_lim[t]);
+                atomicStore(&wg_local_n[t], kept);
+                kept_new = kept - wg_local_held[t];
+                if kept_new > 0u { atomicAdd(&wg_emitted, kept_new); }
+            }
+            let k = min(atomicLoad(&wg_emit_count[t]), promised - min(kept_new, promised));
+            if kept_new + atomicLoad(&wg_emit_count[t]) > promised { sched_raise(ERR_EMIT, q, t); }
             wg_emit_n[t] = k;
             if k > 0u {
                 // Direct enqueue took its tickets item by item; else take k now.
@@ -370,10 +509,12 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
                 st_peak = max(st_peak, end - min(atomicLoad(&ctrl[t * QSTRIDE + Q_HEAD]), end));
                 atomicAdd(&wg_emitted, k);
             }
-            // Unused promised room goes back.
-            if promised > k { atomicSub(&ctrl[t * QSTRIDE + Q_BUDGET], promised - k); }
+            // Unused promised room goes back, and a local batch's own insurance.
+            var refund = promised - k - min(kept_new, promised - k);
+            if from_local && t == q { refund += n; }
+            if refund > 0u { atomicSub(&ctrl[t * QSTRIDE + Q_BUDGET], refund); }
             if t == q {
-                st_executed += n - abandoned;
+                if from_local { st_local += n; } else { st_executed += n - abandoned; }
                 st_batches += 1u;
             }
         }
@@ -472,7 +613,7 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
                 atomicStore(&flags[q_flag_base(t) + s], wg_stamp);
             }
         }
-        for (var i = lid; i < n; i += 256u) {
+        for (var i = lid; i < n && !from_local; i += 256u) {
             if wg_ready[i] != 0u { atomicStore(&flags[q_flag_base(q) + h + i], CONSUMED); }
         }
         storageBarrier();
@@ -481,9 +622,15 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
             atomicAdd(&ctrl[lid * QSTRIDE + Q_COUNT], wg_emit_n[lid]);
         }
     }
+    // Items still held locally go to the global queues for the next launch.
+    if LOCAL {
+        spill_local(lid);
+        if lid == 0u && sched_idle_reg { atomicSub(&ctrl[gw(G_IDLE_NOW)], 1u); }
+    }
     // Statistics, once per workgroup and launch. Every exit of the loop passes here, lavapipe's
     // silent loop cut included, so the host's accounting (executed per queue) stays exact.
     if lid < NQ {
+        if st_local > 0u { atomicAdd(&ctrl[lid * QSTRIDE + Q_LOCAL], st_local); }
         if st_executed > 0u { atomicAdd(&ctrl[lid * QSTRIDE + Q_EXECUTED], st_executed); }
         if st_batches > 0u { atomicAdd(&ctrl[lid * QSTRIDE + Q_BATCHES], st_batches); }
         if st_peak > 0u { atomicMax(&ctrl[lid * QSTRIDE + Q_PEAK], st_peak); }

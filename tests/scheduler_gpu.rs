@@ -156,6 +156,42 @@ fn stress_configs() -> Vec<(&'static str, MegakernelConfig)> {
             },
         ),
         (
+            // Local queues (the trees keep their children local) in regions of a few items:
+            // emits overflow to the global queues, held items spill at short launches' ends and
+            // when a local batch finds no room in tiny queues.
+            "small local regions, tiny queues, short launches",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(3),
+                max_iterations: 24,
+                spin_limit: 1,
+                initial_capacity: 16,
+                local_queues: true,
+                local_bytes: 512,
+                ..base.clone()
+            },
+        ),
+        (
+            "planar items, small local regions, direct enqueue",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(3),
+                max_iterations: 40,
+                initial_capacity: 16,
+                local_queues: true,
+                local_bytes: 512,
+                direct_enqueue: Some(true),
+                item_layout: Some(ItemLayout::Planar),
+                ..base.clone()
+            },
+        ),
+        (
+            "local queues in full regions",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(3),
+                local_queues: true,
+                ..base.clone()
+            },
+        ),
+        (
             "oversubscribed",
             MegakernelConfig {
                 workgroups: Workgroups::Fixed(24),
@@ -187,6 +223,9 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
     let (mut device_moved, mut host_moved) = (0, 0);
     // The same, of megakernels with planar items (moved plane by plane).
     let (mut planar_device_moved, mut planar_host_moved) = (0, 0);
+    // Runs that ran items from local queues, and of those, runs of several launches (held items
+    // spilled at a launch's end or when a local batch found no room).
+    let (mut local_runs, mut local_relaunched) = (0, 0);
     for payload in [1u32, 62] {
         let shape = TreeParams {
             roots: 1,
@@ -327,6 +366,14 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
                 }
                 grown += (stats.queue_growths > 0) as u32;
                 abandoned += (stats.abandoned > 0) as u32;
+                local_runs += (stats.local_items > 0) as u32;
+                local_relaunched += (stats.local_items > 0 && stats.launches > 1) as u32;
+                if stats.local_items > 0 {
+                    assert!(
+                        name.contains("local"),
+                        "{name}: local items without local queues"
+                    );
+                }
             }
         }
     }
@@ -334,9 +381,13 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
         "{runs} runs: {multi_launch} needed several launches, {grown} grew a queue, {abandoned} \
          abandoned a wait; megakernel compactions: {device_moved} runs on the device, \
          {host_moved} on the host ({planar_device_moved} and {planar_host_moved} of them with \
-         planar items)"
+         planar items); {local_runs} ran local queues, {local_relaunched} of them relaunched"
     );
     assert!(runs >= 250, "only {runs} runs");
+    assert!(
+        local_runs > 20 && local_relaunched > 5,
+        "{local_runs} runs with local queues, {local_relaunched} of them relaunched"
+    );
     // The hard paths must have been exercised, or this test proves little.
     assert!(
         multi_launch > 20 && grown > 20,

@@ -159,6 +159,17 @@ pub struct Cli {
     /// `SUBGROUP` operations (by default one atomic per item: `MegakernelConfig::subgroups`).
     #[arg(long, help_heading = "Scheduler")]
     pub subgroups: bool,
+
+    /// The megakernel keeps the emits a workload declares local (the tree's children, Reyes'
+    /// Bound and Split pieces) in workgroup memory and runs them next on the same workgroup
+    /// (`MegakernelConfig::local_queues`; off by default, slower on the H200 so far).
+    #[arg(long, help_heading = "Scheduler")]
+    pub local_queues: bool,
+
+    /// Workgroup memory for the megakernel's local queues, in bytes
+    /// (`MegakernelConfig::local_bytes`; default 16384, less where the device leaves less).
+    #[arg(long, value_name = "BYTES", help_heading = "Scheduler")]
+    pub local_bytes: Option<u32>,
 }
 
 /// `--enqueue`: how megakernel items reach their queue.
@@ -305,6 +316,8 @@ impl Cli {
             },
             item_layout: self.item_layout,
             direct_enqueue: self.enqueue.map(|e| e == Enqueue::Direct),
+            local_queues: self.local_queues,
+            local_bytes: self.local_bytes,
         }
     }
 }

@@ -229,6 +229,7 @@ mod tests {
             rounds: 0,
             launches: 0,
             batches: 0,
+            local_items: 0,
             idle_polls: 0,
             abandoned: 0,
             queue_growths: 0,

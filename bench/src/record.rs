@@ -52,6 +52,9 @@ pub struct RunRecord {
     pub rounds: u64,
     pub launches: u64,
     pub batches: u64,
+    /// Megakernel: items run from workgroups' local queues (`RunStats::local_items`).
+    #[serde(default)]
+    pub local_items: u64,
     pub idle_polls: u64,
     pub abandoned: u64,
     pub queue_growths: u64,
@@ -93,6 +96,7 @@ impl RunRecord {
             rounds: s.rounds,
             launches: s.launches,
             batches: s.batches,
+            local_items: s.local_items,
             idle_polls: s.idle_polls,
             abandoned: s.abandoned,
             queue_growths: s.queue_growths,
@@ -136,6 +140,7 @@ impl RunRecord {
             rounds: 0,
             launches: 0,
             batches: 0,
+            local_items: 0,
             idle_polls: 0,
             abandoned: 0,
             queue_growths: 0,

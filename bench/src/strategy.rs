@@ -138,6 +138,10 @@ pub struct GpuConfig {
     pub turn_anatomy: bool,
     /// `MegakernelConfig::subgroups`; `None`: where the adapter has them; default `Some(false)`.
     pub subgroups: Option<bool>,
+    /// `MegakernelConfig::local_queues`.
+    pub local_queues: bool,
+    /// `MegakernelConfig::local_bytes`; `None`: its default.
+    pub local_bytes: Option<u32>,
 }
 
 impl Default for GpuConfig {
@@ -151,6 +155,8 @@ impl Default for GpuConfig {
             capacity: None,
             turn_anatomy: false,
             subgroups: Some(false),
+            local_queues: false,
+            local_bytes: None,
         }
     }
 }
@@ -183,6 +189,10 @@ pub fn compile(
                 direct_enqueue: config.direct_enqueue,
                 turn_anatomy: config.turn_anatomy,
                 subgroups: config.subgroups,
+                local_queues: config.local_queues,
+                local_bytes: config
+                    .local_bytes
+                    .unwrap_or(MegakernelConfig::default().local_bytes),
                 initial_capacity: capacity,
                 ..Default::default()
             },

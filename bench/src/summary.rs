@@ -412,6 +412,7 @@ mod tests {
             rounds,
             launches: if mk { 3 } else { 0 },
             batches: 10,
+            local_items: 0,
             idle_polls: 50,
             abandoned: 0,
             queue_growths: 0,

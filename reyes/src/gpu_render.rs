@@ -41,13 +41,19 @@ pub fn program_for(features: SceneFeatures) -> Result<Program, RunError> {
         .emits("splitv", 1)
         .emits("diceshade", 1)
         .emits("dicesmall", 1)
+        // Bound and Split recurse on a patch's pieces within the workgroup while they fit
+        // (Micropolis' local bound-and-split; docs/scheduler.md 2.7).
+        .local("splitu")
+        .local("splitv")
         .body(shaders::BOUND);
     let splitu = Procedure::new("splitu", item.clone(), 4)
         .emits("bound", 2)
+        .local("bound")
         .body(shaders::SPLIT);
     // splitv_execute is defined in split.wgsl, given once as SplitU's body.
     let splitv = Procedure::new("splitv", item.clone(), 4)
         .emits("bound", 2)
+        .local("bound")
         .body("");
     let diceshade = Procedure::new("diceshade", item.clone(), 256)
         // With SCENE_UVT the points at shutter close follow the open ones (sample_uvt.wgsl).

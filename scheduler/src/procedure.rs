@@ -93,6 +93,9 @@ pub struct Procedure {
     /// The procedure whose execute function this one runs, if not its own
     /// ([`Procedure::execute_of`]).
     pub execute_of: Option<String>,
+    /// Targets whose items this procedure's batches may keep in workgroup memory and run next on
+    /// the same workgroup ([`Procedure::local`]).
+    pub local: Vec<String>,
 }
 
 impl Procedure {
@@ -108,6 +111,7 @@ impl Procedure {
             max_emits: Vec::new(),
             body: String::new(),
             execute_of: None,
+            local: Vec::new(),
         }
     }
 
@@ -115,6 +119,21 @@ impl Procedure {
     /// the `enqueue_<target>` calls of all its threads. Repeated calls for one target add up.
     pub fn emits(mut self, target: &str, max: u32) -> Self {
         self.max_emits.push((target.into(), max));
+        self
+    }
+
+    /// Lets the items this procedure emits to `target` (declared with [`Procedure::emits`]) stay
+    /// on chip: in the megakernel with `MegakernelConfig::local_queues` (off by default: it did
+    /// not pay on the H200 yet, docs/scheduler.md 2.7), a batch's emits to `target` go to a region of the workgroup's
+    /// own memory while it has room, and the workgroup runs them as its next batch, without the
+    /// global queue's tickets, flags and claim (Whippletree's shared-memory queues, Steinberger et
+    /// al. 2014, section 4; the local bound-and-split of Micropolis, Weber et al. 2015). What does
+    /// not fit goes to the global queue as before. While another workgroup of the launch is idle,
+    /// a workgroup keeps only one step's worth (`items_per_step` of `target`) and shares the rest.
+    /// The multi-pass strategies have no workgroup that outlives a pass and ignore it. Checked by
+    /// [`crate::Program::new`]: `target` must be one this procedure emits to.
+    pub fn local(mut self, target: &str) -> Self {
+        self.local.push(target.into());
         self
     }
 

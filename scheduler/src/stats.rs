@@ -17,6 +17,9 @@ pub struct RunStats {
     pub rounds: u64,
     /// Megakernel: batches run.
     pub batches: u64,
+    /// Megakernel: items run from a workgroup's local queue ([`crate::Procedure::local`]),
+    /// counted in `executed` too.
+    pub local_items: u64,
     /// Megakernel: loop turns that found nothing to claim.
     pub idle_polls: u64,
     /// Kernel launches. Megakernel: persistent launches (a launch ends early at its loop bound or
@@ -72,6 +75,7 @@ impl RunStats {
         self.stage_gpu_ms = stage;
         self.rounds += o.rounds;
         self.batches += o.batches;
+        self.local_items += o.local_items;
         self.idle_polls += o.idle_polls;
         self.launches += o.launches;
         self.submits += o.submits;

@@ -15,6 +15,8 @@ pub const Q_BLOCKED: usize = 7;
 pub const Q_DEMAND: usize = 8;
 /// Items the device compaction kept in this queue (written only by `megakernel_compact.wgsl`).
 pub const Q_KEPT: usize = 9;
+/// Items run from the workgroups' local queues (never ticketed in this queue).
+pub const Q_LOCAL: usize = 10;
 
 pub const G_PENDING: usize = 0;
 pub const G_STOP: usize = 1;
@@ -30,6 +32,8 @@ pub const G_PROBE_RESIDENT: usize = 10;
 pub const G_ITER_EXITS: usize = 11;
 /// Slots the device compaction found reserved but unpublished, or could not place.
 pub const G_LOST: usize = 12;
+/// Workgroups idle right now (local queues only).
+pub const G_IDLE_NOW: usize = 13;
 /// First of the turn anatomy's counters (`anatomy::TurnAnatomy`, `AN_*` in the shader).
 pub const G_AN: usize = 16;
 pub const AN_WORDS: usize = 8;
@@ -91,6 +95,8 @@ mod tests {
             ("Q_BATCHES", Q_BATCHES),
             ("Q_BLOCKED", Q_BLOCKED),
             ("Q_DEMAND", Q_DEMAND),
+            ("Q_LOCAL", Q_LOCAL),
+            ("G_IDLE_NOW", G_IDLE_NOW),
             ("G_PENDING", G_PENDING),
             ("G_STOP", G_STOP),
             ("G_ERROR", G_ERROR),

@@ -6,6 +6,7 @@
 pub mod anatomy;
 mod compact;
 pub(crate) mod layout;
+pub(crate) mod local;
 pub(crate) mod record;
 pub(crate) mod wgsl;
 
@@ -121,6 +122,17 @@ pub struct MegakernelConfig {
     /// round trip) are not shrunk back to `initial_capacity`. `false` starts every run at
     /// `initial_capacity` (tests use it to exercise growth run after run).
     pub size_from_last_run: bool,
+    /// Keep the emits that procedures declare local ([`crate::Procedure::local`]) in each
+    /// workgroup's memory and run them there next: up to `local_bytes` bytes of workgroup memory
+    /// (less where the device's limit leaves less), split between the regions of the local
+    /// targets and the buffer of the batch being run. No effect on a program that declares
+    /// nothing local. Default `false`: measured on the H200 (docs/results.md, 2026-12-02, "Local
+    /// queues") every tree preset and Reyes ran 1.1-2.4x slower with them, as the kernel's
+    /// co-resident workgroups fell from 8 to 2-4 per SM and batches got smaller
+    /// (docs/scheduler.md 2.7).
+    pub local_queues: bool,
+    /// Workgroup memory for the local queues, in bytes (default [`local::LOCAL_MAX_BYTES`]).
+    pub local_bytes: u32,
 }
 
 /// Most tickets one batch may list for direct enqueue (`MegakernelConfig::direct_enqueue`):
@@ -148,6 +160,8 @@ impl Default for MegakernelConfig {
             turn_anatomy: false,
             subgroups: Some(false),
             size_from_last_run: true,
+            local_queues: false,
+            local_bytes: local::LOCAL_MAX_BYTES,
         }
     }
 }
@@ -279,14 +293,35 @@ impl Megakernel {
         }
         let subgroups = config.subgroups.unwrap_or(gpu.subgroups);
         config.subgroups = Some(subgroups);
-        let source = wgsl::source(
-            program,
-            gpu.coherent,
-            items,
-            direct,
-            config.turn_anatomy,
-            subgroups,
-        );
+        let generate = |plan: &local::LocalPlan| {
+            wgsl::source(
+                program,
+                gpu.coherent,
+                items,
+                direct,
+                config.turn_anatomy,
+                subgroups,
+                plan,
+            )
+        };
+        let mut plan = local::LocalPlan::none(nq);
+        let mut source = generate(&plan);
+        if config.local_queues && program.has_local() {
+            // The local queues take what the rest of the kernel leaves of the device's limit.
+            let used = local::workgroup_bytes(&source)?;
+            let limit = gpu.device.limits().max_compute_workgroup_storage_size;
+            let bytes = config.local_bytes.min(limit.saturating_sub(used));
+            plan = local::LocalPlan::new(program, bytes);
+            if plan.active() {
+                source = generate(&plan);
+            }
+            log::debug!(
+                "megakernel: local queues of {:?} items ({} bytes; {used} bytes used otherwise)",
+                plan.cap,
+                plan.bytes()
+            );
+        }
+        config.local_queues = plan.active();
         let entries = [
             storage_entry(0, false),
             storage_entry(1, false),
@@ -629,8 +664,10 @@ impl Megakernel {
             }
             let mut progress = 0;
             for q in 0..nq {
-                stats.executed[q] += ctrl[layout::q(q, Q_EXECUTED)] as u64;
-                progress += ctrl[layout::q(q, Q_EXECUTED)] as u64;
+                let local = ctrl[layout::q(q, Q_LOCAL)] as u64;
+                stats.executed[q] += ctrl[layout::q(q, Q_EXECUTED)] as u64 + local;
+                stats.local_items += local;
+                progress += ctrl[layout::q(q, Q_EXECUTED)] as u64 + local;
                 stats.batches += ctrl[layout::q(q, Q_BATCHES)] as u64;
                 stats.peak_occupancy[q] =
                     stats.peak_occupancy[q].max(ctrl[layout::q(q, Q_PEAK)] as u64);

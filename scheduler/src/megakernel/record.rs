@@ -195,7 +195,10 @@ impl RecordedLaunch {
             strategy: "megakernel".into(),
             item_layout: self.item_layout.name().into(),
             enqueue: if self.direct { "direct" } else { "outbox" }.into(),
-            executed: (0..nq).map(|qi| ctrl[q(qi, Q_EXECUTED)] as u64).collect(),
+            executed: (0..nq)
+                .map(|qi| ctrl[q(qi, Q_EXECUTED)] as u64 + ctrl[q(qi, Q_LOCAL)] as u64)
+                .collect(),
+            local_items: (0..nq).map(|qi| ctrl[q(qi, Q_LOCAL)] as u64).sum(),
             peak_occupancy: (0..nq).map(|qi| ctrl[q(qi, Q_PEAK)] as u64).collect(),
             batches: (0..nq).map(|qi| ctrl[q(qi, Q_BATCHES)] as u64).sum(),
             idle_polls: ctrl[g(nq, G_IDLE)] as u64,

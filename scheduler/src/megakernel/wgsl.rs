@@ -3,6 +3,7 @@
 //! to the workgroup's outbox or (direct enqueue) straight into the slots, and the loop in
 //! `shaders/megakernel.wgsl`.
 
+use super::local::LocalPlan;
 use crate::item_layout::{ItemLayout, planar_load_store_fns};
 use crate::program::Program;
 
@@ -13,7 +14,8 @@ pub const TEMPLATE: &str = include_str!("../../../shaders/megakernel.wgsl");
 /// straight into the slots, with the longest ticket list of a batch and each (source, target)
 /// part's offset in it (`MegakernelConfig::direct_enqueue`). `anatomy`: count each turn's
 /// phases (`MegakernelConfig::turn_anatomy`). `subgroups`: take enqueue tickets once per
-/// subgroup (`MegakernelConfig::subgroups`; the device must have wgpu's `SUBGROUP`).
+/// subgroup (`MegakernelConfig::subgroups`; the device must have wgpu's `SUBGROUP`). `local`:
+/// the workgroup's local regions (`MegakernelConfig::local_queues`; [`LocalPlan::none`] for none).
 pub fn source(
     program: &Program,
     coherent: bool,
@@ -21,6 +23,7 @@ pub fn source(
     direct: Option<(u32, &[u32])>,
     anatomy: bool,
     subgroups: bool,
+    local: &LocalPlan,
 ) -> String {
     let planar = items == ItemLayout::Planar;
     let mut s = program.tables_wgsl();
@@ -40,6 +43,7 @@ pub fn source(
         es.join(", "),
         n2 = nq * nq
     );
+    s += &local.wgsl(program);
     s += &program.common_wgsl();
     if coherent {
         s += "@group(0) @binding(1) @coherent var<storage, read_write> slots: array<vec4<u32>>;\n";
@@ -55,7 +59,31 @@ pub fn source(
     }
     s += &crate::wgsl::vec4_word_accessors("sched_ob", "outbox");
     s += if subgroups { TAKE_SUBGROUP } else { TAKE_ONE };
-    s += &items.execute_switch(program, "sched_slot");
+    if local.active() {
+        // Bodies read their items through `sched_in`: the slots, or in a local batch the
+        // workgroup's input buffer; local emits are stored through `sched_loc`.
+        s += LOCAL_ACCESSORS;
+        s += &items.execute_switch(program, "sched_in");
+        let mut seen = Vec::new();
+        for (t, p) in program.procs.iter().enumerate() {
+            let typed = |prefix: &str| match items {
+                ItemLayout::Interleaved => crate::wgsl::load_store_fns(&p.layout, prefix),
+                ItemLayout::Planar => planar_load_store_fns(&p.layout, prefix),
+            };
+            if !seen.contains(&p.layout.name) {
+                seen.push(p.layout.name.clone());
+                if direct.is_some() {
+                    s += &typed("sched_slot");
+                }
+            }
+            if local.cap[t] > 0 && !seen.contains(&format!("loc {}", p.layout.name)) {
+                seen.push(format!("loc {}", p.layout.name));
+                s += &typed("sched_loc");
+            }
+        }
+    } else {
+        s += &items.execute_switch(program, "sched_slot");
+    }
     // Where item `s` of queue `q`'s slots starts (planar: and its stride).
     let slot_at = |q: &str| {
         if planar {
@@ -70,11 +98,23 @@ pub fn source(
     } else {
         ("sched_outbox + ob_off(q, t) + j * WORDS[t]", "1u")
     };
+    // A local batch's item `s` in `wg_local_in`: the local region's layout (planar: stride the
+    // region's capacity). One call site of `sched_execute` either way (lavapipe inlines it).
+    let (base, local_base, stride_arg) = if planar {
+        ("q_slot_base(q) + s", "s", ", stride")
+    } else {
+        ("q_slot_base(q) + s * WORDS[q]", "s * WORDS[q]", "")
+    };
     s += &format!(
-        "fn mk_execute(q: u32, s: u32, inv: Invocation) {{ sched_execute(q, {}, inv); }}\n\
-         fn mk_outbox_item(q: u32, t: u32, j: u32) -> u32 {{ return {ob_at}; }}\n\
-         fn mk_outbox_stride(q: u32, t: u32) -> u32 {{ return {ob_stride}; }}\n",
-        slot_at("q")
+        "fn mk_execute(q: u32, s: u32, inv: Invocation) {{\n    \
+             var base = {base};\n    var stride = {};\n    \
+             if LOCAL && sched_from_local {{ base = {local_base}; stride = LOCAL_CAP[q]; }}\n    \
+             sched_execute(q, base{stride_arg}, inv);\n}}\n",
+        if planar { "q_cap(q)" } else { "1u" }
+    );
+    s += &format!(
+        "fn mk_outbox_item(q: u32, t: u32, j: u32) -> u32 {{ return {ob_at}; }}\n\
+         fn mk_outbox_stride(q: u32, t: u32) -> u32 {{ return {ob_stride}; }}\n"
     );
     // Typed outbox stores, only where items go through the outbox (direct enqueue stores with
     // the `sched_slot_store_*` that come with `ItemLayout::execute_switch`'s loads).
@@ -90,6 +130,21 @@ pub fn source(
     }
     for (t, p) in program.procs.iter().enumerate() {
         let ty = &p.layout.name;
+        // Local first, where q keeps its emits to t and the region has room this batch.
+        let local_store = if local.cap[t] > 0 {
+            let at = if planar {
+                format!("LOCAL_OFF[{t}u] + l, LOCAL_CAP[{t}u]")
+            } else {
+                format!("LOCAL_OFF[{t}u] + l * WORDS[{t}u]")
+            };
+            format!(
+                "if LOCAL_EDGE[sched_proc * NQ + {t}u] != 0u {{\n        \
+                     let l = atomicAdd(&wg_local_n[{t}u], 1u);\n        \
+                     if l < wg_local_lim[{t}u] {{ sched_loc_store_{ty}({at}, item); return; }}\n    }}\n    "
+            )
+        } else {
+            String::new()
+        };
         let store = if direct.is_some() {
             let at = slot_at(&format!("{t}u"));
             format!(
@@ -106,13 +161,37 @@ pub fn source(
             )
         };
         s += &format!(
-            "fn enqueue_{name}(item: {ty}) {{\n    if !sched_active {{ return; }}\n    {store}\n}}\n",
+            "fn enqueue_{name}(item: {ty}) {{\n    if !sched_active {{ return; }}\n    {local_store}{store}\n}}\n",
             name = p.proc.name,
         );
     }
     s += TEMPLATE;
     s
 }
+
+/// Word accessors of local queues: `sched_in` reads a batch's items from the slots or, in a
+/// local batch, from `wg_local_in` (its stores are never called: bodies only load);
+/// `sched_loc` writes local emits into `wg_local_out`.
+const LOCAL_ACCESSORS: &str = "\
+fn sched_in_load_word(i: u32) -> u32 {
+    if sched_from_local { return wg_local_in[i]; }
+    return sched_slot_load_word(i);
+}
+fn sched_in_load_vec4(i: u32) -> vec4<u32> {
+    if sched_from_local { return vec4<u32>(wg_local_in[i], wg_local_in[i + 1u], wg_local_in[i + 2u], wg_local_in[i + 3u]); }
+    return sched_slot_load_vec4(i);
+}
+fn sched_in_store_word(i: u32, w: u32) { sched_slot_store_word(i, w); }
+fn sched_in_store_vec4(i: u32, v: vec4<u32>) { sched_slot_store_vec4(i, v); }
+fn sched_loc_load_word(i: u32) -> u32 { return wg_local_out[i]; }
+fn sched_loc_store_word(i: u32, w: u32) { wg_local_out[i] = w; }
+fn sched_loc_load_vec4(i: u32) -> vec4<u32> {
+    return vec4<u32>(wg_local_out[i], wg_local_out[i + 1u], wg_local_out[i + 2u], wg_local_out[i + 3u]);
+}
+fn sched_loc_store_vec4(i: u32, v: vec4<u32>) {
+    wg_local_out[i] = v.x; wg_local_out[i + 1u] = v.y; wg_local_out[i + 2u] = v.z; wg_local_out[i + 3u] = v.w;
+}
+";
 
 /// `sched_take` (see `shaders/megakernel.wgsl`): every emitting lane takes its own index and
 /// ticket.
@@ -162,7 +241,16 @@ mod tests {
             .body("fn sink_execute(item: Word, inv: Invocation) {}");
         let two = Procedure::new("two", word, 2).execute_of("one");
         let p = Program::new(vec![one, sink, two], UserBindings::none()).unwrap();
-        let src = super::source(&p, false, ItemLayout::Interleaved, None, false, false);
+        let plan = super::LocalPlan::none(3);
+        let src = super::source(
+            &p,
+            false,
+            ItemLayout::Interleaved,
+            None,
+            false,
+            false,
+            &plan,
+        );
         assert_eq!(src.matches("one_execute(it, inv)").count(), 1, "{src}");
         assert!(src.contains("case 0u, 2u:"), "{src}");
     }

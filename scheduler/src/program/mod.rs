@@ -40,6 +40,8 @@ pub struct ProcInfo {
     pub items_per_step: u32,
     /// `emits[t]`: worst-case items emitted to queue `t` per executed item.
     pub emits: Vec<u32>,
+    /// `local[t]`: items emitted to queue `t` may stay in the workgroup ([`Procedure::local`]).
+    pub local: Vec<bool>,
 }
 
 impl ProcInfo {
@@ -120,6 +122,19 @@ impl Program {
                 })?;
                 emits[ti] += max;
             }
+            let mut local = vec![false; procedures.len()];
+            for target in &p.local {
+                match index(target) {
+                    Some(ti) if emits[ti] > 0 => local[ti] = true,
+                    _ => {
+                        return Err(RunError::Program(format!(
+                            "procedure `{}` keeps its `{target}` items local, but does not emit \
+                             to `{target}` (declare it with `emits`)",
+                            p.name
+                        )));
+                    }
+                }
+            }
             if let Some(other) = &p.execute_of {
                 let o = index(other).map(|o| &procedures[o]).ok_or_else(|| {
                     RunError::Program(format!(
@@ -153,6 +168,7 @@ impl Program {
                 layout,
                 items_per_step: WORKGROUP_SIZE / t,
                 emits,
+                local,
             });
         }
         let mut program = Program {
@@ -178,6 +194,11 @@ impl Program {
     /// into a `var` once and index that (docs/scheduler.md, "Writing fast procedures").
     pub fn notes(&self) -> &[String] {
         &self.notes
+    }
+
+    /// Whether some procedure keeps some of its emits local ([`Procedure::local`]).
+    pub fn has_local(&self) -> bool {
+        self.procs.iter().any(|p| p.local.iter().any(|&l| l))
     }
 
     /// Number of procedures, which is the number of queues.

@@ -450,6 +450,9 @@ impl TreeParams {
         let branch = Procedure::new("branch", item.clone(), 1)
             .emits("branch", k)
             .emits("leaf", k)
+            // A node's children run next on its workgroup while they fit (docs/scheduler.md 2.7).
+            .local("branch")
+            .local("leaf")
             .body(&unrolled(BRANCH_WGSL, p));
         let leaf = Procedure::new("leaf", item, 1).body(&unrolled(LEAF_WGSL, p));
         Program::new(vec![branch, leaf], user)
