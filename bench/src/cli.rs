@@ -122,10 +122,10 @@ pub struct Cli {
     #[arg(long, value_enum, default_value_t = Policy::Priority, help_heading = "Scheduler")]
     pub policy: Policy,
 
-    /// Megakernel workgroup steps per claimed batch.
-    #[arg(long, default_value_t = 1, value_parser = value_parser!(u32).range(1..=64),
-          help_heading = "Scheduler")]
-    pub batch_steps: u32,
+    /// Megakernel workgroup steps per claimed batch [default: the workload's: 2 for Reyes frames
+    /// on a GPU, as `reyes render` runs them (`reyes::gpu_render::megakernel_batch_steps`), else 1].
+    #[arg(long, value_parser = value_parser!(u32).range(1..=64), help_heading = "Scheduler")]
+    pub batch_steps: Option<u32>,
 
     /// Longest pause of an idle megakernel workgroup between polls, in loop trips (0: none).
     #[arg(long, default_value_t = 64, value_parser = value_parser!(u32).range(0..=30000),

@@ -211,7 +211,12 @@ impl Workload for ReyesWorkload {
                     let features = cur.data.features();
                     let program = program_for(features)?;
                     let capacity = self.config.capacity.unwrap_or(INITIAL_CAPACITY);
-                    let scheduler = compile(gpu, &program, strategy, &self.config, capacity)?;
+                    // The renderer's batch size unless the command line names one.
+                    let mut config = self.config.clone();
+                    config.batch_steps = config
+                        .batch_steps
+                        .or(Some(reyes::gpu_render::megakernel_batch_steps(gpu)));
+                    let scheduler = compile(gpu, &program, strategy, &config, capacity)?;
                     let config = RendererConfig::new(scheduler.kind())
                         .features(features)
                         .scheduler(scheduler);

@@ -124,8 +124,9 @@ impl Strategy {
 pub struct GpuConfig {
     /// Megakernel workgroups; `None` probes the co-resident count.
     pub workgroups: Option<u32>,
-    /// Megakernel workgroup steps per claimed batch (at least 1).
-    pub batch_steps: u32,
+    /// Megakernel workgroup steps per claimed batch (at least 1); `None`: the workload's choice
+    /// (1 but for Reyes frames: `reyes::gpu_render::megakernel_batch_steps`).
+    pub batch_steps: Option<u32>,
     /// Longest pause of an idle megakernel workgroup (`MegakernelConfig::idle_backoff`).
     pub idle_backoff: u32,
     /// How the queues hold items (`MegakernelConfig::item_layout`); `None`: `ItemLayout::for_program`.
@@ -148,7 +149,7 @@ impl Default for GpuConfig {
     fn default() -> Self {
         GpuConfig {
             workgroups: None,
-            batch_steps: 1,
+            batch_steps: None,
             idle_backoff: MegakernelConfig::default().idle_backoff,
             item_layout: None,
             direct_enqueue: None,
@@ -183,7 +184,7 @@ pub fn compile(
                     .workgroups
                     .map_or(Workgroups::Probe { max: 4096 }, Workgroups::Fixed),
                 policy: policy.queue_policy(),
-                batch_steps: config.batch_steps,
+                batch_steps: config.batch_steps.unwrap_or(1),
                 idle_backoff: config.idle_backoff,
                 item_layout: config.item_layout,
                 direct_enqueue: config.direct_enqueue,

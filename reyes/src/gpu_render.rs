@@ -21,6 +21,14 @@ use std::time::Instant;
 /// priority: dice before split, which keeps the queues short.
 pub const PROCEDURES: [&str; 5] = ["bound", "splitu", "splitv", "diceshade", "dicesmall"];
 
+/// Workgroup steps per megakernel batch for Reyes frames on `gpu` (`MegakernelConfig::batch_steps`):
+/// 2 on GPUs, where Killeroo at 1920x1080 ran 1.90 -> 1.76 ms (teapot 1.10 -> 1.13; docs/results.md,
+/// 2026-12-02, "Two-step batches"); 1 on lavapipe, whose loop limiter counts a turn's body loops
+/// against the persistent loop's budget (`scheduler::LAVAPIPE_MAX_ITERATIONS`).
+pub fn megakernel_batch_steps(gpu: &Gpu) -> u32 {
+    if gpu.is_lavapipe() { 1 } else { 2 }
+}
+
 /// Device features the pipeline needs: 64-bit atomicMax for the depth-and-colour samples.
 pub fn required_features() -> wgpu::Features {
     wgpu::Features::SHADER_INT64 | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX
@@ -263,6 +271,15 @@ impl GpuRenderer {
                 scheduler::MegakernelConfig {
                     initial_capacity: INITIAL_CAPACITY,
                     max_iterations: 1,
+                    ..Default::default()
+                },
+            )?,
+            StrategyKind::Megakernel => Scheduler::megakernel(
+                gpu,
+                program,
+                scheduler::MegakernelConfig {
+                    initial_capacity: INITIAL_CAPACITY,
+                    batch_steps: megakernel_batch_steps(gpu),
                     ..Default::default()
                 },
             )?,
