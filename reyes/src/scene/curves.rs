@@ -334,7 +334,7 @@ impl Segment {
 #[cfg_attr(not(test), allow(dead_code, reason = "the tests' tolerance"))]
 pub(crate) const DISC_RIM_ERROR: f64 = 2.8e-4;
 
-/// The four bicubic patches (control points, all weights 1) of a disc of `radius` centred at
+/// The four bicubic patches (control points; polynomial) of a disc of `radius` centred at
 /// `p` (camera space), perpendicular to the view direction there, with dPdu x dPdv pointing at
 /// the eye; and that unit normal (towards the eye). A zero radius gives none.
 ///
@@ -344,7 +344,7 @@ pub(crate) const DISC_RIM_ERROR: f64 = 2.8e-4;
 /// crack bound of a rational quarter circle is 4 times its true curvature (docs/reyes.md,
 /// *Rational patches*), which grew discs of a few pixels by a pixel all round; the polynomial
 /// arc's bound is within 12% of its true curvature.
-pub(crate) fn disc(p: DVec3, radius: f64, view: View) -> (Vec<([DVec3; 16], [f64; 16])>, DVec3) {
+pub(crate) fn disc(p: DVec3, radius: f64, view: View) -> (Vec<[DVec3; 16]>, DVec3) {
     let towards_eye = -view.dir(p).try_normalize().unwrap_or(DVec3::Z);
     if !(radius > 0.0) {
         return (Vec::new(), towards_eye);
@@ -369,12 +369,11 @@ pub(crate) fn disc(p: DVec3, radius: f64, view: View) -> (Vec<([DVec3; 16], [f64
                 DVec3::new(-a1.sin(), a1.cos(), 0.0),
             );
             let rim = [c0, c0 + t0 * k, c1 - t1 * k, c1];
-            let cp: [DVec3; 16] = std::array::from_fn(|m| {
+            std::array::from_fn(|m| {
                 let (i, j) = (m % 4, m / 4);
                 let l = rim[i] * (1.0 - j as f64 / 3.0);
                 p + (a * l.x + b * l.y) * radius
-            });
-            (cp, [1.0; 16])
+            })
         })
         .collect();
     (patches, towards_eye)
@@ -383,7 +382,6 @@ pub(crate) fn disc(p: DVec3, radius: f64, view: View) -> (Vec<([DVec3; 16], [f64
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::rational::eval_rational_bezier;
 
     const ID: WidthScale = WidthScale {
         to_object: Some(DMat3::IDENTITY),
@@ -564,11 +562,11 @@ mod tests {
             assert_eq!(patches.len(), 4);
             let e = view.dir(p).normalize();
             assert!(n.distance(-e) < 1e-12);
-            for (cp, w) in &patches {
+            for cp in &patches {
                 for k in 0..=6 {
                     for l in 0..=6 {
                         let (q, du, dv) =
-                            eval_rational_bezier(cp, w, k as f64 / 6.0, l as f64 / 6.0);
+                            crate::scene::eval_bezier(cp, k as f64 / 6.0, l as f64 / 6.0);
                         assert!((q - p).dot(e).abs() < 1e-12, "in the plane");
                         let tol = DISC_RIM_ERROR * 0.5;
                         assert!((q - p).length() <= 0.5 + tol);

@@ -276,18 +276,16 @@ impl Interp {
     /// Emits a camera-space patch of a curve or point: the current material and attributes,
     /// dPdu x dPdv as its outside (the geometry is built facing the eye, or along `"N"`),
     /// displacement scaled by the object's transform `ctm`, and the shading normal `n`.
-    #[allow(clippy::too_many_arguments, reason = "one emitted patch's parts")]
     fn emit_facing(
         &mut self,
         a: &Args,
         ctm: &DMat4,
         index: usize,
         cp: [DVec3; 16],
-        w: [f64; 16],
         fields: (Option<ColorField>, Option<ColorField>),
         n: Option<ColorField>,
     ) -> Result<(), SceneError> {
-        self.emit_with(a, &DMat4::IDENTITY, index, cp, w, fields)?;
+        self.emit_with(a, &DMat4::IDENTITY, index, cp, Patch::POLYNOMIAL, fields)?;
         let displacement = self.displacement(ctm);
         if let Some(p) = self.scene.patches.last_mut() {
             p.flip_normal = false;
@@ -429,7 +427,7 @@ impl Interp {
                     let n = normal
                         .as_ref()
                         .map(|v| v.piece_field(&seg.normal.unwrap(), piece.t, cubic));
-                    self.emit_facing(a, &ctm, seg_index, piece.cp, Patch::POLYNOMIAL, fields, n)?;
+                    self.emit_facing(a, &ctm, seg_index, piece.cp, fields, n)?;
                 }
             }
         }
@@ -486,13 +484,13 @@ impl Interp {
                 _ => half.values[k],
             };
             let (patches, towards_eye) = curves::disc(ctm.transform_point3(*p), h * scale, view);
-            for (cp, w) in patches {
+            for cp in patches {
                 let fields = (
                     cs.as_ref().map(|v| ColorField::Flat(value(v, k))),
                     os.as_ref().map(|v| ColorField::Flat(value(v, k))),
                 );
                 let n = Some(ColorField::Flat(towards_eye));
-                self.emit_facing(a, &ctm, k, cp, w, fields, n)?;
+                self.emit_facing(a, &ctm, k, cp, fields, n)?;
             }
         }
         Ok(())
