@@ -385,9 +385,14 @@ impl Interp {
                     to_bezier: &to_bezier,
                 };
                 let centre = if cubic {
-                    let g: [DVec3; 4] = std::array::from_fn(|k| vertex(s * step + k));
+                    // To Bezier in object space, then transformed: the hermite and power
+                    // bases' control values include vectors, which the translation must
+                    // not move.
+                    let g: [DVec3; 4] =
+                        std::array::from_fn(|k| pts[c.vertex0 + (s * step + k) % c.vertices]);
                     std::array::from_fn(|r| {
-                        (0..4).fold(DVec3::ZERO, |acc, j| acc + g[j] * to_bezier[r][j])
+                        let b = (0..4).fold(DVec3::ZERO, |acc, j| acc + g[j] * to_bezier[r][j]);
+                        ctm.transform_point3(b)
                     })
                 } else {
                     curves::linear(vertex(s), vertex(s + 1))

@@ -69,7 +69,7 @@ fn check_cubic(basis: &str, step: usize, n: usize, periodic: bool) {
         .collect();
     let wrap = if periodic { "periodic" } else { "nonperiodic" };
     let s = parse(&world(&format!(
-        "Basis \"{basis}\" {step} \"{basis}\" {step}\n\
+        "Translate 0.5 -1 2 Basis \"{basis}\" {step} \"{basis}\" {step}\n\
          Curves \"cubic\" [{n}] \"{wrap}\" \"P\" [{}] \"constantwidth\" 0.05",
         nums.join("  ")
     )));
@@ -87,6 +87,7 @@ fn check_cubic(basis: &str, step: usize, n: usize, periodic: bool) {
                 pts[(seg * step + j) % n] * w
             })
             .sum::<DVec3>()
+            + DVec3::new(0.5, -1.0, 2.0)
     };
     let mut seen = vec![false; segments];
     for p in &s.patches {
