@@ -245,7 +245,7 @@ fn exporters_curves_and_points_render() {
             "{file}: covered {bare} px without crack dilation, exact {exact}"
         );
         // The crack dilation (on by default) only grows: the discs of points.rib, 2 to 4 px
-        // across, by 9% (its boundary bound is the chord deviation times a conservative
+        // across, by 6% (its boundary bound is the chord deviation times a conservative
         // camera-to-pixel factor, issue 23 item 6); the ribbons by 0.2%.
         assert!(
             area >= bare - 0.005 * exact && area < 1.12 * exact,

@@ -27,8 +27,8 @@
 //! the object-to-camera transform: the object-space length that maps onto the width
 //! direction), which is h times the scale for a uniform scale.
 //!
-//! **Discs**: four bicubic quarter discs ([`disc`]) of the point's radius, centred on it in the
-//! plane perpendicular to the view direction, the outside facing the eye.
+//! **Discs**: one bicubic patch ([`disc`]) bounded by the four quarters of the point's circle,
+//! centred on it in the plane perpendicular to the view direction, the outside facing the eye.
 
 use glam::{DMat3, DVec3};
 
@@ -334,49 +334,71 @@ impl Segment {
 #[cfg_attr(not(test), allow(dead_code, reason = "the tests' tolerance"))]
 pub(crate) const DISC_RIM_ERROR: f64 = 2.8e-4;
 
-/// The four bicubic patches (control points; polynomial) of a disc of `radius` centred at
-/// `p` (camera space), perpendicular to the view direction there, with dPdu x dPdv pointing at
+/// The inner control points of [`disc`]'s patch at (±s, ±s) of the radius: every s in
+/// [0, 0.45] gives a positive Jacobian inside the square (zero only at its corners); 0.2 gives
+/// the most even one (largest over smallest away from the corners).
+const DISC_INNER: f64 = 0.2;
+
+/// The bicubic patch (control points; polynomial) of a disc of `radius` centred at `p`
+/// (camera space), perpendicular to the view direction there, with dPdu x dPdv pointing at
 /// the eye; and that unit normal (towards the eye). A zero radius gives none.
 ///
-/// Each patch is a quarter: u runs along the rim (a cubic Bezier quarter circle, within
-/// [`DISC_RIM_ERROR`] of the exact one), v from the rim (v = 0) straight in to the centre
-/// (v = 1, a collapsed edge). Polynomial rather than the exact rational `Disk` quadric: the
-/// crack bound of a rational quarter circle is 4 times its true curvature (docs/reyes.md,
-/// *Rational patches*), which grew discs of a few pixels by a pixel all round; the polynomial
-/// arc's bound is within 12% of its true curvature.
+/// The patch's four edges are the circle's quarters between 45, 135, 225 and 315 degrees,
+/// each the cubic Bezier quarter circle (inner points k = 4/3 tan(pi/8) along the end
+/// tangents, within [`DISC_RIM_ERROR`] of the circle), the inner points at
+/// ([`DISC_INNER`] r)(±1, ±1): a map of the square onto the disc whose Jacobian is positive
+/// inside (tested), so it covers the disc once; at the four corners two edges meet in one
+/// tangent direction and the normal is degenerate (the shading normal is given). One patch
+/// per point rather than four quarters; polynomial rather than the exact rational `Disk`
+/// quadric: the crack bound of a rational quarter circle is 4 times its true curvature
+/// (docs/reyes.md, *Rational patches*), which grew discs of a few pixels by a pixel all
+/// round.
 pub(crate) fn disc(p: DVec3, radius: f64, view: View) -> (Vec<[DVec3; 16]>, DVec3) {
     let towards_eye = -view.dir(p).try_normalize().unwrap_or(DVec3::Z);
     if !(radius > 0.0) {
         return (Vec::new(), towards_eye);
     }
-    // Local (x, y) counter-clockwise about local +z, which maps to `towards_eye`: u along the
-    // rim counter-clockwise and v inwards give dPdu x dPdv = +z.
+    // Local (x, y), with local +z mapped to `towards_eye`: u runs along +x, v along +y, so
+    // dPdu x dPdv = +z.
     let a = towards_eye.any_orthonormal_vector();
     let b = towards_eye.cross(a);
     let k = 4.0 / 3.0 * (std::f64::consts::FRAC_PI_8).tan();
-    let patches = (0..4)
-        .map(|q| {
-            let (a0, a1) = (
-                q as f64 * std::f64::consts::FRAC_PI_2,
-                (q + 1) as f64 * std::f64::consts::FRAC_PI_2,
-            );
-            let (c0, c1) = (
-                DVec3::new(a0.cos(), a0.sin(), 0.0),
-                DVec3::new(a1.cos(), a1.sin(), 0.0),
-            );
-            let (t0, t1) = (
-                DVec3::new(-a0.sin(), a0.cos(), 0.0),
-                DVec3::new(-a1.sin(), a1.cos(), 0.0),
-            );
-            let rim = [c0, c0 + t0 * k, c1 - t1 * k, c1];
-            std::array::from_fn(|m| {
-                let (i, j) = (m % 4, m / 4);
-                let l = rim[i] * (1.0 - j as f64 / 3.0);
-                p + (a * l.x + b * l.y) * radius
-            })
-        })
-        .collect();
-    (patches, towards_eye)
+    // The quarter circle counter-clockwise from `deg` degrees.
+    let quarter = |deg: f64| {
+        let (a0, a1) = (deg.to_radians(), (deg + 90.0).to_radians());
+        let (c0, c1) = (
+            DVec3::new(a0.cos(), a0.sin(), 0.0),
+            DVec3::new(a1.cos(), a1.sin(), 0.0),
+        );
+        let (t0, t1) = (
+            DVec3::new(-a0.sin(), a0.cos(), 0.0),
+            DVec3::new(-a1.sin(), a1.cos(), 0.0),
+        );
+        [c0, c0 + t0 * k, c1 - t1 * k, c1]
+    };
+    let (bottom, right) = (quarter(225.0), quarter(315.0));
+    let (mut top, mut left) = (quarter(45.0), quarter(135.0));
+    top.reverse();
+    left.reverse();
+    let s = DISC_INNER;
+    let local: [DVec3; 16] = std::array::from_fn(|m| {
+        let (i, j) = (m % 4, m / 4);
+        match (i, j) {
+            (_, 0) => bottom[i],
+            (_, 3) => top[i],
+            (0, _) => left[j],
+            (3, _) => right[j],
+            _ => DVec3::new(
+                if i == 1 { -s } else { s },
+                if j == 1 { -s } else { s },
+                0.0,
+            ),
+        }
+    });
+    (
+        vec![local.map(|l| p + (a * l.x + b * l.y) * radius)],
+        towards_eye,
+    )
 }
 
 #[cfg(test)]
@@ -556,31 +578,39 @@ mod tests {
 
     #[test]
     fn disc_is_round_flat_and_faces_the_eye() {
-        let p = DVec3::new(1.0, -2.0, 9.0);
+        let (p, r) = (DVec3::new(1.0, -2.0, 9.0), 0.5);
         for view in [View::Perspective, View::Orthographic] {
-            let (patches, n) = disc(p, 0.5, view);
-            assert_eq!(patches.len(), 4);
+            let (patches, n) = disc(p, r, view);
+            assert_eq!(patches.len(), 1);
+            let cp = &patches[0];
             let e = view.dir(p).normalize();
             assert!(n.distance(-e) < 1e-12);
-            for cp in &patches {
-                for k in 0..=6 {
-                    for l in 0..=6 {
-                        let (q, du, dv) =
-                            crate::scene::eval_bezier(cp, k as f64 / 6.0, l as f64 / 6.0);
-                        assert!((q - p).dot(e).abs() < 1e-12, "in the plane");
-                        let tol = DISC_RIM_ERROR * 0.5;
-                        assert!((q - p).length() <= 0.5 + tol);
-                        if l == 0 {
-                            // v = 0 is the rim.
-                            assert!(((q - p).length() - 0.5).abs() < tol);
-                        }
-                        let g = du.cross(dv);
-                        if g.length() > 1e-9 {
-                            assert!(g.dot(e) < 0.0, "faces the eye");
-                        }
-                    }
+            let tol = DISC_RIM_ERROR * r;
+            // The four edges are the circle.
+            for k in 0..=40 {
+                let t = k as f64 / 40.0;
+                for (u, v) in [(t, 0.0), (t, 1.0), (0.0, t), (1.0, t)] {
+                    let q = crate::scene::eval_bezier(cp, u, v).0;
+                    assert!(((q - p).length() - r).abs() < tol, "{u} {v}");
                 }
             }
+            // Inside: in the plane, within the circle, the Jacobian towards the eye (so the
+            // square covers the disc once), the area pi r^2 (the rim's error is outward).
+            let m = 200;
+            let mut area = 0.0;
+            for k in 0..m {
+                for l in 0..m {
+                    let (u, v) = ((k as f64 + 0.5) / m as f64, (l as f64 + 0.5) / m as f64);
+                    let (q, du, dv) = crate::scene::eval_bezier(cp, u, v);
+                    assert!((q - p).dot(e).abs() < 1e-12, "in the plane");
+                    assert!((q - p).length() < r + tol);
+                    let j = -du.cross(dv).dot(e);
+                    assert!(j > 0.0, "Jacobian {j} at ({u}, {v})");
+                    area += j / (m * m) as f64;
+                }
+            }
+            let exact = std::f64::consts::PI * r * r;
+            assert!((area - exact).abs() < 1e-3 * exact, "{area} vs {exact}");
         }
         assert!(disc(p, 0.0, View::Perspective).0.is_empty());
     }
