@@ -9,6 +9,7 @@
 
 mod basis;
 mod bpt;
+pub(crate) mod curves;
 mod displacement;
 mod newell;
 mod nurbs;

@@ -35,6 +35,7 @@
 //! [`camera`] (the window requests, orthographic projection, named coordinate systems).
 
 mod camera;
+mod curves;
 mod displacement;
 mod frames;
 mod input;

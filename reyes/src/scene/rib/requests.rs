@@ -52,6 +52,8 @@ pub(super) const KNOWN: &[&str] = &[
     "PointsPolygons",
     "PointsGeneralPolygons",
     "SubdivisionMesh",
+    "Curves",
+    "Points",
     "Sphere",
     "Cylinder",
     "Cone",
@@ -152,6 +154,8 @@ impl Interp {
                 self.polygon_request(req, a)
             }
             "SubdivisionMesh" => self.subdivision_mesh(req, a),
+            "Curves" => self.curves(req, a),
+            "Points" => self.points(req, a),
             name if QUADRICS.contains(&name) => self.quadric(req, a),
             "ObjectEnd" => Err(a.err("without a matching `ObjectBegin`")),
             "MotionBegin" => self.motion_begin(req, a),
