@@ -156,6 +156,7 @@ fn walk_items(
                     Cull::Offscreen => stages::C_CULL_OFFSCREEN,
                     Cull::Backface => stages::C_CULL_BACKFACE,
                     Cull::Occluded => stages::C_CULL_OCCLUDED,
+                    Cull::Trimmed => stages::C_CULL_TRIMMED,
                 }] += 1
             }
             Decision::Split { along_u, item, eye } => {

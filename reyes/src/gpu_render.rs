@@ -61,6 +61,7 @@ pub fn program_for(features: SceneFeatures) -> Result<Program, RunError> {
             shaders::COMMON,
             shaders::SHADE,
             shaders::SURFACE,
+            shaders::TRIM,
             shaders::SAMPLE,
             shaders::SAMPLE_UVT,
         ]

@@ -22,6 +22,7 @@ mod spin;
 pub mod stacked;
 pub mod subdiv;
 mod teapot;
+pub mod trim;
 
 use glam::{DMat4, DVec3};
 
@@ -175,6 +176,9 @@ pub struct Patch {
     /// point at shutter fraction t is the linear interpolation of the two (docs/reyes.md,
     /// "Motion blur and depth of field"). `None` for a patch that does not move.
     pub motion: Option<Box<glam::DMat4>>,
+    /// Trimming (RIB `TrimCurve` before a `NuPatch`): the loops that keep part of the patch,
+    /// and the patch's span of the surface's parameter space; `None` (no cost) when untrimmed.
+    pub trim: Option<std::sync::Arc<trim::PatchTrim>>,
     /// Where the patch came from, for error messages.
     pub source: PatchSource,
 }

@@ -100,6 +100,7 @@ pub(crate) fn frame(patches: Vec<ObjectPatch>, flip_normal: bool) -> Scene {
             primvars: None,
             displacement: None,
             motion: None,
+            trim: None,
             source,
         })
         .collect();

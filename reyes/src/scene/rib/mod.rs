@@ -52,6 +52,7 @@ mod subdiv;
 mod syntax;
 #[cfg(test)]
 mod tests;
+mod trim;
 
 pub use input::open_rib;
 

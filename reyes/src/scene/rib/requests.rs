@@ -157,13 +157,7 @@ impl Interp {
             "MotionBegin" => self.motion_begin(req, a),
             "MotionEnd" => self.motion_end(req),
             "Shutter" | "DepthOfField" => self.lens_option(req, a),
-            "TrimCurve" => {
-                let msg = "skipped unsupported request `TrimCurve`: the `NuPatch` surfaces \
-                           after it are drawn untrimmed (the regions its curves cut away are \
-                           filled)";
-                self.warn_once(req, "TrimCurve", msg);
-                Ok(())
-            }
+            "TrimCurve" => self.trim_curve(a),
             "MakeShadow" => {
                 self.make_shadow(req);
                 Ok(())

@@ -40,6 +40,11 @@ pub(super) struct Attributes {
     /// `Attribute "displacementbound" "sphere"`: the radius in object space (of each
     /// primitive) or, given in world or camera space, in camera space; the other 0.
     pub(super) displacement_bound: (f64, f64),
+    /// `TrimCurve`: the flattened loops that trim the `NuPatch` surfaces after it; `None`
+    /// when untrimmed.
+    pub(super) trim: Option<std::sync::Arc<crate::scene::trim::TrimLoops>>,
+    /// `Attribute "trimcurve" "sense" "outside"`: trimming keeps the outside of the loops.
+    pub(super) trim_outside: bool,
 }
 
 impl Default for Attributes {
@@ -57,6 +62,8 @@ impl Default for Attributes {
             vbasis: Basis::BEZIER,
             displacement: None,
             displacement_bound: (0.0, 0.0),
+            trim: None,
+            trim_outside: false,
         }
     }
 }

@@ -1,0 +1,119 @@
+//! Camera and image requests of real RIB files that change the picture (issue 23, item 5):
+//! `TrimCurve` on `NuPatch` (the field file that cuts a disc out of a square), through Bound
+//! and DiceShade on the GPU (both strategies, bit-identical) and the CPU twin, against an
+//! independent f64 reference of the disc. Runs on lavapipe in CI; the adapter comes from the
+//! environment and a missing one fails loudly.
+
+use glam::{DVec2, DVec3};
+use reyes::cpu_render::render_cpu;
+use reyes::frame::{FrameData, RenderOptions};
+use reyes::scene::Scene;
+use reyes::stages;
+
+mod common;
+use common::{CPU_TWIN_OVER_HARD, compare, render_both_strategies};
+
+/// The exporter file whose `TrimCurve` (a rational quadratic circle of radius 0.5 about the
+/// centre of the parameter square) cuts a disc out of a square `NuPatch`.
+fn trim_scene() -> Scene {
+    let path = reyes::shared_data_dir().join("field/exporters/trimcurve-format-minus-one.rib");
+    reyes::scene::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// Exact coverage of each pixel by the trimmed patch, from `n` x `n` regular sub-samples: the
+/// ray through each sub-sample meets the patch's plane (its four corners are coplanar and
+/// form a parallelogram, the bilinear NuPatch), the hit's (u, v) on that parallelogram is
+/// inside the circle of radius 1/2 about (1/2, 1/2) or not. Independent of the renderer's
+/// flattening, splitting and dicing.
+fn exact_disc(scene: &Scene, n: u32) -> Vec<f64> {
+    let p = &scene.patches[0];
+    let (o, a, b) = (p.cp[0], p.cp[3] - p.cp[0], p.cp[12] - p.cp[0]);
+    let normal = a.cross(b);
+    let (w, h) = (scene.width, scene.height);
+    let f = w.min(h) as f64 / 2.0 / (scene.camera.fov_deg.to_radians() / 2.0).tan();
+    (0..w * h)
+        .map(|k| {
+            let (x, y) = ((k % w) as f64, (k / w) as f64);
+            let hits = (0..n * n)
+                .filter(|s| {
+                    let sx = x + ((s % n) as f64 + 0.5) / n as f64;
+                    let sy = y + ((s / n) as f64 + 0.5) / n as f64;
+                    let d = DVec3::new((sx - w as f64 / 2.0) / f, (h as f64 / 2.0 - sy) / f, 1.0);
+                    let t = o.dot(normal) / d.dot(normal);
+                    let q = d * t - o;
+                    // q = u a + v b: solve in the plane (a, b orthogonal here: a square).
+                    let uv = DVec2::new(q.dot(a) / a.dot(a), q.dot(b) / b.dot(b));
+                    (0.0..=1.0).contains(&uv.x)
+                        && (0.0..=1.0).contains(&uv.y)
+                        && uv.distance(DVec2::splat(0.5)) <= 0.5
+                })
+                .count();
+            hits as f64 / (n * n) as f64
+        })
+        .collect()
+}
+
+/// The field file renders a disc: its coverage (the sum of alpha) within 0.5% of the exact
+/// disc's (micropolygons are kept or dropped whole by their centre, about 1 px across at the
+/// default size: the error along the ~440 px rim averages out, and 0.5% is 76 px), no pixel
+/// more than half covered where the exact disc covers nothing (the square's corners stay
+/// empty), Bound culls the pieces wholly cut away, the strategies agree bit for bit and the
+/// CPU twin within the tolerance of the other GPU tests.
+#[test]
+fn trimcurve_cuts_a_disc_out_of_the_square() {
+    let scene = trim_scene();
+    assert!(
+        !scene.warnings.iter().any(|w| w.contains("TrimCurve")),
+        "{:?}",
+        scene.warnings
+    );
+    assert_eq!(scene.patches.len(), 1);
+    assert!(scene.patches[0].trim.is_some());
+    let options = RenderOptions {
+        pixel_samples: Some((4, 4)),
+        ..RenderOptions::default()
+    };
+    let data = FrameData::new(&scene, &options).unwrap();
+    assert!(data.features().trim);
+    let (mk, _) = render_both_strategies(&data);
+    let cpu = render_cpu(&data);
+    let (max, over) = compare(&mk.image, &cpu.image);
+    assert!(
+        over < CPU_TWIN_OVER_HARD,
+        "{:.2}% of pixels differ from the CPU twin by more than 2/255 (max {max})",
+        over * 100.0
+    );
+    assert_eq!(
+        mk.counters[stages::C_CULL_TRIMMED],
+        cpu.counters[stages::C_CULL_TRIMMED]
+    );
+    assert!(mk.counters[stages::C_CULL_TRIMMED] > 0, "no piece culled");
+    let exact = exact_disc(&scene, 8);
+    let want: f64 = exact.iter().sum();
+    // The disc is large: more than 10,000 px of a 200 x 150 image.
+    assert!(want > 10_000.0, "exact disc {want} px");
+    for (name, img) in [("GPU", &mk.image), ("CPU twin", &cpu.image)] {
+        let got: f64 = img.rgba.iter().map(|p| p[3] as f64).sum();
+        assert!(
+            (got - want).abs() <= 0.005 * want,
+            "{name}: coverage {got:.1} px, exact disc {want:.1} px"
+        );
+        let stray = (img.rgba.iter().zip(&exact))
+            .filter(|(p, e)| **e == 0.0 && p[3] > 0.5)
+            .count();
+        assert_eq!(stray, 0, "{name}: pixels drawn outside the disc");
+        // The square's corners (outside the disc, inside the untrimmed square) are empty.
+        let (w, h) = (img.width as usize, img.height as usize);
+        let c = DVec2::new(w as f64, h as f64) / 2.0;
+        let r = (want / std::f64::consts::PI).sqrt();
+        for (dx, dy) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)] {
+            let q = c + DVec2::new(dx, dy) * r * 0.85;
+            let at = q.y as usize * w + q.x as usize;
+            assert_eq!(img.rgba[at][3], 0.0, "{name}: corner ({}, {})", q.x, q.y);
+        }
+        assert!(
+            img.rgba[(h / 2) * w + w / 2][3] == 1.0,
+            "{name}: the centre"
+        );
+    }
+}
