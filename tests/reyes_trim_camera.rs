@@ -11,7 +11,7 @@ use reyes::scene::Scene;
 use reyes::stages;
 
 mod common;
-use common::{CPU_TWIN_OVER_HARD, compare, render_both_strategies};
+use common::{CPU_TWIN_OVER, CPU_TWIN_OVER_HARD, compare, render_both_strategies};
 
 /// The exporter file whose `TrimCurve` (a rational quadratic circle of radius 0.5 about the
 /// centre of the parameter square) cuts a disc out of a square `NuPatch`.
@@ -116,4 +116,73 @@ fn trimcurve_cuts_a_disc_out_of_the_square() {
             "{name}: the centre"
         );
     }
+}
+
+/// A small scene: a bilinear square left of centre, partly covering the image, `imager` given
+/// before the world.
+fn imager_scene(imager: &str) -> Scene {
+    let rib = format!(
+        "Format 48 32 1\nPixelSamples 2 2\nProjection \"perspective\" \"fov\" [40]\n{imager}\n\
+         Translate 0 0 5\nWorldBegin\nSurface \"constant\"\nColor [0.9 0.3 0.1]\n\
+         Patch \"bilinear\" \"P\" [-1.5 -1 0  0.3 -1 0  -1.5 1 0  0.3 1 0]\nWorldEnd\n"
+    );
+    let s = reyes::scene::parse_rib(&rib, "imager.rib").unwrap();
+    assert!(
+        !s.warnings.iter().any(|w| w.contains("Imager")),
+        "{:?}",
+        s.warnings
+    );
+    s
+}
+
+/// `Imager "background"`: every pixel is composited over the colour and opaque (RenderMan's
+/// background imager: Ci += (1 - alpha) background, alpha = 1): uncovered pixels take the
+/// colour exactly, covered ones keep theirs, edge pixels are the mix by their coverage, the
+/// same arithmetic on the GPU (both strategies, bit for bit) and in the CPU twin (each against
+/// its own render without the imager; the two within the other GPU tests' tolerance).
+#[test]
+fn imager_background_fills_uncovered_pixels() {
+    let bg = [0.2f32, 0.4, 0.6];
+    let plain = imager_scene("");
+    let with = imager_scene("Imager \"background\" \"color background\" [0.2 0.4 0.6]");
+    assert_eq!(with.background, Some(DVec3::new(0.2, 0.4, 0.6)));
+    // The standard shader's default is white; "bgcolor" is read too; "null" turns it off.
+    assert_eq!(
+        imager_scene("Imager \"background\"").background,
+        Some(DVec3::ONE)
+    );
+    let other = imager_scene("Imager \"background\" \"bgcolor\" [1 0 0]");
+    assert_eq!(other.background, Some(DVec3::X));
+    assert_eq!(
+        imager_scene("Imager \"background\" \"background\" [1 0 0]\nImager \"null\"").background,
+        None
+    );
+    let o = RenderOptions::default();
+    let a = FrameData::new(&plain, &o).unwrap();
+    let b = FrameData::new(&with, &o).unwrap();
+    let (ga, _) = render_both_strategies(&a);
+    let (gb, _) = render_both_strategies(&b);
+    let (ca, cb) = (render_cpu(&a), render_cpu(&b));
+    let (max, over) = compare(&gb.image, &cb.image);
+    assert!(over < CPU_TWIN_OVER, "CPU twin: {over} over, max {max}");
+    let (mut empty, mut full, mut edge) = (0, 0, 0);
+    let gpu_pairs = ga.image.rgba.iter().zip(&gb.image.rgba);
+    for (p, q) in gpu_pairs.chain(ca.image.rgba.iter().zip(&cb.image.rgba)) {
+        assert_eq!(q[3], 1.0, "every pixel opaque");
+        let k = 1.0 - p[3];
+        for c in 0..3 {
+            let want = p[c] * p[3] + bg[c] * k;
+            assert!((q[c] - want).abs() <= 1e-6, "{p:?} over {bg:?} gave {q:?}");
+        }
+        match p[3] {
+            0.0 => empty += 1,
+            1.0 => full += 1,
+            _ => edge += 1,
+        }
+    }
+    // Both images counted: each has uncovered, covered and edge pixels.
+    assert!(
+        empty > 200 && full > 200 && edge > 20,
+        "{empty} {full} {edge}"
+    );
 }

@@ -59,6 +59,7 @@ pub fn render_cpu(data: &FrameData) -> CpuRender {
                     .copied()
                     .collect(),
                 memory_budget: data.memory_budget,
+                background: data.background,
             }),
         };
         let mut samples = vec![0u64; tile.w as usize * tile.h as usize * spp as usize];
@@ -93,7 +94,8 @@ pub fn render_cpu(data: &FrameData) -> CpuRender {
                 },
             );
         }
-        let (rgba, depth) = stages::resolve::resolve(&samples, tile.w, tile.h, spp);
+        let (rgba, depth) =
+            stages::resolve::resolve(&samples, tile.w, tile.h, spp, data.background);
         for row in 0..tile.h as usize {
             let (src, dst) = (
                 row * tile.w as usize,

@@ -258,6 +258,9 @@ pub struct FrameData {
     pub items: Vec<PatchItem>,
     /// See [`RenderOptions::memory_budget`].
     pub memory_budget: Option<u64>,
+    /// `Imager "background"` ([`Scene::background`]) in linear f32: the resolve composites
+    /// every pixel over it and makes it opaque; `None` leaves uncovered pixels transparent.
+    pub background: Option<[f32; 3]>,
 }
 
 impl FrameData {
@@ -538,6 +541,7 @@ impl FrameData {
                 .map(|(i, p)| root_item(i as u32, p))
                 .collect(),
             memory_budget: o.memory_budget,
+            background: scene.background.map(f3),
         })
     }
 }

@@ -130,6 +130,10 @@ pub struct Scene {
     /// One message per kind of input that was skipped (request, shader or parameter),
     /// naming where it first appeared, e.g. "file:line: skipped unsupported request `Display`".
     pub warnings: Vec<String>,
+    /// `Imager "background"`: the linear RGB colour the image is composited over (RenderMan's
+    /// standard background imager: `Ci += (1 - alpha) * background; alpha = 1`), so every
+    /// pixel comes out opaque; `None` (the default) leaves uncovered pixels transparent black.
+    pub background: Option<DVec3>,
 }
 
 impl Default for Scene {
@@ -143,6 +147,7 @@ impl Default for Scene {
             materials: Vec::new(),
             lights: Vec::new(),
             warnings: Vec::new(),
+            background: None,
         }
     }
 }
@@ -628,7 +633,9 @@ mod tests {
         assert_eq!(s.materials.len(), 1);
         assert_eq!(s.materials[0].kind, SurfaceKind::Matte);
         assert_eq!((s.materials[0].ka, s.materials[0].kd), (0.0, 1.0));
-        for req in ["Option", "Imager"] {
+        // Its `Imager "background"` is applied (white: every pixel opaque).
+        assert_eq!(s.background, Some(DVec3::ONE));
+        for req in ["Option"] {
             let hits = s
                 .warnings
                 .iter()

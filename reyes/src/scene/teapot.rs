@@ -116,6 +116,7 @@ pub(crate) fn frame(patches: Vec<ObjectPatch>, flip_normal: bool) -> Scene {
         materials: vec![material],
         lights,
         warnings: Vec::new(),
+        background: None,
     }
 }
 

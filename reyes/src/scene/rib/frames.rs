@@ -95,6 +95,7 @@ impl Interp {
             width: o.width,
             height: o.height,
             pixel_samples: o.pixel_samples,
+            background: o.background,
             camera: crate::scene::Camera {
                 world_to_camera,
                 ..o.camera.clone()

@@ -79,6 +79,8 @@ pub(super) struct Options {
     pub(super) display: Option<Display>,
     /// `ScreenWindow`, `FrameAspectRatio`, `CropWindow`, orthographic projection.
     pub(super) framing: super::camera::Framing,
+    /// `Imager "background"`: the colour the image is composited over (`Scene::background`).
+    pub(super) background: Option<DVec3>,
 }
 
 impl Default for Options {
@@ -91,6 +93,7 @@ impl Default for Options {
             camera: s.camera,
             display: None,
             framing: Default::default(),
+            background: None,
         }
     }
 }
