@@ -288,7 +288,10 @@ impl Interp {
         let (ctm, close) = match name {
             "object" | "shader" => return Ok(()),
             "camera" => (DMat4::IDENTITY, None),
-            "world" => (self.world_to_camera.unwrap_or(DMat4::IDENTITY), None),
+            "world" => (
+                self.world_to_camera.unwrap_or(DMat4::IDENTITY),
+                self.world_to_camera_close,
+            ),
             _ => match self.coordinate_systems.get(name) {
                 Some(c) => *c,
                 None => {

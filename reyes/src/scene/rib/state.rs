@@ -154,6 +154,9 @@ pub(super) struct Interp {
     pub(super) stack: Vec<Saved>,
     /// World-to-camera, saved at `WorldBegin`; `Some` only inside the world block.
     pub(super) world_to_camera: Option<DMat4>,
+    /// World-to-camera at shutter close when the camera moves (a motion block before
+    /// `WorldBegin`), saved with [`Self::world_to_camera`].
+    pub(super) world_to_camera_close: Option<DMat4>,
     /// The world being read: its patches, materials and lights (options are added at
     /// `WorldEnd`). Lights given before `WorldBegin` go to the next world.
     pub(super) scene: Scene,
@@ -190,6 +193,7 @@ impl Interp {
             attrs: Attributes::default(),
             stack: Vec::new(),
             world_to_camera: None,
+            world_to_camera_close: None,
             scene: Scene::default(),
             frame: None,
             frames: Vec::new(),
@@ -302,6 +306,7 @@ impl Interp {
         }
         self.current_material = None;
         self.world_to_camera = None;
+        self.world_to_camera_close = None;
         self.scene = Scene::default();
         self.materials.clear();
         self.motion = None;
