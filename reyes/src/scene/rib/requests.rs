@@ -163,7 +163,10 @@ impl Interp {
                 Ok(())
             }
             _ => {
-                let msg = format!("skipped unsupported request `{}`", shown(&req.name));
+                let mut msg = format!("skipped unsupported request `{}`", shown(&req.name));
+                if let Some(lacks) = skipped_effect(&req.name) {
+                    msg = format!("{msg}: {lacks}");
+                }
                 self.warn_once(req, &req.name, &msg);
                 Ok(())
             }
@@ -363,4 +366,19 @@ impl Interp {
         let msg = format!("ignored parameter \"{}\" of `{}`", shown(name), req.name);
         self.warn_once(req, &key, &msg);
     }
+}
+
+/// What the image lacks when a commonly written request is skipped (the warning says it).
+fn skipped_effect(name: &str) -> Option<&'static str> {
+    Some(match name {
+        "PixelFilter" => {
+            "each pixel is the plain mean of its own samples (a box filter of width 1)"
+        }
+        "Exposure" => "no gain or gamma is applied (linear colour, sRGB-encoded on output)",
+        "ShadingInterpolation" => "micropolygons are flat-shaded at their corners' mean colour",
+        "Matte" => "the object is drawn as an ordinary surface, not a holdout",
+        "Atmosphere" | "Interior" | "Exterior" => "no volume shading (the air is clear)",
+        "Illuminate" => "lights stay on for every object",
+        _ => return None,
+    })
 }

@@ -239,3 +239,22 @@ fn coordinate_systems_are_named_and_restored() {
         "{e}"
     );
 }
+
+/// Skipped requests that change the picture say what the image lacks.
+#[test]
+fn skipped_requests_say_what_the_image_lacks() {
+    let s = parse(&format!(
+        "PixelFilter \"gaussian\" 2 2\nExposure 1 2.2\n{}",
+        world("Matte 1\n")
+    ));
+    let w = s.warnings.join("\n");
+    assert!(
+        w.contains("`PixelFilter`: each pixel is the plain mean"),
+        "{w}"
+    );
+    assert!(w.contains("`Exposure`: no gain or gamma"), "{w}");
+    assert!(
+        w.contains("`Matte`: the object is drawn as an ordinary surface"),
+        "{w}"
+    );
+}
