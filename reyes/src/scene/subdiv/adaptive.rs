@@ -189,9 +189,9 @@ pub fn limit_patches(
 }
 
 /// [`limit_patches`] with facevarying channels: `fv[f][corner][channel]` for every face of
-/// `mesh`, interpolated linearly over each control face (the corners' values, refined with
-/// the faces: [`refine_facevarying`]) and given to each patch at its corners
-/// ([`LimitPatch::facevarying`]).
+/// `mesh`, interpolated linearly over each control face (refined with the faces: each child
+/// corner takes its parent corner's value, an edge's midpoint or the face's mean) and given
+/// to each patch at its corners ([`LimitPatch::facevarying`]).
 pub fn limit_patches_with(
     mesh: Mesh,
     data: Vec<Vec<DVec3>>,
