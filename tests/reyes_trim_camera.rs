@@ -94,6 +94,7 @@ fn trimcurve_cuts_a_disc_out_of_the_square() {
     assert!(want > 10_000.0, "exact disc {want} px");
     for (name, img) in [("GPU", &mk.image), ("CPU twin", &cpu.image)] {
         let got: f64 = img.rgba.iter().map(|p| p[3] as f64).sum();
+        eprintln!("{name}: coverage {got:.1} px, exact disc {want:.1} px");
         assert!(
             (got - want).abs() <= 0.005 * want,
             "{name}: coverage {got:.1} px, exact disc {want:.1} px"
