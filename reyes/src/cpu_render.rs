@@ -59,6 +59,7 @@ pub fn render_cpu(data: &FrameData) -> CpuRender {
                     .copied()
                     .collect(),
                 memory_budget: data.memory_budget,
+                background: data.background,
             }),
         };
         let mut samples = vec![0u64; tile.w as usize * tile.h as usize * spp as usize];
@@ -93,7 +94,8 @@ pub fn render_cpu(data: &FrameData) -> CpuRender {
                 },
             );
         }
-        let (rgba, depth) = stages::resolve::resolve(&samples, tile.w, tile.h, spp);
+        let (rgba, depth) =
+            stages::resolve::resolve(&samples, tile.w, tile.h, spp, data.background);
         for row in 0..tile.h as usize {
             let (src, dst) = (
                 row * tile.w as usize,
@@ -156,6 +158,7 @@ fn walk_items(
                     Cull::Offscreen => stages::C_CULL_OFFSCREEN,
                     Cull::Backface => stages::C_CULL_BACKFACE,
                     Cull::Occluded => stages::C_CULL_OCCLUDED,
+                    Cull::Trimmed => stages::C_CULL_TRIMMED,
                 }] += 1
             }
             Decision::Split { along_u, item, eye } => {

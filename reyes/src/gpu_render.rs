@@ -75,6 +75,7 @@ pub fn program_for(features: SceneFeatures) -> Result<Program, RunError> {
             shaders::COMMON,
             shaders::SHADE,
             shaders::SURFACE,
+            shaders::TRIM,
             shaders::SAMPLE,
             shaders::SAMPLE_UVT,
         ]
@@ -566,7 +567,8 @@ impl GpuRenderer {
             if recut {
                 continue;
             }
-            let resolve_ms = self.resolve(gpu, &tile_frame, samples, rgba, depth)?;
+            let resolve_ms =
+                self.resolve(gpu, (&tile_frame, data.background), samples, rgba, depth)?;
             out.resolve_gpu_ms = out.resolve_gpu_ms.zip(resolve_ms).map(|(a, b)| a + b);
             out.buckets += 1;
             done.push(tile);
@@ -622,12 +624,12 @@ impl GpuRenderer {
     fn resolve(
         &self,
         gpu: &Gpu,
-        f: &FrameUniforms,
+        (f, background): (&FrameUniforms, Option<[f32; 3]>),
         samples: &wgpu::Buffer,
         rgba: &wgpu::Buffer,
         depth: &wgpu::Buffer,
     ) -> Result<Option<f64>, RunError> {
-        let (params, (gx, gy)) = resolve_params(f);
+        let (params, (gx, gy)) = resolve_params(f, background);
         let params_buf = gpu.storage_buffer("resolve params", params.len() as u64)?;
         gpu.queue
             .write_buffer(&params_buf, 0, bytemuck::cast_slice(&params));
@@ -662,11 +664,16 @@ pub(crate) fn dispatch_2d(threads: u64, per_group: u32) -> ((u32, u32), u32) {
     ((gx, gy), gx * per_group)
 }
 
-/// The resolve pass's parameters for the bucket of `f` (`ResolveParams` in resolve.wgsl) and
-/// its dispatch size.
-pub(crate) fn resolve_params(f: &FrameUniforms) -> ([u32; 8], (u32, u32)) {
+/// The resolve pass's parameters for the bucket of `f` (`ResolveParams` in resolve.wgsl), with
+/// the background imager's colour when there is one ([`FrameData::background`]), and its
+/// dispatch size.
+pub(crate) fn resolve_params(
+    f: &FrameUniforms,
+    background: Option<[f32; 3]>,
+) -> ([u32; 12], (u32, u32)) {
     let pixels = f.tile_w as u64 * f.tile_h as u64;
     let ((gx, gy), row) = dispatch_2d(pixels, 256);
+    let bg = background.unwrap_or([0.0; 3]);
     let params = [
         f.tile_w,
         f.tile_h,
@@ -675,6 +682,10 @@ pub(crate) fn resolve_params(f: &FrameUniforms) -> ([u32; 8], (u32, u32)) {
         f.width,
         f.tile_x0,
         f.tile_y0,
+        background.is_some() as u32,
+        bg[0].to_bits(),
+        bg[1].to_bits(),
+        bg[2].to_bits(),
         0,
     ];
     (params, (gx, gy))

@@ -9,6 +9,8 @@ pub const SHADE: &str = include_str!("../../shaders/reyes/shade.wgsl");
 pub const SAMPLE: &str = include_str!("../../shaders/reyes/sample.wgsl");
 /// Sampling in time and on the lens (motion blur, depth of field): `sample_uvt.wgsl`.
 pub const SAMPLE_UVT: &str = include_str!("../../shaders/reyes/sample_uvt.wgsl");
+/// Trimming (`TrimCurve`) in Bound and DiceShade: `trim.wgsl` (twin: `stages::trim`).
+pub const TRIM: &str = include_str!("../../shaders/reyes/trim.wgsl");
 pub const SURFACE: &str = include_str!("../../shaders/reyes/surface.wgsl");
 pub const DICE_SHADE: &str = include_str!("../../shaders/reyes/dice_shade.wgsl");
 pub const RESOLVE: &str = include_str!("../../shaders/reyes/resolve.wgsl");

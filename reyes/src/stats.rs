@@ -180,6 +180,9 @@ pub struct Culls {
     pub backface_micropolygons: u64,
     /// Pieces hidden behind what was already drawn (occlusion culling in Bound).
     pub occluded: u64,
+    /// Pieces wholly cut away by trim curves (`TrimCurve`; culled in Bound).
+    #[serde(default)]
+    pub trimmed: u64,
 }
 
 /// Executions of each procedure (the names of `gpu_render::PROCEDURES`).
@@ -316,6 +319,7 @@ pub fn frame_stats(
             backface_patches: c[s::C_CULL_BACKFACE],
             backface_micropolygons: c[s::C_BACKFACE],
             occluded: c[s::C_CULL_OCCLUDED],
+            trimmed: c[s::C_CULL_TRIMMED],
         },
         depth_limited: c[s::C_DEPTH_LIMIT],
         near_clipped_grids: c[s::C_NEAR_CLIPPED],

@@ -11,7 +11,9 @@
 
 // Workgroup memory per item: 16 control points as (x, y) in pixels, z in camera space,
 // w = 1 (in front of the near plane) + 2 (this thread's back-face terms all hold).
-fn bound_execute(item: PatchItem, inv: Invocation) {
+fn bound_execute(item_in: PatchItem, inv: Invocation) {
+    // `var`: trimming may mark the item TRIM_INSIDE before it is split or diced.
+    var item = item_in;
     var cp = item.cp;
     let t = inv.thread;
     let info = patch_info[item.patch_id];
@@ -74,6 +76,16 @@ fn bound_execute(item: PatchItem, inv: Invocation) {
     if all_back {
         atomicAdd(&counters[C_CULL_BACKFACE], 1u);
         return;
+    }
+    // Trimmed (trim.wgsl): a piece wholly cut away is dropped; one wholly kept is marked so
+    // that nothing below it tests again.
+    if needs_trim(item, info) {
+        let c = trim_classify(trim_header(info), item.uv);
+        if c == TRIM_OUT {
+            atomicAdd(&counters[C_CULL_TRIMMED], 1u);
+            return;
+        }
+        if c == TRIM_IN { item.depth |= TRIM_INSIDE; }
     }
     let depth = item.depth & 255u;
     let eye = (item.depth >> 8u) & 255u;

@@ -137,6 +137,7 @@ const C_EYE_SPLITS: u32 = 6u;
 const C_BACKFACE: u32 = 7u;        // micropolygons culled as back-facing (Sides 1)
 const C_CULL_BACKFACE: u32 = 8u;   // patches culled in Bound as back-facing everywhere
 const C_CULL_OCCLUDED: u32 = 9u;   // pieces culled in Bound as hidden by what is drawn (hiz)
+const C_CULL_TRIMMED: u32 = 10u;   // pieces culled in Bound as wholly cut away by trim curves
 
 // Bound culls only what lies this far outside the bucket, so that a micropolygon grown by its
 // crack dilation (at most MAX_DILATE_PX) never reaches a sample of a bucket that culled it:

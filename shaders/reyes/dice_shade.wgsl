@@ -18,6 +18,11 @@ fn micropolygon_cover(item: PatchItem, info: PatchInfo, i: u32, j: u32, nu: u32,
         let o = color_field(info.os, q.x, q.y);
         alpha = (o.x + o.y + o.z) / 3.0;
     }
+    // Trimmed (trim.wgsl): a micropolygon whose centre is cut away covers nothing.
+    if needs_trim(item, info) {
+        let q = original_uv(item, (f32(i) + 0.5) / f32(nu), (f32(j) + 0.5) / f32(nv));
+        if !trim_keeps(trim_header(info), q.x, q.y) { alpha = 0.0; }
+    }
     return Cover(alpha, reyes_hash(item.patch_id ^ COVER_SALT));
 }
 

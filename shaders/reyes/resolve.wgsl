@@ -4,6 +4,8 @@
 
 // One bucket's samples (`width` x `height` pixels) into the image at (x0, y0), `image_width`
 // wide. `row` = threads per row of workgroups (the dispatch is 2D for large images).
+// `imager` 1: RenderMan's background imager (`Imager "background"`): each pixel composited
+// over `background` (linear RGB) and made opaque, Ci += (1 - alpha) background, alpha = 1.
 struct ResolveParams {
     width: u32,
     height: u32,
@@ -12,7 +14,8 @@ struct ResolveParams {
     image_width: u32,
     x0: u32,
     y0: u32,
-    pad: u32,
+    imager: u32,
+    background: vec4<f32>,
 }
 
 @group(0) @binding(0) var<storage, read> params: ResolveParams;
@@ -52,6 +55,11 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>) {
     if covered > 0u { c = sum / f32(covered); }
     let out = (params.y0 + pixel / params.width) * params.image_width + params.x0
         + pixel % params.width;
-    rgba[out] = vec4<f32>(c, f32(covered) / f32(params.spp));
+    let alpha = f32(covered) / f32(params.spp);
+    if params.imager != 0u {
+        rgba[out] = vec4<f32>(c * alpha + params.background.xyz * (1.0 - alpha), 1.0);
+    } else {
+        rgba[out] = vec4<f32>(c, alpha);
+    }
     depth[out] = zmin;
 }

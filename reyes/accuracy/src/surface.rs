@@ -131,6 +131,7 @@ mod tests {
             primvars: None,
             displacement: None,
             motion: None,
+            trim: None,
             source: PatchSource {
                 file: "test".into(),
                 line: 0,

@@ -13,13 +13,17 @@ use scheduler::Gpu;
 use std::path::Path;
 
 /// The scene named on the command line (none or `teapot`: the built-in teapot) and a short
-/// name for it (the file's stem). Errors: the file's.
+/// name for it (the file's stem), for the commands that measure, compare or time frames
+/// (`measure`, `holes`, `sweep`, `drift`, `bench`, `view`): without its `Imager
+/// "background"`, whose opaque pixels would hide the coverage (alpha) they compare. `render`
+/// streams the file itself ([`stream_sequence`]) and keeps it. Errors: the file's.
 pub fn load_scene(path: Option<&Path>) -> Result<(Scene, String), CliError> {
     match path {
         None => Ok((scene::builtin_teapot(), "teapot".into())),
         Some(p) if p.as_os_str() == "teapot" => Ok((scene::builtin_teapot(), "teapot".into())),
         Some(p) => {
-            let s = scene::load(p)?;
+            let mut s = scene::load(p)?;
+            s.background = None;
             let name = p
                 .file_stem()
                 .map_or("scene".into(), |s| s.to_string_lossy().into_owned());

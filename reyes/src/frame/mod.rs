@@ -258,6 +258,9 @@ pub struct FrameData {
     pub items: Vec<PatchItem>,
     /// See [`RenderOptions::memory_budget`].
     pub memory_budget: Option<u64>,
+    /// `Imager "background"` ([`Scene::background`]) in linear f32: the resolve composites
+    /// every pixel over it and makes it opaque; `None` leaves uncovered pixels transparent.
+    pub background: Option<[f32; 3]>,
 }
 
 impl FrameData {
@@ -269,6 +272,7 @@ impl FrameData {
             primvars: os || self.patch_info.iter().any(|i| i.cs != 0 || i.normal != 0),
             transparent: os || self.materials.iter().any(|m| m.opacity < 1.0),
             displacement: (self.patch_info.iter()).any(|i| i.flags & PATCH_DISPLACED != 0),
+            trim: (self.patch_info.iter()).any(|i| i.flags & PATCH_TRIMMED != 0),
             nearest_raster: self.frame.raster == RASTER_NEAREST,
             uvt: self.frame.uvt != UVT_OFF,
         }
@@ -290,6 +294,9 @@ pub struct SceneFeatures {
     pub transparent: bool,
     /// Some patch is displaced (`PATCH_DISPLACED`).
     pub displacement: bool,
+    /// Some patch is trimmed (`PATCH_TRIMMED`, `SCENE_TRIM`): without it Bound and DiceShade
+    /// hold no trimming code.
+    pub trim: bool,
     /// The frame is rasterized with [`RasterMode::NearestSample`] (`SCENE_NEAREST_RASTER`):
     /// without it the program holds bounding-box rasterization alone, and the default mode
     /// pays nothing for the other.
@@ -307,6 +314,7 @@ impl SceneFeatures {
         primvars: true,
         transparent: true,
         displacement: true,
+        trim: true,
         nearest_raster: true,
         uvt: true,
     };
@@ -317,6 +325,7 @@ impl SceneFeatures {
             && (self.primvars || !need.primvars)
             && (self.transparent || !need.transparent)
             && (self.displacement || !need.displacement)
+            && (self.trim || !need.trim)
             && (self.nearest_raster || !need.nearest_raster)
             && (self.uvt || !need.uvt)
     }
@@ -328,6 +337,7 @@ impl SceneFeatures {
             primvars: self.primvars || o.primvars,
             transparent: self.transparent || o.transparent,
             displacement: self.displacement || o.displacement,
+            trim: self.trim || o.trim,
             nearest_raster: self.nearest_raster || o.nearest_raster,
             uvt: self.uvt || o.uvt,
         }
@@ -338,13 +348,14 @@ impl SceneFeatures {
         format!(
             "const SCENE_RATIONAL: bool = {};\nconst SCENE_PRIMVARS: bool = {};\n\
              const SCENE_TRANSPARENT: bool = {};\nconst SCENE_DISPLACEMENT: bool = {};\nconst SCENE_NEAREST_RASTER: bool = {};\n\
-             const SCENE_UVT: bool = {};\n",
+             const SCENE_UVT: bool = {};\nconst SCENE_TRIM: bool = {};\n",
             self.rational,
             self.primvars,
             self.transparent,
             self.displacement,
             self.nearest_raster,
-            self.uvt
+            self.uvt,
+            self.trim
         )
     }
 }
@@ -457,9 +468,16 @@ impl FrameData {
         let lights = gpu_lights(scene);
         let mut primvars = Vec::new();
         let mut maps = Vec::new();
+        let mut trims = Vec::new();
         let patch_info: Vec<PatchInfo> = (scene.patches.iter())
-            .map(|p| patch_info(p, &mut primvars, &mut maps))
-            .collect::<Result<_, _>>()?;
+            .map(|p| {
+                let mut info = patch_info(p, &mut primvars, &mut maps)?;
+                if let Some(t) = &p.trim {
+                    info.flags |= trim_ref(&mut primvars, &mut trims, t)?;
+                }
+                Ok(info)
+            })
+            .collect::<Result<_, Error>>()?;
         let frame = FrameUniforms {
             width,
             height,
@@ -523,6 +541,7 @@ impl FrameData {
                 .map(|(i, p)| root_item(i as u32, p))
                 .collect(),
             memory_budget: o.memory_budget,
+            background: scene.background.map(f3),
         })
     }
 }

@@ -174,3 +174,66 @@ pub fn displacement_ref(
     ]);
     Ok(at as u32)
 }
+
+/// Bit of [`PatchInfo::flags`] (`PATCH_TRIMMED` in common.wgsl): the patch is trimmed
+/// (`TrimCurve`); bits [`TRIM_SHIFT`].. of the flags hold the index of its trim header in
+/// [`FrameData::primvars`] ([`trim_ref`]). Read only when `SCENE_TRIM`.
+pub const PATCH_TRIMMED: u32 = 32;
+
+/// The trim header's entry index sits in the flags from this bit on (24 bits), so that an
+/// untrimmed patch pays nothing for trimming: no field, no table entry.
+pub const TRIM_SHIFT: u32 = 8;
+
+/// Appends the trimming of one patch to the table and returns the bits to or into its
+/// [`PatchInfo::flags`]: [`PATCH_TRIMMED`] and the header's index << [`TRIM_SHIFT`]. The header
+/// is 2 entries: (u0, u1 - u0, v0, v1 - v0), the map from the patch's (u, v) to the surface's
+/// parameter space, then (first edge entry, edge count, 1 to keep the outside else 0, 0) as
+/// `u32` bits. The edges (one entry (ax, ay, bx, by) each, every loop closed) are written once
+/// per `TrimCurve` and shared by its patches (`trims` remembers where each went). Errors
+/// ([`Error::TablesTooLarge`]) when the table would outgrow what a GPU binding holds, or the
+/// header's index its 24 bits.
+pub fn trim_ref(
+    table: &mut Vec<[f32; 4]>,
+    trims: &mut Vec<(*const crate::scene::trim::TrimLoops, u32, u32)>,
+    t: &crate::scene::trim::PatchTrim,
+) -> Result<u32, Error> {
+    let too_big = || Error::TablesTooLarge {
+        what: "trim curves and primitive variables",
+        limit: MAX_FRAME_BUFFER_BYTES,
+    };
+    let key = std::sync::Arc::as_ptr(&t.loops);
+    let (edges_at, count) = match trims.iter().find(|(k, _, _)| *k == key) {
+        Some(&(_, at, n)) => (at, n),
+        None => {
+            let at = table.len() as u64;
+            let n = t.loops.edge_count() as u64;
+            if (at + n) * 16 > MAX_FRAME_BUFFER_BYTES {
+                return Err(too_big());
+            }
+            table.extend(
+                t.loops
+                    .edges()
+                    .map(|(a, b)| [a.x as f32, a.y as f32, b.x as f32, b.y as f32]),
+            );
+            trims.push((key, at as u32, n as u32));
+            (at as u32, n as u32)
+        }
+    };
+    let at = table.len() as u64;
+    if (at + 2) * 16 > MAX_FRAME_BUFFER_BYTES || at >= 1 << (32 - TRIM_SHIFT) {
+        return Err(too_big());
+    }
+    table.push([
+        t.u.0 as f32,
+        (t.u.1 - t.u.0) as f32,
+        t.v.0 as f32,
+        (t.v.1 - t.v.0) as f32,
+    ]);
+    table.push([
+        f32::from_bits(edges_at),
+        f32::from_bits(count),
+        f32::from_bits(t.outside as u32),
+        0.0,
+    ]);
+    Ok(PATCH_TRIMMED | (at as u32) << TRIM_SHIFT)
+}

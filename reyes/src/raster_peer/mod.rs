@@ -399,7 +399,7 @@ impl RasterPeer {
     }
 
     /// What the peer draws differently from what the scene asks: transparency drawn opaque,
-    /// displacement, motion blur and depth of field left out.
+    /// displacement, trimming, motion blur and depth of field left out.
     pub fn warnings(&self) -> Vec<String> {
         let mut w = Vec::new();
         if self.base.features().transparent {
@@ -413,6 +413,13 @@ impl RasterPeer {
             w.push(
                 "the scene has displaced surfaces (`Displacement`): the raster peer draws them \
                  undisplaced (only the Reyes pipeline's DiceShade displaces)"
+                    .into(),
+            );
+        }
+        if self.base.features().trim {
+            w.push(
+                "the scene has trimmed surfaces (`TrimCurve`): the raster peer draws them \
+                 untrimmed (only the Reyes pipeline's Bound and DiceShade trim)"
                     .into(),
             );
         }

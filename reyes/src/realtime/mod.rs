@@ -232,7 +232,7 @@ impl RealtimeRenderer {
         let target = FrameTarget::new(gpu, pixels_n * spp * 2, pixels_n, true)?;
         let pipelines = &renderer.pipelines;
         let scene_bind = scene_buffers.bind_group(gpu, pipelines.scene_layout(), &target);
-        let (resolve, resolve_groups) = resolve_params(&f);
+        let (resolve, resolve_groups) = resolve_params(&f, base.background);
         let resolve_buf = gpu.upload("resolve params", &resolve)?;
         let resolve_bind = gpu.bind_buffers(
             "resolve",

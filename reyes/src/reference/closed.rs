@@ -94,6 +94,7 @@ pub fn rational_sphere(centre: DVec3, radius: f64) -> Vec<Patch> {
                     primvars: None,
                     displacement: None,
                     motion: None,
+                    trim: None,
                     source: PatchSource {
                         file: "rational_sphere".into(),
                         line: 0,

@@ -562,6 +562,7 @@ mod tests {
                 primvars: None,
                 displacement: None,
                 motion: None,
+                trim: None,
                 source: PatchSource {
                     file: "test".into(),
                     line: 0,

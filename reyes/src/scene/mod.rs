@@ -23,6 +23,7 @@ mod spin;
 pub mod stacked;
 pub mod subdiv;
 mod teapot;
+pub mod trim;
 
 use glam::{DMat4, DVec3};
 
@@ -130,6 +131,10 @@ pub struct Scene {
     /// One message per kind of input that was skipped (request, shader or parameter),
     /// naming where it first appeared, e.g. "file:line: skipped unsupported request `Display`".
     pub warnings: Vec<String>,
+    /// `Imager "background"`: the linear RGB colour the image is composited over (RenderMan's
+    /// standard background imager: `Ci += (1 - alpha) * background; alpha = 1`), so every
+    /// pixel comes out opaque; `None` (the default) leaves uncovered pixels transparent black.
+    pub background: Option<DVec3>,
 }
 
 impl Default for Scene {
@@ -143,6 +148,7 @@ impl Default for Scene {
             materials: Vec::new(),
             lights: Vec::new(),
             warnings: Vec::new(),
+            background: None,
         }
     }
 }
@@ -176,6 +182,9 @@ pub struct Patch {
     /// point at shutter fraction t is the linear interpolation of the two (docs/reyes.md,
     /// "Motion blur and depth of field"). `None` for a patch that does not move.
     pub motion: Option<Box<glam::DMat4>>,
+    /// Trimming (RIB `TrimCurve` before a `NuPatch`): the loops that keep part of the patch,
+    /// and the patch's span of the surface's parameter space; `None` (no cost) when untrimmed.
+    pub trim: Option<std::sync::Arc<trim::PatchTrim>>,
     /// Where the patch came from, for error messages.
     pub source: PatchSource,
 }
@@ -625,14 +634,12 @@ mod tests {
         assert_eq!(s.materials.len(), 1);
         assert_eq!(s.materials[0].kind, SurfaceKind::Matte);
         assert_eq!((s.materials[0].ka, s.materials[0].kd), (0.0, 1.0));
-        for req in ["Option", "Imager"] {
-            let hits = s
-                .warnings
-                .iter()
-                .filter(|w| w.contains(&format!("skipped unsupported request `{req}`")))
-                .count();
-            assert_eq!(hits, 1, "warnings for {req}: {:?}", s.warnings);
-        }
+        // Its `Imager "background"` is applied (white: every pixel opaque).
+        assert_eq!(s.background, Some(DVec3::ONE));
+        let hits = (s.warnings.iter())
+            .filter(|w| w.contains("skipped unsupported request `Option`"))
+            .count();
+        assert_eq!(hits, 1, "warnings for Option: {:?}", s.warnings);
         // Its displacement shader is not a built-in one; its "displacementbound" is read.
         for skipped in [
             "skipped unsupported displacement shader \"disp_textured\"",

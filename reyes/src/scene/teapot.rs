@@ -100,6 +100,7 @@ pub(crate) fn frame(patches: Vec<ObjectPatch>, flip_normal: bool) -> Scene {
             primvars: None,
             displacement: None,
             motion: None,
+            trim: None,
             source,
         })
         .collect();
@@ -115,6 +116,7 @@ pub(crate) fn frame(patches: Vec<ObjectPatch>, flip_normal: bool) -> Scene {
         materials: vec![material],
         lights,
         warnings: Vec::new(),
+        background: None,
     }
 }
 

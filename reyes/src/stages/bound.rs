@@ -28,6 +28,8 @@ pub enum Cull {
     /// Behind what the bucket's samples already hold everywhere under its bound
     /// ([`super::hiz::occluded`]).
     Occluded,
+    /// Wholly cut away by its patch's trim loops ([`super::trim`]).
+    Trimmed,
 }
 
 /// What Bound does with an item ([`bound`]).
@@ -115,6 +117,17 @@ pub fn bound_against(
     if info.flags & 2 == 0 && r == 0.0 && !moving && backfacing(&item.cp, info.flags & 1 != 0) {
         return Decision::Cull(Cull::Backface);
     }
+    // Trimmed (`bound_execute` in bound.wgsl): culled when wholly cut away, marked when
+    // wholly kept.
+    let mut marked = *item;
+    if super::trim::needs_trim(item, info) {
+        match super::trim::classify(primvars, super::trim::header(info), item.uv) {
+            super::trim::TRIM_OUT => return Decision::Cull(Cull::Trimmed),
+            super::trim::TRIM_IN => marked.depth |= super::trim::TRIM_INSIDE,
+            _ => {}
+        }
+    }
+    let item = &marked;
     let depth = item.splits();
     let t0 = Vec2::new(f.tile_x0 as f32, f.tile_y0 as f32) - CULL_MARGIN_PX;
     let t1 =

@@ -219,6 +219,18 @@ pub fn micropolygon_cover(item: &PatchItem, data: &FrameData, [i, j, nu, nv]: [u
         let o = color_field(&data.primvars, info.os, u, v);
         alpha = (o.x + o.y + o.z) / 3.0;
     }
+    // Trimmed (`micropolygon_cover` in dice_shade.wgsl): a micropolygon whose centre is cut
+    // away covers nothing.
+    if super::trim::needs_trim(item, &info) {
+        let (u, v) = original_uv(
+            item,
+            (i as f32 + 0.5) / nu as f32,
+            (j as f32 + 0.5) / nv as f32,
+        );
+        if !super::trim::keeps(&data.primvars, super::trim::header(&info), u, v) {
+            alpha = 0.0;
+        }
+    }
     Cover::new(alpha, item.patch_id)
 }
 

@@ -10,6 +10,7 @@ pub mod sample;
 pub mod sample_uvt;
 pub mod shade;
 pub mod split;
+pub mod trim;
 
 use glam::{Vec3, Vec4};
 
@@ -35,6 +36,8 @@ pub const C_CULL_BACKFACE: usize = 8;
 /// Items culled in Bound as hidden behind what is already drawn (occlusion culling,
 /// [`hiz`]).
 pub const C_CULL_OCCLUDED: usize = 9;
+/// Items culled in Bound as wholly cut away by their patch's trim loops ([`trim`]).
+pub const C_CULL_TRIMMED: usize = 10;
 /// Words of the counter buffer (the `C_*` indices and room to spare).
 pub const COUNTERS: usize = 16;
 

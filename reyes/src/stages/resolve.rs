@@ -3,7 +3,15 @@
 use super::shade::srgb_decode;
 
 /// Straight (not premultiplied) linear RGBA and nearest depth (3e38 where nothing was hit).
-pub fn resolve(keys: &[u64], width: u32, height: u32, spp: u32) -> (Vec<[f32; 4]>, Vec<f32>) {
+/// With a `background` (`Imager "background"`) every pixel is composited over it and opaque:
+/// `c alpha + background (1 - alpha)`, alpha 1.
+pub fn resolve(
+    keys: &[u64],
+    width: u32,
+    height: u32,
+    spp: u32,
+    background: Option<[f32; 3]>,
+) -> (Vec<[f32; 4]>, Vec<f32>) {
     let n = (width * height) as usize;
     let (mut rgba, mut depth) = (Vec::with_capacity(n), Vec::with_capacity(n));
     for p in 0..n {
@@ -24,7 +32,19 @@ pub fn resolve(keys: &[u64], width: u32, height: u32, spp: u32) -> (Vec<[f32; 4]
         } else {
             [0.0; 3]
         };
-        rgba.push([c[0], c[1], c[2], covered as f32 / spp as f32]);
+        let alpha = covered as f32 / spp as f32;
+        rgba.push(match background {
+            Some(b) => {
+                let k = 1.0 - alpha;
+                [
+                    c[0] * alpha + b[0] * k,
+                    c[1] * alpha + b[1] * k,
+                    c[2] * alpha + b[2] * k,
+                    1.0,
+                ]
+            }
+            None => [c[0], c[1], c[2], alpha],
+        });
         depth.push(zmin);
     }
     (rgba, depth)

@@ -20,6 +20,10 @@
 //!   from the image centre is off by its relative depth, at most 1/2000 of that offset (0.1 px
 //!   on a 320x240 image). Depth (`--depth`) is then z' and the clipping planes are moved with
 //!   the world.
+//! - `Imager "background"` (RenderMan's standard imager, parameter "background", also read as
+//!   "bgcolor" or "color"; white when not given) becomes [`Scene::background`]: the resolve
+//!   composites every pixel over it and makes it opaque. `Imager "null"` turns it off; any
+//!   other imager shader is skipped with a warning naming the colour the image lacks.
 
 use super::lexer::shown;
 use super::patches::MAX_COORD;
@@ -83,13 +87,35 @@ impl Interp {
                     (v != [0.0, 1.0, 0.0, 1.0]).then(|| [v[0], v[1], v[2], v[3]]);
             }
             _ => {
-                // Imager: no imager shader runs; name what the image lacks.
                 let name = a.string("the imager name")?;
                 let params = a.params()?;
-                let color = params
-                    .iter()
-                    .find(|p| p.name == "bgcolor" || p.name == "background")
-                    .and_then(|p| p.vec3(a).ok());
+                let param = (params.iter())
+                    .find(|p| p.name == "bgcolor" || p.name == "background" || p.name == "color");
+                let color = param.and_then(|p| p.vec3(a).ok());
+                match name {
+                    // RenderMan's standard imager (RI Spec 3.2, appendix A: its parameter
+                    // "background" defaults to 1, white); other renderers name it "bgcolor".
+                    "background" => {
+                        let c = match param {
+                            Some(p) => p.vec3(a)?,
+                            None => DVec3::ONE,
+                        };
+                        if !c.is_finite() {
+                            return Err(a.err(format!(
+                                "the background colour [{} {} {}] is not finite",
+                                c.x, c.y, c.z
+                            )));
+                        }
+                        self.options.background = Some(c);
+                        return Ok(());
+                    }
+                    "null" | "" => {
+                        self.options.background = None;
+                        return Ok(());
+                    }
+                    _ => {}
+                }
+                // Another imager shader: none runs; name what the image lacks.
                 let msg = match color {
                     Some(c) => format!(
                         "skipped unsupported request `Imager` \"{}\": the background stays transparent black (alpha \
@@ -262,7 +288,10 @@ impl Interp {
         let (ctm, close) = match name {
             "object" | "shader" => return Ok(()),
             "camera" => (DMat4::IDENTITY, None),
-            "world" => (self.world_to_camera.unwrap_or(DMat4::IDENTITY), None),
+            "world" => (
+                self.world_to_camera.unwrap_or(DMat4::IDENTITY),
+                self.world_to_camera_close,
+            ),
             _ => match self.coordinate_systems.get(name) {
                 Some(c) => *c,
                 None => {

@@ -112,6 +112,9 @@ impl Interp {
     ) -> Result<(), SceneError> {
         let name = a.string("the attribute name")?;
         let params = a.params()?;
+        if name == "trimcurve" {
+            return self.trim_attribute(req, a, &params);
+        }
         if name != "displacementbound" {
             let msg = format!("skipped unsupported attribute \"{}\"", shown(name));
             self.warn_once(req, &format!("Attribute \"{name}\""), &msg);

@@ -81,6 +81,7 @@ impl Interp {
         }
         self.push(Block::World, req)?;
         self.world_to_camera = Some(self.attrs.ctm);
+        self.world_to_camera_close = self.attrs.ctm_close;
         Ok(())
     }
 
@@ -90,11 +91,13 @@ impl Interp {
         a.done()?;
         self.pop(Block::World, req)?;
         let world_to_camera = self.world_to_camera.take().unwrap_or_default();
+        self.world_to_camera_close = None;
         let o = &self.options;
         let mut scene = Scene {
             width: o.width,
             height: o.height,
             pixel_samples: o.pixel_samples,
+            background: o.background,
             camera: crate::scene::Camera {
                 world_to_camera,
                 ..o.camera.clone()

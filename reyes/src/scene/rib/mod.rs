@@ -53,6 +53,7 @@ mod subdiv;
 mod syntax;
 #[cfg(test)]
 mod tests;
+mod trim;
 
 pub use input::open_rib;
 

@@ -9,8 +9,14 @@
 //! ([`Attributes::ctm`]) and its value at shutter close ([`Attributes::ctm_close`]); later
 //! transforms apply to both. A patch emitted under a moving transform keeps its shutter-open
 //! points and the camera-space map to its shutter-close points ([`crate::scene::Patch::motion`]).
-//! Camera motion (a block before `WorldBegin`) and motion blocks around anything but
-//! transforms keep the first time's request, with a warning.
+//!
+//! Camera motion is the same block before `WorldBegin`, around the camera's transforms: the
+//! world-to-camera transform then has a shutter-close value too, which every transform in the
+//! world builds on, so each object's map from shutter open to close includes the camera's
+//! (inverse) motion: a still object seen by a moving camera moves in camera space exactly as
+//! if it had moved the opposite way before a still camera. Lights stay where they are at
+//! shutter open. Motion blocks around anything but transforms keep the first time's request,
+//! with a warning.
 
 use super::lexer::shown;
 use super::state::{Attributes, Interp};
@@ -42,7 +48,7 @@ pub(super) struct MotionBlock {
     /// The transform after the first and after the last request.
     first: Option<DMat4>,
     last: Option<DMat4>,
-    /// The block moves transforms (in the world block).
+    /// The block moves transforms (of an object in the world block, or the camera's before it).
     moving: bool,
 }
 
@@ -177,16 +183,12 @@ impl Interp {
             );
             return Err(SceneError::new(&req.file, req.line, msg));
         }
-        let in_world = self.world_to_camera.is_some();
-        if !TRANSFORMS.contains(&req.name.as_str()) || !in_world {
+        if !TRANSFORMS.contains(&req.name.as_str()) {
             if k == 0 {
-                let what = if in_world {
-                    format!("motion of `{}` is not supported", shown(&req.name))
-                } else {
-                    "camera motion is not supported (the image has no blur from the camera \
-                     moving)"
-                        .to_string()
-                };
+                let what = format!(
+                    "motion of `{}` is not supported (the image has no blur from it)",
+                    shown(&req.name)
+                );
                 let key = format!("motion {what}");
                 self.warn_once(req, &key, &format!("{what}: using the first time sample"));
                 return Ok(false);

@@ -133,6 +133,7 @@ impl Interp {
             primvars: None,
             displacement,
             motion: self.attrs.motion(),
+            trim: None,
             source: PatchSource {
                 file: a.req.file.to_string(),
                 line: a.req.line,
@@ -345,9 +346,17 @@ impl Interp {
         let n = patches.len();
         cs.resize(n, None);
         os.resize(n, None);
+        // `TrimCurve`: each patch's span of the surface's parameter space, where the loops are.
+        let trims = match self.attrs.trim {
+            Some(_) => self.patch_trims(&nurbs::patch_spans(&surf).map_err(|m| a.err(m))?),
+            None => Vec::new(),
+        };
         for (i, ((h, cs), os)) in patches.iter().zip(cs).zip(os).enumerate() {
             let (cp, w) = from_homogeneous(h);
             self.emit_with(a, &ctm, i, cp, w, (cs, os))?;
+            if let (Some(t), Some(p)) = (trims.get(i), self.scene.patches.last_mut()) {
+                p.trim = Some(t.clone());
+            }
         }
         Ok(())
     }

@@ -161,19 +161,16 @@ impl Interp {
             "MotionBegin" => self.motion_begin(req, a),
             "MotionEnd" => self.motion_end(req),
             "Shutter" | "DepthOfField" => self.lens_option(req, a),
-            "TrimCurve" => {
-                let msg = "skipped unsupported request `TrimCurve`: the `NuPatch` surfaces \
-                           after it are drawn untrimmed (the regions its curves cut away are \
-                           filled)";
-                self.warn_once(req, "TrimCurve", msg);
-                Ok(())
-            }
+            "TrimCurve" => self.trim_curve(a),
             "MakeShadow" => {
                 self.make_shadow(req);
                 Ok(())
             }
             _ => {
-                let msg = format!("skipped unsupported request `{}`", shown(&req.name));
+                let mut msg = format!("skipped unsupported request `{}`", shown(&req.name));
+                if let Some(lacks) = skipped_effect(&req.name) {
+                    msg = format!("{msg}: {lacks}");
+                }
                 self.warn_once(req, &req.name, &msg);
                 Ok(())
             }
@@ -373,4 +370,19 @@ impl Interp {
         let msg = format!("ignored parameter \"{}\" of `{}`", shown(name), req.name);
         self.warn_once(req, &key, &msg);
     }
+}
+
+/// What the image lacks when a commonly written request is skipped (the warning says it).
+fn skipped_effect(name: &str) -> Option<&'static str> {
+    Some(match name {
+        "PixelFilter" => {
+            "each pixel is the plain mean of its own samples (a box filter of width 1)"
+        }
+        "Exposure" => "no gain or gamma is applied (linear colour, sRGB-encoded on output)",
+        "ShadingInterpolation" => "micropolygons are flat-shaded at their corners' mean colour",
+        "Matte" => "the object is drawn as an ordinary surface, not a holdout",
+        "Atmosphere" | "Interior" | "Exterior" => "no volume shading (the air is clear)",
+        "Illuminate" => "lights stay on for every object",
+        _ => return None,
+    })
 }

@@ -40,6 +40,11 @@ pub(super) struct Attributes {
     /// `Attribute "displacementbound" "sphere"`: the radius in object space (of each
     /// primitive) or, given in world or camera space, in camera space; the other 0.
     pub(super) displacement_bound: (f64, f64),
+    /// `TrimCurve`: the flattened loops that trim the `NuPatch` surfaces after it; `None`
+    /// when untrimmed.
+    pub(super) trim: Option<std::sync::Arc<crate::scene::trim::TrimLoops>>,
+    /// `Attribute "trimcurve" "sense" "outside"`: trimming keeps the outside of the loops.
+    pub(super) trim_outside: bool,
 }
 
 impl Default for Attributes {
@@ -57,6 +62,8 @@ impl Default for Attributes {
             vbasis: Basis::BEZIER,
             displacement: None,
             displacement_bound: (0.0, 0.0),
+            trim: None,
+            trim_outside: false,
         }
     }
 }
@@ -72,6 +79,8 @@ pub(super) struct Options {
     pub(super) display: Option<Display>,
     /// `ScreenWindow`, `FrameAspectRatio`, `CropWindow`, orthographic projection.
     pub(super) framing: super::camera::Framing,
+    /// `Imager "background"`: the colour the image is composited over (`Scene::background`).
+    pub(super) background: Option<DVec3>,
 }
 
 impl Default for Options {
@@ -84,6 +93,7 @@ impl Default for Options {
             camera: s.camera,
             display: None,
             framing: Default::default(),
+            background: None,
         }
     }
 }
@@ -144,6 +154,9 @@ pub(super) struct Interp {
     pub(super) stack: Vec<Saved>,
     /// World-to-camera, saved at `WorldBegin`; `Some` only inside the world block.
     pub(super) world_to_camera: Option<DMat4>,
+    /// World-to-camera at shutter close when the camera moves (a motion block before
+    /// `WorldBegin`), saved with [`Self::world_to_camera`].
+    pub(super) world_to_camera_close: Option<DMat4>,
     /// The world being read: its patches, materials and lights (options are added at
     /// `WorldEnd`). Lights given before `WorldBegin` go to the next world.
     pub(super) scene: Scene,
@@ -180,6 +193,7 @@ impl Interp {
             attrs: Attributes::default(),
             stack: Vec::new(),
             world_to_camera: None,
+            world_to_camera_close: None,
             scene: Scene::default(),
             frame: None,
             frames: Vec::new(),
@@ -292,6 +306,7 @@ impl Interp {
         }
         self.current_material = None;
         self.world_to_camera = None;
+        self.world_to_camera_close = None;
         self.scene = Scene::default();
         self.materials.clear();
         self.motion = None;

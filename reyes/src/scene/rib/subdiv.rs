@@ -5,11 +5,13 @@
 //!
 //! Primitive variables: "P"; "Cs" and "Os" constant or uniform (one value per face, every
 //! patch of the face gets it), vertex or varying (subdivided with the positions: varying is
-//! smoothed like vertex, a choice). Facevarying colours are ignored with a warning.
+//! smoothed like vertex, a choice), or facevarying (one value per face corner, interpolated
+//! linearly over each face: bilinearly on a quad, over the n quads of the first subdivision
+//! step on another polygon; values differ across faces where they are given so).
 
 use super::lexer::shown;
 use super::patches::check_points;
-use super::primvars::{Class, ClassCounts, parse_decl};
+use super::primvars::{Class, ClassCounts};
 use super::state::Interp;
 use super::syntax::{Arg, Args, Request};
 use crate::scene::subdiv::{BoundaryMode, Tags, catmull_clark};
@@ -50,28 +52,7 @@ impl Interp {
         let ids = a.array("vertices")?;
         let ids = ints(a, ids, "vertices", 0, MAX)?;
         let tags = self.subdiv_tags(req, a)?;
-        let mut params = a.params()?;
-        // Facevarying colours need per-corner interpolation: not read.
-        params.retain(|p| {
-            let class = match p.decl {
-                Some(d) => parse_decl(d).ok().map(|d| d.class),
-                None => self.declared.get(p.name).map(|d| d.class),
-            };
-            let drop = matches!(p.name, "Cs" | "Os") && class == Some(Class::FaceVarying);
-            if drop {
-                let msg = format!(
-                    "ignored facevarying \"{}\" of `SubdivisionMesh` (the material's colour \
-                     is used)",
-                    p.name
-                );
-                self.warn_once(
-                    req,
-                    &format!("SubdivisionMesh facevarying {}", p.name),
-                    &msg,
-                );
-            }
-            !drop
-        });
+        let params = a.params()?;
         let n = match params.iter().find(|p| p.name == "P" || p.name == "Pw") {
             Some(p) => p.nums(a)?.len() / if p.name == "P" { 3 } else { 4 },
             None => return Err(a.err("missing the \"P\" parameter")),
@@ -81,7 +62,7 @@ impl Interp {
             uniform: sizes.len(),
             varying: n,
             vertex: n,
-            // One per face corner (facevarying values were dropped above with a warning).
+            // One per face corner.
             facevarying: ids.len(),
         };
         let vars = self.color_vars(a, &params, &counts)?;
@@ -97,19 +78,35 @@ impl Interp {
             _ => None,
         };
         let (cs_ch, os_ch) = (slot(&vars.cs), slot(&vars.os));
+        // Facevarying colours: channels interpolated linearly over each face.
+        fn facevarying(
+            v: &Option<super::primvars::ColorVar>,
+        ) -> Option<&super::primvars::ColorVar> {
+            v.as_ref().filter(|c| c.class == Class::FaceVarying)
+        }
+        let fv: Vec<&[glam::DVec3]> = [facevarying(&vars.cs), facevarying(&vars.os)]
+            .into_iter()
+            .flatten()
+            .map(|c| c.values.as_slice())
+            .collect();
+        let cs_fv = facevarying(&vars.cs).map(|_| 0);
+        let os_fv = facevarying(&vars.os).map(|_| cs_fv.map_or(0, |_| 1));
         let ids: Vec<u32> = ids.into_iter().map(|i| i as u32).collect();
-        let patches = catmull_clark(&sizes, &ids, &tags, data)
+        let patches = catmull_clark(&sizes, &ids, &tags, data, &fv)
             .map_err(|e| a.err(format!("{e} (faces and vertices count from 0)")))?;
         for (k, p) in patches.into_iter().enumerate() {
-            let field = |v: &Option<super::primvars::ColorVar>, ch: Option<usize>| {
+            let field = |v: &Option<super::primvars::ColorVar>,
+                         ch: Option<usize>,
+                         f: Option<usize>| {
                 let v = v.as_ref()?;
-                Some(match (ch, v.class) {
-                    (Some(c), _) => ColorField::Bezier(p.channels[c]),
-                    (None, Class::Uniform) => ColorField::Flat(v.values[p.origin as usize]),
-                    (None, _) => ColorField::Flat(v.values[0]),
+                Some(match (ch, f, v.class) {
+                    (Some(c), _, _) => ColorField::Bezier(p.channels[c]),
+                    (None, Some(f), _) => ColorField::Bilinear(p.facevarying[f]),
+                    (None, None, Class::Uniform) => ColorField::Flat(v.values[p.origin as usize]),
+                    (None, None, _) => ColorField::Flat(v.values[0]),
                 })
             };
-            let fields = (field(&vars.cs, cs_ch), field(&vars.os, os_ch));
+            let fields = (field(&vars.cs, cs_ch, cs_fv), field(&vars.os, os_ch, os_fv));
             self.emit_with(a, &ctm, k, p.channels[0], Patch::POLYNOMIAL, fields)?;
         }
         Ok(())
@@ -208,6 +205,8 @@ impl Interp {
 #[cfg(test)]
 mod tests {
     use super::super::tests::{err, parse, world};
+    use crate::scene::ColorField;
+    use glam::DVec3;
 
     const TETRA: &str = "SubdivisionMesh \"catmull-clark\" [3 3 3 3] [0 1 3 1 2 3 2 0 3 2 1 0] \
                          \"P\" [1 0 0  -0.5 0.866 0  -0.5 -0.866 0  0 0 1]";
@@ -233,6 +232,75 @@ mod tests {
         let pv = s.patches[0].primvars.as_ref().unwrap();
         assert!(matches!(pv.cs, Some(crate::scene::ColorField::Bezier(_))));
         assert!(matches!(pv.os, Some(crate::scene::ColorField::Flat(_))));
+    }
+
+    /// Facevarying "Cs" is interpolated linearly over each face: on a flat unit square with
+    /// sharp boundaries (whose limit surface is the square, each point where its linear
+    /// refinement puts it) every patch corner has the bilinear blend of the four corner
+    /// colours at its position; on a cube whose faces each have one colour, every patch has its
+    /// face's colour alone (the colour jumps at the edges).
+    #[test]
+    fn facevarying_colours_are_linear_over_each_face() {
+        let quad = "SubdivisionMesh \"catmull-clark\" [4] [0 1 2 3] [\"interpolateboundary\"] \
+                    [0 0] [] [] \"P\" [0 0 0 1 0 0 1 1 0 0 1 0] \
+                    \"facevarying color Cs\" [1 0 0 0 1 0 0 0 1 1 1 1]";
+        let s = parse(&world(quad));
+        assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+        assert!(s.patches.len() >= 4);
+        let corner = [
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(0.0, 0.0, 1.0),
+            DVec3::ONE,
+        ];
+        let want = |x: f64, y: f64| {
+            (corner[0] * (1.0 - x) + corner[1] * x) * (1.0 - y)
+                + (corner[3] * (1.0 - x) + corner[2] * x) * y
+        };
+        for p in &s.patches {
+            let cs = p.primvars.as_ref().and_then(|v| v.cs.clone()).unwrap();
+            assert!(matches!(cs, ColorField::Bilinear(_)));
+            for (u, v, k) in [(0.0, 0.0, 0), (1.0, 0.0, 3), (0.0, 1.0, 12), (1.0, 1.0, 15)] {
+                let q = p.cp[k];
+                let d = cs.eval(u, v) - want(q.x, q.y);
+                assert!(
+                    d.length() < 1e-9,
+                    "at {q}: {} vs {}",
+                    cs.eval(u, v),
+                    want(q.x, q.y)
+                );
+            }
+        }
+        let cube = "SubdivisionMesh \"catmull-clark\" [4 4 4 4 4 4] \
+                    [0 1 3 2 2 3 5 4 4 5 7 6 6 7 1 0 1 7 5 3 6 0 2 4] \
+                    \"P\" [-1 -1 1 1 -1 1 -1 1 1 1 1 1 -1 1 -1 1 1 -1 -1 -1 -1 1 -1 -1] \
+                    \"facevarying color Cs\" [1 0 0 1 0 0 1 0 0 1 0 0  0 1 0 0 1 0 0 1 0 0 1 0 \
+                    0 0 1 0 0 1 0 0 1 0 0 1  1 1 0 1 1 0 1 1 0 1 1 0  0 1 1 0 1 1 0 1 1 0 1 1 \
+                    1 0 1 1 0 1 1 0 1 1 0 1]";
+        let s = parse(&world(cube));
+        assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+        let colours = [
+            DVec3::X,
+            DVec3::Y,
+            DVec3::Z,
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(0.0, 1.0, 1.0),
+            DVec3::new(1.0, 0.0, 1.0),
+        ];
+        let mut seen = [0; 6];
+        for p in &s.patches {
+            let Some(ColorField::Bilinear(c)) = p.primvars.as_ref().and_then(|v| v.cs.clone())
+            else {
+                panic!("no bilinear Cs");
+            };
+            let f = colours
+                .iter()
+                .position(|k| *k == c[0])
+                .expect("a face colour");
+            assert!(c.iter().all(|x| *x == colours[f]), "{c:?}");
+            seen[f] += 1;
+        }
+        assert!(seen.iter().all(|&n| n > 0), "{seen:?}");
     }
 
     #[test]

@@ -24,6 +24,43 @@ pub struct LimitPatch {
     pub level: u32,
     /// True for an exact B-spline patch, false for an approximation near an irregularity.
     pub exact: bool,
+    /// Per facevarying channel ([`limit_patches_with`]) its values at the patch's corners
+    /// (u, v) = (0, 0), (1, 0), (0, 1), (1, 1), interpolated bilinearly in between; empty
+    /// without facevarying channels.
+    pub facevarying: Vec<[DVec3; 4]>,
+}
+
+/// Facevarying values: per face, per corner, per channel.
+pub type FaceVarying = Vec<Vec<Vec<DVec3>>>;
+
+/// The facevarying values of the children [`refine`] makes of `faces` (in its order: per face,
+/// the child at each corner i, (vertex i, edge i -> i+1, face centre, edge i-1 -> i)),
+/// interpolated linearly over each face: the corner's value, the edges' midpoints, the mean
+/// of the corners.
+fn refine_facevarying(faces: &[Vec<Vec<DVec3>>]) -> FaceVarying {
+    let mid = |a: &[DVec3], b: &[DVec3]| -> Vec<DVec3> {
+        a.iter().zip(b).map(|(x, y)| (*x + *y) * 0.5).collect()
+    };
+    let mut out = Vec::new();
+    for face in faces {
+        let n = face.len();
+        let centre: Vec<DVec3> = (0..face[0].len())
+            .map(|c| face.iter().map(|corner| corner[c]).sum::<DVec3>() / n as f64)
+            .collect();
+        for i in 0..n {
+            let (prev, v, next) = (&face[(i + n - 1) % n], &face[i], &face[(i + 1) % n]);
+            out.push(vec![v.clone(), mid(v, next), centre.clone(), mid(prev, v)]);
+        }
+    }
+    out
+}
+
+/// The bilinear corner values ([`LimitPatch::facevarying`]) of a quad whose corners 0..3 are
+/// the patch's (u, v) = (0, 0), (1, 0), (1, 1), (0, 1) (its first edge along u).
+fn quad_corners(face: &[Vec<DVec3>]) -> Vec<[DVec3; 4]> {
+    (0..face.first().map_or(0, |c| c.len()))
+        .map(|c| [face[0][c], face[1][c], face[3][c], face[2][c]])
+        .collect()
 }
 
 /// Local ring position to 4x4 grid position for corner `i` of a quad (see [`grid16`]).
@@ -148,6 +185,19 @@ pub fn limit_patches(
     data: Vec<Vec<DVec3>>,
     max_level: u32,
 ) -> Result<Vec<LimitPatch>, String> {
+    limit_patches_with(mesh, data, None, max_level)
+}
+
+/// [`limit_patches`] with facevarying channels: `fv[f][corner][channel]` for every face of
+/// `mesh`, interpolated linearly over each control face (refined with the faces: each child
+/// corner takes its parent corner's value, an edge's midpoint or the face's mean) and given
+/// to each patch at its corners ([`LimitPatch::facevarying`]).
+pub fn limit_patches_with(
+    mesh: Mesh,
+    data: Vec<Vec<DVec3>>,
+    mut fv: Option<FaceVarying>,
+    max_level: u32,
+) -> Result<Vec<LimitPatch>, String> {
     let max_level = max_level.max(1);
     let mut need: Vec<bool> = mesh.hole.iter().map(|h| !h).collect();
     let (mut mesh, mut data) = (mesh, data);
@@ -175,6 +225,7 @@ pub fn limit_patches(
                     origin: mesh.origin[f],
                     level,
                     exact: true,
+                    facevarying: fv.as_ref().map_or(Vec::new(), |fv| quad_corners(&fv[f])),
                 });
                 need[f] = false;
             } else if last && mesh.faces[f].len() == 4 {
@@ -230,6 +281,7 @@ pub fn limit_patches(
                     origin: mesh.origin[f],
                     level,
                     exact: false,
+                    facevarying: fv.as_ref().map_or(Vec::new(), |fv| quad_corners(&fv[f])),
                 });
                 need[f] = false;
             }
@@ -241,6 +293,13 @@ pub fn limit_patches(
         let (sub, sub_data, sub_need) = extract(&mesh, &data, &keep, &need);
         let sub_topo = Topology::new(&sub)?;
         let (child, stencils) = refine(&sub, &sub_topo);
+        if let Some(values) = &mut fv {
+            let kept: Vec<Vec<Vec<DVec3>>> = (values.drain(..).zip(&keep))
+                .filter(|(_, k)| **k)
+                .map(|(v, _)| v)
+                .collect();
+            *values = refine_facevarying(&kept);
+        }
         need = sub
             .faces
             .iter()

@@ -23,7 +23,7 @@ pub mod topology;
 #[cfg(test)]
 mod tests;
 
-pub use adaptive::{LimitPatch, limit_patches, uniform};
+pub use adaptive::{FaceVarying, LimitPatch, limit_patches, limit_patches_with, uniform};
 use glam::DVec3;
 use topology::{INFINITELY_SHARP, Mesh, SHARPNESS_CAP, Topology, edge_key};
 
@@ -160,13 +160,27 @@ pub fn control_mesh(
 }
 
 /// The limit surface of a `SubdivisionMesh` as patches ([`control_mesh`], then
-/// [`limit_patches`] to [`max_level_for`] its size); `data[0]` the positions.
+/// [`limit_patches_with`] to [`max_level_for`] its size); `data[0]` the positions, `fv` the
+/// facevarying channels (`fv[channel][corner]`, one value per entry of `indices`).
 pub fn catmull_clark(
     sizes: &[usize],
     indices: &[u32],
     tags: &Tags,
     data: Vec<Vec<DVec3>>,
+    fv: &[&[DVec3]],
 ) -> Result<Vec<LimitPatch>, String> {
     let mesh = control_mesh(sizes, indices, data[0].len(), tags)?;
-    limit_patches(mesh, data, max_level_for(sizes.len()))
+    let fv = (!fv.is_empty()).then(|| {
+        let mut at = 0;
+        (sizes.iter())
+            .map(|&n| {
+                let face = (at..at + n)
+                    .map(|k| fv.iter().map(|ch| ch[k]).collect())
+                    .collect();
+                at += n;
+                face
+            })
+            .collect()
+    });
+    limit_patches_with(mesh, data, fv, max_level_for(sizes.len()))
 }

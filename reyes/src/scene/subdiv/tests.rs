@@ -155,7 +155,7 @@ fn normal_at(patches: &[LimitPatch], q: DVec3) -> (f64, DVec3) {
 fn a_cube_becomes_a_rounded_cube_close_to_its_limit_surface() {
     let (sizes, idx, p) = cube();
     let tags = Tags::default();
-    let patches = catmull_clark(&sizes, &idx, &tags, vec![p.clone()]).unwrap();
+    let patches = catmull_clark(&sizes, &idx, &tags, vec![p.clone()], &[]).unwrap();
     let exact = patches.iter().filter(|p| p.exact).count();
     eprintln!("cube: {} patches, {exact} exact", patches.len());
     // Level 2: 96 faces, 72 away from the 8 valence-3 corners are B-spline patches; the 24 at
@@ -183,7 +183,7 @@ fn a_cube_becomes_a_rounded_cube_close_to_its_limit_surface() {
 #[test]
 fn a_tetrahedron_becomes_a_smooth_watertight_blob() {
     let (sizes, idx, p) = tetrahedron();
-    let patches = catmull_clark(&sizes, &idx, &Tags::default(), vec![p.clone()]).unwrap();
+    let patches = catmull_clark(&sizes, &idx, &Tags::default(), vec![p.clone()], &[]).unwrap();
     let mesh = mesh_of(&sizes, &idx, &p, &Tags::default());
     let size = 150.0;
     let err = max_error_to_uniform(&mesh, &p, &patches);
@@ -227,7 +227,7 @@ fn infinitely_sharp_cube_edges_keep_the_cube() {
         creases: edges.iter().map(|&(a, b)| (vec![a, b], 10.0)).collect(),
         ..Tags::default()
     };
-    let patches = catmull_clark(&sizes, &idx, &tags, vec![p]).unwrap();
+    let patches = catmull_clark(&sizes, &idx, &tags, vec![p], &[]).unwrap();
     for pa in &patches {
         for c in &pa.channels[0] {
             assert!((c.abs().max_element() - 1.0).abs() < 1e-12, "{c}");
@@ -254,7 +254,7 @@ fn boundaries_holes_and_colours() {
         ..Tags::default()
     };
     let sizes = [4; 9];
-    let patches = catmull_clark(&sizes, &idx, &tags, vec![p.clone(), colour]).unwrap();
+    let patches = catmull_clark(&sizes, &idx, &tags, vec![p.clone(), colour], &[]).unwrap();
     let s = samples(&patches, 4);
     for corner in [0, 3, 12, 15] {
         assert!(s.iter().any(|x| x.3.distance(p[corner]) < 1e-12));
@@ -271,14 +271,14 @@ fn boundaries_holes_and_colours() {
     // The centre face is regular: one exact B-spline patch at level 0.
     assert_eq!(patches.iter().filter(|p| p.level == 0).count(), 1);
     // Without interpolateboundary only the centre face (away from the boundary) is drawn.
-    let inner = catmull_clark(&sizes, &idx, &Tags::default(), vec![p.clone()]).unwrap();
+    let inner = catmull_clark(&sizes, &idx, &Tags::default(), vec![p.clone()], &[]).unwrap();
     assert!(inner.len() == 1 && inner[0].origin == 4);
     // A hole leaves its face out.
     let holed = Tags {
         holes: vec![4],
         ..tags
     };
-    let patches = catmull_clark(&sizes, &idx, &holed, vec![p]).unwrap();
+    let patches = catmull_clark(&sizes, &idx, &holed, vec![p], &[]).unwrap();
     assert!(patches.iter().all(|p| p.origin != 4));
     assert!(patches.iter().any(|p| p.origin == 5));
 }

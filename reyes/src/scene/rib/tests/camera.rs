@@ -170,13 +170,13 @@ fn format_pixel_aspect_minus_one_is_one() {
     let path = crate::shared_data_dir().join("field/exporters/trimcurve-format-minus-one.rib");
     let s = load(&path).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!((s.width, s.height), (200, 150));
+    // Its `TrimCurve` trims the NuPatch (tests/reyes_trim_camera.rs renders the disc).
     assert!(
-        s.warnings
-            .iter()
-            .any(|w| w.contains("TrimCurve") && w.contains("untrimmed")),
+        !s.warnings.iter().any(|w| w.contains("TrimCurve")),
         "{:?}",
         s.warnings
     );
+    assert!(s.patches.iter().all(|p| p.trim.is_some()));
 }
 
 #[test]
@@ -237,5 +237,24 @@ fn coordinate_systems_are_named_and_restored() {
     assert!(
         e.contains("t.rib:2:") && e.contains("no coordinate system \"nowhere\""),
         "{e}"
+    );
+}
+
+/// Skipped requests that change the picture say what the image lacks.
+#[test]
+fn skipped_requests_say_what_the_image_lacks() {
+    let s = parse(&format!(
+        "PixelFilter \"gaussian\" 2 2\nExposure 1 2.2\n{}",
+        world("Matte 1\n")
+    ));
+    let w = s.warnings.join("\n");
+    assert!(
+        w.contains("`PixelFilter`: each pixel is the plain mean"),
+        "{w}"
+    );
+    assert!(w.contains("`Exposure`: no gain or gamma"), "{w}");
+    assert!(
+        w.contains("`Matte`: the object is drawn as an ordinary surface"),
+        "{w}"
     );
 }

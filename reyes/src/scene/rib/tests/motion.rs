@@ -76,7 +76,8 @@ fn motion_block_errors_name_the_line() {
     );
 }
 
-/// Camera motion and motion of anything but transforms keep the first time, with a warning.
+/// Motion of anything but transforms keeps the first time, with a warning; camera motion (a
+/// block before `WorldBegin`) moves every object by the camera's motion, in camera space.
 #[test]
 fn unsupported_motion_warns_and_keeps_the_first_time() {
     let s = parse(&format!(
@@ -86,10 +87,19 @@ fn unsupported_motion_warns_and_keeps_the_first_time() {
         ))
     ));
     assert!(close(s.patches[0].cp[0], DVec3::new(0.0, 0.0, 1.0)));
-    assert!(s.patches[0].motion.is_none());
-    assert_eq!(s.warnings.len(), 2, "{:?}", s.warnings);
-    assert!(s.warnings[0].contains("camera motion is not supported"));
-    assert!(s.warnings[1].contains("motion of `Color` is not supported"));
+    let m = s.patches[0].motion.as_deref().expect("the camera's motion");
+    assert!(close(
+        m.transform_point3(s.patches[0].cp[0]),
+        DVec3::new(0.0, 0.0, 2.0)
+    ));
+    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+    assert!(s.warnings[0].contains("motion of `Color` is not supported"));
+    // "world" space under a moving camera moves with the world.
+    let s = parse(&format!(
+        "Shutter 0 1\nMotionBegin [0 1]\nTranslate 0 0 1\nTranslate 0 0 2\nMotionEnd\n{}",
+        world(&format!("CoordSysTransform \"world\"\n{QUAD}"))
+    ));
+    assert!(s.patches[0].motion.is_some());
 }
 
 #[test]
