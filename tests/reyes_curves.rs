@@ -5,44 +5,17 @@
 //! render without a skipped-primitive warning. Runs on lavapipe in CI.
 
 use glam::DVec3;
-use reyes::cpu_render::render_cpu;
 use reyes::frame::{FrameData, RenderOptions};
 use reyes::gpu_render::GpuFrame;
 use reyes::scene::{self, Scene};
-use scheduler::StrategyKind;
 
 mod common;
-use common::{CPU_TWIN_OVER, compare, gpu, renderer};
+use common::render_everywhere;
 
 fn parse(text: &str) -> Scene {
     let s = scene::parse_rib(text, "curves.rib").unwrap_or_else(|e| panic!("{e}"));
     assert!(s.warnings.is_empty(), "{:?}", s.warnings);
     s
-}
-
-/// Every strategy (identical images) and the CPU twin (the usual agreement).
-fn render_everywhere(data: &FrameData) -> GpuFrame {
-    let mut first: Option<GpuFrame> = None;
-    for kind in StrategyKind::ALL {
-        let f = renderer(kind).render(gpu(), data).unwrap();
-        if let Some(a) = &first {
-            assert!(
-                a.image == f.image,
-                "{kind:?}: image differs from megakernel"
-            );
-            assert_eq!(a.counters, f.counters, "{kind:?}: counters");
-        }
-        first.get_or_insert(f);
-    }
-    let first = first.unwrap();
-    let cpu = render_cpu(data);
-    let (max, over) = compare(&first.image, &cpu.image);
-    assert!(
-        over < CPU_TWIN_OVER,
-        "CPU twin: {:.3}% of pixels differ by more than 2/255 (max {max})",
-        over * 100.0
-    );
-    first
 }
 
 fn alpha_sum(g: &GpuFrame) -> f64 {

@@ -4,14 +4,11 @@
 //! square's own projected area), every strategy gives the same image and the CPU twin
 //! agrees. Runs on lavapipe in CI.
 
-use reyes::cpu_render::render_cpu;
 use reyes::frame::{FrameData, RenderOptions};
-use reyes::gpu_render::GpuFrame;
 use reyes::scene::{self, Scene};
-use scheduler::StrategyKind;
 
 mod common;
-use common::{CPU_TWIN_OVER, compare, gpu, renderer};
+use common::render_everywhere;
 
 /// A 4 x 4 grid of points over [-1.5, 1.5]² at depth 4 (fov 45, 160 x 120), tiled by faces of
 /// every kind; colours per point (vertex class) so the twin comparison sees interpolation.
@@ -66,31 +63,6 @@ fn mesh_rib() -> String {
 
 fn parse(text: &str) -> Scene {
     scene::parse_rib(text, "mesh.rib").unwrap_or_else(|e| panic!("{e}"))
-}
-
-/// Every strategy (identical images) and the CPU twin (the usual agreement).
-fn render_everywhere(data: &FrameData) -> GpuFrame {
-    let mut first: Option<GpuFrame> = None;
-    for kind in StrategyKind::ALL {
-        let f = renderer(kind).render(gpu(), data).unwrap();
-        if let Some(a) = &first {
-            assert!(
-                a.image == f.image,
-                "{kind:?}: image differs from megakernel"
-            );
-            assert_eq!(a.counters, f.counters, "{kind:?}: counters");
-        }
-        first.get_or_insert(f);
-    }
-    let first = first.unwrap();
-    let cpu = render_cpu(data);
-    let (max, over) = compare(&first.image, &cpu.image);
-    assert!(
-        over < CPU_TWIN_OVER,
-        "CPU twin: {:.3}% of pixels differ by more than 2/255 (max {max})",
-        over * 100.0
-    );
-    first
 }
 
 #[test]

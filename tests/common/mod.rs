@@ -67,6 +67,32 @@ pub fn render_both_strategies(data: &FrameData) -> (GpuFrame, GpuFrame) {
     (a, b)
 }
 
+/// `data`'s frames by every strategy, asserting identical images and counters, and the CPU
+/// twin's, within [`CPU_TWIN_OVER`] of them; the first strategy's frame.
+pub fn render_everywhere(data: &FrameData) -> GpuFrame {
+    let mut first: Option<GpuFrame> = None;
+    for kind in StrategyKind::ALL {
+        let f = renderer(kind).render(gpu(), data).unwrap();
+        if let Some(a) = &first {
+            assert!(
+                a.image == f.image,
+                "{kind:?}: image differs from megakernel"
+            );
+            assert_eq!(a.counters, f.counters, "{kind:?}: counters");
+        }
+        first.get_or_insert(f);
+    }
+    let first = first.unwrap();
+    let cpu = reyes::cpu_render::render_cpu(data);
+    let (max, over) = compare(&first.image, &cpu.image);
+    assert!(
+        over < CPU_TWIN_OVER,
+        "CPU twin: {:.3}% of pixels differ by more than 2/255 (max {max})",
+        over * 100.0
+    );
+    first
+}
+
 pub fn small(w: u32, h: u32) -> RenderOptions {
     RenderOptions {
         width: Some(w),
