@@ -183,7 +183,11 @@ fn rmse(a: &FrameImage, b: &FrameImage) -> f64 {
 
 /// The three algorithms estimate the same image: their error (RMSE of premultiplied linear
 /// RGBA) against a many-sample reference (the CPU twin's mean of the three at 16x16 samples
-/// per pixel) shrinks as the samples grow from 1 to 64 per pixel, to under a quarter.
+/// per pixel) shrinks as the samples grow from 1 to 64 per pixel, to under 0.3 of it. (Noise
+/// alone would fall 8-fold; the reference's own noise and the anti-aliasing of the edges hold
+/// every algorithm near 0.04 at 64 samples: measured 0.23-0.26 of the 1-sample error for
+/// the three, the bounding box's per-pixel samples, hashed over the whole image since they
+/// became the default, at 0.26.)
 #[test]
 fn the_algorithms_converge_to_one_reference() {
     let s = quads(&format!("{SHUTTER}\n{DOF}"), MOVE);
@@ -230,7 +234,7 @@ fn the_algorithms_converge_to_one_reference() {
             .collect();
         eprintln!("{sampling:?}: RMSE at 1, 4, 16, 64 spp: {errors:?}");
         assert!(
-            errors.windows(2).all(|w| w[1] < w[0]) && errors[3] < 0.25 * errors[0],
+            errors.windows(2).all(|w| w[1] < w[0]) && errors[3] < 0.3 * errors[0],
             "{sampling:?}: RMSE at 1, 4, 16, 64 spp: {errors:?}"
         );
     }
@@ -287,4 +291,122 @@ fn the_pipelined_renderer_blurs_like_render() {
         frames[0].image.as_ref().unwrap() != &still,
         "the spin and the lens blur"
     );
+}
+
+/// A bar 6 px wide and 200 px tall sliding 90 px to the right over the shutter (x from
+/// [30, 36] at shutter open to [120, 126] at close), 240x240, the default pixel samples (2x2).
+fn sliding_bar() -> Scene {
+    // fov 90 on a square frame: focal 120 px; at depth 1.2, x = 120 + 100 X, y = 120 - 100 Y.
+    let text = "Format 240 240 1\nProjection \"perspective\" \"fov\" 90\nShutter 0 1\n\
+        WorldBegin\nSurface \"constant\"\nAttributeBegin\n\
+        MotionBegin [0 1]\nTranslate 0 0 0\nTranslate 0.9 0 0\nMotionEnd\n\
+        Patch \"bilinear\" \"P\" [-0.9 -1 1.2  -0.84 -1 1.2  -0.9 1 1.2  -0.84 1 1.2]\n\
+        AttributeEnd\nWorldEnd\n";
+    scene::parse_rib(text, "sliding_bar.rib").unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Alpha summed over each column of `img`.
+fn column_coverage(img: &FrameImage) -> Vec<f64> {
+    let mut c = vec![0f64; img.width as usize];
+    for (i, p) in img.rgba.iter().enumerate() {
+        c[i % img.width as usize] += p[3] as f64;
+    }
+    c
+}
+
+/// The exact time-averaged column coverage of [`sliding_bar`]: 200 rows times the mean over
+/// the shutter of the overlap of column [x, x + 1] with the bar [30 + 90 t, 36 + 90 t]
+/// (midpoint rule over 90,000 instants: 1,000 per pixel of travel, far below the noise).
+fn sliding_bar_exact(width: usize) -> Vec<f64> {
+    let steps = 90_000;
+    let mut c = vec![0f64; width];
+    for s in 0..steps {
+        let t = (s as f64 + 0.5) / steps as f64;
+        let (a, b) = (30.0 + 90.0 * t, 36.0 + 90.0 * t);
+        for (x, v) in c.iter_mut().enumerate() {
+            let overlap = (b.min(x as f64 + 1.0) - a.max(x as f64)).max(0.0);
+            *v += 200.0 * overlap / steps as f64;
+        }
+    }
+    c
+}
+
+/// `profile` box-filtered over 5 columns (a ghost copy's gap is 16 px wide, the noise of one
+/// column about 13% of the plateau; the filter takes it to about 6%).
+fn smooth(profile: &[f64]) -> Vec<f64> {
+    (0..profile.len())
+        .map(|x| {
+            let (a, b) = (x.saturating_sub(2), (x + 3).min(profile.len()));
+            profile[a..b].iter().sum::<f64>() / 5.0
+        })
+        .collect()
+}
+
+/// The ghost criterion: how many distinct copies the smoothed column coverage shows, that is
+/// separate runs where it rises above 3/4 of `plateau` (the exact blur's height), a run ending
+/// only where it falls below 1/4 of it. A smooth blur is one run; S ghosts (Simple UVT at S
+/// samples, copies apart) are S.
+fn copies(profile: &[f64], plateau: f64) -> usize {
+    let (mut runs, mut inside) = (0, false);
+    for &v in profile {
+        if !inside && v > 0.75 * plateau {
+            runs += 1;
+            inside = true;
+        } else if inside && v < 0.25 * plateau {
+            inside = false;
+        }
+    }
+    runs
+}
+
+/// Issue 23, item 7: at the default settings a moving bar blurs smoothly instead of showing S
+/// copies. The default sampler (bounding box: each pixel's samples at their own times,
+/// stratified per pixel) shows one copy where Simple UVT shows the 4 of its 4 instants, its
+/// column coverage follows the exact time average (the most any smoothed column is off is
+/// under 0.3 of the plateau; Simple's copies are 3.75 times it), and the covered area is the
+/// bar's, 1,200 px, within 5%: each of the 76,800 samples under the swept band (96 x 200 px, 4
+/// each) is covered with probability at most p = 1/15, so the area's standard deviation is at
+/// most sqrt(76800 p (1 - p)) / 4 = 17 px (1.4%; the tolerance is 3.5 of it) without the time
+/// stratification, which only lowers it. Both GPU strategies give
+/// the same bits (render_gpu) and the CPU twin the same image within the motion tolerance.
+#[test]
+fn the_default_blurs_motion_without_ghosts() {
+    assert_eq!(RenderOptions::default().sampling, Sampling::BoundingBox);
+    let s = sliding_bar();
+    let exact = sliding_bar_exact(240);
+    let plateau = 200.0 * 6.0 / 90.0;
+    let exact_smooth = smooth(&exact);
+    let d = FrameData::new(&s, &RenderOptions::default()).unwrap();
+    assert_eq!((d.frame.spp_x, d.frame.spp_y), (2, 2));
+    let img = render_gpu(&d);
+    let (max, over) = compare(&img, &render_cpu(&d).image);
+    assert!(
+        over <= CPU_TWIN_OVER_MOTION,
+        "CPU twin: {:.2}% over 2/255 (max {max})",
+        over * 100.0
+    );
+    let simple = render_gpu(&FrameData::new(&s, &options(Sampling::Simple, 2)).unwrap());
+    for (name, img) in [("default", &img), ("simple", &simple)] {
+        let profile = smooth(&column_coverage(img));
+        let n = copies(&profile, plateau);
+        let off = (profile.iter().zip(&exact_smooth))
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        let area: f64 = column_coverage(img).iter().sum();
+        eprintln!(
+            "{name}: {n} copies, smoothed column coverage off by up to {:.2} of the plateau, \
+             area {area:.1} px (exact 1200)",
+            off / plateau
+        );
+        if name == "default" {
+            assert_eq!(n, 1, "the default shows {n} copies");
+            assert!(off < 0.3 * plateau, "profile off by {off:.2} px");
+            assert!((area - 1200.0).abs() < 60.0, "area {area:.1}, exact 1200");
+        } else {
+            assert!(
+                n >= 3,
+                "Simple UVT shows {n} copies: the criterion misses ghosts"
+            );
+        }
+    }
 }

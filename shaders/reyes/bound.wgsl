@@ -212,7 +212,15 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
     atomicMax(&counters[C_MAX_DEPTH], depth);
     var g = item;
     g.rates = d.y | (d.z << 8u);
-    g.dilate = select(0u, crack_dilation(&cp, &w, rational, d.y, d.z, zmin), frame.crack_dilation != 0u);
+    if frame.crack_dilation != 0u {
+        g.dilate = crack_dilation(&cp, &w, rational, d.y, d.z, zmin);
+        // Undisplaced and seen through the pinhole at one time: the tighter bound on screen.
+        if r == 0.0 && !(SCENE_UVT && frame.uvt != UVT_OFF) {
+            g.dilate = packed_min(g.dilate, screen_crack_dilation(&pts, &w, rational, d.y, d.z));
+        }
+    } else {
+        g.dilate = 0u;
+    }
     if (d.y + 1u) * (d.z + 1u) <= SMALL_GRID_POINTS {
         enqueue_dicesmall(g);
     } else {
@@ -359,6 +367,45 @@ fn crack_dilation(cp: ptr<function, array<f32, 48>>, w: ptr<function, array<f32,
         packed |= u32(q) << (8u * e);
     }
     return packed;
+}
+
+// crack_dilation from the boundary curves as they are on screen: `pts` holds the control
+// points projected (xy, pixels) with their camera depths (z), all in front of the eye. The
+// perspective image of a rational curve with points b_i and weights w_i is the rational curve
+// with points project(b_i) and weights w_i b_i.z (a polynomial curve: weights b_i.z), so
+// curve_c2_rational bounds |C''| in pixels, with no allowance for the view (crack_dilation's
+// slack, about 3.5 at a 40 degree view): rims and seams of thin surfaces grow by their own
+// chords' sagitta, |C''| / (8 n^2), and no more. Rust twin: stages::bound.
+fn screen_crack_dilation(pts: ptr<function, array<vec4<f32>, 16>>,
+                         w: ptr<function, array<f32, 16>>, rational: bool, nu: u32, nv: u32)
+    -> u32 {
+    var packed = 0u;
+    for (var e = 0u; e < 4u; e++) {
+        let along_u = e < 2u;
+        let start = select(select(0u, 3u, e == 3u), select(0u, 12u, e == 1u), along_u);
+        let step = select(4u, 1u, along_u);
+        let n = f32(select(nv, nu, along_u));
+        var q: array<vec4<f32>, 4>;
+        for (var k = 0u; k < 4u; k++) {
+            let i = start + k * step;
+            let p = (*pts)[i];
+            q[k] = vec4<f32>(p.xy, 0.0, select(1.0, (*w)[i], rational) * p.z);
+        }
+        let c2 = curve_c2_rational(q[0], q[1], q[2], q[3]);
+        let px = c2 / (8.0 * n * n);
+        let qq = clamp(ceil(px * (255.0 / MAX_DILATE_PX)), 1.0, 255.0);
+        packed |= u32(qq) << (8u * e);
+    }
+    return packed;
+}
+
+// The smaller of two packed crack dilations, edge by edge.
+fn packed_min(a: u32, b: u32) -> u32 {
+    var m = 0u;
+    for (var s = 0u; s < 32u; s += 8u) {
+        m |= min((a >> s) & 255u, (b >> s) & 255u) << s;
+    }
+    return m;
 }
 
 // An upper bound of |C''| on [0, 1] for the rational cubic C with Euclidean control points

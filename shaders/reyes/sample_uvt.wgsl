@@ -14,16 +14,16 @@
 //     to the sub-sample at slot permute(j, N, perm) (slot = (ly K + lx) S + k) with
 //     perm = (tile number + tx + ty) mod P (the paper's eq. 2-3); the micropolygon is moved N
 //     times, and at each the one sub-sample per tile holding that sample is tested;
-//   UVT_BBOX: each pixel's S samples come from a 64 x 64 pixel table repeated over the image;
-//     one pass over the bound grown by the motion and the circles of confusion tests every
-//     sub-sample under it with its own sample.
+//   UVT_BBOX (the default): each pixel's S samples are its own, hashed from its index, one per
+//     time stratum in an order shifted per pixel; for each stratum the
+//     bound of the micropolygon over that stratum's times, grown by the circles of confusion,
+//     tests the one sub-sample per pixel under it whose time lies in the stratum, at its own
+//     time and lens position (stochastic sampling: Cook, Porter and Carpenter 1984).
 // Rust twin: reyes/src/stages/sample_uvt.rs.
 
 // Mixed into the keys of the 3D samples and the permutations (differ from the jitter hash).
 const UVT_SALT: u32 = 0x9e3779b9u;
 const PERM_SALT: u32 = 0x632be5abu;
-// The side of the repeated table of per-pixel samples (UVT_BBOX).
-const UVT_TABLE: u32 = 64u;
 // Where DiceShade keeps the shutter-close points in diceshade_shared (after the open ones).
 const UVT_CLOSE: u32 = 256u;
 
@@ -54,12 +54,29 @@ fn uvt_sample(key: u32, stratum: u32, n: u32) -> vec3<f32> {
     return vec3<f32>(lens, t);
 }
 
-// The 3D sample of sub-sample k of pixel (px, py) under UVT_BBOX: entry (px mod 64, py mod 64)
-// of the table; its S samples are stratified in time, their order shuffled per entry.
+// The 3D sample of sub-sample k of pixel (px, py) under UVT_BBOX, hashed from the pixel's index
+// in the image (no table repeated over the image: a repeat would show as a pattern in the
+// noise and correlate the estimate across the repeats): its S samples are stratified in time,
+// their order shifted per pixel.
 fn uvt_table_sample(px: u32, py: u32, k: u32, n: u32) -> vec3<f32> {
-    let texel = (py % UVT_TABLE) * UVT_TABLE + px % UVT_TABLE;
+    let texel = py * frame.width + px;
     let shift = reyes_hash(texel ^ PERM_SALT) % n;
     return uvt_sample(texel * n + k, (k + shift) % n, n);
+}
+
+// The sub-sample of pixel (px, py) whose time lies in stratum j of n (UVT_BBOX): the inverse
+// of uvt_table_sample's (k + shift) mod n.
+fn table_slot(px: u32, py: u32, j: u32, n: u32) -> u32 {
+    let texel = py * frame.width + px;
+    let shift = reyes_hash(texel ^ PERM_SALT) % n;
+    return (j + n - shift) % n;
+}
+
+// Growth of a time stratum's bound against rounding: the stratum's end points and a sample's
+// point inside it are computed by different roundings (one may be fused), each within an ulp
+// or two of |x|; 1/64 px plus 1e-5 |x| is far above that and costs at most a pixel row.
+fn stratum_margin(x: vec2<f32>) -> f32 {
+    return 0.015625 + 1.0e-5 * max(abs(x.x), abs(x.y));
 }
 
 // Kensler's hashed permutation ("Correlated Multi-Jittered Sampling", 2013): a bijection of
@@ -184,22 +201,46 @@ fn sample_micropolygon_uvt(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32
             }
         }
     } else {
-        // The bound over all times and lens positions: both ends of every corner's motion,
-        // grown by the largest circle of confusion (monotonic in depth, which moves linearly).
-        var lo = vec2<f32>(3.0e38);
-        var hi = vec2<f32>(-3.0e38);
-        var r = 0.0;
-        for (var i = 0u; i < 4u; i++) {
-            lo = min(lo, min(q0[i].xy, q1[i].xy));
-            hi = max(hi, max(q0[i].xy, q1[i].xy));
-            r = max(r, max(abs(coc(q0[i].z)), abs(coc(q1[i].z))));
-        }
-        let g = max(max(grow.x, grow.y), max(grow.z, grow.w)) + r;
-        let p = bucket_pixels(lo - vec2<f32>(g), hi + vec2<f32>(g));
-        for (var py = p[0].y; py <= p[1].y; py++) {
-            for (var px = p[0].x; px <= p[1].x; px++) {
-                for (var k = 0u; k < spp; k++) {
-                    let m = moved_quad(q0, q1, uvt_table_sample(px, py, k, spp), grow);
+        // Time stratum by time stratum: pixel (px, py)'s sub-sample k has its time in stratum
+        // (k + shift) mod S (uvt_table_sample), so stratum j is held by its sub-sample
+        // (j + S - shift) mod S. The micropolygon over [j / S, (j + 1) / S] lies in the bound of
+        // both ends of each corner's motion (linear in t, rounding monotone in t), grown by the
+        // largest circle of confusion there (monotone in depth, which moves linearly): only
+        // the pixels under that bound can hold a sample of stratum j it covers. The same
+        // samples and tests as one pass over the whole shutter's bound, S times fewer when the
+        // motion dominates.
+        let g = max(max(grow.x, grow.y), max(grow.z, grow.w));
+        for (var j = 0u; j < spp; j++) {
+            let tb = vec2<f32>(f32(j), f32(j + 1u)) / f32(spp);
+            var lo = vec2<f32>(3.0e38);
+            var hi = vec2<f32>(-3.0e38);
+            var r = 0.0;
+            for (var i = 0u; i < 4u; i++) {
+                let e0 = q0[i].xyz + (q1[i].xyz - q0[i].xyz) * tb.x;
+                let e1 = q0[i].xyz + (q1[i].xyz - q0[i].xyz) * tb.y;
+                lo = min(lo, min(e0.xy, e1.xy));
+                hi = max(hi, max(e0.xy, e1.xy));
+                r = max(r, max(abs(coc(e0.z)), abs(coc(e1.z))));
+            }
+            let p = bucket_pixels(lo - vec2<f32>(g + r + stratum_margin(lo)),
+                hi + vec2<f32>(g + r + stratum_margin(hi)));
+            for (var py = p[0].y; py <= p[1].y; py++) {
+                for (var px = p[0].x; px <= p[1].x; px++) {
+                    let k = table_slot(px, py, j, spp);
+                    let s = uvt_table_sample(px, py, k, spp);
+                    // Most pixels of a long blur miss the micropolygon at their sample's time:
+                    // the moved corners' bound (moved_quad's lo, hi, the same bits) rejects
+                    // them before the triangles are set up.
+                    let ma = uvt_corner(q0[0], q1[0], s).xy;
+                    let mb = uvt_corner(q0[1], q1[1], s).xy;
+                    let mc = uvt_corner(q0[2], q1[2], s).xy;
+                    let md = uvt_corner(q0[3], q1[3], s).xy;
+                    let q = sample_position(px, py, k % frame.spp_x, k / frame.spp_x);
+                    if any(q < min(min(ma, mb), min(mc, md)) - vec2<f32>(g))
+                        || any(q > max(max(ma, mb), max(mc, md)) + vec2<f32>(g)) {
+                        continue;
+                    }
+                    let m = moved_quad(q0, q1, s, grow);
                     uvt_test(m, px, py, k % frame.spp_x, k / frame.spp_x, color, cover);
                 }
             }

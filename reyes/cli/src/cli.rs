@@ -174,10 +174,11 @@ pub struct RenderArgs {
     /// How motion blur and depth of field sample time and the lens (each pixel's --samples
     /// sub-samples get one (lens, time) sample each): simple (Simple UVT: the same samples in
     /// every pixel; ghosts when few), interleave (Interleave UVT: KxK pixel tiles share K^2
-    /// times as many, permuted per tile; noise instead) or bbox (Bounding box: one pass over
-    /// the micropolygon's bound grown by its motion and blur, per-pixel samples from a
-    /// repeated 64x64 table). Scenes without motion or depth of field ignore it.
-    #[arg(long, value_name = "ALGORITHM", value_enum, default_value_t = SamplingArg::Simple)]
+    /// times as many, permuted per tile; noise instead) or bbox (Bounding box, the default:
+    /// per-pixel samples, stratified in time, from a repeated 64x64 table, each tested at its
+    /// own time against the micropolygon's bound over its time stratum; noise instead of
+    /// ghosts). Scenes without motion or depth of field ignore it.
+    #[arg(long, value_name = "ALGORITHM", value_enum, default_value_t = SamplingArg::BoundingBox)]
     pub sampling: SamplingArg,
 
     /// Interleave UVT's tile side K in pixels: 2, 3 or 4.
@@ -625,8 +626,9 @@ pub enum SamplingArg {
     /// them, assigned by one of P permutations chosen per tile (the paper's eq. 2-3). Noise
     /// instead of ghosts.
     Interleave,
-    /// Bounding box: one pass over the micropolygon's bound grown by its motion and circle of
-    /// confusion; each pixel's triples come from a 64 x 64 pixel table repeated over the image.
+    /// Bounding box (the default): each pixel's triples come from a 64 x 64 pixel table repeated
+    /// over the image, stratified in time; each is tested at its own time against the
+    /// micropolygon's bound over its time stratum. Noise instead of ghosts.
     #[value(name = "bbox")]
     BoundingBox,
 }

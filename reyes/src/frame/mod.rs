@@ -134,14 +134,18 @@ pub enum Sampling {
     /// Simple UVT: the same S triples in every pixel (S = samples per pixel); each
     /// micropolygon is moved to each triple and rasterized into that triple's sub-sample.
     /// Ghost images when S is small.
-    #[default]
     Simple,
     /// Interleave UVT: K x K pixel tiles share K^2 S triples, each sub-sample of the tile one of
     /// them, assigned by one of P permutations chosen per tile (the paper's eq. 2-3). Noise
     /// instead of ghosts.
     Interleave,
-    /// Bounding box: one pass over the micropolygon's bound grown by its motion and circle of
-    /// confusion; each pixel's triples come from a 64 x 64 pixel table repeated over the image.
+    /// Bounding box (the default): each pixel's S triples come from a 64 x 64 pixel table
+    /// repeated over the image, one per time stratum in an order shifted per pixel; for each
+    /// stratum, the micropolygon's bound over that stratum's times (grown by its circle of
+    /// confusion) tests the sub-sample of each pixel under it whose time lies there, at its own
+    /// time and lens position. Noise instead of ghosts (stochastic sampling: Cook, Porter and
+    /// Carpenter 1984), at a cost that grows with the blur's length rather than its area.
+    #[default]
     BoundingBox,
 }
 

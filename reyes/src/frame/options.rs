@@ -111,7 +111,7 @@ impl Default for RenderOptions {
             crack_dilation: true,
             displacement_normals: DisplacementNormals::Exact,
             raster: RasterMode::BoundingBox,
-            sampling: Sampling::Simple,
+            sampling: Sampling::BoundingBox,
             il_tile: 2,
             il_perms: 64,
             occlusion: Occlusion::Auto,

@@ -233,7 +233,12 @@ pub fn bound_against(
     let mut g = *item;
     g.rates = nu | nv << 8;
     g.dilate = if f.crack_dilation != 0 {
-        crack_dilation(f, cp, &w, rational, nu, nv, zmin)
+        let camera = crack_dilation(f, cp, &w, rational, nu, nv, zmin);
+        if r == 0.0 && uvt.is_none() {
+            packed_min(camera, screen_crack_dilation(&pts, &w, nu, nv))
+        } else {
+            camera
+        }
     } else {
         0
     };
@@ -369,6 +374,45 @@ pub fn crack_dilation(
         packed |= (q as u32) << (8 * e);
     }
     packed
+}
+
+/// `screen_crack_dilation` in bound.wgsl: the crack dilation of each boundary edge, packed as
+/// [`crack_dilation`] packs it, from the boundary curves as they are on screen. `pts` holds the
+/// control points projected (pixels) with their camera depths, all in front of the eye; `w`
+/// their weights (1 for a polynomial patch). A perspective view of a rational curve with
+/// points b_i and weights w_i is the rational curve with points project(b_i) and weights
+/// w_i b_i.z, so [`curve_c2_rational`] bounds |C''| in pixels directly, and a chord over a
+/// parameter step 1/n deviates at most |C''| / (8 n^2) pixels from it.
+pub fn screen_crack_dilation(pts: &[(Vec2, f32)], w: &Weights, nu: u32, nv: u32) -> u32 {
+    let mut packed = 0;
+    for e in 0..4 {
+        let along_u = e < 2;
+        let start = if along_u {
+            if e == 1 { 12 } else { 0 }
+        } else if e == 3 {
+            3
+        } else {
+            0
+        };
+        let step = if along_u { 1 } else { 4 };
+        let n = if along_u { nu } else { nv } as f32;
+        let c2 = curve_c2_rational([0, 1, 2, 3].map(|k| {
+            let (s, z) = pts[start + k * step];
+            Vec4::new(s.x, s.y, 0.0, w[start + k * step] * z)
+        }));
+        let px = c2 / (8.0 * n * n);
+        let q = (px * (255.0 / MAX_DILATE_PX)).ceil().clamp(1.0, 255.0);
+        packed |= (q as u32) << (8 * e);
+    }
+    packed
+}
+
+/// `packed_min` in bound.wgsl: the smaller of two packed crack dilations, edge by edge.
+pub fn packed_min(a: u32, b: u32) -> u32 {
+    (0..4).fold(0, |m, e| {
+        let s = 8 * e;
+        m | ((a >> s) & 255).min((b >> s) & 255) << s
+    })
 }
 
 /// An upper bound of |C''| on [0, 1] for the rational cubic with Euclidean control points and
