@@ -217,7 +217,7 @@ mod tests {
         let s = parse(&world(&format!("Translate 0 0 5\n{TETRA}")));
         assert!(s.warnings.is_empty(), "{:?}", s.warnings);
         assert!(s.patches.len() > 100, "{}", s.patches.len());
-        assert!(s.patches.iter().all(|p| p.cp.iter().all(|c| c.z > 4.0)));
+        assert!(s.patches.iter().all(|p| p.cp().iter().all(|c| c.z > 4.0)));
     }
 
     #[test]
