@@ -20,11 +20,13 @@ use glam::{DMat4, DVec3, DVec4};
 /// finite in f32 (at most 3.4e38), as the renderer's bound arithmetic needs.
 pub(crate) const MAX_COORD: f64 = 1.0e12;
 
-/// Most patches one frame may hold, 2^22 (4,194,304): a `Patch` is about 600 bytes on the host
-/// (16 f64 points and weights, its source), so a frame at the limit holds about 2.5 GB before
-/// the GPU tables. The patch past it is refused at its request's line (10 million identical
-/// bilinear patches in a 1.6 MB gzip once took 4 GB and never finished). Frames stream: the
-/// limit is per frame, not per file.
+/// Most patches one frame may hold, 2^22 (4,194,304): a bilinear `Patch` is 176 bytes on the
+/// host (its 4 corners and a shared transform, [`crate::scene::PatchNet`]), a bicubic one 568
+/// (16 f64 points on the heap), a rational one 696 (and 16 weights), so a frame of bilinear
+/// patches at the limit holds 738 MB before the GPU tables (a bicubic one 2.4 GB). The patch
+/// past it is refused at its request's line (10 million identical bilinear patches in a 1.6 MB
+/// gzip once took 4 GB and never finished). Frames stream: the limit is per frame, not per
+/// file.
 pub(crate) const MAX_FRAME_PATCHES: usize = 1 << 22;
 
 #[cfg(test)]
@@ -144,7 +146,7 @@ impl Interp {
         if self.scene.patches.len() >= max {
             return Err(a.err(format!(
                 "patch {index}: more than {max} patches in one frame (the limit \
-                 on scene size: each holds about 600 bytes on the host; split the scene into \
+                 on scene size: each holds 176 to 696 bytes on the host; split the scene into \
                  frames or coarser patches)"
             )));
         }
