@@ -102,6 +102,13 @@ pub struct GpuFrame {
 /// Queue slots a renderer's scheduler starts with (queues grow by doubling beyond).
 pub const INITIAL_CAPACITY: u32 = 1 << 14;
 
+/// The megakernel's workgroup steps per claimed batch on lavapipe (1 elsewhere), its turns per
+/// launch divided by as much (the same steps per launch under lavapipe's loop cut; 16 steps
+/// per batch at 96 turns broke the queue accounting): on 20,000 small patches a turn's own cost
+/// was about a step's, and 8 steps took 5.1 s of lavapipe time against 5.7 with 4 and 8.7 with
+/// 1 (`schedbench --workload reyes --batch-steps N`, docs/results.md).
+pub const LAVAPIPE_BATCH_STEPS: u32 = 8;
+
 /// How a [`GpuRenderer`] is built: the scheduling strategy, whether multi-pass times its
 /// stages, the scene features the program is compiled for, and optionally a scheduler the
 /// caller compiled itself. A bare [`StrategyKind`] converts into the default configuration.
@@ -257,6 +264,22 @@ impl GpuRenderer {
                 scheduler::MegakernelConfig {
                     initial_capacity: INITIAL_CAPACITY,
                     max_iterations: 1,
+                    ..Default::default()
+                },
+            )?,
+            // lavapipe runs the megakernel's one workgroup on one thread, and each loop turn's
+            // claim and publish (barriers: its invocations are coroutines switched there) cost
+            // about as much as a step of work: several steps per batch, and proportionally
+            // fewer turns per launch (the same work under the loop cut), halve the turns' cost
+            // (docs/results.md, "The megakernel on lavapipe").
+            StrategyKind::Megakernel if gpu.is_lavapipe() => Scheduler::megakernel(
+                gpu,
+                program,
+                scheduler::MegakernelConfig {
+                    initial_capacity: INITIAL_CAPACITY,
+                    batch_steps: LAVAPIPE_BATCH_STEPS,
+                    max_iterations: scheduler::megakernel::LAVAPIPE_MAX_ITERATIONS
+                        / LAVAPIPE_BATCH_STEPS,
                     ..Default::default()
                 },
             )?,
