@@ -1489,6 +1489,7 @@ fn display_names_the_file_system_cannot_hold_fail_before_rendering() {
 /// (docs/reyes.md, *Limits*; the command peaked at 4 GB before the limit, ~600 bytes a patch).
 #[test]
 #[allow(unsafe_code)]
+#[allow(clippy::zombie_processes)] // reaped by wait4, which gives its rusage
 fn ten_million_patches_stop_at_the_frame_limit_within_a_memory_bound() {
     use flate2::{Compression, write::GzEncoder};
     use std::io::{Read, Write};
@@ -1514,7 +1515,12 @@ fn ten_million_patches_stop_at_the_frame_limit_within_a_memory_bound() {
         .spawn()
         .unwrap();
     let mut err = String::new();
-    child.stderr.take().unwrap().read_to_string(&mut err).unwrap();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
     // wait4: this child's own rusage (peak resident set in KiB on Linux), where
     // getrusage(RUSAGE_CHILDREN) would mix in the other tests' children.
     // SAFETY: rusage is plain integers (all-zero is valid); wait4 writes only the two
@@ -1526,9 +1532,7 @@ fn ten_million_patches_stop_at_the_frame_limit_within_a_memory_bound() {
     assert_eq!(libc::WEXITSTATUS(status), 1, "{err}");
     // The header's 4 lines, then patch k (from 1) on line 4 + k: patch 2^22 + 1 on 4194309.
     assert!(
-        err.contains(
-            "p.rib.gz:4194309: `Patch`: patch 0: more than 4194304 patches in one frame"
-        ),
+        err.contains("p.rib.gz:4194309: `Patch`: patch 0: more than 4194304 patches in one frame"),
         "{err}"
     );
     assert!(!dir.join("p.png").exists());
