@@ -109,6 +109,13 @@ pub const INITIAL_CAPACITY: u32 = 1 << 14;
 /// 1 (`schedbench --workload reyes --batch-steps N`, docs/results.md).
 pub const LAVAPIPE_BATCH_STEPS: u32 = 8;
 
+/// Most root patches one megakernel run takes on lavapipe (more go in as further batches, to
+/// the same image): a launch there runs 96 workgroup steps, and each launch that leaves work
+/// copies the live queues through the host (`compact::host_compact`), so 100,000 roots in one
+/// run cost 652 launches, each copying up to 100,000 items (200,000 patches: 57 s of lavapipe
+/// time, 34 s more of host time; docs/results.md).
+pub const LAVAPIPE_MEGAKERNEL_SEEDS: usize = 4096;
+
 /// How a [`GpuRenderer`] is built: the scheduling strategy, whether multi-pass times its
 /// stages, the scene features the program is compiled for, and optionally a scheduler the
 /// caller compiled itself. A bare [`StrategyKind`] converts into the default configuration.
@@ -483,9 +490,22 @@ impl GpuRenderer {
             // (atomicMax), so batches, in any order and even a refused batch's partial work run
             // again, give the same image bit for bit; counters are read per finished batch.
             // One batch per pass (one without occlusion culling), the first on top.
+            // On lavapipe the megakernel's batches are at most LAVAPIPE_MEGAKERNEL_SEEDS
+            // roots: each of its (short) launches compacts the live queues on the host.
+            let chunk = match self.scheduler.kind() == StrategyKind::Megakernel && gpu.is_lavapipe()
+            {
+                true => LAVAPIPE_MEGAKERNEL_SEEDS,
+                false => usize::MAX,
+            };
             let mut batches: Vec<std::ops::Range<usize>> = (starts.iter().enumerate())
                 .rev()
                 .map(|(k, &s)| s..starts.get(k + 1).copied().unwrap_or(items.len()))
+                .flat_map(|r| match r.len() > chunk {
+                    true => (r.clone().step_by(chunk).rev())
+                        .map(|a| a..(a + chunk).min(r.end))
+                        .collect(),
+                    false => vec![r],
+                })
                 .collect();
             let mut recut = false;
             while let Some(batch) = batches.pop() {
