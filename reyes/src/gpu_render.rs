@@ -132,6 +132,12 @@ pub struct RendererConfig {
     /// A scheduler compiled by the caller from [`program_for`]`(features)` with its own
     /// configuration (e.g. another queue policy; [`INITIAL_CAPACITY`] is the usual start).
     pub scheduler: Option<Scheduler>,
+    /// On lavapipe, the megakernel's settings for frames rendered one by one
+    /// ([`LAVAPIPE_BATCH_STEPS`], [`LAVAPIPE_MEGAKERNEL_SEEDS`]); default `true`. `false` for
+    /// pipelined frames (`realtime`), whose recorded launches take their queue sizes from a
+    /// frame rendered here and add a batch's worst case per workgroup: they keep one step per
+    /// batch and all roots in one run, as the frames they size.
+    pub lavapipe_tuning: bool,
 }
 
 impl RendererConfig {
@@ -143,6 +149,15 @@ impl RendererConfig {
             stage_timing: false,
             features: SceneFeatures::ALL,
             scheduler: None,
+            lavapipe_tuning: true,
+        }
+    }
+
+    /// With or without the lavapipe settings ([`RendererConfig::lavapipe_tuning`]).
+    pub fn lavapipe_tuning(self, lavapipe_tuning: bool) -> RendererConfig {
+        RendererConfig {
+            lavapipe_tuning,
+            ..self
         }
     }
 
@@ -191,6 +206,8 @@ pub struct GpuRenderer {
     /// changed, a frame of the same size allocates nothing large (a 1080p frame's samples are
     /// 66 MB).
     resources: std::sync::Mutex<Option<(SceneBuffers, Option<FrameTarget>)>>,
+    /// [`RendererConfig::lavapipe_tuning`], on lavapipe only.
+    lavapipe_tuning: bool,
 }
 
 /// Full GPU load before frames are timed (`scheduler::clocks::raise_clocks`): frames alone,
@@ -218,12 +235,15 @@ impl GpuRenderer {
             stage_timing,
             features,
             scheduler,
+            lavapipe_tuning,
         } = config.into();
+        let lavapipe_tuning = lavapipe_tuning && gpu.is_lavapipe();
         let (program, scheduler) = match scheduler {
             Some(s) => (s.program().clone(), s),
             None => {
                 let program = program_for(features)?;
-                let s = Self::scheduler(gpu, &program, strategy, stage_timing, features)?;
+                let tuned = (stage_timing, features, lavapipe_tuning);
+                let s = Self::scheduler(gpu, &program, strategy, tuned)?;
                 (program, s)
             }
         };
@@ -235,6 +255,7 @@ impl GpuRenderer {
             scheduler,
             pipelines,
             resources: Default::default(),
+            lavapipe_tuning,
         })
     }
 
@@ -249,8 +270,7 @@ impl GpuRenderer {
         gpu: &Gpu,
         program: &Program,
         strategy: StrategyKind,
-        stage_timing: bool,
-        features: SceneFeatures,
+        (stage_timing, features, lavapipe_tuning): (bool, SceneFeatures, bool),
     ) -> Result<Scheduler, RunError> {
         Ok(match strategy {
             StrategyKind::Multipass => Scheduler::multipass(
@@ -279,7 +299,7 @@ impl GpuRenderer {
             // about as much as a step of work: several steps per batch, and proportionally
             // fewer turns per launch (the same work under the loop cut), halve the turns' cost
             // (docs/results.md, "The megakernel on lavapipe").
-            StrategyKind::Megakernel if gpu.is_lavapipe() => Scheduler::megakernel(
+            StrategyKind::Megakernel if lavapipe_tuning => Scheduler::megakernel(
                 gpu,
                 program,
                 scheduler::MegakernelConfig {
@@ -492,11 +512,11 @@ impl GpuRenderer {
             // One batch per pass (one without occlusion culling), the first on top.
             // On lavapipe the megakernel's batches are at most LAVAPIPE_MEGAKERNEL_SEEDS
             // roots: each of its (short) launches compacts the live queues on the host.
-            let chunk = match self.scheduler.kind() == StrategyKind::Megakernel && gpu.is_lavapipe()
-            {
-                true => LAVAPIPE_MEGAKERNEL_SEEDS,
-                false => usize::MAX,
-            };
+            let chunk =
+                match self.lavapipe_tuning && self.scheduler.kind() == StrategyKind::Megakernel {
+                    true => LAVAPIPE_MEGAKERNEL_SEEDS,
+                    false => usize::MAX,
+                };
             let mut batches: Vec<std::ops::Range<usize>> = (starts.iter().enumerate())
                 .rev()
                 .map(|(k, &s)| s..starts.get(k + 1).copied().unwrap_or(items.len()))
