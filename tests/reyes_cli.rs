@@ -1480,3 +1480,63 @@ fn display_names_the_file_system_cannot_hold_fail_before_rendering() {
     assert_eq!(err.matches("wrote").count(), 2, "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Issue 24: 10 million identical bilinear patches in one frame (a 1.6 MB gzip, written as the
+/// field's `hostile/many-patches-memory.gen.py` writes it: one compressed block of 100,000
+/// requests repeated) are refused at the patch past the per-frame limit (2^22), at its line,
+/// exit 1, nothing written, and `reyes render` holds at most 1 GiB on the way: a bilinear
+/// patch is 176 bytes on the host, so the 2^22 patches held at the limit are 738 MB
+/// (docs/reyes.md, *Limits*; the command peaked at 4 GB before the limit, ~600 bytes a patch).
+#[test]
+#[allow(unsafe_code)]
+#[allow(clippy::zombie_processes)] // reaped by wait4, which gives its rusage
+fn ten_million_patches_stop_at_the_frame_limit_within_a_memory_bound() {
+    use flate2::{Compression, write::GzEncoder};
+    use std::io::{Read, Write};
+    let dir = scratch("ten-million");
+    let gz = |s: &str| {
+        let mut e = GzEncoder::new(Vec::new(), Compression::best());
+        e.write_all(s.as_bytes()).unwrap();
+        e.finish().unwrap()
+    };
+    let head = "Format 64 48 1\nProjection \"perspective\" \"fov\" [40]\nTranslate 0 0 5\n\
+                WorldBegin\n";
+    let block = gz(&"Patch \"bilinear\" \"P\" [-1 -1 0  1 -1 0  -1 1 0  1 1 0]\n".repeat(100_000));
+    let mut file = gz(head);
+    for _ in 0..100 {
+        file.extend_from_slice(&block);
+    }
+    file.extend(gz("WorldEnd\n"));
+    std::fs::write(dir.join("p.rib.gz"), file).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_reyes"))
+        .args(["render", "p.rib.gz", "--cpu", "-o", "p.png"])
+        .current_dir(&dir)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    // wait4: this child's own rusage (peak resident set in KiB on Linux), where
+    // getrusage(RUSAGE_CHILDREN) would mix in the other tests' children.
+    // SAFETY: rusage is plain integers (all-zero is valid); wait4 writes only the two
+    // locals given, and reaps the child `Child` has not waited for.
+    let (mut status, mut usage) = (0, unsafe { std::mem::zeroed::<libc::rusage>() });
+    let pid = unsafe { libc::wait4(child.id() as i32, &mut status, 0, &mut usage) };
+    assert_eq!(pid, child.id() as i32);
+    assert!(libc::WIFEXITED(status), "{err}");
+    assert_eq!(libc::WEXITSTATUS(status), 1, "{err}");
+    // The header's 4 lines, then patch k (from 1) on line 4 + k: patch 2^22 + 1 on 4194309.
+    assert!(
+        err.contains("p.rib.gz:4194309: `Patch`: patch 0: more than 4194304 patches in one frame"),
+        "{err}"
+    );
+    assert!(!dir.join("p.png").exists());
+    let peak_mib = usage.ru_maxrss / 1024;
+    assert!(peak_mib < 1024, "peak resident {peak_mib} MiB");
+    eprintln!("10M patches: refused at the limit, peak resident {peak_mib} MiB");
+}

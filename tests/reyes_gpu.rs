@@ -126,7 +126,7 @@ fn empty_worlds_render_an_empty_image_on_every_path() {
     // The teapot behind the eye: every patch is culled in Bound.
     let mut behind = scene::builtin_teapot();
     for p in &mut behind.patches {
-        for c in &mut p.cp {
+        for c in p.cp_mut() {
             c.z = -c.z - 100.0;
         }
     }
@@ -175,9 +175,9 @@ fn empty_worlds_render_an_empty_image_on_every_path() {
 fn patches_behind_the_eye_are_split_then_clipped_like_the_cpu_pipeline() {
     // Move the camera into the teapot's spout region: patches cross the near plane.
     let mut s = scene::builtin_teapot();
-    let shift = s.patches[0].cp[0];
+    let shift = s.patches[0].cp()[0];
     for p in &mut s.patches {
-        for c in &mut p.cp {
+        for c in p.cp_mut() {
             c.z -= shift.z;
         }
     }
@@ -438,7 +438,7 @@ fn a_renderer_compiled_for_the_scenes_features_draws_the_same_image() {
             );
         }
         let mut rational = scene.clone();
-        rational.patches[0].w[5] = 2.0;
+        rational.patches[0].w_mut()[5] = 2.0;
         let needs = FrameData::new(&rational, &small(96, 72)).unwrap();
         assert!(needs.features().rational);
         match plain.render(gpu(), &needs) {

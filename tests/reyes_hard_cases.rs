@@ -710,7 +710,7 @@ fn check_normals(name: &str, s: &Scene, data: &FrameData, max_deg: f64) -> f64 {
                 n.is_finite() && n.length() > 0.0,
                 "{name} patch {i} at ({u}, {v}): normal {n}"
             );
-            if let Some(r) = reference_normal(&p.cp, u, v, p.flip_normal) {
+            if let Some(r) = reference_normal(&p.cp(), u, v, p.flip_normal) {
                 let cos = n.normalize().as_dvec3().dot(r).clamp(-1.0, 1.0);
                 let deg = cos.acos().to_degrees();
                 assert!(
@@ -821,7 +821,7 @@ fn very_thin_patches_cover_what_they_should() {
         let got = alpha_area(&g.image);
         // The ribbon's length on screen, along its middle.
         let proj = |t: f64| {
-            let p = eval_bezier(&one.patches[0].cp, t, 0.5).0;
+            let p = eval_bezier(&one.patches[0].cp(), t, 0.5).0;
             reyes::reference::project(&one, 64, 48, p).unwrap()
         };
         let length: f64 = (0..64)
@@ -872,7 +872,7 @@ fn a_model_1e6_units_from_the_origin_renders_like_at_the_origin() {
     };
     // In camera space the two are the same surface to f64 rounding.
     for (a, b) in far.patches.iter().zip(&near.patches) {
-        for (p, q) in a.cp.iter().zip(&b.cp) {
+        for (p, q) in a.cp().iter().zip(&b.cp()) {
             assert!(p.distance(*q) < 1.0e-8, "{p} vs {q}");
         }
     }

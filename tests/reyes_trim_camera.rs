@@ -27,7 +27,7 @@ fn trim_scene() -> Scene {
 /// flattening, splitting and dicing.
 fn exact_disc(scene: &Scene, n: u32) -> Vec<f64> {
     let p = &scene.patches[0];
-    let (o, a, b) = (p.cp[0], p.cp[3] - p.cp[0], p.cp[12] - p.cp[0]);
+    let (o, a, b) = (p.cp()[0], p.cp()[3] - p.cp()[0], p.cp()[12] - p.cp()[0]);
     let normal = a.cross(b);
     let (w, h) = (scene.width, scene.height);
     let f = w.min(h) as f64 / 2.0 / (scene.camera.fov_deg.to_radians() / 2.0).tan();
@@ -216,7 +216,7 @@ fn camera_motion_blurs_like_the_opposite_object_motion() {
     let (pa, pb) = (&moving_camera.patches[0], &moving_square.patches[0]);
     let (ma, mb) = (pa.motion.as_deref().unwrap(), pb.motion.as_deref().unwrap());
     assert!(ma.abs_diff_eq(*mb, 1e-12), "{ma} vs {mb}");
-    for (a, b) in pa.cp.iter().zip(&pb.cp) {
+    for (a, b) in pa.cp().iter().zip(&pb.cp()) {
         assert!(a.abs_diff_eq(*b, 1e-12));
     }
     let o = RenderOptions::default();

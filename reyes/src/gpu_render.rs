@@ -117,6 +117,20 @@ pub struct GpuFrame {
 /// Queue slots a renderer's scheduler starts with (queues grow by doubling beyond).
 pub const INITIAL_CAPACITY: u32 = 1 << 14;
 
+/// The megakernel's workgroup steps per claimed batch on lavapipe (1 elsewhere), its turns per
+/// launch divided by as much (the same steps per launch under lavapipe's loop cut; 16 steps
+/// per batch at 96 turns broke the queue accounting): on 20,000 small patches a turn's own cost
+/// was about a step's, and 8 steps took 5.1 s of lavapipe time against 5.7 with 4 and 8.7 with
+/// 1 (`schedbench --workload reyes --batch-steps N`, docs/results.md).
+pub const LAVAPIPE_BATCH_STEPS: u32 = 8;
+
+/// Most root patches one megakernel run takes on lavapipe (more go in as further batches, to
+/// the same image): a launch there runs 96 workgroup steps, and each launch that leaves work
+/// copies the live queues through the host (`compact::host_compact`), so 100,000 roots in one
+/// run cost 652 launches, each copying up to 100,000 items (200,000 patches: 57 s of lavapipe
+/// time, 34 s more of host time; docs/results.md).
+pub const LAVAPIPE_MEGAKERNEL_SEEDS: usize = 4096;
+
 /// How a [`GpuRenderer`] is built: the scheduling strategy, whether multi-pass times its
 /// stages, the scene features the program is compiled for, and optionally a scheduler the
 /// caller compiled itself. A bare [`StrategyKind`] converts into the default configuration.
@@ -133,6 +147,12 @@ pub struct RendererConfig {
     /// A scheduler compiled by the caller from [`program_for`]`(features)` with its own
     /// configuration (e.g. another queue policy; [`INITIAL_CAPACITY`] is the usual start).
     pub scheduler: Option<Scheduler>,
+    /// On lavapipe, the megakernel's settings for frames rendered one by one
+    /// ([`LAVAPIPE_BATCH_STEPS`], [`LAVAPIPE_MEGAKERNEL_SEEDS`]); default `true`. `false` for
+    /// pipelined frames (`realtime`), whose recorded launches take their queue sizes from a
+    /// frame rendered here and add a batch's worst case per workgroup: they keep one step per
+    /// batch and all roots in one run, as the frames they size.
+    pub lavapipe_tuning: bool,
 }
 
 impl RendererConfig {
@@ -144,6 +164,15 @@ impl RendererConfig {
             stage_timing: false,
             features: SceneFeatures::ALL,
             scheduler: None,
+            lavapipe_tuning: true,
+        }
+    }
+
+    /// With or without the lavapipe settings ([`RendererConfig::lavapipe_tuning`]).
+    pub fn lavapipe_tuning(self, lavapipe_tuning: bool) -> RendererConfig {
+        RendererConfig {
+            lavapipe_tuning,
+            ..self
         }
     }
 
@@ -192,6 +221,8 @@ pub struct GpuRenderer {
     /// changed, a frame of the same size allocates nothing large (a 1080p frame's samples are
     /// 66 MB).
     resources: std::sync::Mutex<Option<(SceneBuffers, Option<FrameTarget>)>>,
+    /// [`RendererConfig::lavapipe_tuning`], on lavapipe only.
+    lavapipe_tuning: bool,
 }
 
 /// Full GPU load before frames are timed (`scheduler::clocks::raise_clocks`): frames alone,
@@ -219,12 +250,15 @@ impl GpuRenderer {
             stage_timing,
             features,
             scheduler,
+            lavapipe_tuning,
         } = config.into();
+        let lavapipe_tuning = lavapipe_tuning && gpu.is_lavapipe();
         let (program, scheduler) = match scheduler {
             Some(s) => (s.program().clone(), s),
             None => {
                 let program = program_for(features)?;
-                let s = Self::scheduler(gpu, &program, strategy, stage_timing, features)?;
+                let tuned = (stage_timing, features, lavapipe_tuning);
+                let s = Self::scheduler(gpu, &program, strategy, tuned)?;
                 (program, s)
             }
         };
@@ -236,6 +270,7 @@ impl GpuRenderer {
             scheduler,
             pipelines,
             resources: Default::default(),
+            lavapipe_tuning,
         })
     }
 
@@ -250,8 +285,7 @@ impl GpuRenderer {
         gpu: &Gpu,
         program: &Program,
         strategy: StrategyKind,
-        stage_timing: bool,
-        features: SceneFeatures,
+        (stage_timing, features, lavapipe_tuning): (bool, SceneFeatures, bool),
     ) -> Result<Scheduler, RunError> {
         Ok(match strategy {
             StrategyKind::Multipass => Scheduler::multipass(
@@ -272,6 +306,22 @@ impl GpuRenderer {
                 scheduler::MegakernelConfig {
                     initial_capacity: INITIAL_CAPACITY,
                     max_iterations: 1,
+                    ..Default::default()
+                },
+            )?,
+            // lavapipe runs the megakernel's one workgroup on one thread, and each loop turn's
+            // claim and publish (barriers: its invocations are coroutines switched there) cost
+            // about as much as a step of work: several steps per batch, and proportionally
+            // fewer turns per launch (the same work under the loop cut), halve the turns' cost
+            // (docs/results.md, "The megakernel on lavapipe").
+            StrategyKind::Megakernel if lavapipe_tuning => Scheduler::megakernel(
+                gpu,
+                program,
+                scheduler::MegakernelConfig {
+                    initial_capacity: INITIAL_CAPACITY,
+                    batch_steps: LAVAPIPE_BATCH_STEPS,
+                    max_iterations: scheduler::megakernel::LAVAPIPE_MAX_ITERATIONS
+                        / LAVAPIPE_BATCH_STEPS,
                     ..Default::default()
                 },
             )?,
@@ -484,9 +534,22 @@ impl GpuRenderer {
             // (atomicMax), so batches, in any order and even a refused batch's partial work run
             // again, give the same image bit for bit; counters are read per finished batch.
             // One batch per pass (one without occlusion culling), the first on top.
+            // On lavapipe the megakernel's batches are at most LAVAPIPE_MEGAKERNEL_SEEDS
+            // roots: each of its (short) launches compacts the live queues on the host.
+            let chunk =
+                match self.lavapipe_tuning && self.scheduler.kind() == StrategyKind::Megakernel {
+                    true => LAVAPIPE_MEGAKERNEL_SEEDS,
+                    false => usize::MAX,
+                };
             let mut batches: Vec<std::ops::Range<usize>> = (starts.iter().enumerate())
                 .rev()
                 .map(|(k, &s)| s..starts.get(k + 1).copied().unwrap_or(items.len()))
+                .flat_map(|r| match r.len() > chunk {
+                    true => (r.clone().step_by(chunk).rev())
+                        .map(|a| a..(a + chunk).min(r.end))
+                        .collect(),
+                    false => vec![r],
+                })
                 .collect();
             let mut recut = false;
             while let Some(batch) = batches.pop() {

@@ -42,7 +42,7 @@ pub fn orbit_scene(scene: &Scene, angle: f64) -> Scene {
     let inv = m.inverse();
     let mut out = scene.clone();
     for p in &mut out.patches {
-        for c in &mut p.cp {
+        for c in p.net.points_mut() {
             *c = m.transform_point3(*c);
         }
         if let Some(d) = &mut p.motion {

@@ -476,7 +476,7 @@ mod tests {
         let s = builtin_teapot();
         let data = frame_data(&s, (320, 240));
         let cam = Projector::new(&s, &data.frame);
-        for p in s.patches.iter().flat_map(|p| p.cp) {
+        for p in s.patches.iter().flat_map(|p| p.cp()) {
             let a = cam.pixel(p).unwrap();
             let b = reyes::reference::project(&s, 320, 240, p).unwrap();
             assert!(a.distance(b) < 1e-9, "{a} vs {b}");
@@ -502,7 +502,7 @@ mod tests {
                 for (a, b) in [(0.0, 0.0), (0.3, 0.7), (1.0, 0.5)] {
                     let sub = eval_net(&cp, false, a, b).0;
                     let orig = reyes::scene::eval_bezier(
-                        &p.cp,
+                        &p.cp(),
                         uv[0] + a * (uv[1] - uv[0]),
                         uv[2] + b * (uv[3] - uv[2]),
                     )
@@ -525,7 +525,7 @@ mod tests {
         for (item, p) in data.items.iter_mut().zip(&s.patches) {
             for k in 0..16 {
                 // One pixel in x at this point's depth.
-                item.cp[3 * k] += (p.cp[k].z / data.frame.focal as f64 * p.w[k]) as f32;
+                item.cp[3 * k] += (p.cp()[k].z / data.frame.focal as f64 * p.w()[k]) as f32;
             }
         }
         let rows = path_drift(&s, &data, &PathOptions::default());

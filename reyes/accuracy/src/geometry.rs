@@ -202,7 +202,7 @@ mod tests {
         let half = 1.0;
         let z = 2.0 * half * focal / 30.2;
         s.patches.truncate(1);
-        s.patches[0].cp = std::array::from_fn(|k| {
+        *s.patches[0].cp_mut() = std::array::from_fn(|k| {
             let (x, y) = ((k % 4) as f64 / 3.0, (k / 4) as f64 / 3.0);
             glam::DVec3::new((2.0 * x - 1.0) * half, (2.0 * y - 1.0) * half, z)
         });
@@ -232,7 +232,7 @@ mod tests {
         let f = data.frame.focal as f64;
         let mut moved = s.clone();
         for p in &mut moved.patches {
-            for c in &mut p.cp {
+            for c in p.cp_mut() {
                 c.x += c.z / f;
             }
         }

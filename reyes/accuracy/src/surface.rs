@@ -35,7 +35,7 @@ pub fn eval(patch: &Patch, u: f64, v: f64) -> SurfacePoint {
     // of about 1e-16 |P| (quotient rule), at any angle: call it degenerate below 1e-12 of the
     // control points' distance from the eye. (Polynomial: tiny = 0, an exact zero test.)
     let tiny = if patch.is_rational() {
-        1.0e-12 * patch.cp.iter().map(|c| c.length()).fold(0.0, f64::max)
+        1.0e-12 * patch.cp().iter().map(|c| c.length()).fold(0.0, f64::max)
     } else {
         0.0
     };
@@ -122,22 +122,12 @@ mod tests {
     use reyes::scene::{PatchSource, builtin_teapot};
 
     fn patch(cp: [DVec3; 16]) -> Patch {
-        Patch {
-            cp,
-            w: Patch::POLYNOMIAL,
-            material: 0,
-            flip_normal: false,
-            two_sided: true,
-            primvars: None,
-            displacement: None,
-            motion: None,
-            trim: None,
-            source: PatchSource {
-                file: "test".into(),
-                line: 0,
-                index: 0,
-            },
-        }
+        let source = PatchSource {
+            file: "test".into(),
+            line: 0,
+            index: 0,
+        };
+        Patch::new(cp, Patch::POLYNOMIAL, source)
     }
 
     /// z = u^2 + v^2 over x = u, y = v: u^2 is the cubic Bernstein polynomial with
@@ -167,7 +157,7 @@ mod tests {
         // Corners interpolate the corner control points.
         let t = &builtin_teapot().patches[5];
         for (u, v, k) in [(0.0, 0.0, 0), (1.0, 0.0, 3), (0.0, 1.0, 12), (1.0, 1.0, 15)] {
-            assert_eq!(eval(t, u, v).p, t.cp[k]);
+            assert_eq!(eval(t, u, v).p, t.cp()[k]);
         }
     }
 

@@ -658,10 +658,11 @@ fn weights_ref(table: &mut Vec<[f32; 4]>, h: &[[f32; 4]; 16]) -> Result<u32, Err
 /// polynomial patch (all w = 1) these are exactly the f32 coordinates and 1. The object table
 /// of the real-time renderer (roots.wgsl) holds these.
 pub fn homogeneous_points(p: &Patch) -> [[f32; 4]; 16] {
-    let top = p.w.iter().copied().fold(0.0, f64::max);
+    let (cp, w) = (p.cp(), p.w());
+    let top = w.iter().copied().fold(0.0, f64::max);
     std::array::from_fn(|i| {
-        let w = p.w[i] / top;
-        let c = p.cp[i] * w;
+        let w = w[i] / top;
+        let c = cp[i] * w;
         [c.x as f32, c.y as f32, c.z as f32, w as f32]
     })
 }
@@ -822,8 +823,8 @@ mod tests {
     #[test]
     fn rational_weights_go_to_the_table() {
         let mut scene = crate::scene::builtin_teapot();
-        scene.patches[5].w[6] = 4.0;
-        scene.patches[5].w[9] = 0.5;
+        scene.patches[5].w_mut()[6] = 4.0;
+        scene.patches[5].w_mut()[9] = 0.5;
         let d = FrameData::new(&scene, &RenderOptions::default()).unwrap();
         assert_eq!(d.primvars.len(), 4);
         for (i, (p, info)) in scene.patches.iter().zip(&d.patch_info).enumerate() {
@@ -840,9 +841,10 @@ mod tests {
                 assert_eq!(h[9][3], 0.125);
             } else {
                 assert_eq!((info.flags & PATCH_RATIONAL, info.weights), (0, 0));
-                let pts =
-                    p.cp.iter()
-                        .flat_map(|c| [c.x as f32, c.y as f32, c.z as f32]);
+                let pts = p
+                    .cp()
+                    .into_iter()
+                    .flat_map(|c| [c.x as f32, c.y as f32, c.z as f32]);
                 assert_eq!(d.items[i].cp.to_vec(), pts.collect::<Vec<_>>());
             }
         }

@@ -222,8 +222,8 @@ impl RealtimeRenderer {
         // culling*); the frame that sizes their queues and a frame rendered again must do the
         // same work, or the sizes fall short of it.
         base.frame.occlusion = crate::stages::hiz::OCCLUSION_OFF;
-        let renderer =
-            GpuRenderer::new(gpu, RendererConfig::new(strategy).features(base.features()))?;
+        let config = RendererConfig::new(strategy).features(base.features());
+        let renderer = GpuRenderer::new(gpu, config.lavapipe_tuning(false))?;
         let f = base.frame;
         let n = scene.patches.len() as u32;
         let mut scene_buffers = SceneBuffers::with_patches(gpu, scene, &base)?;

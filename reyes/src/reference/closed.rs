@@ -10,7 +10,7 @@
 //! Also an exact sphere of eight rational patches ([`rational_sphere`]), the closed surface
 //! with a known silhouette that the rational pipeline is tested on.
 
-use crate::scene::{Patch, PatchSource};
+use crate::scene::{Patch, PatchNet, PatchSource};
 use glam::{DVec3, DVec4};
 
 /// Grid coordinates along each face.
@@ -86,8 +86,7 @@ pub fn rational_sphere(centre: DVec3, radius: f64) -> Vec<Patch> {
                     })
                     .unzip();
                 out.push(Patch {
-                    cp: cp.try_into().unwrap(),
-                    w: w.try_into().unwrap(),
+                    net: PatchNet::new(cp.try_into().unwrap(), w.try_into().unwrap()),
                     material: 0,
                     flip_normal: sx * sy * sz < 0.0,
                     two_sided: true,
@@ -162,7 +161,7 @@ mod tests {
     /// Centre of the blob in camera space: the mean of all control points (the control
     /// point set is symmetric about it).
     fn centre(s: &Scene) -> DVec3 {
-        let pts: Vec<DVec3> = s.patches.iter().flat_map(|p| p.cp).collect();
+        let pts: Vec<DVec3> = s.patches.iter().flat_map(|p| p.cp()).collect();
         pts.iter().sum::<DVec3>() / pts.len() as f64
     }
 
@@ -198,7 +197,7 @@ mod tests {
             .iter()
             .enumerate()
             .flat_map(|(i, p)| {
-                let c = |k: [usize; 4]| (i, k.map(|k| p.cp[k]));
+                let c = |k: [usize; 4]| (i, k.map(|k| p.cp()[k]));
                 [
                     c([0, 1, 2, 3]),
                     c([12, 13, 14, 15]),
@@ -230,14 +229,14 @@ mod tests {
             for a in 0..=8 {
                 for b in 0..=8 {
                     let (u, v) = (a as f64 / 8.0, b as f64 / 8.0);
-                    let (pos, du, dv) = eval_bezier(&p.cp, u, v);
+                    let (pos, du, dv) = eval_bezier(&p.cp(), u, v);
                     let n = du.cross(dv);
                     let n = if p.flip_normal { -n } else { n };
                     let out = n.normalize().dot((pos - c).normalize());
                     assert!(out > 0.3, "patch {k} at ({u}, {v}): {out}");
                 }
             }
-            let (pos, du, dv) = eval_bezier(&p.cp, 0.5, 0.5);
+            let (pos, du, dv) = eval_bezier(&p.cp(), 0.5, 0.5);
             if du.cross(dv).dot(pos) < 0.0 {
                 facing += 1;
             }
@@ -264,7 +263,7 @@ mod tests {
         let outer = s
             .patches
             .iter()
-            .flat_map(|p| p.cp)
+            .flat_map(|p| p.cp())
             .map(|p| p.distance(c))
             .fold(0.0, f64::max);
         let inner = s
@@ -273,7 +272,7 @@ mod tests {
             .flat_map(|p| {
                 (0..=40 * 40).map(|k| {
                     let (u, v) = ((k % 41) as f64 / 40.0, (k / 41) as f64 / 40.0);
-                    eval_bezier(&p.cp, u, v).0.distance(c)
+                    eval_bezier(&p.cp(), u, v).0.distance(c)
                 })
             })
             .fold(f64::INFINITY, f64::min)

@@ -543,7 +543,7 @@ fn net_extent_v(q: &[DVec2; 16]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{Camera, Patch, PatchSource, builtin_teapot};
+    use crate::scene::{Camera, Patch, PatchNet, PatchSource, builtin_teapot};
 
     /// A scene of bilinear-flat quads (corners c00, c10, c01, c11, uniformly parametrised).
     fn quad_scene(quads: &[[DVec3; 4]], fov_deg: f64, near: f64, far: f64) -> Scene {
@@ -551,11 +551,14 @@ mod tests {
             .iter()
             .enumerate()
             .map(|(i, c)| Patch {
-                cp: std::array::from_fn(|k| {
-                    let (s, t) = ((k % 4) as f64 / 3.0, (k / 4) as f64 / 3.0);
-                    (c[0] * (1.0 - s) + c[1] * s) * (1.0 - t) + (c[2] * (1.0 - s) + c[3] * s) * t
-                }),
-                w: Patch::POLYNOMIAL,
+                net: PatchNet::new(
+                    std::array::from_fn(|k| {
+                        let (s, t) = ((k % 4) as f64 / 3.0, (k / 4) as f64 / 3.0);
+                        (c[0] * (1.0 - s) + c[1] * s) * (1.0 - t)
+                            + (c[2] * (1.0 - s) + c[3] * s) * t
+                    }),
+                    Patch::POLYNOMIAL,
+                ),
                 material: 0,
                 flip_normal: false,
                 two_sided: true,
@@ -713,7 +716,7 @@ mod tests {
             patches: cps
                 .iter()
                 .map(|cp| Patch {
-                    cp: *cp,
+                    net: PatchNet::new(*cp, Patch::POLYNOMIAL),
                     ..quad_scene(&[[DVec3::Z; 4]], 40.0, 0.01, 100.0).patches[0].clone()
                 })
                 .collect(),

@@ -12,7 +12,8 @@ pub type HomNet = [DVec4; 16];
 
 /// The homogeneous net of `p` (its Euclidean `cp` times its weights `w`).
 pub fn homogeneous(p: &Patch) -> HomNet {
-    std::array::from_fn(|k| (p.cp[k] * p.w[k]).extend(p.w[k]))
+    let (cp, w) = (p.cp(), p.w());
+    std::array::from_fn(|k| (cp[k] * w[k]).extend(w[k]))
 }
 
 /// The Euclidean point of a homogeneous one: xyz / w.
@@ -37,7 +38,7 @@ pub fn eval_patch(p: &Patch, u: f64, v: f64) -> (DVec3, DVec3, DVec3) {
     if p.is_rational() {
         eval_rational(&homogeneous(p), u, v)
     } else {
-        eval_bezier(&p.cp, u, v)
+        eval_bezier(&p.cp(), u, v)
     }
 }
 
@@ -160,12 +161,12 @@ mod tests {
         for (k, q) in a.iter().chain(&b).enumerate() {
             assert_eq!(q.w, 1.0, "point {k}");
         }
-        assert_eq!(euclidean_net(&a)[0], teapot.cp[0]);
+        assert_eq!(euclidean_net(&a)[0], teapot.cp()[0]);
         let e = euclidean_net(&b);
-        assert_eq!(e[3], teapot.cp[3]);
+        assert_eq!(e[3], teapot.cp()[3]);
         assert_eq!(
             eval_patch(teapot, 0.3, 0.6),
-            eval_bezier(&teapot.cp, 0.3, 0.6)
+            eval_bezier(&teapot.cp(), 0.3, 0.6)
         );
     }
 }

@@ -11,6 +11,7 @@ pub fn parse_bpt(text: &str, file: &str) -> Result<Vec<ObjectPatch>, SceneError>
     let mut r = Fields::new(text, file, false);
     let (count, _) = r.int("the patch count")?;
     let mut out = Vec::with_capacity(count.min(1 << 16) as usize);
+    let shared: std::sync::Arc<str> = file.into();
     for p in 0..count {
         let (du, line) = r.int(&format!("the u degree of patch {p}"))?;
         let (dv, _) = r.int(&format!("the v degree of patch {p}"))?;
@@ -27,7 +28,7 @@ pub fn parse_bpt(text: &str, file: &str) -> Result<Vec<ObjectPatch>, SceneError>
                 .0;
         }
         let src = PatchSource {
-            file: file.to_string(),
+            file: shared.clone(),
             line,
             index: p as u32,
         };

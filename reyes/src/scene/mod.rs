@@ -13,6 +13,7 @@ pub(crate) mod curves;
 mod displacement;
 mod newell;
 mod nurbs;
+mod patch;
 pub(crate) mod polygon;
 mod primvars;
 mod quadric;
@@ -37,6 +38,8 @@ pub use displacement::{
     MAX_MAP_SIDE, MAX_MAP_TEXELS,
 };
 pub use newell::parse_newell;
+pub(crate) use patch::{BilinearForm, bilinear_to_bezier};
+pub use patch::{Patch, PatchNet, PatchSource};
 pub use primvars::{ColorField, Primvars};
 pub use rational::eval_rational_bezier;
 pub use rib::{RibFrames, load_rib, open_rib, parse_rib, parse_rib_frames, stream_rib};
@@ -153,64 +156,6 @@ impl Default for Scene {
     }
 }
 
-/// One bicubic Bezier patch.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Patch {
-    /// 16 control points, row-major: cp[4*v + u], u varies fastest (RenderMan order).
-    /// Euclidean (already divided by their weight when the patch is rational).
-    pub cp: [DVec3; 16],
-    /// The weight of each control point, same order: the patch is the rational Bezier surface
-    /// sum(B_i B_j w_ij P_ij) / sum(B_i B_j w_ij). All 1.0 for a polynomial patch (every loader
-    /// but rational `NuPatch` "Pw" and the quadrics); always finite and positive.
-    pub w: [f64; 16],
-    /// Index into [`Scene::materials`].
-    pub material: u32,
-    /// True when the camera-space geometric normal dPdu x dPdv must be negated to get the
-    /// surface's OUTSIDE normal as RenderMan defines it (`Orientation`/`ReverseOrientation`
-    /// versus the handedness of the current transform; see `rib/mod.rs` for the derivation).
-    pub flip_normal: bool,
-    /// `Sides 2` (the default): both sides visible. `Sides 1`: back-facing parts are culled.
-    pub two_sided: bool,
-    /// The patch's own `"Cs"` / `"Os"` over its parameter square; `None` (no cost) when the
-    /// material's `Color` and `Opacity` apply everywhere.
-    pub primvars: Option<Box<Primvars>>,
-    /// Displacement along the normal in DiceShade (RIB `Displacement`); `None` (no cost) for
-    /// the undisplaced surface. Shared by the patches of one request.
-    pub displacement: Option<std::sync::Arc<Displacement>>,
-    /// Motion over the shutter (RIB `MotionBegin` around transforms): the camera-space
-    /// affine map taking the patch at shutter open (`cp`) to the patch at shutter close; a
-    /// point at shutter fraction t is the linear interpolation of the two (docs/reyes.md,
-    /// "Motion blur and depth of field"). `None` for a patch that does not move.
-    pub motion: Option<Box<glam::DMat4>>,
-    /// Trimming (RIB `TrimCurve` before a `NuPatch`): the loops that keep part of the patch,
-    /// and the patch's span of the surface's parameter space; `None` (no cost) when untrimmed.
-    pub trim: Option<std::sync::Arc<trim::PatchTrim>>,
-    /// Where the patch came from, for error messages.
-    pub source: PatchSource,
-}
-
-impl Patch {
-    /// Weights of a polynomial (non-rational) patch.
-    pub const POLYNOMIAL: [f64; 16] = [1.0; 16];
-
-    /// True when some weight differs from 1 (the patch needs homogeneous arithmetic).
-    pub fn is_rational(&self) -> bool {
-        self.w != Self::POLYNOMIAL
-    }
-}
-
-/// Origin of a patch: file, line of the request, and index of the patch within that request
-/// (0-based; for meshes and NURBS, the index of the sub-patch or span).
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct PatchSource {
-    /// The scene file, as named to the loader.
-    pub file: String,
-    /// Line of the request in that file.
-    pub line: u64,
-    /// Index of the patch within the request.
-    pub index: u32,
-}
-
 /// The three standard RenderMan surface shaders this renderer implements.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum SurfaceKind {
@@ -307,7 +252,7 @@ pub enum InputFormat {
 /// Centre of the axis-aligned bounding box of every control point, camera space; the origin
 /// for a scene without patches.
 pub fn scene_centre(scene: &Scene) -> DVec3 {
-    let mut pts = scene.patches.iter().flat_map(|p| p.cp.iter().copied());
+    let mut pts = scene.patches.iter().flat_map(|p| p.cp());
     let Some(first) = pts.next() else {
         return DVec3::ZERO;
     };
@@ -514,7 +459,7 @@ mod tests {
             for a in 0..5 {
                 for b in 0..5 {
                     let (pos, du, dv) =
-                        eval_bezier(&p.cp, 0.1 + 0.2 * a as f64, 0.1 + 0.2 * b as f64);
+                        eval_bezier(&p.cp(), 0.1 + 0.2 * a as f64, 0.1 + 0.2 * b as f64);
                     let mut n = du.cross(dv);
                     if p.flip_normal {
                         n = -n;
@@ -565,7 +510,7 @@ mod tests {
         let (mut sx, mut sy) = (0.0, 0.0);
         for p in &s.patches {
             assert!(!p.flip_normal && p.two_sided && p.material == 0);
-            for c in &p.cp {
+            for c in &p.cp() {
                 assert!(c.z > 0.0, "control point behind the camera: {c}");
                 let (x, y) = raster(&s, *c);
                 n += 1;
@@ -587,8 +532,8 @@ mod tests {
             "centre {cx},{cy}"
         );
         // The teapot is upright: its knob (top) is above its bottom on screen.
-        let knob = raster(&s, s.patches[24].cp[0]);
-        let bottom = raster(&s, s.patches[0].cp[15]);
+        let knob = raster(&s, s.patches[24].cp()[0]);
+        let bottom = raster(&s, s.patches[0].cp()[15]);
         assert!(knob.1 < bottom.1, "knob {knob:?} bottom {bottom:?}");
 
         // Orientation. uteapot.rib leaves Orientation at its default ("outside", left-handed)
@@ -661,12 +606,12 @@ mod tests {
         assert!(s.patches.iter().all(|p| p.flip_normal));
         // Rough check that this makes the model's outside face outward: most patch centres'
         // outside normals point away from the centroid (about 63%; 37% without the flip).
-        let centroid = s.patches.iter().map(|p| p.cp[5]).sum::<DVec3>() / s.patches.len() as f64;
+        let centroid = s.patches.iter().map(|p| p.cp()[5]).sum::<DVec3>() / s.patches.len() as f64;
         let outward = s
             .patches
             .iter()
             .filter(|p| {
-                let (pos, du, dv) = eval_bezier(&p.cp, 0.5, 0.5);
+                let (pos, du, dv) = eval_bezier(&p.cp(), 0.5, 0.5);
                 let n = if p.flip_normal {
                     -du.cross(dv)
                 } else {
@@ -682,8 +627,8 @@ mod tests {
         // The model is in front of the camera and mostly in view.
         let mut inside = 0;
         for p in &s.patches {
-            assert!(p.cp.iter().all(|c| c.z > 30.0));
-            let (x, y) = raster(&s, p.cp[5]);
+            assert!(p.cp().iter().all(|c| c.z > 30.0));
+            let (x, y) = raster(&s, p.cp()[5]);
             if (0.0..796.0).contains(&x) && (0.0..515.0).contains(&y) {
                 inside += 1;
             }
@@ -709,7 +654,7 @@ mod tests {
         let t = builtin_teapot();
         assert_eq!(s.patches.len(), 32);
         for (a, b) in s.patches.iter().zip(&t.patches) {
-            assert_eq!(a.cp, b.cp);
+            assert_eq!(a.cp(), b.cp());
             assert_eq!(a.flip_normal, b.flip_normal);
         }
     }
@@ -723,7 +668,7 @@ mod tests {
         let mut n = 0;
         let mut inside = 0;
         for p in &s.patches {
-            for c in &p.cp {
+            for c in &p.cp() {
                 assert!(c.z > 0.0);
                 let (x, y) = raster(&s, *c);
                 n += 1;
@@ -779,7 +724,7 @@ mod tests {
         let s = s.unwrap();
         assert_eq!(s.patches.len(), 1);
         assert_eq!((s.width, s.height), (800, 600));
-        assert!(s.patches[0].cp.iter().all(|c| c.z > 0.0));
+        assert!(s.patches[0].cp().iter().all(|c| c.z > 0.0));
         assert_eq!(s.patches[0].source.line, 2);
     }
 

@@ -105,6 +105,7 @@ pub fn parse_newell(text: &str, file: &str) -> Result<Vec<ObjectPatch>, SceneErr
         verts.push(r.point(&format!("coordinate of vertex {}", v + 1))?.0);
     }
     r.finish()?;
+    let shared: std::sync::Arc<str> = file.into();
     indices
         .into_iter()
         .enumerate()
@@ -120,7 +121,7 @@ pub fn parse_newell(text: &str, file: &str) -> Result<Vec<ObjectPatch>, SceneErr
                 *c = verts[i as usize - 1];
             }
             let src = PatchSource {
-                file: file.to_string(),
+                file: shared.clone(),
                 line,
                 index: p as u32,
             };

@@ -1,7 +1,9 @@
 //! The built-in Utah teapot: Martin Newell's 32 bicubic Bezier patches (public domain data),
 //! and the framing (camera, lights, material) used for every geometry-only input.
 
-use super::{Camera, Light, Material, ObjectPatch, Patch, PatchSource, Scene, SurfaceKind};
+use super::{
+    Camera, Light, Material, ObjectPatch, Patch, PatchNet, PatchSource, Scene, SurfaceKind,
+};
 use glam::{DMat4, DVec3};
 
 /// Newell's data is wound so that dPdu x dPdv points out of the teapot when read in a
@@ -23,7 +25,7 @@ pub fn builtin_teapot() -> Scene {
         .enumerate()
         .map(|(i, cp)| {
             let src = PatchSource {
-                file: "<builtin teapot>".to_string(),
+                file: "<builtin teapot>".into(),
                 line: 0,
                 index: i as u32,
             };
@@ -92,8 +94,7 @@ pub(crate) fn frame(patches: Vec<ObjectPatch>, flip_normal: bool) -> Scene {
     let patches = patches
         .into_iter()
         .map(|(cp, source)| Patch {
-            cp: cp.map(|p| view.transform_point3(p)),
-            w: Patch::POLYNOMIAL,
+            net: PatchNet::new(cp.map(|p| view.transform_point3(p)), Patch::POLYNOMIAL),
             material: 0,
             flip_normal,
             two_sided: true,
@@ -127,7 +128,7 @@ pub(crate) fn axis_in_camera() -> (DVec3, DVec3) {
         .into_iter()
         .map(|cp| {
             let src = PatchSource {
-                file: String::new(),
+                file: "".into(),
                 line: 0,
                 index: 0,
             };

@@ -232,7 +232,7 @@ impl Interp {
 
 /// The axis-aligned box of every control point (the origin for an empty world).
 fn bounds(scene: &Scene) -> (DVec3, DVec3) {
-    let mut pts = scene.patches.iter().flat_map(|p| p.cp.iter().copied());
+    let mut pts = scene.patches.iter().flat_map(|p| p.cp());
     let Some(first) = pts.next() else {
         return (DVec3::ZERO, DVec3::ZERO);
     };
@@ -244,7 +244,7 @@ fn bounds(scene: &Scene) -> (DVec3, DVec3) {
 fn transform_scene(scene: &mut Scene, m: &DMat4) -> Result<(), String> {
     let inv = m.inverse();
     for p in &mut scene.patches {
-        for c in &mut p.cp {
+        for c in p.net.points_mut() {
             *c = m.transform_point3(*c);
             if !c.to_array().iter().all(|x| x.abs() <= MAX_COORD) {
                 return Err(format!(

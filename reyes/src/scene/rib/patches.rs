@@ -10,18 +10,23 @@ use super::syntax::{Arg, Args, Param, Request};
 use crate::scene::basis::{Basis, block_to_bezier};
 use crate::scene::nurbs::{self, NuSurface};
 use crate::scene::rational::from_homogeneous;
-use crate::scene::{ColorField, Patch, PatchSource, Primvars, SceneError};
+use crate::scene::{
+    BilinearForm, ColorField, Patch, PatchNet, PatchSource, Primvars, SceneError,
+    bilinear_to_bezier,
+};
 use glam::{DMat4, DVec3, DVec4};
 
 /// The largest camera-space coordinate a control point may have: its cube, 1e36, is still
 /// finite in f32 (at most 3.4e38), as the renderer's bound arithmetic needs.
 pub(crate) const MAX_COORD: f64 = 1.0e12;
 
-/// Most patches one frame may hold, 2^22 (4,194,304): a `Patch` is about 600 bytes on the host
-/// (16 f64 points and weights, its source), so a frame at the limit holds about 2.5 GB before
-/// the GPU tables. The patch past it is refused at its request's line (10 million identical
-/// bilinear patches in a 1.6 MB gzip once took 4 GB and never finished). Frames stream: the
-/// limit is per frame, not per file.
+/// Most patches one frame may hold, 2^22 (4,194,304): a bilinear `Patch` is 176 bytes on the
+/// host (its 4 corners and a shared transform, [`crate::scene::PatchNet`]), a bicubic one 568
+/// (16 f64 points on the heap), a rational one 696 (and 16 weights), so a frame of bilinear
+/// patches at the limit holds 738 MB before the GPU tables (a bicubic one 2.4 GB). The patch
+/// past it is refused at its request's line (10 million identical bilinear patches in a 1.6 MB
+/// gzip once took 4 GB and never finished). Frames stream: the limit is per frame, not per
+/// file.
 pub(crate) const MAX_FRAME_PATCHES: usize = 1 << 22;
 
 #[cfg(test)]
@@ -42,6 +47,40 @@ fn max_frame_patches() -> usize {
 #[cfg(test)]
 fn max_frame_patches() -> usize {
     TEST_MAX_FRAME_PATCHES.with(|m| m.get())
+}
+
+/// What the patches of a frame share rather than each hold: the file name of their requests
+/// and the transform of bilinear nets ([`PatchNet`]), each kept while it repeats.
+#[derive(Default)]
+pub(super) struct SharedParts {
+    file: Option<(std::rc::Rc<str>, std::sync::Arc<str>)>,
+    ctm: Option<std::sync::Arc<DMat4>>,
+}
+
+impl SharedParts {
+    /// `file` as the patches' shared name (one allocation per file read in a row).
+    fn file(&mut self, file: &std::rc::Rc<str>) -> std::sync::Arc<str> {
+        match &self.file {
+            Some((rc, arc)) if std::rc::Rc::ptr_eq(rc, file) => arc.clone(),
+            _ => {
+                let arc: std::sync::Arc<str> = std::sync::Arc::from(&**file);
+                self.file = Some((file.clone(), arc.clone()));
+                arc
+            }
+        }
+    }
+
+    /// `ctm` shared (one allocation per transform used in a row).
+    fn ctm(&mut self, ctm: &DMat4) -> std::sync::Arc<DMat4> {
+        match &self.ctm {
+            Some(m) if **m == *ctm => m.clone(),
+            _ => {
+                let m = std::sync::Arc::new(*ctm);
+                self.ctm = Some(m.clone());
+                m
+            }
+        }
+    }
 }
 
 impl Interp {
@@ -72,11 +111,42 @@ impl Interp {
         cp: [DVec3; 16],
         w: [f64; 16],
     ) -> Result<(), SceneError> {
+        self.emit_net(a, ctm, index, cp, w, None)
+    }
+
+    /// [`Self::emit`] of the bilinear patch of object-space `corners`, elevated to bicubic
+    /// as `form` says: kept as its corners and the shared transform ([`PatchNet`]), which
+    /// give the same camera-space points when asked for.
+    pub(super) fn emit_bilinear(
+        &mut self,
+        a: &Args,
+        ctm: &DMat4,
+        index: usize,
+        corners: [DVec3; 4],
+        form: BilinearForm,
+    ) -> Result<(), SceneError> {
+        let cp = match form {
+            BilinearForm::Patch => bilinear_to_bezier(corners),
+            BilinearForm::Polygon => crate::scene::polygon::bilinear_patch(corners),
+        };
+        self.emit_net(a, ctm, index, cp, Patch::POLYNOMIAL, Some((corners, form)))
+    }
+
+    /// [`Self::emit`]; `bilinear` the corners the points `cp` were elevated from.
+    fn emit_net(
+        &mut self,
+        a: &Args,
+        ctm: &DMat4,
+        index: usize,
+        cp: [DVec3; 16],
+        w: [f64; 16],
+        bilinear: Option<([DVec3; 4], BilinearForm)>,
+    ) -> Result<(), SceneError> {
         let max = max_frame_patches();
         if self.scene.patches.len() >= max {
             return Err(a.err(format!(
                 "patch {index}: more than {max} patches in one frame (the limit \
-                 on scene size: each holds about 600 bytes on the host; split the scene into \
+                 on scene size: each holds 176 to 696 bytes on the host; split the scene into \
                  frames or coarser patches)"
             )));
         }
@@ -124,9 +194,17 @@ impl Interp {
         }
         let material = self.material();
         let displacement = self.displacement(ctm);
+        let net = match bilinear {
+            Some((corners, form)) => {
+                let net = PatchNet::bilinear(corners, self.shared.ctm(ctm), form);
+                debug_assert!(net.points() == cp);
+                net
+            }
+            None => PatchNet::new(cp, w),
+        };
+        let file = self.shared.file(&a.req.file);
         self.scene.patches.push(Patch {
-            cp,
-            w,
+            net,
             material,
             flip_normal: self.attrs.orientation_rh,
             two_sided: self.attrs.two_sided,
@@ -135,11 +213,28 @@ impl Interp {
             motion: self.attrs.motion(),
             trim: None,
             source: PatchSource {
-                file: a.req.file.to_string(),
+                file,
                 line: a.req.line,
                 index: index as u32,
             },
         });
+        Ok(())
+    }
+
+    /// [`Self::emit_bilinear`], then gives the new patch its primitive variables.
+    pub(super) fn emit_bilinear_with(
+        &mut self,
+        a: &Args,
+        ctm: &DMat4,
+        index: usize,
+        corners: [DVec3; 4],
+        form: BilinearForm,
+        (cs, os): (Option<ColorField>, Option<ColorField>),
+    ) -> Result<(), SceneError> {
+        self.emit_bilinear(a, ctm, index, corners, form)?;
+        if let Some(p) = self.scene.patches.last_mut() {
+            p.primvars = Primvars { cs, os, n: None }.boxed();
+        }
         Ok(())
     }
 
@@ -175,13 +270,13 @@ impl Interp {
         let ctm = self.geometry_ctm(a)?;
         check_points(a, 0, &pts, 0..n)?;
         let (ub, vb) = (&self.attrs.ubasis, &self.attrs.vbasis);
-        let cp = if n == 4 {
-            bilinear_to_bezier([pts[0], pts[1], pts[2], pts[3]])
-        } else {
-            let g: [DVec3; 16] = std::array::from_fn(|k| pts[k]);
-            block_to_bezier(&g, ub, vb)
-        };
         let fields = vars.map(|v| v.patch_field(n == 16, ub, vb));
+        if n == 4 {
+            let corners = [pts[0], pts[1], pts[2], pts[3]];
+            return self.emit_bilinear_with(a, &ctm, 0, corners, BilinearForm::Patch, fields);
+        }
+        let g: [DVec3; 16] = std::array::from_fn(|k| pts[k]);
+        let cp = block_to_bezier(&g, ub, vb);
         self.emit_with(a, &ctm, 0, cp, Patch::POLYNOMIAL, fields)
     }
 
@@ -223,17 +318,12 @@ impl Interp {
                 let used =
                     (0..size * size).map(|k| ((r0 + k / size) % nv) * nu + (c0 + k % size) % nu);
                 check_points(a, pv * nup + pu, &pts, used)?;
-                let cp = if cubic {
-                    let g = std::array::from_fn(|k| at(r0 + k / 4, c0 + k % 4));
-                    block_to_bezier(&g, &self.attrs.ubasis, &self.attrs.vbasis)
-                } else {
-                    bilinear_to_bezier([
-                        at(r0, c0),
-                        at(r0, c0 + 1),
-                        at(r0 + 1, c0),
-                        at(r0 + 1, c0 + 1),
-                    ])
-                };
+                let corners = [
+                    at(r0, c0),
+                    at(r0, c0 + 1),
+                    at(r0 + 1, c0),
+                    at(r0 + 1, c0 + 1),
+                ];
                 let cell = MeshCell {
                     pu,
                     pv,
@@ -248,7 +338,15 @@ impl Interp {
                 };
                 let (ub, vb) = (&self.attrs.ubasis, &self.attrs.vbasis);
                 let fields = vars.map(|v| v.mesh_field(&cell, cubic, ub, vb));
-                self.emit_with(a, &ctm, pv * nup + pu, cp, Patch::POLYNOMIAL, fields)?;
+                let k = pv * nup + pu;
+                if cubic {
+                    let g = std::array::from_fn(|k| at(r0 + k / 4, c0 + k % 4));
+                    let cp = block_to_bezier(&g, ub, vb);
+                    self.emit_with(a, &ctm, k, cp, Patch::POLYNOMIAL, fields)?;
+                } else {
+                    let form = BilinearForm::Patch;
+                    self.emit_bilinear_with(a, &ctm, k, corners, form, fields)?;
+                }
             }
         }
         Ok(())
@@ -512,14 +610,6 @@ pub(super) fn mesh_patches(
         n / step
     } else {
         (n - order) / step + 1
-    })
-}
-
-/// Elevates a bilinear patch (corners (0,0), (1,0), (0,1), (1,1)) to bicubic Bezier.
-pub(super) fn bilinear_to_bezier(c: [DVec3; 4]) -> [DVec3; 16] {
-    std::array::from_fn(|k| {
-        let (u, v) = ((k % 4) as f64 / 3.0, (k / 4) as f64 / 3.0);
-        c[0].lerp(c[1], u).lerp(c[2].lerp(c[3], u), v)
     })
 }
 

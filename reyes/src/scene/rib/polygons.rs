@@ -13,8 +13,8 @@ use super::lexer::shown;
 use super::primvars::{Class, ClassCounts, ColorVar, Decl, parse_decl};
 use super::state::Interp;
 use super::syntax::{Args, Param, Request};
-use crate::scene::polygon::{bilinear_patch, pieces};
-use crate::scene::{ColorField, Patch, SceneError};
+use crate::scene::polygon::pieces;
+use crate::scene::{BilinearForm, ColorField, SceneError};
 use glam::{DMat3, DMat4, DVec3};
 
 /// Most loops, corners or points of one polygon request (each index must fit the renderer's
@@ -228,9 +228,10 @@ impl Interp {
             for piece in pieces(&slices) {
                 let fv = piece.map(|k| fv_of[k]);
                 let pt = fv.map(|k| mesh.corners[k]);
-                let cp = bilinear_patch(pt.map(|k| pts[k]));
+                let corners = pt.map(|k| pts[k]);
                 let fields = vars.map(|v| v.polygon_field(f, fv, pt));
-                self.emit_with(a, &ctm, f, cp, Patch::POLYNOMIAL, fields)?;
+                let form = BilinearForm::Polygon;
+                self.emit_bilinear_with(a, &ctm, f, corners, form, fields)?;
                 if let (Some(v), Some(p)) = (&nvar, self.scene.patches.last_mut()) {
                     let mut vars = p.primvars.take().map(|b| *b).unwrap_or_default();
                     vars.n = Some(v.polygon_field(f, fv, pt));

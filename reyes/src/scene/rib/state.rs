@@ -184,6 +184,8 @@ pub(super) struct Interp {
     pub(super) instance_depth: usize,
     /// `CoordinateSystem`s by name: the transform at shutter open and close.
     pub(super) coordinate_systems: HashMap<String, (DMat4, Option<DMat4>)>,
+    /// The file name and transform the patches share.
+    pub(super) shared: super::patches::SharedParts,
 }
 
 impl Interp {
@@ -209,6 +211,7 @@ impl Interp {
             objects: HashMap::new(),
             instance_depth: 0,
             coordinate_systems: HashMap::new(),
+            shared: Default::default(),
         }
     }
 

@@ -216,7 +216,7 @@ mod tests {
         let s = parse(&world(&format!("Translate 0 0 5\n{TETRA}")));
         assert!(s.warnings.is_empty(), "{:?}", s.warnings);
         assert!(s.patches.len() > 100, "{}", s.patches.len());
-        assert!(s.patches.iter().all(|p| p.cp.iter().all(|c| c.z > 4.0)));
+        assert!(s.patches.iter().all(|p| p.cp().iter().all(|c| c.z > 4.0)));
     }
 
     #[test]
@@ -261,7 +261,7 @@ mod tests {
             let cs = p.primvars.as_ref().and_then(|v| v.cs.clone()).unwrap();
             assert!(matches!(cs, ColorField::Bilinear(_)));
             for (u, v, k) in [(0.0, 0.0, 0), (1.0, 0.0, 3), (0.0, 1.0, 12), (1.0, 1.0, 15)] {
-                let q = p.cp[k];
+                let q = p.cp()[k];
                 let d = cs.eval(u, v) - want(q.x, q.y);
                 assert!(
                     d.length() < 1e-9,

@@ -34,7 +34,7 @@ fn read_archive_rib_reads_the_gzip_archive_beside_it() {
     assert_eq!(s.patches.len(), 32);
     assert!(s.warnings.is_empty(), "{:?}", s.warnings);
     let archive = field.join("teapot-patches.rib.gz").display().to_string();
-    assert_eq!(s.patches[5].source.file, archive);
+    assert_eq!(*s.patches[5].source.file, archive);
     assert_eq!(s.patches[5].source.line, 7);
     // The archive itself, given as the scene, is read as RIB (a gzip file is never "binary
     // RIB"): its patches are outside a world block, which is what the error says.
@@ -47,7 +47,7 @@ fn read_archive_rib_reads_the_gzip_archive_beside_it() {
     );
     // The same patches inline (uteapot.rib's camera and geometry) give the same points.
     let u = load(&crate::shared_data_dir().join("rib/uteapot.rib")).unwrap();
-    assert!(close(s.patches[0].cp[0], u.patches[0].cp[0]));
+    assert!(close(s.patches[0].cp()[0], u.patches[0].cp()[0]));
 }
 
 #[test]
@@ -72,7 +72,7 @@ fn archives_beside_the_including_file_then_the_current_directory() {
     let s = load(&d.join("scene.rib")).unwrap();
     assert_eq!(s.patches.len(), 2);
     // The archive's transform stays in effect after it (an archive is read in place).
-    assert!(close(s.patches[0].cp[0], DVec3::X) && close(s.patches[1].cp[0], DVec3::X));
+    assert!(close(s.patches[0].cp()[0], DVec3::X) && close(s.patches[1].cp()[0], DVec3::X));
     assert_eq!(s.materials[0].color, DVec3::new(0.0, 1.0, 0.0));
     assert!(s.patches[0].source.file.ends_with("sub/inner.rib"));
     assert_eq!(s.patches[0].source.line, 3);

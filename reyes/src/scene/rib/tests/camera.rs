@@ -26,7 +26,7 @@ fn dot_at(c: DVec3) -> String {
 }
 
 fn first_corner(p: &Patch) -> DVec3 {
-    p.cp[0]
+    p.cp()[0]
 }
 
 fn near(a: (f64, f64), b: (f64, f64), tol: f64) -> bool {
@@ -46,7 +46,7 @@ fn k3d_screen_window_frames_like_its_field_of_view() {
     );
     assert_eq!(a.patches.len(), b.patches.len());
     for (p, q) in a.patches.iter().zip(&b.patches) {
-        assert_eq!(p.cp, q.cp);
+        assert_eq!(p.cp(), q.cp());
     }
     // CropWindow 0 1 0 1 is the whole image; the imager's background is named.
     assert_eq!((a.width, a.height), (320, 240));
@@ -213,7 +213,7 @@ fn coordinate_systems_are_named_and_restored() {
         .iter()
         .filter(|p| p.source.line == s.patches.last().unwrap().source.line);
     let (lo, hi) = cyl
-        .flat_map(|p| p.cp.iter().copied())
+        .flat_map(|p| p.cp())
         .fold((DVec3::MAX, DVec3::MIN), |(lo, hi), p| {
             (lo.min(p), hi.max(p))
         });

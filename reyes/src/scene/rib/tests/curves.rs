@@ -8,8 +8,8 @@ use glam::DVec3;
 
 /// The ribbon's centre and width vector at v on a patch (u runs across the width).
 fn across(p: &Patch, v: f64) -> (DVec3, DVec3) {
-    let a = eval_bezier(&p.cp, 0.0, v).0;
-    let b = eval_bezier(&p.cp, 1.0, v).0;
+    let a = eval_bezier(&p.cp(), 0.0, v).0;
+    let b = eval_bezier(&p.cp(), 1.0, v).0;
     ((a + b) * 0.5, b - a)
 }
 
@@ -22,13 +22,13 @@ fn straight_linear_curve_is_a_rectangle_facing_the_eye() {
     assert_eq!(s.patches.len(), 1);
     let p = &s.patches[0];
     assert_eq!((p.source.line, p.source.index), (2, 0));
-    let corners = [p.cp[0], p.cp[3], p.cp[12], p.cp[15]];
+    let corners = [p.cp()[0], p.cp()[3], p.cp()[12], p.cp()[15]];
     let want = [(-5.0, -0.2), (-5.0, 0.2), (5.0, -0.2), (5.0, 0.2)];
     for (c, (x, y)) in corners.iter().zip(want) {
         assert!(close(*c, DVec3::new(x, y, 6.0)), "{c}");
     }
     // The outside (dPdu x dPdv, not flipped) faces the eye.
-    let (_, du, dv) = eval_bezier(&p.cp, 0.5, 0.5);
+    let (_, du, dv) = eval_bezier(&p.cp(), 0.5, 0.5);
     assert!(!p.flip_normal && du.cross(dv).z < 0.0);
 }
 
@@ -177,7 +177,7 @@ fn linear_curves_periodic_and_mitred() {
     ));
     assert_eq!(s.patches.len(), 4);
     for k in 0..4 {
-        let (a, b) = (&s.patches[k].cp, &s.patches[(k + 1) % 4].cp);
+        let (a, b) = (&s.patches[k].cp(), &s.patches[(k + 1) % 4].cp());
         assert_eq!(a[12..16], b[0..4], "corner {k}");
     }
 }
@@ -234,7 +234,7 @@ fn normals_orient_the_ribbon() {
     let p = &s.patches[0];
     let (_, w) = across(p, 0.5);
     assert!(w.normalize().cross(DVec3::Z).length() < 1e-12, "{w}");
-    let (_, du, dv) = eval_bezier(&p.cp, 0.5, 0.5);
+    let (_, du, dv) = eval_bezier(&p.cp(), 0.5, 0.5);
     assert!(du.cross(dv).normalize().distance(DVec3::Y) < 1e-12);
     let n = p.primvars.as_ref().unwrap().n.clone().unwrap();
     assert_eq!(n.eval(0.5, 0.5), DVec3::Y);
@@ -261,7 +261,7 @@ fn points_are_discs_facing_the_eye() {
         for p in discs {
             // The rim (v = 0) at the radius, in the plane across the view.
             for u in [0.0, 0.4, 1.0] {
-                let q = crate::scene::eval_rational_bezier(&p.cp, &p.w, u, 0.0).0;
+                let q = crate::scene::eval_rational_bezier(&p.cp(), &p.w(), u, 0.0).0;
                 let tol = crate::scene::curves::DISC_RIM_ERROR * r;
                 assert!(((q - centre).length() - r).abs() < tol);
                 assert!((q - centre).dot(centre).abs() < 1e-9);
@@ -275,7 +275,7 @@ fn points_are_discs_facing_the_eye() {
         }
     }
     let s = parse(&world("Points \"P\" [0 0 5] \"constantwidth\" 0.2"));
-    let q = crate::scene::eval_rational_bezier(&s.patches[0].cp, &s.patches[0].w, 0.5, 0.0).0;
+    let q = crate::scene::eval_rational_bezier(&s.patches[0].cp(), &s.patches[0].w(), 0.5, 0.0).0;
     assert!((q.distance(DVec3::new(0.0, 0.0, 5.0)) - 0.1).abs() < 0.1 * 3e-4);
 }
 
@@ -290,7 +290,7 @@ fn orthographic_ribbons_and_discs_face_along_z() {
     ));
     // Off the axis, a perspective ribbon would tilt towards the eye; an orthographic one
     // faces -z exactly.
-    let (_, du, dv) = eval_bezier(&s.patches[0].cp, 0.5, 0.5);
+    let (_, du, dv) = eval_bezier(&s.patches[0].cp(), 0.5, 0.5);
     assert!(du.cross(dv).normalize().distance(-DVec3::Z) < 1e-12);
     let vars = s.patches[1].primvars.as_ref().unwrap();
     assert_eq!(vars.n, Some(ColorField::Flat(-DVec3::Z)));

@@ -34,7 +34,7 @@ fn three_frames_rib() {
     // The same teapot, turned 30 degrees more about the world z axis in each frame: the
     // camera-space distance between corresponding points of frames 1 and 2 equals the one
     // between frames 2 and 3, and is not zero.
-    let p = |f: usize| seq.frames[f].scene.patches[0].cp[0];
+    let p = |f: usize| seq.frames[f].scene.patches[0].cp()[0];
     let (d12, d23) = (p(0).distance(p(1)), p(1).distance(p(2)));
     assert!(d12 > 1.0 && (d12 - d23).abs() < 1e-9, "{d12} {d23}");
     // A single-image consumer takes frame 1 and is told.
@@ -67,9 +67,9 @@ fn frame_blocks_save_and_restore_options_and_attributes() {
     );
     assert_eq!(a.display.as_ref().unwrap().name, "a.tif");
     assert!(b.display.is_none(), "a frame's Display stays in it");
-    assert!(close(a.scene.patches[0].cp[0], DVec3::new(1.0, 0.0, 5.0)));
+    assert!(close(a.scene.patches[0].cp()[0], DVec3::new(1.0, 0.0, 5.0)));
     assert!(
-        close(b.scene.patches[0].cp[0], DVec3::new(0.0, 0.0, 5.0)),
+        close(b.scene.patches[0].cp()[0], DVec3::new(0.0, 0.0, 5.0)),
         "FrameEnd restores the transform"
     );
     // Attributes set before the frames apply to both; materials are per frame.

@@ -14,10 +14,10 @@ fn motion_blocks_move_transforms() {
         ))
     ));
     let p = &s.patches[0];
-    assert!(close(p.cp[15], DVec3::new(2.0, 2.0, 0.0)));
+    assert!(close(p.cp()[15], DVec3::new(2.0, 2.0, 0.0)));
     let m = p.motion.as_deref().expect("moving");
     assert!(close(
-        m.transform_point3(p.cp[15]),
+        m.transform_point3(p.cp()[15]),
         DVec3::new(4.0, 2.0, 0.0)
     ));
     // The shutter half open: half way.
@@ -86,10 +86,10 @@ fn unsupported_motion_warns_and_keeps_the_first_time() {
             "MotionBegin [0 1]\nColor 1 0 0\nColor 0 1 0\nMotionEnd\n{QUAD}"
         ))
     ));
-    assert!(close(s.patches[0].cp[0], DVec3::new(0.0, 0.0, 1.0)));
+    assert!(close(s.patches[0].cp()[0], DVec3::new(0.0, 0.0, 1.0)));
     let m = s.patches[0].motion.as_deref().expect("the camera's motion");
     assert!(close(
-        m.transform_point3(s.patches[0].cp[0]),
+        m.transform_point3(s.patches[0].cp()[0]),
         DVec3::new(0.0, 0.0, 2.0)
     ));
     assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);

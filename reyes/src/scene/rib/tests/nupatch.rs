@@ -126,7 +126,7 @@ impl Nurbs {
                     for b in 0..=8 {
                         let (a, b) = (a as f64 / 8.0, b as f64 / 8.0);
                         let want = self.eval(ku, u0 + a * (u1 - u0), kv, v0 + b * (v1 - v0));
-                        let got = eval_rational_bezier(&p.cp, &p.w, a, b).0;
+                        let got = eval_rational_bezier(&p.cp(), &p.w(), a, b).0;
                         assert!(
                             want.distance(got) < 1e-11,
                             "orders {}x{} patch ({i},{j}) at ({a},{b}): {want} vs {got}",
@@ -235,7 +235,7 @@ fn field_rational_sphere_lies_on_the_unit_sphere() {
         for a in 0..=24 {
             for b in 0..=24 {
                 let (pos, du, dv) =
-                    eval_rational_bezier(&p.cp, &p.w, a as f64 / 24.0, b as f64 / 24.0);
+                    eval_rational_bezier(&p.cp(), &p.w(), a as f64 / 24.0, b as f64 / 24.0);
                 // The file gives sqrt(1/2) to 9 digits: the sphere is exact to about 1e-9.
                 let r = pos.distance(centre);
                 assert!((r - 1.0).abs() < 1e-8, "radius {r} at {pos}");
@@ -281,7 +281,7 @@ fn rational_nupatch_follows_the_transform() {
     let p = &s.patches[0];
     for a in 0..=10 {
         for b in 0..=10 {
-            let pos = eval_rational_bezier(&p.cp, &p.w, a as f64 / 10.0, b as f64 / 10.0).0;
+            let pos = eval_rational_bezier(&p.cp(), &p.w(), a as f64 / 10.0, b as f64 / 10.0).0;
             let radial = (pos - DVec3::new(1.0, 2.0, 0.0)).truncate().length();
             assert!((radial - 2.0).abs() < 1e-12, "{pos}");
             assert!(pos.z >= 3.0 - 1e-12 && pos.z <= 5.0 + 1e-12);

@@ -4,7 +4,7 @@
 use super::*;
 
 fn centre(p: &crate::scene::Patch) -> DVec3 {
-    p.cp.iter().sum::<DVec3>() / 16.0
+    p.cp().iter().sum::<DVec3>() / 16.0
 }
 
 #[test]

@@ -38,8 +38,8 @@ fn basis_b_spline_patch_becomes_the_same_surface() {
     )));
     for (u, v) in [(0.0, 0.0), (0.5, 0.5), (0.2, 0.9), (1.0, 1.0)] {
         let want = eval_bspline(&pts, 4, 0, 0, u, v);
-        assert!(close(eval_bezier(&by_name.patches[0].cp, u, v).0, want));
-        assert!(close(eval_bezier(&by_matrix.patches[0].cp, u, v).0, want));
+        assert!(close(eval_bezier(&by_name.patches[0].cp(), u, v).0, want));
+        assert!(close(eval_bezier(&by_matrix.patches[0].cp(), u, v).0, want));
     }
     assert!(err(&world("Basis \"nurbs\" 1 \"bezier\" 3")).contains("unknown basis \"nurbs\""));
     assert!(err(&world("Basis \"bezier\" 0 \"bezier\" 3")).contains("step"));
@@ -48,7 +48,7 @@ fn basis_b_spline_patch_becomes_the_same_surface() {
 #[test]
 fn bilinear_patch_is_elevated() {
     let s = parse(&world(QUAD));
-    let cp = &s.patches[0].cp;
+    let cp = &s.patches[0].cp();
     assert!(close(cp[0], DVec3::ZERO) && close(cp[3], DVec3::X) && close(cp[12], DVec3::Y));
     assert!(close(cp[15], DVec3::new(1.0, 1.0, 0.0)));
     assert!(close(cp[5], DVec3::new(1.0 / 3.0, 1.0 / 3.0, 0.0)));
@@ -56,7 +56,7 @@ fn bilinear_patch_is_elevated() {
     let t = parse(&world(&format!(
         "Basis \"b-spline\" 1 \"catmull-rom\" 1\n{QUAD}"
     )));
-    assert_eq!(t.patches[0].cp, *cp);
+    assert_eq!(t.patches[0].cp(), *cp);
 }
 
 fn mesh(
@@ -139,7 +139,7 @@ fn patch_mesh_patches_follow_the_basis_steps() {
     assert_eq!(p.source.index, 7);
     for (u, v) in [(0.0, 0.0), (0.4, 0.7), (1.0, 1.0)] {
         assert!(close(
-            eval_bezier(&p.cp, u, v).0,
+            eval_bezier(&p.cp(), u, v).0,
             eval_bspline(&pts, 6, 1, 1, u, v)
         ));
     }
@@ -147,8 +147,8 @@ fn patch_mesh_patches_follow_the_basis_steps() {
     let (first, last) = (&s.patches[0], &s.patches[5]);
     for v in [0.0, 0.5, 1.0] {
         assert!(close(
-            eval_bezier(&last.cp, 1.0, v).0,
-            eval_bezier(&first.cp, 0.0, v).0
+            eval_bezier(&last.cp(), 1.0, v).0,
+            eval_bezier(&first.cp(), 0.0, v).0
         ));
     }
     // Bezier meshes share edge points (step 3).
@@ -161,7 +161,7 @@ fn patch_mesh_patches_follow_the_basis_steps() {
         "nonperiodic",
     )
     .unwrap();
-    assert_eq!(s.patches[0].cp[3], s.patches[1].cp[0]);
+    assert_eq!(s.patches[0].cp()[3], s.patches[1].cp()[0]);
 }
 
 /// NuPatch 5x4 cubic, clamped in u with one interior knot, a Bezier span in v.
@@ -196,11 +196,11 @@ fn nu_patch_spans_become_patches() {
         }
     );
     let t = parse(&nu_patch(true, 1.0));
-    assert_eq!(s.patches[0].cp, t.patches[0].cp);
+    assert_eq!(s.patches[0].cp(), t.patches[0].cp());
     // The two spans meet.
     assert!(close(
-        eval_bezier(&s.patches[0].cp, 1.0, 0.3).0,
-        eval_bezier(&s.patches[1].cp, 0.0, 0.3).0
+        eval_bezier(&s.patches[0].cp(), 1.0, 0.3).0,
+        eval_bezier(&s.patches[1].cp(), 0.0, 0.3).0
     ));
 }
 

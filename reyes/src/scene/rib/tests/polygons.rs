@@ -11,7 +11,7 @@ fn area(s: &Scene) -> f64 {
     s.patches
         .iter()
         .map(|p| {
-            let (c0, c1, c2, c3) = (p.cp[0], p.cp[3], p.cp[12], p.cp[15]);
+            let (c0, c1, c2, c3) = (p.cp()[0], p.cp()[3], p.cp()[12], p.cp()[15]);
             tri(c0, c1, c3) + tri(c0, c3, c2)
         })
         .sum()
@@ -22,7 +22,7 @@ fn polygon_square_is_one_bilinear_patch() {
     let s = parse(&world("Polygon \"P\" [0 0 0  2 0 0  2 2 0  0 2 0]"));
     assert_eq!(s.patches.len(), 1);
     assert!((area(&s) - 4.0).abs() < 1e-12);
-    let (p, du, dv) = eval_bezier(&s.patches[0].cp, 0.5, 0.5);
+    let (p, du, dv) = eval_bezier(&s.patches[0].cp(), 0.5, 0.5);
     assert!(close(p, DVec3::new(1.0, 1.0, 0.0)));
     // The polygon's winding normal, +z.
     assert!(du.cross(dv).z > 0.0);
@@ -39,7 +39,7 @@ fn points_polygons_share_points_and_cover_their_area() {
     assert_eq!(s.patches.len(), 3);
     assert!((area(&s) - 3.0).abs() < 1e-12, "{}", area(&s));
     // The shared edge (1,0)-(1,1) has bit-identical control points in both quads.
-    let (a, b) = (&s.patches[0].cp, &s.patches[1].cp);
+    let (a, b) = (&s.patches[0].cp(), &s.patches[1].cp());
     let right: Vec<DVec3> = [3, 7, 11, 15].iter().map(|&k| a[k]).collect();
     let left: Vec<DVec3> = [0, 4, 8, 12].iter().map(|&k| b[k]).collect();
     assert_eq!(right, left);

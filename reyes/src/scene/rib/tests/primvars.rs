@@ -160,7 +160,7 @@ fn vertex_cs_is_converted_like_the_positions() {
          Patch \"bicubic\" \"P\" [{nums}] \"vertex color Cs\" [{nums}]"
     )));
     let p = &s.patches[0];
-    assert_eq!(*cs(p), ColorField::Bezier(p.cp));
+    assert_eq!(*cs(p), ColorField::Bezier(p.cp()));
     for (u, v) in [(0.0, 0.0), (0.3, 0.8), (1.0, 0.5)] {
         let (wu, wv) = (bspline(u), bspline(v));
         let want: DVec3 = (0..16).map(|k| pts[k] * (wu[k % 4] * wv[k / 4])).sum();
@@ -202,7 +202,7 @@ fn patch_mesh_classes_count_sub_patches_and_corners() {
         for (u, v) in [(0.0, 0.0), (0.5, 0.25), (1.0, 1.0)] {
             assert!(close(
                 cs(patch).eval(u, v),
-                crate::scene::eval_bezier(&patch.cp, u, v).0
+                crate::scene::eval_bezier(&patch.cp(), u, v).0
             ));
         }
     }
@@ -239,7 +239,7 @@ fn periodic_patch_mesh_varying_wraps_to_the_first_corners() {
     // Vertex: the positions as colours give the patches' own control points (wrapping too).
     let s = parse(&world(&mesh(&format!("\"vertex color Cs\" [{p}]"))));
     for patch in &s.patches {
-        assert_eq!(*cs(patch), ColorField::Bezier(patch.cp));
+        assert_eq!(*cs(patch), ColorField::Bezier(patch.cp()));
     }
     // And that is the B-spline of the values: patch (0, 0) at (u, v).
     let (wu, wv) = (bspline(0.3), bspline(0.6));
@@ -287,7 +287,7 @@ fn nu_patch_classes_follow_segments_and_knot_spans() {
     // Vertex values through the same conversion as the points.
     let s = parse(&world(&nu(&format!("\"vertex color Cs\" [{p}]"))));
     for patch in &s.patches {
-        for (a, b) in cs(patch).values().iter().zip(&patch.cp) {
+        for (a, b) in cs(patch).values().iter().zip(&patch.cp()) {
             assert!(close(*a, *b), "{a} vs {b}");
         }
     }
@@ -312,10 +312,10 @@ fn vertex_cs_on_a_rational_nu_patch_is_weighted_like_the_points() {
     assert_eq!(s.patches.len(), 4);
     for patch in &s.patches {
         assert!(patch.is_rational());
-        for (a, b) in cs(patch).values().iter().zip(&patch.cp) {
+        for (a, b) in cs(patch).values().iter().zip(&patch.cp()) {
             assert!(close(*a, *b), "{a} vs {b}");
         }
-        let surface = |u, v| crate::scene::eval_rational_bezier(&patch.cp, &patch.w, u, v).0;
+        let surface = |u, v| crate::scene::eval_rational_bezier(&patch.cp(), &patch.w(), u, v).0;
         for (u, v) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)] {
             assert!(close(cs(patch).eval(u, v), surface(u, v)), "({u}, {v})");
         }

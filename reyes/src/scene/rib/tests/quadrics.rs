@@ -12,7 +12,7 @@ fn samples(s: &Scene) -> Vec<(DVec3, DVec3)> {
         for a in 0..=8 {
             for b in 0..=8 {
                 let (pos, du, dv) =
-                    eval_rational_bezier(&p.cp, &p.w, a as f64 / 8.0, b as f64 / 8.0);
+                    eval_rational_bezier(&p.cp(), &p.w(), a as f64 / 8.0, b as f64 / 8.0);
                 let n = du.cross(dv);
                 out.push((pos, if p.flip_normal { -n } else { n }));
             }
@@ -43,7 +43,7 @@ fn each_quadric_request_makes_its_patches() {
         assert!(s.warnings.is_empty(), "{req}: {:?}", s.warnings);
         for (k, p) in s.patches.iter().enumerate() {
             assert!(p.is_rational(), "{req}");
-            assert!(p.w.iter().all(|&w| w > 0.0 && w <= 1.0), "{req}");
+            assert!(p.w().iter().all(|&w| w > 0.0 && w <= 1.0), "{req}");
             assert_eq!((p.source.line, p.source.index), (2, k as u32));
         }
     }

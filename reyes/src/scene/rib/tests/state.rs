@@ -71,28 +71,28 @@ fn option_errors() {
 fn transforms_apply_last_first() {
     // Translate then Scale: points are scaled first, then translated.
     let s = parse(&world(&format!("Translate 1 0 0\nScale 2 2 2\n{QUAD}")));
-    let cp = &s.patches[0].cp;
+    let cp = &s.patches[0].cp();
     assert!(close(cp[3], DVec3::new(3.0, 0.0, 0.0)), "{}", cp[3]);
     assert!(close(cp[12], DVec3::new(1.0, 2.0, 0.0)));
     let s = parse(&world(&format!("Scale 2 2 2\nTranslate 1 0 0\n{QUAD}")));
-    assert!(close(s.patches[0].cp[3], DVec3::new(4.0, 0.0, 0.0)));
+    assert!(close(s.patches[0].cp()[3], DVec3::new(4.0, 0.0, 0.0)));
 }
 
 #[test]
 fn rotate_convention() {
     let s = parse(&world(&format!("Rotate 90 0 0 1\n{QUAD}")));
     assert!(
-        close(s.patches[0].cp[3], DVec3::new(0.0, 1.0, 0.0)),
+        close(s.patches[0].cp()[3], DVec3::new(0.0, 1.0, 0.0)),
         "x -> y about z"
     );
     let s = parse(&world(&format!("Rotate 90 1 0 0\n{QUAD}")));
     assert!(
-        close(s.patches[0].cp[12], DVec3::new(0.0, 0.0, 1.0)),
+        close(s.patches[0].cp()[12], DVec3::new(0.0, 0.0, 1.0)),
         "y -> z about x"
     );
     let s = parse(&world(&format!("Rotate 90 0 2 0\n{QUAD}")));
     assert!(
-        close(s.patches[0].cp[3], DVec3::new(0.0, 0.0, -1.0)),
+        close(s.patches[0].cp()[3], DVec3::new(0.0, 0.0, -1.0)),
         "x -> -z about y"
     );
     assert!(err(&world("Rotate 30 0 0 0")).contains("axis is zero"));
@@ -104,13 +104,13 @@ fn camera_transform_and_identity_in_world() {
         "Translate 0 0 5\n{}",
         world(&format!("Translate 1 0 0\nIdentity\n{QUAD}"))
     ));
-    assert!(close(s.patches[0].cp[0], DVec3::new(0.0, 0.0, 5.0)));
+    assert!(close(s.patches[0].cp()[0], DVec3::new(0.0, 0.0, 5.0)));
     // Before WorldBegin, Identity really is the identity.
     let s = parse(&format!(
         "Translate 0 0 5 Identity Translate 0 0 2\n{}",
         world(QUAD)
     ));
-    assert!(close(s.patches[0].cp[0], DVec3::new(0.0, 0.0, 2.0)));
+    assert!(close(s.patches[0].cp()[0], DVec3::new(0.0, 0.0, 2.0)));
 }
 
 #[test]
@@ -121,17 +121,17 @@ fn transform_matrices_are_row_vector_order() {
         "Translate 0 0 5\n{}",
         world(&format!("Translate 7 7 7\nTransform {m}\n{QUAD}"))
     ));
-    assert!(close(s.patches[0].cp[0], DVec3::new(10.0, 20.0, 35.0)));
+    assert!(close(s.patches[0].cp()[0], DVec3::new(10.0, 20.0, 35.0)));
     let s = parse(&format!(
         "Translate 0 0 5\n{}",
         world(&format!("Scale 2 2 2\nConcatTransform {m}\n{QUAD}"))
     ));
-    assert!(close(s.patches[0].cp[0], DVec3::new(20.0, 40.0, 65.0)));
+    assert!(close(s.patches[0].cp()[0], DVec3::new(20.0, 40.0, 65.0)));
     // A non-symmetric linear part: the first row is where x goes.
     let s = parse(&world(&format!(
         "ConcatTransform [0 1 0 0  -1 0 0 0  0 0 1 0  0 0 0 1]\n{QUAD}"
     )));
-    assert!(close(s.patches[0].cp[3], DVec3::new(0.0, 1.0, 0.0)));
+    assert!(close(s.patches[0].cp()[3], DVec3::new(0.0, 1.0, 0.0)));
     assert!(
         err(&world("Transform [1 0 0 0 0 1 0 0 0 0 1 0 0 0 0]")).contains("expected 16 numbers")
     );
@@ -145,7 +145,7 @@ fn transform_and_attribute_blocks() {
     )));
     let [a, b, c] = [&s.patches[0], &s.patches[1], &s.patches[2]];
     assert!(
-        close(a.cp[0], DVec3::ZERO),
+        close(a.cp()[0], DVec3::ZERO),
         "TransformEnd restores the transform"
     );
     assert_eq!(
@@ -153,13 +153,13 @@ fn transform_and_attribute_blocks() {
         DVec3::new(1.0, 0.0, 0.0),
         "but not attributes"
     );
-    assert!(close(b.cp[0], DVec3::new(0.0, 3.0, 0.0)));
+    assert!(close(b.cp()[0], DVec3::new(0.0, 3.0, 0.0)));
     assert_eq!(
         s.materials[b.material as usize].color,
         DVec3::new(0.0, 1.0, 0.0)
     );
     assert!(!b.two_sided && b.flip_normal);
-    assert!(close(c.cp[0], DVec3::ZERO));
+    assert!(close(c.cp()[0], DVec3::ZERO));
     assert_eq!(c.material, a.material);
     assert!(c.two_sided && !c.flip_normal);
     assert_eq!(s.materials.len(), 2);
@@ -199,7 +199,7 @@ fn mirrored_patch_keeps_its_outside() {
     // The outside normal of a mirror image is the mirror image of the outside normal.
     let outside = |body: &str| {
         let s = parse(&world(&format!("{body}\n{QUAD}")));
-        let (_, du, dv) = eval_bezier(&s.patches[0].cp, 0.5, 0.5);
+        let (_, du, dv) = eval_bezier(&s.patches[0].cp(), 0.5, 0.5);
         let n = du.cross(dv).normalize();
         if s.patches[0].flip_normal { -n } else { n }
     };

@@ -30,7 +30,7 @@ fn object_and_motion_blocks() {
         "ObjectBegin 1\n{QUAD}\nObjectEnd\nMotionBegin [0 1]\nTranslate 1 0 0\nTranslate 5 0 0\nMotionEnd\n{QUAD}"
     )));
     assert_eq!(s.patches.len(), 1);
-    assert!(close(s.patches[0].cp[0], DVec3::X));
+    assert!(close(s.patches[0].cp()[0], DVec3::X));
     // Shutter 0 0 (the default): the transform at time 0, no motion.
     assert!(s.patches[0].motion.is_none());
     // The object is defined, not drawn (no `ObjectInstance`): nothing is skipped.
