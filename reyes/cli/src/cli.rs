@@ -382,7 +382,7 @@ impl RenderCmd {
         if cpu {
             eprintln!(
                 "note: rendering with the CPU reference (the same pipeline, compiled natively): \
-                 the adapter is a CPU ({}), on which the GPU path is 10-40x slower (--gpu or \
+                 the adapter is a CPU ({}), on which the GPU path is about 10x slower or more (--gpu or \
                  --strategy NAME renders on it anyway)",
                 gpu.adapter_name()
             );

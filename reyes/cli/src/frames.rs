@@ -88,6 +88,13 @@ impl<'a> Namer<'a> {
                 return Err(CliError::UnnumberedOutput { flag });
             }
         }
+        if let Some(out) = req.out.filter(|o| sequence && several && !has_pattern(o)) {
+            log::warn!(
+                "-o {}: several frames are rendered, so each is written under its `Display` \
+                 name in that folder (give -o NAME.####.png for numbered names)",
+                out.display()
+            );
+        }
         Ok(Namer {
             req,
             sequence,

@@ -348,6 +348,6 @@ mod tests {
             )
         };
         assert_eq!(p.host_bytes(), std::mem::size_of::<Patch>());
-        assert!(p.host_bytes() <= 176, "{} bytes", p.host_bytes());
+        assert!(p.host_bytes() <= 184, "{} bytes", p.host_bytes());
     }
 }

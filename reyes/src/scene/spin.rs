@@ -42,7 +42,9 @@ pub fn spin(scene: &mut Scene, degrees: f64) -> Result<(), Error> {
 mod tests {
     use super::*;
 
-    /// The turn keeps the centre and moves other points about the world z axis.
+    /// The turn keeps the centre and moves other points about the world z axis: for the
+    /// built-in teapot, the teapot's own up axis (its object space is its world), not the
+    /// camera's view axis.
     #[test]
     fn spin_turns_about_world_z_through_the_centre() {
         let mut s = crate::scene::builtin_teapot();
@@ -50,9 +52,14 @@ mod tests {
         spin(&mut s, 90.0).unwrap();
         let m = s.patches[0].motion.as_deref().unwrap();
         assert!((m.transform_point3(c) - c).length() < 1e-9);
-        // Identity world-to-camera: x goes to y.
-        let p = m.transform_point3(c + DVec3::X) - c;
-        assert!((p - DVec3::Y).length() < 1e-9, "{p}");
+        // The teapot's axis in camera space is the turn's axis: its direction stays put.
+        let (_, up) = crate::scene::teapot::axis_in_camera();
+        assert!((m.transform_vector3(up) - up).length() < 1e-9, "{up}");
+        assert!(up.dot(DVec3::Z).abs() < 0.99, "the view axis: {up}");
+        // A direction across the axis turns by 90 degrees.
+        let across = up.any_orthonormal_vector();
+        let turned = m.transform_vector3(across);
+        assert!(turned.dot(across).abs() < 1e-9 && turned.dot(up).abs() < 1e-9);
         assert!(spin(&mut s, f64::NAN).is_err());
     }
 }

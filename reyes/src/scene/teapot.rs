@@ -111,6 +111,9 @@ pub(crate) fn frame(patches: Vec<ObjectPatch>, flip_normal: bool) -> Scene {
         pixel_samples: (2, 2),
         camera: Camera {
             fov_deg: FOV_DEG,
+            // The object's space is the world: its z axis is the teapot's up (`--spin` turns
+            // about it), as uteapot.rib's world is.
+            world_to_camera: view,
             ..Camera::default()
         },
         patches,

@@ -7,6 +7,7 @@ pub mod anatomy;
 mod compact;
 pub(crate) mod layout;
 pub(crate) mod local;
+pub use local::LOCAL_MAX_BYTES;
 pub(crate) mod record;
 pub(crate) mod wgsl;
 
@@ -131,7 +132,7 @@ pub struct MegakernelConfig {
     /// co-resident workgroups fell from 8 to 2-4 per SM and batches got smaller
     /// (docs/scheduler.md 2.7).
     pub local_queues: bool,
-    /// Workgroup memory for the local queues, in bytes (default [`local::LOCAL_MAX_BYTES`]).
+    /// Workgroup memory for the local queues, in bytes (default [`LOCAL_MAX_BYTES`]).
     pub local_bytes: u32,
 }
 
@@ -161,7 +162,7 @@ impl Default for MegakernelConfig {
             subgroups: Some(false),
             size_from_last_run: true,
             local_queues: false,
-            local_bytes: local::LOCAL_MAX_BYTES,
+            local_bytes: LOCAL_MAX_BYTES,
         }
     }
 }

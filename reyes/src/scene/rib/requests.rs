@@ -166,6 +166,8 @@ impl Interp {
                 self.make_shadow(req);
                 Ok(())
             }
+            // The RIB version every exporter writes first: nothing to do, nothing to warn.
+            "version" => Ok(()),
             _ => {
                 let mut msg = format!("skipped unsupported request `{}`", shown(&req.name));
                 if let Some(lacks) = skipped_effect(&req.name) {
@@ -383,6 +385,10 @@ fn skipped_effect(name: &str) -> Option<&'static str> {
         "Matte" => "the object is drawn as an ordinary surface, not a holdout",
         "Atmosphere" | "Interior" | "Exterior" => "no volume shading (the air is clear)",
         "Illuminate" => "lights stay on for every object",
+        "ShadingRate" => {
+            "micropolygons are `--mp-size` pixels on a side (default 1, a shading rate of 1) \
+             whatever the file asks"
+        }
         _ => return None,
     })
 }

@@ -259,3 +259,20 @@ fn a_file_that_is_not_rib_is_refused_at_its_first_token() {
         vec!["t.rib:1: skipped unsupported request `Frobnicate`"]
     );
 }
+
+/// Exporters' boilerplate: `version` says nothing; `ShadingRate`'s warning says what sets the
+/// micropolygon size instead.
+#[test]
+fn version_is_silent_and_shading_rate_says_what_applies() {
+    let s = crate::scene::parse_rib(
+        "version 3.04\nShadingRate 4\nWorldBegin\nPatch \"bilinear\" \"P\" [0 0 5 1 0 5 0 1 5 1 1 5]\nWorldEnd\n",
+        "boiler.rib",
+    )
+    .unwrap();
+    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+    assert!(
+        s.warnings[0].contains("boiler.rib:2") && s.warnings[0].contains("--mp-size"),
+        "{:?}",
+        s.warnings
+    );
+}
