@@ -30,11 +30,20 @@ pub fn list_devices() -> Result<(), CliError> {
     }
     let all = devices::usable_indices(&list);
     if all.is_empty() {
-        return Err(scheduler::RunError::NoAdapter(
-            "no adapter can render (64-bit atomic min/max); install a Vulkan driver (on \
+        // The environment may have narrowed the search (wgpu's own variables).
+        let narrowed: Vec<String> = ["WGPU_BACKEND", "WGPU_ADAPTER_NAME"]
+            .iter()
+            .filter_map(|v| std::env::var(v).ok().map(|x| format!("{v}={x}")))
+            .collect();
+        let hint = if narrowed.is_empty() {
+            String::new()
+        } else {
+            format!(" (searched only where {} allows)", narrowed.join(" and "))
+        };
+        return Err(scheduler::RunError::NoAdapter(format!(
+            "no adapter can render (64-bit atomic min/max){hint}; install a Vulkan driver (on \
              Debian: `apt-get install -y mesa-vulkan-drivers` for lavapipe)"
-                .into(),
-        )
+        ))
         .into());
     }
     let all: Vec<String> = all.iter().map(usize::to_string).collect();

@@ -454,6 +454,16 @@ impl Interp {
             })
             .transpose()?
             .ok_or_else(|| a.err("missing the \"P\" parameter"))?;
+        // The points are counted from "P" itself: its length must be a whole number of them.
+        if let Some(p) = params.iter().find(|p| p.name == "P" || p.name == "Pw") {
+            let (dim, len) = (if p.name == "P" { 3 } else { 4 }, p.nums(a)?.len());
+            if len % dim != 0 {
+                return Err(a.err(format!(
+                    "\"{}\" needs a multiple of {dim} numbers ({dim} per point), found {len}",
+                    p.name
+                )));
+            }
+        }
         if n > MAX_COUNT {
             return Err(a.err(format!(
                 "{n} points, more than the reader's limit {MAX_COUNT}"

@@ -172,6 +172,8 @@ impl Interp {
                 let mut msg = format!("skipped unsupported request `{}`", shown(&req.name));
                 if let Some(lacks) = skipped_effect(&req.name) {
                     msg = format!("{msg}: {lacks}");
+                } else if let Some(known) = misspelt(&req.name) {
+                    msg = format!("{msg} (did you mean `{known}`?)");
                 }
                 self.warn_once(req, &req.name, &msg);
                 Ok(())
@@ -375,6 +377,18 @@ impl Interp {
 }
 
 /// What the image lacks when a commonly written request is skipped (the warning says it).
+/// The request `name` probably meant: one it reads whose name is `name` but for case, or one
+/// edit away (two for names of 8 letters or more), so that a typo does not pass as an
+/// unsupported request. Other standard requests (`Hider`, `Option`) are not that close to
+/// one the reader knows.
+fn misspelt(name: &str) -> Option<&'static str> {
+    let close = |k: &str| {
+        let d = strsim::damerau_levenshtein(name, k);
+        k.eq_ignore_ascii_case(name) || (name.len() >= 4 && d == 1) || (name.len() >= 8 && d == 2)
+    };
+    KNOWN.iter().copied().find(|k| close(k))
+}
+
 fn skipped_effect(name: &str) -> Option<&'static str> {
     Some(match name {
         "PixelFilter" => {

@@ -400,3 +400,13 @@ fn exporters_curves_and_points_are_read() {
         );
     }
 }
+
+/// `Points` counts its points from "P": a length that is not a whole number of points says so.
+#[test]
+fn points_with_a_partial_point_name_the_multiple() {
+    let e = err(&world("Points \"P\" [0 0 5 1 0 5 2 0]"));
+    assert!(
+        e.starts_with("t.rib:2:") && e.contains("\"P\" needs a multiple of 3 numbers"),
+        "{e}"
+    );
+}

@@ -276,3 +276,27 @@ fn version_is_silent_and_shading_rate_says_what_applies() {
         s.warnings
     );
 }
+
+/// A misspelt request is still skipped with a warning, which names the request it was close to.
+#[test]
+fn a_misspelt_request_names_the_one_meant() {
+    let s = crate::scene::parse_rib(
+        "WorldBegin\nNuPach 2 2 [0 0 1 1] 0 1 2 2 [0 0 1 1] 0 1 \"P\" [0 0 5 1 0 5 0 1 5 1 1 5]\nHider \"hidden\"\nWorldEnd\n",
+        "typo.rib",
+    )
+    .unwrap();
+    assert!(
+        s.warnings
+            .iter()
+            .any(|w| w.contains("typo.rib:2") && w.contains("did you mean `NuPatch`?")),
+        "{:?}",
+        s.warnings
+    );
+    assert!(
+        s.warnings
+            .iter()
+            .all(|w| !w.contains("Hider") || !w.contains("did you mean")),
+        "{:?}",
+        s.warnings
+    );
+}
