@@ -12,35 +12,13 @@ use reyes::cpu_render::render_cpu;
 use reyes::frame::{DisplacementNormals, FrameData, RenderOptions};
 use reyes::image::FrameImage;
 use reyes::scene::{self, Scene};
-use scheduler::StrategyKind;
 
 mod common;
-use common::{CPU_TWIN_OVER, compare, gpu, renderer};
 
 /// Renders `data` with every strategy (asserting identical images and counters) and the CPU
 /// twin (asserting the usual agreement); returns the GPU image.
 fn render_everywhere(data: &FrameData) -> FrameImage {
-    let mut first: Option<reyes::gpu_render::GpuFrame> = None;
-    for kind in StrategyKind::ALL {
-        let f = renderer(kind).render(gpu(), data).unwrap();
-        if let Some(a) = &first {
-            assert!(
-                a.image == f.image,
-                "{kind:?}: image differs from megakernel"
-            );
-            assert_eq!(a.counters, f.counters, "{kind:?}: counters");
-        }
-        first.get_or_insert(f);
-    }
-    let image = first.unwrap().image;
-    let cpu = render_cpu(data);
-    let (max, over) = compare(&image, &cpu.image);
-    assert!(
-        over < CPU_TWIN_OVER,
-        "CPU twin: {:.3}% of pixels differ by more than 2/255 (max {max})",
-        over * 100.0
-    );
-    image
+    common::render_everywhere(data).image
 }
 
 /// The megakernel's image of `data`, asserting that the multipass strategy gives the same

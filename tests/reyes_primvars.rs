@@ -7,7 +7,6 @@
 //! centre maps to the patch parameters (u, v) linearly and the expected colour is computed
 //! here, independently of the renderer.
 
-use reyes::cpu_render::render_cpu;
 use reyes::frame::{FrameData, RenderOptions};
 use reyes::image::FrameImage;
 use reyes::scene::{self, Scene};
@@ -15,7 +14,7 @@ use reyes::stages;
 use scheduler::StrategyKind;
 
 mod common;
-use common::{CPU_TWIN_OVER, compare, gpu, renderer};
+use common::{gpu, renderer};
 
 /// Renders `data` with every strategy (asserting identical images and counters) and the CPU
 /// twin (asserting the usual agreement); returns the GPU image.
@@ -25,28 +24,8 @@ fn render_everywhere(data: &FrameData) -> FrameImage {
 
 /// [`render_everywhere`], also returning the GPU's counters.
 fn render_counted(data: &FrameData) -> (FrameImage, [u64; stages::COUNTERS]) {
-    let mut first: Option<reyes::gpu_render::GpuFrame> = None;
-    for kind in StrategyKind::ALL {
-        let f = renderer(kind).render(gpu(), data).unwrap();
-        if let Some(a) = &first {
-            assert!(
-                a.image == f.image,
-                "{kind:?}: image differs from megakernel"
-            );
-            assert_eq!(a.counters, f.counters, "{kind:?}: counters");
-        }
-        first.get_or_insert(f);
-    }
-    let first = first.unwrap();
-    let image = first.image;
-    let cpu = render_cpu(data);
-    let (max, over) = compare(&image, &cpu.image);
-    assert!(
-        over < CPU_TWIN_OVER,
-        "CPU twin: {:.3}% of pixels differ by more than 2/255 (max {max})",
-        over * 100.0
-    );
-    (image, first.counters)
+    let f = common::render_everywhere(data);
+    (f.image, f.counters)
 }
 
 fn parse(text: &str) -> Scene {

@@ -353,15 +353,11 @@ impl Interp {
                     len: 1,
                 };
                 let v = self.var_values(a, p, decl, &["normal", "vector"], 3, &counts)?;
-                let m = linear_part.inverse().transpose();
-                let values: Vec<DVec3> =
-                    v.values.iter().map(|c| m * DVec3::from_slice(c)).collect();
-                if let Some(k) = values.iter().position(|x| !x.as_vec3().is_finite()) {
-                    return Err(a.err(format!(
-                        "value {k} of \"N\" is not finite in camera space in the f32 range the \
-                         renderer shades in"
-                    )));
-                }
+                let values = super::primvars::normals_to_camera(
+                    a,
+                    linear_part,
+                    v.values.iter().map(|c| &c[..]),
+                )?;
                 Some(Var {
                     class: v.class,
                     values,

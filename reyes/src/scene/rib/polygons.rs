@@ -284,17 +284,8 @@ impl Interp {
                 v.len()
             )));
         }
-        let m = DMat3::from_mat4(*ctm).inverse().transpose();
-        let values: Vec<DVec3> = v
-            .chunks_exact(3)
-            .map(|c| m * DVec3::from_slice(c))
-            .collect();
-        if let Some(k) = values.iter().position(|x| !x.as_vec3().is_finite()) {
-            return Err(a.err(format!(
-                "value {k} of \"N\" is not finite in camera space in the f32 range the \
-                 renderer shades in"
-            )));
-        }
+        let values =
+            super::primvars::normals_to_camera(a, DMat3::from_mat4(*ctm), v.chunks_exact(3))?;
         Ok(ColorVar {
             class: decl.class,
             values,

@@ -58,6 +58,28 @@ const TYPES: &[&str] = &[
 ];
 
 /// Parses a declaration (`[class] type[n]`; the class defaults to uniform, as the spec says).
+/// Normals `values` (3 numbers each) taken to camera space by the inverse transpose of the
+/// transform's linear part `linear`. Errors: one that leaves the f32 range the renderer shades
+/// in, naming its index.
+pub(super) fn normals_to_camera<'v>(
+    a: &Args,
+    linear: glam::DMat3,
+    values: impl IntoIterator<Item = &'v [f64]>,
+) -> Result<Vec<DVec3>, SceneError> {
+    let m = linear.inverse().transpose();
+    let values: Vec<DVec3> = values
+        .into_iter()
+        .map(|c| m * DVec3::from_slice(c))
+        .collect();
+    if let Some(k) = values.iter().position(|x| !x.as_vec3().is_finite()) {
+        return Err(a.err(format!(
+            "value {k} of \"N\" is not finite in camera space in the f32 range the renderer \
+             shades in"
+        )));
+    }
+    Ok(values)
+}
+
 pub(super) fn parse_decl(text: &str) -> Result<Decl, Error> {
     let mut words = text.split_whitespace().peekable();
     let class = match words.peek().copied() {
