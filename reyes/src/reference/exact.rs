@@ -550,27 +550,17 @@ mod tests {
         let patches = quads
             .iter()
             .enumerate()
-            .map(|(i, c)| Patch {
-                net: PatchNet::new(
-                    std::array::from_fn(|k| {
-                        let (s, t) = ((k % 4) as f64 / 3.0, (k / 4) as f64 / 3.0);
-                        (c[0] * (1.0 - s) + c[1] * s) * (1.0 - t)
-                            + (c[2] * (1.0 - s) + c[3] * s) * t
-                    }),
-                    Patch::POLYNOMIAL,
-                ),
-                material: 0,
-                flip_normal: false,
-                two_sided: true,
-                primvars: None,
-                displacement: None,
-                motion: None,
-                trim: None,
-                source: PatchSource {
+            .map(|(i, c)| {
+                let cp = std::array::from_fn(|k| {
+                    let (s, t) = ((k % 4) as f64 / 3.0, (k / 4) as f64 / 3.0);
+                    (c[0] * (1.0 - s) + c[1] * s) * (1.0 - t) + (c[2] * (1.0 - s) + c[3] * s) * t
+                });
+                let source = PatchSource {
                     file: "test".into(),
                     line: 0,
                     index: i as u32,
-                },
+                };
+                Patch::new(cp, Patch::POLYNOMIAL, source)
             })
             .collect();
         Scene {

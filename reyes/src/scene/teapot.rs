@@ -1,9 +1,7 @@
 //! The built-in Utah teapot: Martin Newell's 32 bicubic Bezier patches (public domain data),
 //! and the framing (camera, lights, material) used for every geometry-only input.
 
-use super::{
-    Camera, Light, Material, ObjectPatch, Patch, PatchNet, PatchSource, Scene, SurfaceKind,
-};
+use super::{Camera, Light, Material, ObjectPatch, Patch, PatchSource, Scene, SurfaceKind};
 use glam::{DMat4, DVec3};
 
 /// Newell's data is wound so that dPdu x dPdv points out of the teapot when read in a
@@ -94,15 +92,12 @@ pub(crate) fn frame(patches: Vec<ObjectPatch>, flip_normal: bool) -> Scene {
     let patches = patches
         .into_iter()
         .map(|(cp, source)| Patch {
-            net: PatchNet::new(cp.map(|p| view.transform_point3(p)), Patch::POLYNOMIAL),
-            material: 0,
             flip_normal,
-            two_sided: true,
-            primvars: None,
-            displacement: None,
-            motion: None,
-            trim: None,
-            source,
+            ..Patch::new(
+                cp.map(|p| view.transform_point3(p)),
+                Patch::POLYNOMIAL,
+                source,
+            )
         })
         .collect();
     Scene {

@@ -441,24 +441,13 @@ impl Interp {
         let (widths, params): (Vec<Param>, Vec<Param>) = all
             .into_iter()
             .partition(|p| matches!(p.name, "width" | "constantwidth"));
-        let n = params
-            .iter()
-            .find(|p| p.name == "P" || p.name == "Pw")
-            .map(|p| {
-                p.nums(a)
-                    .map(|v| v.len() / if p.name == "P" { 3 } else { 4 })
-            })
-            .transpose()?
-            .ok_or_else(|| a.err("missing the \"P\" parameter"))?;
         // The points are counted from "P" itself: its length must be a whole number of them.
-        if let Some(p) = params.iter().find(|p| p.name == "P" || p.name == "Pw") {
-            let (dim, len) = (if p.name == "P" { 3 } else { 4 }, p.nums(a)?.len());
-            if len % dim != 0 {
-                return Err(a.err(format!(
-                    "\"{}\" needs a multiple of {dim} numbers ({dim} per point), found {len}",
-                    p.name
-                )));
-            }
+        let (n, dim, len) = super::primvars::counted_by_p(a, &params)?;
+        if len % dim != 0 {
+            let name = if dim == 3 { "P" } else { "Pw" };
+            return Err(a.err(format!(
+                "\"{name}\" needs a multiple of {dim} numbers ({dim} per point), found {len}"
+            )));
         }
         if n > MAX_COUNT {
             return Err(a.err(format!(

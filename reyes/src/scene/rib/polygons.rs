@@ -151,15 +151,7 @@ impl Interp {
             "Polygon" => {
                 // The point count comes from "P" itself.
                 let params = a.params()?;
-                let n = params
-                    .iter()
-                    .find(|p| p.name == "P" || p.name == "Pw")
-                    .map(|p| {
-                        p.nums(a)
-                            .map(|v| v.len() / if p.name == "P" { 3 } else { 4 })
-                    })
-                    .transpose()?
-                    .ok_or_else(|| a.err("missing the \"P\" parameter"))?;
+                let (n, _, _) = super::primvars::counted_by_p(a, &params)?;
                 a.pos = 0;
                 Mesh::new(a, &[1], &[n], None)?
             }

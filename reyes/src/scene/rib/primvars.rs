@@ -58,6 +58,22 @@ const TYPES: &[&str] = &[
 ];
 
 /// Parses a declaration (`[class] type[n]`; the class defaults to uniform, as the spec says).
+/// The positions of a primitive whose point count comes from its `"P"` (3 numbers a point) or
+/// `"Pw"` (4) itself (`Polygon`, `Points`): `(points, numbers per point, numbers given)`.
+/// Errors: neither is given.
+pub(super) fn counted_by_p(
+    a: &Args,
+    params: &[Param],
+) -> Result<(usize, usize, usize), SceneError> {
+    let p = params
+        .iter()
+        .find(|p| p.name == "P" || p.name == "Pw")
+        .ok_or_else(|| a.err("missing the \"P\" parameter"))?;
+    let dim = if p.name == "P" { 3 } else { 4 };
+    let len = p.nums(a)?.len();
+    Ok((len / dim, dim, len))
+}
+
 /// Normals `values` (3 numbers each) taken to camera space by the inverse transpose of the
 /// transform's linear part `linear`. Errors: one that leaves the f32 range the renderer shades
 /// in, naming its index.
