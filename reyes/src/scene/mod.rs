@@ -406,6 +406,30 @@ pub(crate) fn rotation(angle_deg: f64, axis: DVec3) -> Option<DMat4> {
     Some(DMat4::from_axis_angle(axis / len, angle_deg.to_radians()))
 }
 
+/// RenderMan's `Skew angle dx1 dy1 dz1 dx2 dy2 dz2`: the shear along `d2` that turns `d1` by
+/// `angle_deg` degrees towards `d2` (points move parallel to `d2` in proportion to their
+/// component along `d1`'s part perpendicular to `d2`), as BMRT and Pixie build it: with `n` the
+/// unit `d2` and `p` the unit part of `d1` across it, `x -> x + s (p . x) n`, `s = cot(theta -
+/// angle) - cot(theta)`, `theta` the angle from `d2` to `d1`. `None` when `d2` is zero, `d1`
+/// has no part across `d2`, a value is not finite, or the turn would reach (within 1e-9 of
+/// `d1`'s length) or pass `d2`.
+pub(crate) fn skew(angle_deg: f64, d1: DVec3, d2: DVec3) -> Option<DMat4> {
+    let n = d2.try_normalize()?;
+    let across = d1 - d1.dot(n) * n;
+    let p = across.try_normalize()?;
+    let (a_perp, a_par) = (d1.dot(p), d1.dot(n));
+    let (sin, cos) = angle_deg.to_radians().sin_cos();
+    let (rx, ry) = (a_perp * cos - a_par * sin, a_perp * sin + a_par * cos);
+    // Reaching d2 within round-off (cos 90 degrees is 6e-17, not 0) is reaching it.
+    if !(rx > 1e-9 * d1.length()) || !ry.is_finite() {
+        return None;
+    }
+    let s = ry / rx - a_par / a_perp;
+    // Column-vector form: I + s n p^T.
+    let shear = glam::DMat3::from_cols(p.x * s * n, p.y * s * n, p.z * s * n);
+    Some(DMat4::from_mat3(glam::DMat3::IDENTITY + shear))
+}
+
 /// Evaluates a bicubic Bezier patch (cp[4*v + u]) and its derivatives at (u, v).
 /// Used by tests and handy for renderer-side checks.
 pub fn eval_bezier(cp: &[DVec3; 16], u: f64, v: f64) -> (DVec3, DVec3, DVec3) {

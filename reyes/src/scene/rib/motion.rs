@@ -29,6 +29,7 @@ const TRANSFORMS: &[&str] = &[
     "Translate",
     "Rotate",
     "Scale",
+    "Skew",
     "ConcatTransform",
     "Transform",
     "Identity",

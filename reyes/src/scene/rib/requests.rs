@@ -35,6 +35,7 @@ pub(super) const KNOWN: &[&str] = &[
     "Translate",
     "Rotate",
     "Scale",
+    "Skew",
     "WorldBegin",
     "WorldEnd",
     "FrameBegin",
@@ -115,9 +116,8 @@ impl Interp {
                 self.camera_request(req, a)
             }
             "CoordinateSystem" | "CoordSysTransform" => self.coordinate_system(req, a),
-            "Identity" | "Transform" | "ConcatTransform" | "Translate" | "Rotate" | "Scale" => {
-                self.transform(req, a)
-            }
+            "Identity" | "Transform" | "ConcatTransform" | "Translate" | "Rotate" | "Scale"
+            | "Skew" => self.transform(req, a),
             "FrameBegin" => self.frame_begin(req, a),
             "FrameEnd" => self.frame_end(req, a),
             "WorldBegin" => self.world_begin(req, a),
@@ -267,7 +267,7 @@ impl Interp {
         Ok(())
     }
 
-    /// Identity, Transform, ConcatTransform, Translate, Rotate, Scale.
+    /// Identity, Transform, ConcatTransform, Translate, Rotate, Scale, Skew.
     fn transform(&mut self, req: &Request, a: &mut Args) -> Result<(), SceneError> {
         let m = match req.name.as_str() {
             "Identity" => {
@@ -298,6 +298,18 @@ impl Interp {
                 a.done()?;
                 crate::scene::rotation(v[0], DVec3::new(v[1], v[2], v[3]))
                     .ok_or_else(|| a.err("the rotation axis is zero"))?
+            }
+            "Skew" => {
+                let v = a.fixed(7, "angle and two vectors")?;
+                a.done()?;
+                let (d1, d2) = (DVec3::new(v[1], v[2], v[3]), DVec3::new(v[4], v[5], v[6]));
+                crate::scene::skew(v[0], d1, d2).ok_or_else(|| {
+                    a.err(format!(
+                        "no shear turns ({d1}) by {} degrees towards ({d2}): the second vector \
+                         is zero, the first lies along it, or the turn reaches it",
+                        v[0]
+                    ))
+                })?
             }
             _ => {
                 let v = a.fixed(3, "the scale factors")?;

@@ -216,3 +216,32 @@ fn mirrored_patch_keeps_its_outside() {
         "z mirror mirrors it"
     );
 }
+
+/// `Skew 45` of y towards x shears x by y (BMRT's and Pixie's matrix): the quad's corner at
+/// y = 1 moves by +1 in x; other transforms still apply around it. A skew that would reach
+/// its second vector, or of parallel vectors, is an error at its line.
+#[test]
+fn skew_shears_along_the_second_vector() {
+    let s = parse(&world(&format!(
+        "Translate 0 0 5\nSkew 45 0 1 0 1 0 0\n{QUAD}"
+    )));
+    let cp = s.patches[0].cp();
+    assert!(close(cp[0], DVec3::new(0.0, 0.0, 5.0)), "{:?}", cp[0]);
+    assert!(close(cp[3], DVec3::new(1.0, 0.0, 5.0)), "{:?}", cp[3]);
+    assert!(close(cp[12], DVec3::new(1.0, 1.0, 5.0)), "{:?}", cp[12]);
+    assert!(close(cp[15], DVec3::new(2.0, 1.0, 5.0)), "{:?}", cp[15]);
+    // Turning y by -45 degrees (away from x) shears the other way.
+    let s = parse(&world(&format!("Skew -45 0 1 0 1 0 0\n{QUAD}")));
+    assert!(close(s.patches[0].cp()[12], DVec3::new(-1.0, 1.0, 0.0)));
+    for bad in [
+        "Skew 90 0 1 0 1 0 0",
+        "Skew 10 1 0 0 2 0 0",
+        "Skew 10 0 1 0 0 0 0",
+    ] {
+        let e = err(&world(&format!("{bad}\n{QUAD}")));
+        assert!(
+            e.starts_with("t.rib:2:") && e.contains("no shear"),
+            "{bad}: {e}"
+        );
+    }
+}
