@@ -56,15 +56,15 @@ const P_SPIN: u32 = 1u;
 const P_PROBE: u32 = 2u;
 const P_POLICY: u32 = 3u;      // 0 = priority order, 1 = oldest batch first (FIFO)
 const P_OUTBOX_STRIDE: u32 = 4u;
-const P_BATCH_STEPS: u32 = 5u;
 const P_IDLE_BACKOFF: u32 = 6u; // longest pause of an idle workgroup between polls (loop trips)
 fn q_cap(q: u32) -> u32 { return params[8u + q * 4u]; }
 fn q_slot_base(q: u32) -> u32 { return params[9u + q * 4u]; }
 fn q_flag_base(q: u32) -> u32 { return params[10u + q * 4u]; }
 fn prio(i: u32) -> u32 { return params[8u + NQ * 4u + i]; }
 fn ob_off(q: u32, t: u32) -> u32 { return params[8u + NQ * 5u + q * NQ + t]; }
-// Most items a batch of q claims; host twin: the outbox sizing in Megakernel::new.
-fn batch_max(q: u32) -> u32 { return min((256u / THREADS[q]) * params[P_BATCH_STEPS], MAX_BATCH); }
+// Most items a batch of q claims (host twin: `batch_items` in megakernel/mod.rs, steps x
+// items per step); the outbox and the queues' slack are sized for it.
+fn batch_max(q: u32) -> u32 { return params[11u + q * 4u]; }
 // Items the outbox part (q, t) holds: a batch's worst-case output to t.
 fn ob_cap(q: u32, t: u32) -> u32 { return batch_max(q) * EMITS[q * NQ + t]; }
 

@@ -79,6 +79,20 @@ fn stress_configs() -> Vec<(&'static str, MegakernelConfig)> {
             },
         ),
         (
+            // Batches of a different size per procedure (the outbox parts and the queues'
+            // slack follow each source's own batch), tiny queues that grow, short launches.
+            "steps per procedure, tiny queues, short launches",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(3),
+                procedure_batch_steps: vec![("leaf".into(), 3), ("branch".into(), 1)],
+                batch_steps: 2,
+                max_iterations: 24,
+                spin_limit: 1,
+                initial_capacity: 16,
+                ..base.clone()
+            },
+        ),
+        (
             // Launches end at their loop bound with room to spare: the live items go through the
             // host compaction, not the growth one.
             "roomy queues, very short launches",

@@ -127,6 +127,13 @@ pub struct Cli {
     #[arg(long, value_parser = value_parser!(u32).range(1..=64), help_heading = "Scheduler")]
     pub batch_steps: Option<u32>,
 
+    /// Megakernel steps per batch of named procedures, overriding --batch-steps for them:
+    /// `NAME=STEPS`, repeated or comma-separated (e.g. `diceshade=4,dicesmall=2`) [default: the
+    /// workload's; none for the trees and BFS].
+    #[arg(long, value_delimiter = ',', value_parser = parse_procedure_steps,
+          help_heading = "Scheduler")]
+    pub procedure_steps: Vec<(String, u32)>,
+
     /// Longest pause of an idle megakernel workgroup between polls, in loop trips (0: none).
     #[arg(long, default_value_t = 64, value_parser = value_parser!(u32).range(0..=30000),
           help_heading = "Scheduler")]
@@ -307,6 +314,8 @@ impl Cli {
         GpuConfig {
             workgroups: self.workgroups,
             batch_steps: self.batch_steps,
+            procedure_steps: (!self.procedure_steps.is_empty())
+                .then(|| self.procedure_steps.clone()),
             idle_backoff: self.idle_backoff,
             capacity: self.capacity,
             turn_anatomy: self.turn_anatomy,
@@ -394,4 +403,20 @@ mod tests {
         let s = parse(&["--suite", "--out", "d", "--size", "small"]).unwrap();
         assert_eq!((s.size, s.out), (Scale::Small, Some(PathBuf::from("d"))));
     }
+}
+
+/// `NAME=STEPS` of `--procedure-steps`: a procedure name and its steps per batch (1..=64).
+fn parse_procedure_steps(s: &str) -> Result<(String, u32), String> {
+    let (name, steps) = s
+        .split_once('=')
+        .ok_or_else(|| format!("`{s}`: expected NAME=STEPS, e.g. diceshade=4"))?;
+    let steps: u32 = steps
+        .parse()
+        .map_err(|e| format!("`{s}`: steps `{steps}` is not a number ({e})"))?;
+    if !(1..=64).contains(&steps) || name.is_empty() {
+        return Err(format!(
+            "`{s}`: expected a procedure name and steps in 1..=64"
+        ));
+    }
+    Ok((name.to_string(), steps))
 }

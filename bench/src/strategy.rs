@@ -127,6 +127,10 @@ pub struct GpuConfig {
     /// Megakernel workgroup steps per claimed batch (at least 1); `None`: the workload's choice
     /// (1 but for Reyes frames: `reyes::gpu_render::megakernel_batch_steps`).
     pub batch_steps: Option<u32>,
+    /// Steps per batch of named procedures (`MegakernelConfig::procedure_batch_steps`);
+    /// `None`: the workload's choice (none but for Reyes frames:
+    /// `reyes::gpu_render::megakernel_procedure_steps`).
+    pub procedure_steps: Option<Vec<(String, u32)>>,
     /// Longest pause of an idle megakernel workgroup (`MegakernelConfig::idle_backoff`).
     pub idle_backoff: u32,
     /// How the queues hold items (`MegakernelConfig::item_layout`); `None`: `ItemLayout::for_program`.
@@ -150,6 +154,7 @@ impl Default for GpuConfig {
         GpuConfig {
             workgroups: None,
             batch_steps: None,
+            procedure_steps: None,
             idle_backoff: MegakernelConfig::default().idle_backoff,
             item_layout: None,
             direct_enqueue: None,
@@ -185,6 +190,7 @@ pub fn compile(
                     .map_or(Workgroups::Probe { max: 4096 }, Workgroups::Fixed),
                 policy: policy.queue_policy(),
                 batch_steps: config.batch_steps.unwrap_or(1),
+                procedure_batch_steps: config.procedure_steps.clone().unwrap_or_default(),
                 idle_backoff: config.idle_backoff,
                 item_layout: config.item_layout,
                 direct_enqueue: config.direct_enqueue,

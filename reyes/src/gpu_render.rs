@@ -29,6 +29,14 @@ pub fn megakernel_batch_steps(gpu: &Gpu) -> u32 {
     if gpu.is_lavapipe() { 1 } else { 2 }
 }
 
+/// Steps per megakernel batch of named Reyes procedures on `gpu`, overriding
+/// [`megakernel_batch_steps`] for them (`MegakernelConfig::procedure_batch_steps`). A DiceShade
+/// batch of one grid (256 threads) pays a whole turn's scheduling for one item.
+pub fn megakernel_procedure_steps(gpu: &Gpu) -> Vec<(String, u32)> {
+    let _ = gpu;
+    Vec::new()
+}
+
 /// Device features the pipeline needs: 64-bit atomicMax for the depth-and-colour samples.
 pub fn required_features() -> wgpu::Features {
     wgpu::Features::SHADER_INT64 | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX
@@ -331,6 +339,7 @@ impl GpuRenderer {
                 scheduler::MegakernelConfig {
                     initial_capacity: INITIAL_CAPACITY,
                     batch_steps: megakernel_batch_steps(gpu),
+                    procedure_batch_steps: megakernel_procedure_steps(gpu),
                     ..Default::default()
                 },
             )?,

@@ -46,7 +46,6 @@ pub const P_SPIN: usize = 1;
 pub const P_PROBE: usize = 2;
 pub const P_POLICY: usize = 3;
 pub const P_OUTBOX_STRIDE: usize = 4;
-pub const P_BATCH_STEPS: usize = 5;
 pub const P_IDLE_BACKOFF: usize = 6;
 pub const P_QUEUES: usize = 8;
 
@@ -106,7 +105,6 @@ mod tests {
             ("G_AN", G_AN),
             ("AN_WORDS", AN_WORDS),
             ("P_MAX_ITERS", P_MAX_ITERS),
-            ("P_BATCH_STEPS", P_BATCH_STEPS),
             ("P_IDLE_BACKOFF", P_IDLE_BACKOFF),
         ] {
             assert_eq!(wgsl_const(src, name), Some(host), "{name}");

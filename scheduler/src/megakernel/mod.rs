@@ -4,6 +4,7 @@
 //! grows a queue that lacked room, and launches again. Protocol: `docs/scheduler.md`.
 
 pub mod anatomy;
+mod claim;
 mod compact;
 pub(crate) mod layout;
 pub(crate) mod local;
@@ -70,8 +71,16 @@ pub struct MegakernelConfig {
     pub workgroups: Workgroups,
     /// Which queue a workgroup takes its next batch from (default: later procedures first).
     pub policy: QueuePolicy,
-    /// Workgroup steps per claimed batch (a step runs 256 / threads_per_item items).
+    /// Workgroup steps per claimed batch (a step runs 256 / threads_per_item items), for every
+    /// procedure not named in `procedure_batch_steps`.
     pub batch_steps: u32,
+    /// Workgroup steps per batch of the procedures named here (`(name, steps)`), overriding
+    /// `batch_steps` for them: a batch's turn costs the same scheduling atomics however many
+    /// items it holds, so a procedure of few items a step (one grid of 256 threads) amortizes
+    /// them over more steps, while one of many small items keeps batches short and its
+    /// children published early. Default empty. A name that is not a procedure of the program
+    /// is an error of [`Megakernel::new`].
+    pub procedure_batch_steps: Vec<(String, u32)>,
     /// Loop turns per workgroup per launch; far below lavapipe's 65,535-iteration cut. On
     /// lavapipe that cut counts every loop iteration nested in the persistent loop, bodies'
     /// loops included, so there it is lowered to [`LAVAPIPE_MAX_ITERATIONS`].
@@ -150,6 +159,7 @@ impl Default for MegakernelConfig {
             workgroups: Workgroups::Probe { max: 4096 },
             policy: QueuePolicy::Priority(Vec::new()),
             batch_steps: 1,
+            procedure_batch_steps: Vec::new(),
             max_iterations: 16_384,
             spin_limit: 4096,
             idle_backoff: 64,
@@ -179,6 +189,8 @@ pub struct Megakernel {
     outbox_stride: u32,
     ob_off: Vec<u32>,
     priority: Vec<u32>,
+    /// Most items a batch of each queue holds ([`batch_items`]).
+    batch: Vec<u32>,
     /// Buffers of the last run, reused when the next run needs the same layout.
     cache: std::sync::Mutex<Option<DeviceQueues>>,
     /// The mapped buffer ctrl is read back through after each launch, kept between runs.
@@ -247,7 +259,8 @@ impl Megakernel {
             return Err(RunError::Program("spin_limit must be 1..=30000".into()));
         }
         let nq = program.queue_count();
-        let priority = priority_order(program, &config.policy)?;
+        let priority = claim::priority_order(program, &config.policy)?;
+        let batch = claim::batch_items(program, &config)?;
         // Outbox: per source queue, room for a whole batch's worst-case output to each target.
         let mut ob_off = vec![0u32; nq * nq];
         let mut outbox_stride = 1;
@@ -256,7 +269,7 @@ impl Megakernel {
         let mut es_off = vec![0u32; nq * nq];
         let mut emit_slots = 1;
         for (q, p) in program.procs.iter().enumerate() {
-            let batch = (p.items_per_step * config.batch_steps.max(1)).min(MAX_BATCH);
+            let batch = batch[q];
             let (mut off, mut es) = (0, 0);
             for t in 0..nq {
                 ob_off[q * nq + t] = off;
@@ -351,6 +364,7 @@ impl Megakernel {
             outbox_stride,
             ob_off,
             priority,
+            batch,
             cache: Default::default(),
             readback: Default::default(),
             compaction: DeviceCompaction::new(gpu)?,
@@ -446,12 +460,12 @@ impl Megakernel {
         p[P_SPIN] = self.config.spin_limit;
         p[P_POLICY] = matches!(self.config.policy, QueuePolicy::Fifo) as u32;
         p[P_OUTBOX_STRIDE] = self.outbox_stride;
-        p[P_BATCH_STEPS] = self.config.batch_steps.max(1);
         p[P_IDLE_BACKOFF] = self.config.idle_backoff;
         for q in 0..nq {
             p[P_QUEUES + q * 4] = layout.capacity[q];
             p[P_QUEUES + q * 4 + 1] = layout.slot_base[q];
             p[P_QUEUES + q * 4 + 2] = layout.flag_base[q];
+            p[P_QUEUES + q * 4 + 3] = self.batch[q];
             p[P_QUEUES + nq * 4 + q] = self.priority[q];
         }
         p[P_QUEUES + nq * 5..].copy_from_slice(&self.ob_off);
@@ -772,9 +786,7 @@ impl Megakernel {
                 let promised: u64 = (0..nq)
                     .map(|q| {
                         let p = &self.program.procs[q];
-                        let batch = (p.items_per_step * self.config.batch_steps.max(1))
-                            .min(MAX_BATCH) as u64;
-                        workgroups as u64 * batch * p.emits[t] as u64
+                        workgroups as u64 * self.batch[q] as u64 * p.emits[t] as u64
                     })
                     .sum();
                 *need = (*need).max(stats.executed[t] + promised);
@@ -790,25 +802,4 @@ impl Megakernel {
         *self.readback.lock().unwrap() = Some(rb);
         Ok(stats)
     }
-}
-
-fn priority_order(program: &Program, policy: &QueuePolicy) -> Result<Vec<u32>, RunError> {
-    let nq = program.queue_count();
-    let mut order = Vec::new();
-    if let QueuePolicy::Priority(names) = policy {
-        for n in names {
-            let q = program.index_of(n).ok_or_else(|| {
-                RunError::Program(format!("priority names unknown procedure `{n}`"))
-            })?;
-            if !order.contains(&(q as u32)) {
-                order.push(q as u32);
-            }
-        }
-    }
-    for q in (0..nq as u32).rev() {
-        if !order.contains(&q) {
-            order.push(q);
-        }
-    }
-    Ok(order)
 }

@@ -59,12 +59,8 @@ impl Megakernel {
         let nq = seeded.len();
         let slack: Vec<u64> = (0..nq)
             .map(|t| {
-                let worst = (self.program.procs.iter())
-                    .map(|p| {
-                        let batch =
-                            (p.items_per_step * self.config.batch_steps.max(1)).min(MAX_BATCH);
-                        batch as u64 * p.emits[t] as u64
-                    })
+                let worst = (self.program.procs.iter().zip(&self.batch))
+                    .map(|(p, &batch)| batch as u64 * p.emits[t] as u64)
                     .max()
                     .unwrap_or(0);
                 workgroups as u64 * worst
