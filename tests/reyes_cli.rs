@@ -451,20 +451,23 @@ fn frame_sequences_write_one_image_per_frame() {
     );
     // Several frames need a pattern for --stats (which the GPU path writes: both fail before
     // the GPU is opened); a missing folder fails before rendering.
-    for (args, expected) in [
+    // The first is a usage error (exit 2, as README says of usage errors), the second not.
+    for (args, expected, code) in [
         (
             &["--stats", "s.json"][..],
             "--stats: several frames are rendered",
+            2,
         ),
         (
             &["--cpu", "-o", "nowhere/x.png"][..],
             "the folder nowhere does not exist",
+            1,
         ),
     ] {
         let mut all = vec![scene.as_str(), "--frames", "1-2"];
         all.extend_from_slice(args);
-        let (ok, err) = reyes(&dir, &all);
-        assert!(!ok && err.contains(expected), "{args:?}: {err}");
+        let (got, err) = render_code(&dir, &all);
+        assert!(got == code && err.contains(expected), "{args:?}: {got} {err}");
     }
     assert!(!dir.join("s.json").exists() && !dir.join("teapot.0001.png").exists());
 }

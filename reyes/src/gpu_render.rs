@@ -30,11 +30,17 @@ pub fn megakernel_batch_steps(gpu: &Gpu) -> u32 {
 }
 
 /// Steps per megakernel batch of named Reyes procedures on `gpu`, overriding
-/// [`megakernel_batch_steps`] for them (`MegakernelConfig::procedure_batch_steps`). A DiceShade
-/// batch of one grid (256 threads) pays a whole turn's scheduling for one item.
+/// [`megakernel_batch_steps`] for them (`MegakernelConfig::procedure_batch_steps`): on GPUs 8 for
+/// DiceShade and DiceSmall, whose step holds one grid (four small ones), so that a turn's
+/// scheduling is paid once per 8 grids; Bound and Split keep 2, which publishes their pieces
+/// early (4 for Bound made Killeroo slower). H200, Killeroo at 1920x1080: 1.768 -> 1.675 ms,
+/// teapot 1.150 -> 1.120 (docs/results.md, 2026-12-02, "Batch steps per procedure"). None on
+/// lavapipe ([`megakernel_batch_steps`]).
 pub fn megakernel_procedure_steps(gpu: &Gpu) -> Vec<(String, u32)> {
-    let _ = gpu;
-    Vec::new()
+    if gpu.is_lavapipe() {
+        return Vec::new();
+    }
+    vec![("diceshade".into(), 8), ("dicesmall".into(), 8)]
 }
 
 /// Device features the pipeline needs: 64-bit atomicMax for the depth-and-colour samples.

@@ -185,10 +185,13 @@ pub enum CliError {
 
 impl CliError {
     /// The exit status of this error: 2 for a usage error (a `--frames` selection that names
-    /// none of the file's frames), 1 for the rest (bad input, a failed render or write).
+    /// none of the file's frames, a `--stats`-like name without a frame pattern when several
+    /// frames are rendered), 1 for the rest (bad input, a failed render or write).
     pub fn exit_code(&self) -> u8 {
         match self {
-            CliError::Conflict { .. } | CliError::NoFrameSelected { .. } => 2,
+            CliError::Conflict { .. }
+            | CliError::NoFrameSelected { .. }
+            | CliError::UnnumberedOutput { .. } => 2,
             _ => 1,
         }
     }
