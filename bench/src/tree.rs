@@ -15,6 +15,10 @@ impl ScheduledProblem for TreeParams {
         TreeParams::describe(self)
     }
 
+    fn procedure_steps(gpu: &Gpu) -> Vec<(String, u32)> {
+        workloads::tree::megakernel_procedure_steps(gpu)
+    }
+
     fn reference(&self) -> TreeResult {
         TreeParams::reference(self)
     }

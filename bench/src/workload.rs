@@ -91,6 +91,12 @@ pub trait ScheduledProblem: Clone {
     ) -> Result<(RunStats, Self::Output), RunError>;
     /// Points `run` at this problem when its compiled program serves it unchanged (so the
     /// schedulers compiled for it are kept); false (the default) builds a new run.
+    /// The workload's megakernel batch steps per procedure on `gpu`
+    /// (`GpuConfig::procedure_steps` when the command line gives none); default none.
+    fn procedure_steps(_gpu: &Gpu) -> Vec<(String, u32)> {
+        Vec::new()
+    }
+
     fn retarget(&self, _run: &mut Self::Run) -> bool {
         false
     }
@@ -243,7 +249,10 @@ impl<P: ScheduledProblem> Workload for ProblemWorkload<P> {
                 let capacity = self.config.capacity.unwrap_or(p.capacity(reference));
                 let have = |s: &&(String, u32, Scheduler)| s.0 == name && s.1 == capacity;
                 if !schedulers.iter().any(|s| have(&s)) {
-                    let s = compile(gpu, P::program(run), strategy, &self.config, capacity)?;
+                    let mut config = self.config.clone();
+                    config.procedure_steps = (config.procedure_steps.take())
+                        .or_else(|| Some(P::procedure_steps(gpu)));
+                    let s = compile(gpu, P::program(run), strategy, &config, capacity)?;
                     schedulers.push((name.clone(), capacity, s));
                 }
                 let scheduler = &schedulers.iter().find(have).unwrap().2;
