@@ -36,6 +36,10 @@ impl ScheduledProblem for BfsParams {
         Ok(self.clone())
     }
 
+    fn procedure_steps(gpu: &Gpu) -> Vec<(String, u32)> {
+        workloads::bfs::megakernel_procedure_steps(gpu)
+    }
+
     fn describe(&self) -> String {
         BfsParams::describe(self)
     }

@@ -384,6 +384,19 @@ impl BfsRun {
     }
 }
 
+/// Megakernel steps per batch of both BFS procedures on `gpu`
+/// (`MegakernelConfig::procedure_batch_steps`): 16, i.e. batches of up to 512 items of 8 threads.
+/// A BFS level is wide and its items short, so the turn's claim and publish, not the work, set
+/// the pace at one step a batch. H200, scale 22 (docs/results.md, 2026-12-02, "Batch steps per
+/// procedure"): 9.19 ms at 1 step, 4.17 at 4, 3.61 at 8, 3.38 at 16 (multipass-host 5.27).
+/// None on lavapipe, whose loop limiter counts a batch's steps.
+pub fn megakernel_procedure_steps(gpu: &scheduler::Gpu) -> Vec<(String, u32)> {
+    if gpu.is_lavapipe() {
+        return Vec::new();
+    }
+    vec![("bfs_vertex".into(), 16), ("bfs_edges".into(), 16)]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
