@@ -180,8 +180,8 @@ fn pipelined(
     occlusion: bool,
     (angles, centre): (&[f64], Option<glam::DVec3>),
 ) -> (RealtimeRenderer, Vec<RealtimeFrame>) {
-    let mut r = RealtimeRenderer::new(gpu(), scene, &with(o, occlusion), kind, Pixels::Float)
-        .unwrap();
+    let mut r =
+        RealtimeRenderer::new(gpu(), scene, &with(o, occlusion), kind, Pixels::Float).unwrap();
     assert_eq!(r.not_pipelined(), None);
     assert_eq!(r.occlusion(), occlusion, "{kind:?}");
     let centre = centre.unwrap_or(r.centre());
@@ -207,14 +207,24 @@ fn pipelined_frames_that_cull_render_the_same_bits() {
     let o = small(64, 48);
     for kind in [StrategyKind::Multipass, StrategyKind::Megakernel] {
         for (name, s, angles) in [
-            ("teapot", scene::builtin_teapot(), [0.0, 30.0, 60.0, 90.0, 120.0]),
+            (
+                "teapot",
+                scene::builtin_teapot(),
+                [0.0, 30.0, 60.0, 90.0, 120.0],
+            ),
             ("stacked", stack.clone(), [0.0, 1.0, 2.0, 3.0, 4.0]),
         ] {
             let (mut r, on) = pipelined(&s, &o, kind, true, (&angles, None));
             let (_, off) = pipelined(&s, &o, kind, false, (&angles, None));
             for (i, (a, b)) in on.iter().zip(&off).enumerate() {
-                assert!(image(a) == image(b), "{name} {kind:?} frame {i}: image changed");
-                assert!(image(a).covered_pixels() > 0, "{name} {kind:?} frame {i}: empty");
+                assert!(
+                    image(a) == image(b),
+                    "{name} {kind:?} frame {i}: image changed"
+                );
+                assert!(
+                    image(a).covered_pixels() > 0,
+                    "{name} {kind:?} frame {i}: empty"
+                );
                 assert_eq!(b.counters[C_CULL_OCCLUDED], 0, "{name} {kind:?} frame {i}");
                 eprintln!(
                     "{name} {kind:?} frame {i}: micropolygons {} (off {}), culled {}{}",
@@ -236,10 +246,16 @@ fn pipelined_frames_that_cull_render_the_same_bits() {
             let t = orbit_transform(r.centre(), angles[1].to_radians());
             let again = r.render_transforms(gpu(), &[t; 3], &NoProgress).unwrap();
             for (i, f) in again.iter().enumerate() {
-                assert!(image(f) == image(&off[1]), "{name} {kind:?} small queues, frame {i}");
+                assert!(
+                    image(f) == image(&off[1]),
+                    "{name} {kind:?} small queues, frame {i}"
+                );
             }
             if kind == StrategyKind::Multipass {
-                assert!(again[0].rerendered.is_some(), "{name}: one round cannot hold it");
+                assert!(
+                    again[0].rerendered.is_some(),
+                    "{name}: one round cannot hold it"
+                );
             }
         }
     }
@@ -272,14 +288,21 @@ fn pipelined_stacked_frames_do_only_the_front_layers_work() {
                 // Rendered again without culling, so its counters are the whole frame's: on
                 // lavapipe the megakernel's launch of the first frame (every layer) reaches
                 // its loop bound, and a loaded CPU adapter may cause a scheduling event.
-                assert!(kind == StrategyKind::Megakernel, "{kind:?} frame {i}: {why}");
+                assert!(
+                    kind == StrategyKind::Megakernel,
+                    "{kind:?} frame {i}: {why}"
+                );
                 eprintln!("{kind:?} frame {i}: rendered again: {why}");
                 continue;
             }
             let (mp, culled) = (f.counters[C_MICROPOLYGONS], f.counters[C_CULL_OCCLUDED]);
             eprintln!("{kind:?} frame {i}: micropolygons {mp}, culled {culled}");
             if i == 0 {
-                assert_eq!((mp, culled), (off[0].counters[C_MICROPOLYGONS], 0), "{kind:?}");
+                assert_eq!(
+                    (mp, culled),
+                    (off[0].counters[C_MICROPOLYGONS], 0),
+                    "{kind:?}"
+                );
                 continue;
             }
             assert_eq!(mp, alone[i].counters[C_MICROPOLYGONS], "{kind:?} frame {i}");
@@ -287,7 +310,13 @@ fn pipelined_stacked_frames_do_only_the_front_layers_work() {
             checked += 1;
         }
         assert!(checked >= 3, "{kind:?}: only {checked} frames pipelined");
-        let (mp_on, mp_off) = (on[4].counters[C_MICROPOLYGONS], off[4].counters[C_MICROPOLYGONS]);
-        assert!(mp_off >= mp_on * layers as u64 * 9 / 10, "{mp_off} vs {mp_on}");
+        let (mp_on, mp_off) = (
+            on[4].counters[C_MICROPOLYGONS],
+            off[4].counters[C_MICROPOLYGONS],
+        );
+        assert!(
+            mp_off >= mp_on * layers as u64 * 9 / 10,
+            "{mp_off} vs {mp_on}"
+        );
     }
 }

@@ -267,7 +267,12 @@ impl RealtimeRenderer {
         for _ in 0..IN_FLIGHT {
             let orbit = gpu.storage_buffer("orbit", (size_of::<Orbit>() / 4) as u64)?;
             let roots = gpu.upload("roots", &vec![PatchItem::zeroed(); n as usize])?;
-            let buffers = [&orbit, scene_buffers.objects(), &roots, scene_buffers.visible()];
+            let buffers = [
+                &orbit,
+                scene_buffers.objects(),
+                &roots,
+                scene_buffers.visible(),
+            ];
             let entries: Vec<wgpu::BindGroupEntry> = ([0, 1, 2, 10].into_iter().zip(buffers))
                 .map(|(binding, b)| wgpu::BindGroupEntry {
                     binding,

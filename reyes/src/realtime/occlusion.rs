@@ -102,7 +102,14 @@ impl Culling {
             }
             enc.copy_buffer_to_buffer(uniform, 0, frame, 0, uniform.size());
             let sched = &renderer.scheduler;
-            rec.record(sched, enc, seeds, Some(scene_bind), status, k as u64 * words)?;
+            rec.record(
+                sched,
+                enc,
+                seeds,
+                Some(scene_bind),
+                status,
+                k as u64 * words,
+            )?;
         }
         Ok(())
     }
