@@ -779,6 +779,7 @@ mod tests {
             ("m", std::mem::offset_of!(Orbit, m)),
             ("patches", std::mem::offset_of!(Orbit, patches)),
             ("row", std::mem::offset_of!(Orbit, row)),
+            ("history", std::mem::offset_of!(Orbit, history)),
         ] {
             let got = l
                 .members
