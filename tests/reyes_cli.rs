@@ -769,11 +769,16 @@ fn bench_prints_its_report_as_json() {
         "wall_minus_gpu_ms",
         "fps",
         "micropolygons",
+        "occlusion",
+        "occluded",
         "rerendered",
         "per_frame",
     ] {
         assert!(v.get(key).is_some(), "no `{key}` in {out}");
     }
+    // `--occlusion auto` (the default) does not cull the shallow teapot.
+    assert_eq!(v["occlusion"], false);
+    assert_eq!(v["occluded"]["max"], 0.0);
     assert_eq!(v["scene"], "teapot");
     // The default strategy is chosen per adapter: multipass on a CPU adapter (lavapipe).
     let cpu = v["adapter"].as_str().unwrap().contains("llvmpipe");
@@ -797,6 +802,7 @@ fn bench_prints_its_report_as_json() {
     let rows = v["per_frame"].as_array().unwrap();
     assert_eq!(rows.len(), 3);
     assert_eq!(rows[1]["angle_deg"], 120.0);
+    assert_eq!(rows[1]["occluded"], 0);
     let (code, out, err) = reyes_any(
         &dir,
         &[
@@ -814,8 +820,36 @@ fn bench_prints_its_report_as_json() {
         ],
     );
     assert_eq!(code, 0, "{err}");
-    for label in ["wall ms", "GPU ms", "fps", "re-rendered"] {
+    for label in ["wall ms", "GPU ms", "fps", "re-rendered", "occluded"] {
         assert!(out.contains(label), "no `{label}` in the table: {out}");
+    }
+    // A stacked scene with --occlusion on and off: frames after the first cull the layers
+    // behind the front one, with the same image (tests/reyes_occlusion.rs); off culls nothing.
+    let rib = dir.join("stacked.rib");
+    std::fs::write(&rib, reyes::scene::stacked::stacked_rib(8, 2, 32, 24)).unwrap();
+    for (mode, culls) in [("on", true), ("off", false)] {
+        let rib = rib.to_str().unwrap();
+        let args = [
+            "bench",
+            rib,
+            "--frames",
+            "3",
+            "--warmup",
+            "0",
+            "--json",
+            "--occlusion",
+        ];
+        let (code, out, err) = reyes_any(&dir, &[&args[..], &[mode][..]].concat());
+        assert_eq!(code, 0, "{err}");
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        assert_eq!(v["occlusion"], culls, "--occlusion {mode}");
+        let rows = v["per_frame"].as_array().unwrap();
+        assert_eq!(rows[0]["occluded"], 0, "no history in the first frame");
+        let culled = rows[2]["occluded"].as_u64().unwrap();
+        match culls {
+            true => assert!(culled >= 7 * 4, "--occlusion on culled {culled}: {out}"),
+            false => assert_eq!(culled, 0),
+        }
     }
 }
 

@@ -32,6 +32,20 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
     bound_shared[base + t] = vec4<f32>(s, p.z, select(0.0, 1.0, front) + select(0.0, 2.0, back));
     workgroupBarrier();
     if !inv.live || t != 0u { return; }
+    // Pipelined frames that cull from the previous frame (roots tagged by make_roots in
+    // roots.wgsl; docs/reyes.md, *Occlusion culling*) seed every root in both phases. Phase 1
+    // (no pyramid yet) takes the roots some piece of which passed the occlusion test last frame
+    // and drops the others here; phase 2 (OCCLUSION_TEST) takes the others, with the test, and
+    // only tests phase 1's roots again, at the root (`retest`), which draws and counts nothing.
+    // The next frame's phase 1 takes the roots of which some piece was diced in phase 2 and
+    // those of phase 1 that passed the test again (`visible`, mark_visible). Any split of the
+    // roots between the phases gives the same image.
+    let history = (item.rates & ROOT_HISTORY) != 0u;
+    let root = (item.depth & 255u) == 0u;
+    let was_visible = (item.rates & ROOT_WAS_VISIBLE) != 0u;
+    let testing = frame.occlusion == OCCLUSION_TEST;
+    if history && root && !testing && !was_visible { return; }
+    let retest = history && root && testing && was_visible;
     // From here on cp holds the Euclidean points, and w their weights (rational only).
     var w: array<f32, 16>;
     if rational {
@@ -67,14 +81,14 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
         ucoc = u[1].z;
     }
     if uz.y < frame.near || uz.x > frame.far {
-        atomicAdd(&counters[C_CULL_CLIP], 1u);
+        count_cull(C_CULL_CLIP, retest);
         return;
     }
     // (A displaced surface may face the eye where its patch does not; a moving one may turn.)
     var all_back = one_sided && r == 0.0 && !moving;
     for (var k = 0u; k < 16u; k++) { all_back = all_back && pts[k].w >= 2.0; }
     if all_back {
-        atomicAdd(&counters[C_CULL_BACKFACE], 1u);
+        count_cull(C_CULL_BACKFACE, retest);
         return;
     }
     // Trimmed (trim.wgsl): a piece wholly cut away is dropped; one wholly kept is marked so
@@ -82,7 +96,7 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
     if needs_trim(item, info) {
         let c = trim_classify(trim_header(info), item.uv);
         if c == TRIM_OUT {
-            atomicAdd(&counters[C_CULL_TRIMMED], 1u);
+            count_cull(C_CULL_TRIMMED, retest);
             return;
         }
         if c == TRIM_IN { item.depth |= TRIM_INSIDE; }
@@ -103,7 +117,12 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
             vis = array<vec2<f32>, 2>(vec2<f32>(-3.0e38), vec2<f32>(3.0e38));
         }
         if any(vis[1] < t0) || any(vis[0] > t1) {
-            atomicAdd(&counters[C_CULL_OFFSCREEN], 1u);
+            count_cull(C_CULL_OFFSCREEN, retest);
+            return;
+        }
+        // Never culled by occlusion: seen, for the next frame.
+        if retest {
+            mark_visible(item.patch_id);
             return;
         }
         // Split while what can be seen of it spans more of the image than one finest grid
@@ -134,6 +153,7 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
         // space (sample.wgsl), as rasterizers clip triangles.
         atomicAdd(&counters[C_NEAR_CLIPPED], 1u);
         atomicMax(&counters[C_MAX_DEPTH], depth);
+        if history && testing { mark_visible(item.patch_id); }
         var g = item;
         g.rates = frame.grid_max | (frame.grid_max << 8u) | NEAR_CLIP_GRID;
         // The dilation bound at the nearest front control point, not at the near plane (where
@@ -179,13 +199,17 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
         chi = max(hi + vec2<f32>(ucoc), ub[1]);
     }
     if any(chi < t0) || any(clo > t1) {
-        atomicAdd(&counters[C_CULL_OFFSCREEN], 1u);
+        count_cull(C_CULL_OFFSCREEN, retest);
         return;
     }
     // Occlusion: hidden behind what the bucket's samples already hold (hiz_occluded), by the
     // bound over the shutter and the lens (the screen bound and depths the culls above use).
-    if frame.occlusion == OCCLUSION_TEST && hiz_occluded(clo, chi, hiz_depth(uz.x, uz.y)) {
-        atomicAdd(&counters[C_CULL_OCCLUDED], 1u);
+    if testing && hiz_occluded(clo, chi, hiz_depth(uz.x, uz.y)) {
+        count_cull(C_CULL_OCCLUDED, retest);
+        return;
+    }
+    if retest {
+        mark_visible(item.patch_id);
         return;
     }
     // Screen lengths of the control polygon along u and v bound the curves' lengths. (Chords
@@ -210,6 +234,8 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
     }
     if d.x != 0u { atomicAdd(&counters[C_DEPTH_LIMIT], 1u); }
     atomicMax(&counters[C_MAX_DEPTH], depth);
+    // Diced after passing the occlusion test: visible, for the next frame's phase 1.
+    if history && testing { mark_visible(item.patch_id); }
     var g = item;
     g.rates = d.y | (d.z << 8u);
     if frame.crack_dilation != 0u {
@@ -226,6 +252,19 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
     } else {
         enqueue_diceshade(g);
     }
+}
+
+// A piece culled in Bound, counted unless it is a root only tested again (bound_execute's
+// `retest`: phase 1 of its frame drew it and counted its culls).
+fn count_cull(counter: u32, retest: bool) {
+    if !retest { atomicAdd(&counters[counter], 1u); }
+}
+
+// Root patch `id` is visible: a piece of it passed the occlusion test and is diced, or it
+// passed the test again as a root of phase 1; it is drawn in phase 1 of the next pipelined
+// frame (`visible` in common.wgsl; cleared by make_roots).
+fn mark_visible(id: u32) {
+    if atomicLoad(&visible[id]) == 0u { atomicStore(&visible[id], 1u); }
 }
 
 // Motion blur and depth of field: the screen bound (lo.xy, hi.xy in [0]) and depth range ([1].xy)

@@ -43,8 +43,9 @@ struct Frame {
     // coc_scale * (inv_focus - 1 / z) pixels (0 without depth of field).
     coc_scale: f32,
     inv_focus: f32,
-    // Occlusion culling in Bound: OCCLUSION_OFF, OCCLUSION_ON (no pyramid yet) or
-    // OCCLUSION_TEST (test items against the bucket's depth pyramid, hiz).
+    // Occlusion culling in Bound: OCCLUSION_OFF, OCCLUSION_ON (no pyramid yet; for roots
+    // tagged ROOT_HISTORY, phase 1 of a pipelined frame) or OCCLUSION_TEST (test items against
+    // the bucket's depth pyramid, hiz; phase 2 of a pipelined frame).
     occlusion: u32,
 }
 
@@ -122,6 +123,10 @@ struct PatchInfo {
 // one is empty); each level above the largest of up to 2x2 tiles below. Read by Bound only
 // when frame.occlusion == OCCLUSION_TEST.
 @group(1) @binding(7) var<storage, read> hiz: array<u32>;
+// Per patch, the occlusion history of pipelined frames that cull (roots.wgsl reads and clears
+// it when it makes the next frame's roots): Bound sets 1 where some piece of a root tagged
+// ROOT_HISTORY passes the occlusion test and goes on. Untouched by other frames.
+@group(1) @binding(8) var<storage, read_write> visible: array<atomic<u32>>;
 
 const FIELD_FLAT: u32 = 1u;
 const FIELD_BILINEAR: u32 = 2u;

@@ -10,12 +10,20 @@ struct Orbit {
     patches: u32,
     // Threads per row of workgroups (the dispatch is 2D for many patches).
     row: u32,
+    // 1: the frame culls from the previous frame's visibility (two phases, bound.wgsl): each
+    // root is tagged ROOT_HISTORY, and ROOT_WAS_VISIBLE from `visible`, which is then cleared
+    // for this frame's Bound to set. 0: untagged roots, `visible` untouched.
+    history: u32,
 }
 
 @group(0) @binding(0) var<storage, read> orbit: Orbit;
 // 16 homogeneous control points per patch, cp[4*v + u].
 @group(0) @binding(1) var<storage, read> objects: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read_write> roots: array<PatchItem>;
+// Per patch: nonzero when some piece of its root passed Bound's occlusion test in the last
+// frame (`visible` in common.wgsl, the same buffer). Binding 10: tessellate.wgsl, which
+// includes this file, declares 3 to 9.
+@group(0) @binding(10) var<storage, read_write> root_visible: array<u32>;
 
 // The root item of patch `id` from its 16 transformed homogeneous control points (an affine
 // transform of (x w, y w, z w, w) is the homogeneous point of the transformed x, with the same
@@ -43,5 +51,10 @@ fn make_roots(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var i = 0u; i < 16u; i++) {
         cp[i] = orbit.m * objects[16u * id + i];
     }
-    roots[id] = root_item(id, cp);
+    var item = root_item(id, cp);
+    if orbit.history != 0u {
+        item.rates = ROOT_HISTORY | select(0u, ROOT_WAS_VISIBLE, root_visible[id] != 0u);
+        root_visible[id] = 0u;
+    }
+    roots[id] = item;
 }

@@ -12,7 +12,7 @@ use reyes::gpu_render::WARM_UP;
 use reyes::progress::NoProgress;
 use reyes::raster_peer::{PeerFrame, RasterPeer};
 use reyes::realtime::{Pixels, RealtimeFrame, RealtimeRenderer};
-use reyes::stages::C_MICROPOLYGONS;
+use reyes::stages::{C_CULL_OCCLUDED, C_MICROPOLYGONS};
 use scheduler::Gpu;
 use scheduler::StrategyKind;
 use serde::Serialize;
@@ -56,6 +56,8 @@ pub struct FrameRow {
     pub wall_ms: f64,
     pub gpu_ms: Option<f64>,
     pub micropolygons: u64,
+    /// Pieces culled by occlusion (`culls.occluded` of `render --stats`).
+    pub occluded: u64,
     /// Why the pipelined attempt did not finish, when the frame was rendered again.
     pub rerendered: Option<String>,
 }
@@ -77,6 +79,9 @@ pub struct BenchReport {
     /// Frames pipelined on the GPU; `false` with the reason in `not_pipelined`.
     pub pipelined: bool,
     pub not_pipelined: Option<String>,
+    /// Pipelined frames cull from the previous frame (`--occlusion on`, or `auto` on a deep
+    /// scene; docs/reyes.md, *Occlusion culling*). Frames not pipelined cull as `render` does.
+    pub occlusion: bool,
     /// Per-frame host time between frame completions.
     pub wall_ms: Summary,
     /// Per-frame GPU time (first pass start to last pass end); null without timestamps.
@@ -87,6 +92,8 @@ pub struct BenchReport {
     /// Timed frames over the sum of their wall times.
     pub fps: f64,
     pub micropolygons: Summary,
+    /// Pieces culled by occlusion per frame.
+    pub occluded: Summary,
     /// Frames rendered again because their fixed sizes did not suffice.
     pub rerendered: u32,
     pub per_frame: Vec<FrameRow>,
@@ -298,9 +305,7 @@ pub(crate) fn report(
     let diff = gpu_ms
         .as_ref()
         .map(|g| wall.iter().zip(g).map(|(w, g)| w - g).collect::<Vec<_>>());
-    let mp: Vec<f64> = (frames.iter())
-        .map(|f| f.counters[C_MICROPOLYGONS] as f64)
-        .collect();
+    let count = |c: usize| -> Vec<f64> { frames.iter().map(|f| f.counters[c] as f64).collect() };
     BenchReport {
         scene: name.into(),
         adapter: gpu.adapter_name(),
@@ -313,11 +318,13 @@ pub(crate) fn report(
         degrees_per_frame: step,
         pipelined: r.not_pipelined().is_none(),
         not_pipelined: r.not_pipelined().map(String::from),
+        occlusion: r.occlusion(),
         wall_ms: Summary::of(&wall).expect("at least one frame"),
         gpu_ms: gpu_ms.as_deref().and_then(Summary::of),
         wall_minus_gpu_ms: diff.as_deref().and_then(Summary::of),
         fps: frames.len() as f64 / (wall.iter().sum::<f64>() / 1e3),
-        micropolygons: Summary::of(&mp).expect("at least one frame"),
+        micropolygons: Summary::of(&count(C_MICROPOLYGONS)).expect("at least one frame"),
+        occluded: Summary::of(&count(C_CULL_OCCLUDED)).expect("at least one frame"),
         rerendered: frames.iter().filter(|f| f.rerendered.is_some()).count() as u32,
         per_frame: (frames.iter().zip(angles))
             .map(|(f, angle)| FrameRow {
@@ -325,6 +332,7 @@ pub(crate) fn report(
                 wall_ms: f.wall_ms,
                 gpu_ms: f.gpu_ms,
                 micropolygons: f.counters[C_MICROPOLYGONS],
+                occluded: f.counters[C_CULL_OCCLUDED],
                 rerendered: f.rerendered.clone(),
             })
             .collect(),
@@ -353,6 +361,9 @@ pub(crate) fn print_table(r: &BenchReport) {
     if let Some(why) = &r.not_pipelined {
         println!("not pipelined: {why}");
     }
+    if r.occlusion {
+        println!("occlusion culling from the previous frame (two phases)");
+    }
     println!("{:<14} {:>10} {:>10}", "", "median", "p95");
     let row = |label: &str, s: Option<&Summary>| match s {
         Some(s) => println!("{label:<14} {:>10.3} {:>10.3}", s.median, s.p95),
@@ -365,6 +376,7 @@ pub(crate) fn print_table(r: &BenchReport) {
         println!("{note}");
     }
     println!("{:<14} {:>10.0}", "micropolygons", r.micropolygons.median);
+    println!("{:<14} {:>10.0}", "occluded", r.occluded.median);
     println!("{:<14} {:>10.1}", "fps", r.fps);
     println!(
         "{:<14} {:>10}",

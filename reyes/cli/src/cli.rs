@@ -68,10 +68,11 @@ pub enum Command {
 
 const VIEW_CONTROLS: &str = "Controls: left drag orbits about the scene's centre; right or \
 middle drag pans; the wheel zooms (dollies towards the centre); M cycles the strategy \
-(megakernel, multipass, multipass-host); [ and ] divide and multiply the micropolygon size \
+(megakernel, multipass, multipass-host); O cycles --occlusion (auto, on, off); [ and ] divide and multiply the micropolygon size \
 by sqrt 2; 1-4 set NxN pixel samples, + and - add or remove one per axis; R resets the camera; \
 S saves a screenshot PNG; Esc or Q quits. The title shows frames per second, wall and GPU \
-milliseconds, micropolygons, the strategy, micropolygon size and samples.";
+milliseconds, micropolygons, pieces culled by occlusion (or no culling), the strategy, \
+micropolygon size and samples.";
 
 impl Command {
     /// The subcommand's name, for error messages.
@@ -198,8 +199,9 @@ pub struct RenderArgs {
     pub spin: Option<f64>,
 
     /// Occlusion culling in Bound: pieces hidden behind what is already drawn (a depth
-    /// pyramid of the samples after a first pass over the nearest patches) are not split or
-    /// diced. The image is the same in every mode. `auto`: passes only in buckets whose
+    /// pyramid of the samples after a first pass over the nearest patches; in `bench` and
+    /// `view`, over the patches seen in the previous frame) are not split or diced. The image
+    /// is the same in every mode. `auto`: passes only in buckets (bench, view: frames) whose
     /// patches lie about 4 deep or more over the screen they reach (each pass costs a
     /// scheduler run); `on`: always; `off`: never.
     #[arg(long, value_name = "AUTO|ON|OFF", value_enum, default_value_t = OcclusionArg::Auto)]

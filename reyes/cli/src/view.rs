@@ -18,13 +18,13 @@
 use crate::cli::ViewCmd;
 use crate::error::CliError;
 use reyes::camera::ViewCamera;
-use reyes::frame::{MAX_PIXEL_SAMPLES, RenderOptions};
+use reyes::frame::{MAX_PIXEL_SAMPLES, Occlusion, RenderOptions};
 use reyes::gpu_render::required_features;
 use reyes::present::Presenter;
 use reyes::progress::NoProgress;
 use reyes::realtime::{Pixels, RealtimeFrame, RealtimeRenderer};
 use reyes::scene::Scene;
-use reyes::stages::C_MICROPOLYGONS;
+use reyes::stages::{C_CULL_OCCLUDED, C_MICROPOLYGONS};
 use scheduler::{Gpu, StrategyKind};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -59,6 +59,7 @@ pub fn main(a: ViewCmd) -> Result<(), CliError> {
             strategy: a.render.strategy,
             mp_size: options.mp_size,
             samples: (first.spp_x, first.spp_y),
+            occlusion: options.occlusion,
         },
         first_size: (first.width, first.height),
         options,
@@ -91,6 +92,9 @@ struct Settings {
     strategy: Option<StrategyKind>,
     mp_size: f32,
     samples: (u32, u32),
+    /// `--occlusion`, cycled by O: whether frames cull from the previous frame
+    /// ([`RealtimeRenderer::occlusion`]).
+    occlusion: Occlusion,
 }
 
 /// The window and what draws into it, made when the event loop resumes.
@@ -231,6 +235,7 @@ impl Viewer {
                 height: Some(size.1),
                 pixel_samples: Some(self.settings.samples),
                 mp_size: self.settings.mp_size,
+                occlusion: self.settings.occlusion,
                 ..self.options.clone()
             };
             let strategy = self.settings.strategy.unwrap_or(StrategyKind::Multipass);
@@ -242,6 +247,7 @@ impl Viewer {
             self.rebuild = false;
         }
         let r = st.renderer.as_mut().expect("made above");
+        let culling = r.occlusion();
         let transform = self.camera.transform(r.centre());
         let frame = (r.render_transforms(&st.gpu, &[transform], &NoProgress))?
             .pop()
@@ -289,7 +295,7 @@ impl Viewer {
         }
         self.last_shown = Some(now);
         self.shown += 1;
-        let mut title = self.title(&frame);
+        let mut title = self.title(&frame, culling);
         if size != window {
             title += &format!(
                 " | rendered at {}x{}, scaled up to the window",
@@ -304,11 +310,15 @@ impl Viewer {
         Ok(true)
     }
 
-    fn title(&self, frame: &RealtimeFrame) -> String {
+    fn title(&self, frame: &RealtimeFrame, culling: bool) -> String {
         let ms = |v: Option<f64>| v.map_or("n/a".into(), |v| format!("{v:.1}"));
         let s = &self.settings;
+        let occlusion = match culling {
+            true => format!("{} culled", frame.counters[C_CULL_OCCLUDED]),
+            false => "no culling".into(),
+        };
         format!(
-            "reyes view: {} | {} fps | wall {} ms | GPU {} ms | {} micropolygons | {} | mp {:.2} px | {}x{} samples{}",
+            "reyes view: {} | {} fps | wall {} ms | GPU {} ms | {} micropolygons | {occlusion} | {} | mp {:.2} px | {}x{} samples{}",
             self.name,
             self.fps.map_or("-".into(), |f| format!("{f:.1}")),
             ms(Some(frame.wall_ms)),
@@ -365,6 +375,13 @@ impl Viewer {
                         .position(|k| Some(*k) == s.strategy)
                         .map_or(0, |i| (i + 1) % all.len());
                     s.strategy = Some(all[i]);
+                }
+                "o" | "O" => {
+                    s.occlusion = match s.occlusion {
+                        Occlusion::Auto => Occlusion::On,
+                        Occlusion::On => Occlusion::Off,
+                        Occlusion::Off => Occlusion::Auto,
+                    }
                 }
                 "[" => s.mp_size = (s.mp_size / 2f32.sqrt()).max(MP_SIZE_RANGE.0),
                 "]" => s.mp_size = (s.mp_size * 2f32.sqrt()).min(MP_SIZE_RANGE.1),

@@ -50,14 +50,31 @@ impl HizPipelines {
         hiz: &wgpu::Buffer,
         pixels: u64,
     ) -> Result<bool, RunError> {
+        match self.passes(gpu, f, samples, hiz, pixels)? {
+            Some(p) => {
+                self.record_passes(enc, &p);
+                Ok(true)
+            }
+            None => Ok(false),
+        }
+    }
+
+    /// The passes of [`HizPipelines::record`] with their parameters and bind groups, to be
+    /// recorded any number of times ([`HizPipelines::record_passes`]; pipelined frames make
+    /// them once). `None` when the bucket's pyramid would not fit.
+    pub(crate) fn passes(
+        &self,
+        gpu: &Gpu,
+        f: &FrameUniforms,
+        samples: &wgpu::Buffer,
+        hiz: &wgpu::Buffer,
+        pixels: u64,
+    ) -> Result<Option<HizPasses>, RunError> {
         let lv = levels(f.tile_w, f.tile_h);
         if crate::stages::hiz::words(f.tile_w, f.tile_h) > capacity(pixels) {
-            return Ok(false);
+            return Ok(None);
         }
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("reyes hiz"),
-            timestamp_writes: None,
-        });
+        let mut passes = Vec::with_capacity(lv.len());
         for (k, l) in lv.iter().enumerate() {
             let below = if k == 0 { [0; 3] } else { lv[k - 1] };
             let params = HizParams {
@@ -90,12 +107,30 @@ impl HizPipelines {
                 layout: &pipeline.get_bind_group_layout(0),
                 entries: &entries,
             });
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, &bind, &[]);
-            pass.dispatch_workgroups(l[0].div_ceil(8), l[1].div_ceil(8), 1);
+            passes.push((k == 0, bind, [l[0].div_ceil(8), l[1].div_ceil(8)]));
         }
-        Ok(true)
+        Ok(Some(HizPasses { passes }))
     }
+
+    /// Records `p` ([`HizPipelines::passes`]) into `enc`: one compute pass, a dispatch per
+    /// level.
+    pub(crate) fn record_passes(&self, enc: &mut wgpu::CommandEncoder, p: &HizPasses) {
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("reyes hiz"),
+            timestamp_writes: None,
+        });
+        for (level0, bind, [gx, gy]) in &p.passes {
+            pass.set_pipeline(if *level0 { &self.level0 } else { &self.reduce });
+            pass.set_bind_group(0, bind, &[]);
+            pass.dispatch_workgroups(*gx, *gy, 1);
+        }
+    }
+}
+
+/// The pyramid's passes for one bucket, made by [`HizPipelines::passes`]: per level, whether
+/// it is level 0, its bind group (which keeps its parameters alive) and its workgroups.
+pub(crate) struct HizPasses {
+    passes: Vec<(bool, wgpu::BindGroup, [u32; 2])>,
 }
 
 #[cfg(test)]

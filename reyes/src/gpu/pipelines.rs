@@ -13,10 +13,11 @@ use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
 /// Layout entries of the scene bind group: 0-3 frame, materials, lights, patch info (read
-/// only); 4-5 samples, counters; 6 primitive variables, 7 the depth pyramid (read only).
+/// only); 4-5 samples, counters; 6 primitive variables, 7 the depth pyramid (read only); 8 the
+/// per-patch occlusion history of pipelined frames (`visible` in common.wgsl).
 pub(crate) fn scene_layout_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
-    (0..8)
-        .map(|b| storage_entry(b, !(4..6).contains(&b)))
+    (0..9)
+        .map(|b| storage_entry(b, !(4..6).contains(&b) && b != 8))
         .collect()
 }
 

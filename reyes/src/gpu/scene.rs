@@ -60,6 +60,10 @@ pub struct SceneBuffers {
     /// (`frame::homogeneous_points`: weights scaled to a largest of 1); `objects` in
     /// roots.wgsl. Only for renderers that make root items on the GPU.
     objects: Option<wgpu::Buffer>,
+    /// Per patch, one u32: the occlusion history of pipelined frames that cull (`visible` in
+    /// common.wgsl, `root_visible` in roots.wgsl), every patch visible at first (the first
+    /// frame has no history); one word when the scene was uploaded without its patch table.
+    visible: wgpu::Buffer,
     /// The scene bind group last made and the target it binds ([`FrameTarget::id`]).
     bind: Option<(u64, wgpu::BindGroup)>,
 }
@@ -76,6 +80,7 @@ impl SceneBuffers {
             infos: Table::new(gpu, "patch info", &data.patch_info)?,
             primvars: Table::new(gpu, "primvars", &data.primvars)?,
             objects: None,
+            visible: gpu.storage_buffer("occlusion history", 1)?,
             bind: None,
         })
     }
@@ -93,6 +98,7 @@ impl SceneBuffers {
         let objects = gpu.upload("patch table", &objects)?;
         let mut s = SceneBuffers::new(gpu, data)?;
         s.objects = Some(objects);
+        s.visible = gpu.upload("occlusion history", &vec![1u32; scene.patches.len()])?;
         Ok(s)
     }
 
@@ -108,6 +114,11 @@ impl SceneBuffers {
             self.bind = None;
         }
         Ok(())
+    }
+
+    /// The frame uniform's buffer (pipelined frames copy each phase's into it).
+    pub(crate) fn frame_buffer(&self) -> &wgpu::Buffer {
+        &self.frame
     }
 
     /// Writes the frame uniform (queue order: work submitted before reads the old one).
@@ -126,7 +137,8 @@ impl SceneBuffers {
     }
 
     /// The scene bind group (common.wgsl's group: frame, materials, lights, patch info,
-    /// `target`'s samples and counters, primvars) for the layout of
+    /// `target`'s samples and counters, primvars, `target`'s depth pyramid, the occlusion
+    /// history) for the layout of
     /// [`Pipelines::scene_layout`](super::Pipelines::scene_layout); made again only when the
     /// target or a table's buffer changed.
     pub(crate) fn bind_group(
@@ -152,6 +164,7 @@ impl SceneBuffers {
                 &target.counters,
                 &self.primvars.buffer,
                 &target.hiz,
+                &self.visible,
             ],
         );
         self.bind = Some((target.id(), bind.clone()));
@@ -174,6 +187,11 @@ impl SceneBuffers {
             (3, &self.infos.buffer),
             (6, &self.primvars.buffer),
         ]
+    }
+
+    /// The per-patch occlusion history ([`SceneBuffers::with_patches`]: one word a patch).
+    pub(crate) fn visible(&self) -> &wgpu::Buffer {
+        &self.visible
     }
 
     /// The patch table ([`SceneBuffers::with_patches`]). Panics when the scene was uploaded

@@ -28,6 +28,9 @@
 //! was rendered again ([`RealtimeFrame::rerendered`]); the fixed sizes then grow to what that
 //! render needed. A wrong frame is never returned.
 //!
+//! Occlusion culling (`--occlusion on`, or `auto` on a deep scene): each frame in two phases
+//! from the previous frame's visibility, all on the GPU ([`occlusion`]); the image is the same.
+//!
 //! Motion blur: a moving patch's motion (camera space, [`crate::scene::Patch::motion`]) is
 //! seen by a frame of camera transform T as T D T^-1; a frame whose transform differs from the
 //! last one's rewrites the primitive-variable table that holds them (one upload per frame).
@@ -57,7 +60,9 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
+pub mod occlusion;
 mod readback;
+use occlusion::{Culling, PHASES};
 pub use readback::Pixels;
 pub(crate) use readback::{await_mapped, map_buffer, map_for_read, read_mapped};
 
@@ -80,8 +85,10 @@ pub struct Orbit {
     pub patches: u32,
     /// Threads per row of the 2D dispatch.
     pub row: u32,
+    /// 1: tag the roots with the occlusion history and clear it ([`occlusion`]); 0: not.
+    pub history: u32,
     /// Padding to a multiple of 16 bytes.
-    pub pad: [u32; 2],
+    pub pad: u32,
 }
 
 impl Orbit {
@@ -99,7 +106,8 @@ impl Orbit {
             m: (transform.to_cols_array_2d()).map(|col| col.map(|v| v as f32)),
             patches,
             row,
-            pad: [0; 2],
+            history: 0,
+            pad: 0,
         }
     }
 }
@@ -146,6 +154,8 @@ struct InFlight {
     submission: wgpu::SubmissionIndex,
     /// The run recorded (the sizes may grow while this frame is in flight).
     recorded: Option<Rc<RecordedRun>>,
+    /// Scheduler runs recorded: 1, or [`PHASES`] when the frame culls.
+    phases: usize,
     /// Buffers mapped for reading (status, then pixels), and maps completed by their callbacks.
     maps: Vec<wgpu::Buffer>,
     mapped: Arc<AtomicUsize>,
@@ -186,6 +196,11 @@ pub struct RealtimeRenderer {
     /// rows of the transform in `motion_written`.
     motion: Vec<(u32, DMat4)>,
     motion_written: std::cell::Cell<DMat4>,
+    /// Pipelined frames cull from the previous frame ([`occlusion`]) when `Some`.
+    culling: Option<Culling>,
+    /// `FrameUniforms::occlusion` of the options (`base.frame` has it off): frames that are
+    /// not pipelined render with it.
+    asked_occlusion: u32,
 }
 
 /// `base`'s primitive-variable table with each moving patch's motion `d` (at entry `at`) as
@@ -218,9 +233,9 @@ impl RealtimeRenderer {
     ) -> Result<RealtimeRenderer, RunError> {
         let mut base =
             FrameData::new(scene, options).map_err(|e| RunError::Program(e.to_string()))?;
-        // Pipelined frames run one pass, without occlusion culling (docs/reyes.md, *Occlusion
-        // culling*); the frame that sizes their queues and a frame rendered again must do the
-        // same work, or the sizes fall short of it.
+        // The frame that sizes the pipelined run and a frame rendered again render without
+        // culling: all the work, of which each phase of a frame that culls does a part.
+        let asked_occlusion = base.frame.occlusion;
         base.frame.occlusion = crate::stages::hiz::OCCLUSION_OFF;
         let config = RendererConfig::new(strategy).features(base.features());
         let renderer = GpuRenderer::new(gpu, config.lavapipe_tuning(false))?;
@@ -252,11 +267,23 @@ impl RealtimeRenderer {
         for _ in 0..IN_FLIGHT {
             let orbit = gpu.storage_buffer("orbit", (size_of::<Orbit>() / 4) as u64)?;
             let roots = gpu.upload("roots", &vec![PatchItem::zeroed(); n as usize])?;
-            let roots_bind = gpu.bind_buffers(
-                "roots",
-                &roots_pipeline.get_bind_group_layout(0),
-                &[&orbit, scene_buffers.objects(), &roots],
-            );
+            let buffers = [
+                &orbit,
+                scene_buffers.objects(),
+                &roots,
+                scene_buffers.visible(),
+            ];
+            let entries: Vec<wgpu::BindGroupEntry> = ([0, 1, 2, 10].into_iter().zip(buffers))
+                .map(|(binding, b)| wgpu::BindGroupEntry {
+                    binding,
+                    resource: b.as_entire_binding(),
+                })
+                .collect();
+            let roots_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("roots"),
+                layout: &roots_pipeline.get_bind_group_layout(0),
+                entries: &entries,
+            });
             slots.push(Slot {
                 orbit,
                 roots,
@@ -293,6 +320,8 @@ impl RealtimeRenderer {
                 .collect(),
             motion_written: std::cell::Cell::new(DMat4::IDENTITY),
             base,
+            culling: None,
+            asked_occlusion,
         };
         r.set_pixels(gpu, pixels)?;
         if strategy == StrategyKind::MultipassHost {
@@ -308,8 +337,18 @@ impl RealtimeRenderer {
             let first = r.render_on_target(gpu, &r.base.clone())?;
             let size = r.size_from(&first.run);
             r.resize(gpu, size)?;
+            if occlusion::wanted(&r.base, asked_occlusion) {
+                r.culling = Culling::new(gpu, &r.renderer, &r.base.frame, &r.target)?;
+            }
         }
         Ok(r)
+    }
+
+    /// Whether pipelined frames cull from the previous frame ([`occlusion`]): with
+    /// `--occlusion on`, or `auto` where the unturned frame's root patches lie deep over each
+    /// other; never when frames are not pipelined (those cull as `reyes render` does).
+    pub fn occlusion(&self) -> bool {
+        self.culling.is_some()
     }
 
     /// Why frames are not pipelined, when they are not.
@@ -387,7 +426,7 @@ impl RealtimeRenderer {
                 )
             }),
         )?;
-        let words = run.status_words() + STATUS_COUNTERS + SpanTimer::WORDS;
+        let words = PHASES as u64 * run.status_words() + STATUS_COUNTERS + SpanTimer::WORDS;
         for s in &mut self.slots {
             if s.status.size() < words * 4 {
                 s.status = map_buffer(gpu, "frame status", words)?;
@@ -481,7 +520,10 @@ impl RealtimeRenderer {
             self.motion_written.set(transform);
         }
         let s = &self.slots[slot];
-        let orbit = Orbit::from_transform(transform, self.patches);
+        let orbit = Orbit {
+            history: self.culling.is_some() as u32,
+            ..Orbit::from_transform(transform, self.patches)
+        };
         gpu.queue
             .write_buffer(&s.orbit, 0, bytemuck::bytes_of(&orbit));
         let recorded = self.recorded.clone();
@@ -502,6 +544,7 @@ impl RealtimeRenderer {
             groups(&mut pass, self.roots_groups);
         }
         let mut maps = Vec::new();
+        let mut phases = 1;
         if let Some(rec) = &recorded {
             enc.clear_buffer(&self.target.samples, 0, None);
             enc.clear_buffer(&self.target.counters, 0, None);
@@ -510,15 +553,24 @@ impl RealtimeRenderer {
                 buffer: &s.roots,
                 count: self.patches,
             }];
-            rec.record(
-                &self.renderer.scheduler,
-                &mut enc,
-                &seeds,
-                Some(&self.scene_bind),
-                &s.status,
-                0,
-            )?;
-            let at = rec.status_words();
+            let words = rec.status_words();
+            match &self.culling {
+                Some(c) => {
+                    let scene = (&self.scene, &self.scene_bind);
+                    let (status, r) = (&s.status, &self.renderer);
+                    c.record(gpu, r, &mut enc, (rec, &seeds), scene, status, words)?;
+                    phases = PHASES;
+                }
+                None => rec.record(
+                    &self.renderer.scheduler,
+                    &mut enc,
+                    &seeds,
+                    Some(&self.scene_bind),
+                    &s.status,
+                    0,
+                )?,
+            }
+            let at = PHASES as u64 * words;
             enc.copy_buffer_to_buffer(
                 &self.target.counters,
                 0,
@@ -554,6 +606,7 @@ impl RealtimeRenderer {
             slot,
             submission,
             recorded,
+            phases,
             mapped,
             maps,
             pixels: self.pixels,
@@ -575,15 +628,34 @@ impl RealtimeRenderer {
             return self.render_again(gpu, f.slot, f.transform, why, None, last);
         };
         let words = rec.status_words();
-        let status = read_mapped(&f.maps[0], words + STATUS_COUNTERS + SpanTimer::WORDS)?;
-        let (sched, rest) = status.split_at(words as usize);
+        let at = PHASES as u64 * words;
+        let status = read_mapped(&f.maps[0], at + STATUS_COUNTERS + SpanTimer::WORDS)?;
+        let (sched, rest) = status.split_at(at as usize);
         let gpu_ms = self.timer.ms(&rest[COUNTERS..]);
         let mut pixels: Vec<Vec<u32>> = Vec::new();
         for (b, src) in f.maps[1..].iter().zip(self.pixel_sources()) {
             pixels.push(read_mapped(b, src.size() / 4)?);
         }
         let program = self.renderer.scheduler.program();
-        match rec.outcome(program, sched)? {
+        // Each phase's run; the frame is done when all are.
+        let mut outcome = Outcome::Done(RunStats::default());
+        for (k, status) in sched.chunks(words as usize).take(f.phases).enumerate() {
+            outcome = match (outcome, rec.outcome(program, status)?) {
+                (Outcome::Done(mut a), Outcome::Done(b)) => {
+                    match k {
+                        0 => a = b,
+                        _ => a.absorb(&b),
+                    }
+                    Outcome::Done(a)
+                }
+                (Outcome::Incomplete(why), _) => Outcome::Incomplete(why),
+                (_, Outcome::Incomplete(why)) if f.phases > 1 => {
+                    Outcome::Incomplete(format!("phase {} of {}: {why}", k + 1, f.phases))
+                }
+                (_, o) => o,
+            };
+        }
+        match outcome {
             Outcome::Done(run) => {
                 let mut counters = [0u64; COUNTERS];
                 for (c, v) in counters.iter_mut().zip(&rest[..COUNTERS]) {
@@ -637,11 +709,18 @@ impl RealtimeRenderer {
     ) -> Result<RealtimeFrame, RunError> {
         let bytes = self.patches as u64 * size_of::<PatchItem>() as u64;
         let roots = gpu.read_buffer(&self.slots[slot].roots, 0, bytes)?;
-        let data = FrameData {
-            items: bytemuck::pod_collect_to_vec(&roots),
+        let mut items: Vec<PatchItem> = bytemuck::pod_collect_to_vec(&roots);
+        occlusion::untag(&mut items);
+        let mut data = FrameData {
+            items,
             primvars: motion_primvars(&self.base.primvars, &self.motion, transform),
             ..self.base.clone()
         };
+        // A frame that is never pipelined culls as `reyes render` does; one whose pipelined
+        // attempt fell short renders all the work, which the sizes then grow to.
+        if self.recorded.is_none() {
+            data.frame.occlusion = self.asked_occlusion;
+        }
         let g = self.render_on_target(gpu, &data)?;
         // The table now holds this frame's motion: the next frame writes its own.
         self.motion_written.set(transform);
@@ -700,6 +779,7 @@ mod tests {
             ("m", std::mem::offset_of!(Orbit, m)),
             ("patches", std::mem::offset_of!(Orbit, patches)),
             ("row", std::mem::offset_of!(Orbit, row)),
+            ("history", std::mem::offset_of!(Orbit, history)),
         ] {
             let got = l
                 .members

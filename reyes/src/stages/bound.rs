@@ -2,7 +2,9 @@
 //! Rational patches are bounded by their Euclidean control points (convex hull; the weights
 //! blossomed from the patch's table, [`super::rational_weights`]), culled as back-facing by
 //! the test on their homogeneous net, and get a rational crack bound; the arguments are
-//! beside the WGSL.
+//! beside the WGSL. Not twinned: bound.wgsl's phases for root items tagged with an occlusion
+//! history (`ROOT_HISTORY`), which only the GPU's pipelined frames make
+//! ([`crate::realtime::occlusion`]); the twin renders single frames, whose roots carry none.
 
 use super::{
     ControlNet, Weights, coc, cp_h, cp_point, item_weights, moved_point, project, to_euclidean,
