@@ -225,9 +225,13 @@ impl Interp {
                 let form = BilinearForm::Polygon;
                 self.emit_bilinear_with(a, &ctm, f, corners, form, fields)?;
                 if let (Some(v), Some(p)) = (&nvar, self.scene.patches.last_mut()) {
-                    let mut vars = p.primvars.take().map(|b| *b).unwrap_or_default();
+                    let mut vars = p
+                        .primvars
+                        .take()
+                        .map(std::sync::Arc::unwrap_or_clone)
+                        .unwrap_or_default();
                     vars.n = Some(v.polygon_field(f, fv, pt));
-                    p.primvars = vars.boxed();
+                    p.primvars = vars.shared();
                 }
             }
         }
