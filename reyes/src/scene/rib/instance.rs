@@ -58,8 +58,8 @@ const PLACEABLE: &[&str] = &[
 /// The kept builds of the primitives of object definitions, and the build under way.
 #[derive(Default)]
 pub(super) struct Instancing {
-    /// By (the definition's address, the request's index in it). Cleared when an object is
-    /// defined (a definition's address is reused only after it was replaced).
+    /// By (the definition's address, the request's index in it). A definition's builds go
+    /// when it is replaced (its address may be reused) and all at the end of each world.
     builds: HashMap<(usize, usize), Vec<Build>>,
     /// The loops of the definitions' `TrimCurve`s, by the same key: read once, so that the
     /// primitives after one find their builds (whose key holds the loops) and share them.
@@ -71,6 +71,13 @@ pub(super) struct Instancing {
 }
 
 impl Instancing {
+    /// Drops every build (at the end of a world: the builds hold at most what its patches
+    /// hold, so a file of many frames keeps one frame's worth).
+    pub(super) fn end_of_world(&mut self) {
+        self.builds.clear();
+        self.trims.clear();
+    }
+
     /// Called by [`Interp::emit_net`] with the object-space net it transforms: kept while a
     /// primitive is built for its instances.
     pub(super) fn captured(
@@ -234,9 +241,12 @@ impl Interp {
         if req.name == "ObjectEnd" {
             Args::new(&req).done()?;
             if let Some(r) = self.recording.take() {
-                self.objects.insert(r.handle, Rc::from(r.requests));
-                self.instancing.builds.clear();
-                self.instancing.trims.clear();
+                if let Some(old) = self.objects.insert(r.handle, Rc::from(r.requests)) {
+                    // The old definition's address may be reused: its builds go with it.
+                    let at = Rc::as_ptr(&old) as *const Request as usize;
+                    self.instancing.builds.retain(|k, _| k.0 != at);
+                    self.instancing.trims.retain(|k, _| k.0 != at);
+                }
             }
             return Ok(());
         }

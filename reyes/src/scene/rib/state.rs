@@ -315,6 +315,7 @@ impl Interp {
         self.world_to_camera_close = None;
         self.scene = Scene::default();
         self.materials.clear();
+        self.instancing.end_of_world();
         self.motion = None;
         self.recording = None;
         self.frame = None;

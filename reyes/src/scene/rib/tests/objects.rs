@@ -226,23 +226,24 @@ fn nested_instances_are_the_written_out_requests() {
     ));
 }
 
-/// A redefined object is built again; a `Declare` between instances builds again (it may
-/// change how the primitive's parameters read).
+/// A redefined object is built again, and another object's definition keeps the builds of
+/// the others; a `Declare` between instances builds again (it may change how the
+/// primitive's parameters read).
 #[test]
 fn redefinitions_and_declarations_build_again() {
     let s = parse(&world(&format!(
         "ObjectBegin 1 {QUAD} ObjectEnd ObjectInstance 1\n\
          ObjectBegin 1 Translate 0 0 2 {QUAD} ObjectEnd ObjectInstance 1\n\
          ObjectBegin 2 Polygon \"P\" [0 0 0 1 0 0 1 1 0] \"Cs\" [1 0 0 0 1 0 0 0 1] ObjectEnd\n\
-         ObjectInstance 2 Declare \"Cs\" \"vertex color\" ObjectInstance 2"
+         ObjectInstance 2 ObjectBegin 3 {QUAD} ObjectEnd ObjectInstance 2\n\
+         Declare \"Cs\" \"vertex color\" ObjectInstance 2"
     )));
-    assert_eq!(s.patches.len(), 4);
+    assert_eq!(s.patches.len(), 5);
     assert!(close(centre(&s.patches[1]), DVec3::new(0.5, 0.5, 2.0)));
-    let (a, b) = (&s.patches[2], &s.patches[3]);
-    assert!(!Arc::ptr_eq(
-        a.primvars.as_ref().unwrap(),
-        b.primvars.as_ref().unwrap()
-    ));
+    let fields = |k: usize| s.patches[k].primvars.as_ref().unwrap();
+    assert!(Arc::ptr_eq(fields(2), fields(3)));
+    assert!(!Arc::ptr_eq(fields(3), fields(4)));
+    assert_eq!(fields(3), fields(4));
 }
 
 /// The frame tables of N instances: one copy of the object's fields, weights, trims and
