@@ -240,13 +240,13 @@ impl Interp {
         }
         if req.name == "ObjectEnd" {
             Args::new(&req).done()?;
-            if let Some(r) = self.recording.take() {
-                if let Some(old) = self.objects.insert(r.handle, Rc::from(r.requests)) {
-                    // The old definition's address may be reused: its builds go with it.
-                    let at = Rc::as_ptr(&old) as *const Request as usize;
-                    self.instancing.builds.retain(|k, _| k.0 != at);
-                    self.instancing.trims.retain(|k, _| k.0 != at);
-                }
+            if let Some(r) = self.recording.take()
+                && let Some(old) = self.objects.insert(r.handle, Rc::from(r.requests))
+            {
+                // The old definition's address may be reused: its builds go with it.
+                let at = Rc::as_ptr(&old) as *const Request as usize;
+                self.instancing.builds.retain(|k, _| k.0 != at);
+                self.instancing.trims.retain(|k, _| k.0 != at);
             }
             return Ok(());
         }

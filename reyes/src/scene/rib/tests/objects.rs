@@ -200,10 +200,8 @@ fn instances_are_the_written_out_requests_bit_for_bit() {
 /// the inner object's fields are shared through every level.
 #[test]
 fn nested_instances_are_the_written_out_requests() {
-    let outer = format!(
-        "AttributeBegin Translate 3 0 0 ObjectInstance 1 AttributeEnd\n\
-         Color 0 0 1 Rotate 45 0 0 1 ObjectInstance 1\n"
-    );
+    let outer = "AttributeBegin Translate 3 0 0 ObjectInstance 1 AttributeEnd\n\
+                 Color 0 0 1 Rotate 45 0 0 1 ObjectInstance 1\n";
     let inst = {
         let mut s = String::from("Translate 0 0 12\nWorldBegin\n");
         s += &format!("ObjectBegin 1\n{OBJECT}ObjectEnd\nObjectBegin 2\n{outer}ObjectEnd\n");
