@@ -617,9 +617,24 @@ struct SharedEntries {
     loops: Vec<(*const crate::scene::trim::TrimLoops, u32, u32)>,
 }
 
-/// The address of a shared allocation, the key of [`SharedEntries`].
-fn key<T>(a: &std::sync::Arc<T>) -> usize {
-    std::sync::Arc::as_ptr(a) as usize
+/// The entries of `a` in the table: those `seen` remembers for its allocation, else `make`'s
+/// (remembered when another patch holds the allocation too: one the patch holds alone costs
+/// no lookup).
+fn once<T, V: Copy>(
+    seen: &mut std::collections::HashMap<usize, V>,
+    a: &std::sync::Arc<T>,
+    make: impl FnOnce() -> Result<V, Error>,
+) -> Result<V, Error> {
+    if std::sync::Arc::strong_count(a) == 1 {
+        return make();
+    }
+    let key = std::sync::Arc::as_ptr(a) as usize;
+    if let Some(&v) = seen.get(&key) {
+        return Ok(v);
+    }
+    let v = make()?;
+    seen.insert(key, v);
+    Ok(v)
 }
 
 /// `p`'s [`PatchInfo`], appending to `table` what `shared` does not hold yet: one copy per
@@ -632,42 +647,27 @@ fn patch_info(
 ) -> Result<PatchInfo, Error> {
     let (cs, os, normal) = match &p.primvars {
         None => (0, 0, 0),
-        Some(v) => match shared.primvars.get(&key(v)) {
-            Some(&refs) => refs,
-            None => {
-                let mut field =
-                    |f: Option<&crate::scene::ColorField>| f.map_or(Ok(0), |f| field_ref(table, f));
-                let refs = (
-                    field(v.cs.as_ref())?,
-                    field(v.os.as_ref())?,
-                    field(v.n.as_ref())?,
-                );
-                shared.primvars.insert(key(v), refs);
-                refs
-            }
-        },
+        Some(v) => once(&mut shared.primvars, v, || {
+            let mut field =
+                |f: Option<&crate::scene::ColorField>| f.map_or(Ok(0), |f| field_ref(table, f));
+            Ok((
+                field(v.cs.as_ref())?,
+                field(v.os.as_ref())?,
+                field(v.n.as_ref())?,
+            ))
+        })?,
     };
     let weights = match p.net.shared_weights().filter(|_| p.is_rational()) {
         None => 0,
-        Some(w) => match shared.weights.get(&key(w)) {
-            Some(&at) => at,
-            None => {
-                let at = weights_ref(table, &homogeneous_points(p))?;
-                shared.weights.insert(key(w), at);
-                at
-            }
-        },
+        Some(w) => once(&mut shared.weights, w, || {
+            weights_ref(table, &homogeneous_points(p))
+        })?,
     };
     let displacement = match &p.displacement {
         None => 0,
-        Some(d) => match shared.displacements.get(&key(d)) {
-            Some(&at) => at,
-            None => {
-                let at = displacement_ref(table, &mut shared.maps, d)?;
-                shared.displacements.insert(key(d), at);
-                at
-            }
-        },
+        Some(d) => once(&mut shared.displacements, d, || {
+            displacement_ref(table, &mut shared.maps, d)
+        })?,
     };
     let motion = match &p.motion {
         Some(m) => motion_ref(table, m)?,
@@ -675,14 +675,9 @@ fn patch_info(
     };
     let trim = match &p.trim {
         None => 0,
-        Some(t) => match shared.trims.get(&key(t)) {
-            Some(&bits) => bits,
-            None => {
-                let bits = trim_ref(table, &mut shared.loops, t)?;
-                shared.trims.insert(key(t), bits);
-                bits
-            }
-        },
+        Some(t) => once(&mut shared.trims, t, || {
+            trim_ref(table, &mut shared.loops, t)
+        })?,
     };
     Ok(PatchInfo {
         material: p.material,
