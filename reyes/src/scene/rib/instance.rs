@@ -20,8 +20,8 @@ use super::state::{Block, Interp};
 use super::syntax::{Arg, Args, Request};
 use crate::scene::basis::Basis;
 use crate::scene::trim::{PatchTrim, TrimLoops};
-use crate::scene::{BilinearForm, Patch, Primvars, SceneError};
-use glam::{DMat4, DVec3};
+use crate::scene::{BilinearForm, ColorField, Patch, Primvars, SceneError};
+use glam::{DMat3, DMat4, DVec3};
 use std::collections::HashMap;
 use std::rc::Rc;
 use std::sync::Arc;
@@ -64,8 +64,8 @@ pub(super) struct Instancing {
     /// The loops of the definitions' `TrimCurve`s, by the same key: read once, so that the
     /// primitives after one find their builds (whose key holds the loops) and share them.
     trims: HashMap<(usize, usize), Option<Arc<TrimLoops>>>,
-    /// The nets [`Interp::emit_net`] is given while a primitive is built.
-    capture: Option<Vec<Emitted>>,
+    /// What [`Interp::emit_net`] and the polygons are given while a primitive is built.
+    capture: Option<Capture>,
     /// Counts `Declare`s: a declaration changes how a primitive's parameters read.
     declarations: u64,
 }
@@ -80,6 +80,26 @@ impl Instancing {
 
     /// Called by [`Interp::emit_net`] with the object-space net it transforms: kept while a
     /// primitive is built for its instances.
+    /// True while a primitive is built for instances (its object-space parts are kept).
+    pub(super) fn capturing(&self) -> bool {
+        self.capture.is_some()
+    }
+
+    /// The object-space `"N"` field of the patch just emitted (polygon meshes).
+    pub(super) fn captured_normals(&mut self, field: ColorField) {
+        if let Some(e) = self.capture.as_mut().and_then(|c| c.emitted.last_mut()) {
+            e.normals = Some(field);
+        }
+    }
+
+    /// Every object-space `"N"` value of the request (each placement checks them as a build
+    /// does).
+    pub(super) fn captured_normal_values(&mut self, values: &[DVec3]) {
+        if let Some(c) = &mut self.capture {
+            c.normal_values = Some(values.to_vec());
+        }
+    }
+
     pub(super) fn captured(
         &mut self,
         ctm: &DMat4,
@@ -88,13 +108,14 @@ impl Instancing {
         bilinear: Option<([DVec3; 4], BilinearForm)>,
     ) {
         if let Some(c) = &mut self.capture {
-            c.push(Emitted {
+            c.emitted.push(Emitted {
                 ctm: *ctm,
                 index,
                 net: match bilinear {
                     Some((corners, form)) => PlacedNet::Bilinear(corners, form),
                     None => PlacedNet::Bicubic(Box::new(*cp)),
                 },
+                normals: None,
             });
         }
     }
@@ -129,10 +150,24 @@ impl BuildKey {
 }
 
 /// One build of a primitive: its patches, or `None` when they cannot be placed (some net
-/// was not under the current transform, or a patch has camera-space normals).
+/// was not under the current transform, or a patch has normals not kept in object space).
 struct Build {
     key: BuildKey,
-    patches: Option<Rc<[Placed]>>,
+    patches: Option<Rc<Built>>,
+}
+
+/// The placeable patches of one build.
+struct Built {
+    patches: Vec<Placed>,
+    /// The request's `"N"` values in object space (polygon meshes with normals).
+    normal_values: Option<Vec<DVec3>>,
+}
+
+/// What a build is given.
+#[derive(Default)]
+struct Capture {
+    emitted: Vec<Emitted>,
+    normal_values: Option<Vec<DVec3>>,
 }
 
 /// A net given to [`Interp::emit_net`] during a build.
@@ -140,6 +175,8 @@ struct Emitted {
     ctm: DMat4,
     index: usize,
     net: PlacedNet,
+    /// The patch's `"N"` field in object space.
+    normals: Option<ColorField>,
 }
 
 /// An object-space net as [`Interp::emit_net`] takes it.
@@ -155,28 +192,62 @@ struct Placed {
     index: usize,
     net: PlacedNet,
     weights: Option<Arc<[f64; 16]>>,
+    /// The fields; without `"N"` when the patch has normals (`normals`).
     primvars: Option<Arc<Primvars>>,
+    /// The `"N"` field in object space: each placement takes it to camera space, and its
+    /// fields are then its own.
+    normals: Option<ColorField>,
     trim: Option<Arc<PatchTrim>>,
 }
 
-/// The placeable form of the patches `built` of one request from the nets `emitted`
+/// The placeable form of the patches `built` of one request from what `capture` kept
 /// while building it under `ctm`; `None` when they cannot be placed.
-fn placeable(emitted: Vec<Emitted>, built: &[Patch], ctm: &DMat4) -> Option<Rc<[Placed]>> {
-    if emitted.len() != built.len() {
+fn placeable(capture: Capture, built: &[Patch], ctm: &DMat4) -> Option<Rc<Built>> {
+    if capture.emitted.len() != built.len() {
         return None;
     }
-    (emitted.into_iter().zip(built))
+    let patches = (capture.emitted.into_iter().zip(built))
         .map(|(e, p)| {
             let normals = p.primvars.as_ref().is_some_and(|v| v.n.is_some());
-            (e.ctm == *ctm && !normals).then(|| Placed {
+            if e.ctm != *ctm || normals != e.normals.is_some() {
+                return None;
+            }
+            let primvars = match (&p.primvars, normals) {
+                (Some(v), true) => Primvars {
+                    n: None,
+                    ..Primvars::clone(v)
+                }
+                .shared(),
+                (v, _) => v.clone(),
+            };
+            Some(Placed {
                 index: e.index,
                 net: e.net,
                 weights: p.net.shared_weights().cloned(),
-                primvars: p.primvars.clone(),
+                primvars,
+                normals: e.normals,
                 trim: p.trim.clone(),
             })
         })
-        .collect()
+        .collect::<Option<Vec<Placed>>>()?;
+    let normal_values = capture.normal_values;
+    if patches.iter().any(|p| p.normals.is_some()) && normal_values.is_none() {
+        return None;
+    }
+    Some(Rc::new(Built {
+        patches,
+        normal_values,
+    }))
+}
+
+/// `field` (of normals) taken to camera space by `m`, the inverse transpose of the
+/// transform's linear part (as [`super::primvars::normals_to_camera`] takes the values).
+fn normals_by(field: &ColorField, m: &DMat3) -> ColorField {
+    match field {
+        ColorField::Flat(c) => ColorField::Flat(*m * *c),
+        ColorField::Bilinear(c) => ColorField::Bilinear(c.map(|c| *m * c)),
+        ColorField::Bezier(c) => ColorField::Bezier(c.map(|c| *m * c)),
+    }
 }
 
 /// The definition being recorded.
@@ -333,11 +404,11 @@ impl Interp {
             None => {}
         }
         let (start, ctm) = (self.scene.patches.len(), self.attrs.ctm);
-        self.instancing.capture = Some(Vec::new());
+        self.instancing.capture = Some(Capture::default());
         let r = self.request(req);
-        let emitted = self.instancing.capture.take().unwrap_or_default();
+        let capture = self.instancing.capture.take().unwrap_or_default();
         r?;
-        let patches = placeable(emitted, &self.scene.patches[start..], &ctm);
+        let patches = placeable(capture, &self.scene.patches[start..], &ctm);
         let builds = self.instancing.builds.entry(at).or_default();
         if builds.len() < MAX_BUILDS {
             builds.push(Build { key, patches });
@@ -347,10 +418,21 @@ impl Interp {
 
     /// The built `patches` of `req` under the current transform and attributes, as
     /// [`Interp::emit_net`] made them in the build (so with the same checks and bits).
-    fn place(&mut self, req: &Request, patches: &[Placed]) -> Result<(), SceneError> {
+    fn place(&mut self, req: &Request, built: &Built) -> Result<(), SceneError> {
         let a = Args::new(req);
         let ctm = self.geometry_ctm(&a)?;
-        for p in patches {
+        // The normals: checked as a build checks them (all, in camera space), and the
+        // inverse transpose of the same linear part to take each patch's field there.
+        let normals = match &built.normal_values {
+            None => None,
+            Some(values) => {
+                let linear = DMat3::from_mat4(ctm);
+                let values = values.iter().map(|v| v.as_ref().as_slice());
+                super::primvars::normals_to_camera(&a, linear, values)?;
+                Some(linear.inverse().transpose())
+            }
+        };
+        for p in &built.patches {
             let w = p.weights.as_deref().copied().unwrap_or(Patch::POLYNOMIAL);
             let (cp, bilinear) = match &p.net {
                 PlacedNet::Bilinear(corners, form) => {
@@ -364,7 +446,14 @@ impl Interp {
             };
             self.emit_net(&a, &ctm, p.index, cp, w, bilinear, p.weights.as_ref())?;
             if let Some(last) = self.scene.patches.last_mut() {
-                last.primvars = p.primvars.clone();
+                last.primvars = match (&p.normals, &normals) {
+                    (Some(n), Some(m)) => Primvars {
+                        n: Some(normals_by(n, m)),
+                        ..p.primvars.as_deref().cloned().unwrap_or_default()
+                    }
+                    .shared(),
+                    _ => p.primvars.clone(),
+                };
                 last.trim = p.trim.clone();
             }
         }

@@ -189,6 +189,18 @@ impl Interp {
             [p] => Some(self.normal_var(a, p, &mesh.counts(), &ctm)?),
             _ => return Err(a.err("\"N\" given twice")),
         };
+        // Building an object's primitive for its instances: the normals as given (object
+        // space), which each instance takes to its own camera space.
+        let object_normals = match (&nvar, normals.as_slice()) {
+            (Some(v), [p]) if self.instancing.capturing() => Some(ColorVar {
+                class: v.class,
+                values: p.nums(a)?.chunks_exact(3).map(DVec3::from_slice).collect(),
+            }),
+            _ => None,
+        };
+        if let Some(v) = &object_normals {
+            self.instancing.captured_normal_values(&v.values);
+        }
         let mut skipped = 0usize;
         for (f, face) in mesh.faces.iter().enumerate() {
             let loops: Vec<&std::ops::Range<usize>> = mesh.loops[face.clone()]
@@ -232,6 +244,9 @@ impl Interp {
                         .unwrap_or_default();
                     vars.n = Some(v.polygon_field(f, fv, pt));
                     p.primvars = vars.shared();
+                }
+                if let Some(v) = &object_normals {
+                    self.instancing.captured_normals(v.polygon_field(f, fv, pt));
                 }
             }
         }

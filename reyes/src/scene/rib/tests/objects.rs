@@ -245,13 +245,15 @@ fn redefinitions_and_declarations_build_again() {
 }
 
 /// The frame tables of N instances: one copy of the object's fields, weights, trims and
-/// displacement, and per instance only its root items (224 bytes) and patch infos (32).
+/// displacement, and per instance only its root items (224 bytes), patch infos (32) and the
+/// camera-space normal fields of its polygons with `"N"` (4 entries of 16 bytes each).
 #[test]
 fn frame_tables_hold_the_shared_data_once() {
     use crate::frame::{FrameData, RenderOptions};
-    // No normals, curves or rotations (a rotation may round a displacement's bound apart).
+    // No curves (their fields are made at each replay) or rotations (a rotation may round a
+    // displacement's bound apart).
     let object: String = (OBJECT.lines())
-        .filter(|l| !l.starts_with("PointsPolygons") && !l.starts_with("Curves"))
+        .filter(|l| !l.starts_with("Curves"))
         .map(|l| format!("{l}\n"))
         .collect();
     let at = |n: usize| -> Vec<String> {
@@ -270,29 +272,43 @@ fn frame_tables_hold_the_shared_data_once() {
     };
     let one = data(1, true);
     let per = one.items.len();
-    assert!(per > 0 && !one.primvars.is_empty());
+    let with_normals = (parse(&placed(&object, &["Translate 0 0 0"], true))
+        .patches
+        .iter())
+    .filter(|p| p.primvars.as_ref().is_some_and(|v| v.n.is_some()))
+    .count();
+    assert!(per > 0 && with_normals == 1 && !one.primvars.is_empty());
     for n in [2, 7] {
         let d = data(n, true);
         assert_eq!(d.items.len(), n * per);
-        let first = d
-            .primvars
-            .iter()
-            .zip(&one.primvars)
-            .position(|(a, b)| a != b);
-        assert!(
-            d.primvars.len() == one.primvars.len() && first.is_none(),
-            "{n} instances: one copy of the shared data ({} entries against {}, first \
-             difference at {first:?})",
+        assert_eq!(
             d.primvars.len(),
-            one.primvars.len()
+            one.primvars.len() + (n - 1) * with_normals * 4,
+            "{n} instances: one copy of the shared data"
         );
         assert_eq!(
             d.table_bytes(),
-            one.table_bytes() + (n as u64 - 1) * per as u64 * (224 + 32),
+            one.table_bytes() + (n as u64 - 1) * (per as u64 * (224 + 32) + 64),
             "{n} instances"
         );
         let written = data(n, false);
         assert_eq!(written.items, d.items);
         assert!(written.primvars.len() > d.primvars.len());
+    }
+}
+
+/// A placement checks what a build checks: normals that leave the f32 range under the
+/// instance's transform fail the instance, as the written-out requests fail.
+#[test]
+fn a_placement_fails_where_the_written_out_requests_fail() {
+    let mesh =
+        "PointsPolygons [3] [0 1 2] \"P\" [0 0 2 1 0 2 0 1 2] \"N\" [0 0 1 0 0.2 1 0.2 0 1]\n";
+    for instanced in [true, false] {
+        let e = err(&placed(
+            mesh,
+            &["Translate 1 0 0", "Scale 1e-40 1 1"],
+            instanced,
+        ));
+        assert!(e.contains("\"N\" is not finite in camera space"), "{e}");
     }
 }
