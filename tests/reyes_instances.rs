@@ -11,8 +11,8 @@ use reyes::scene::{self, Scene};
 mod common;
 use common::{render_everywhere, small};
 
-/// A coloured bilinear patch, a sphere, a trimmed rational NuPatch with vertex colours and a
-/// subdivided cube with face-varying colours.
+/// A coloured bilinear patch, a sphere, a trimmed rational NuPatch with vertex colours, a
+/// subdivided cube with face-varying colours and a polygon mesh with normals.
 const OBJECT: &str = "\
 AttributeBegin Color 0 1 0 Patch \"bilinear\" \"P\" [-1 -1 0 1 -1 0 -1 1 0 1 1 0] \
  \"varying color Cs\" [1 0 0 0 1 0 0 0 1 1 1 1] AttributeEnd
@@ -28,6 +28,8 @@ SubdivisionMesh \"catmull-clark\" [4 4 4 4 4 4] [0 1 3 2 2 3 5 4 4 5 7 6 6 7 1 0
  \"P\" [-1 -1 1 1 -1 1 -1 1 1 1 1 1 -1 1 -1 1 1 -1 -1 -1 -1 1 -1 -1] \
  \"facevarying color Cs\" [1 0 0 1 0 0 1 0 0 1 0 0  0 1 0 0 1 0 0 1 0 0 1 0 \
  0 0 1 0 0 1 0 0 1 0 0 1  1 1 0 1 1 0 1 1 0 1 1 0  0 1 1 0 1 1 0 1 1 0 1 1 1 0 1 1 0 1 1 0 1 1 0 1]
+PointsPolygons [4 3] [0 1 2 3 1 4 2] \"P\" [-2 -3 1.5  2 -3 1.5  2 -2 1.5  -2 -2 1.5  3 -3 1.5] \
+ \"N\" [0 -0.5 1  0 -0.5 1  0.5 0 1  -0.5 0 1  1 0 1]
 ";
 
 /// Four instances: coloured, mirrored and turned, one-sided and reversed, scaled.
