@@ -598,45 +598,6 @@ fn gpu_lights(scene: &Scene) -> Vec<GpuLight> {
         .collect()
 }
 
-/// What the patches share ([`std::sync::Arc`]: the instances of an object, the patches of
-/// one request) and the table has once: each allocation's entries, by its address. Patches
-/// hold their allocations while the table is made, so an address names one allocation.
-#[derive(Default)]
-struct SharedEntries {
-    /// Primitive variables: `(cs, os, normal)` references.
-    primvars: std::collections::HashMap<usize, (u32, u32, u32)>,
-    /// Rational weights: the first entry.
-    weights: std::collections::HashMap<usize, u32>,
-    /// Displacements: the entry.
-    displacements: std::collections::HashMap<usize, u32>,
-    /// Trims: the flag bits of the header ([`trim_ref`]).
-    trims: std::collections::HashMap<usize, u32>,
-    /// Displacement maps' blocks ([`displacement_ref`]).
-    maps: Vec<(*const crate::scene::DisplacementMap, u32)>,
-    /// Trim loops' edges ([`trim_ref`]).
-    loops: Vec<(*const crate::scene::trim::TrimLoops, u32, u32)>,
-}
-
-/// The entries of `a` in the table: those `seen` remembers for its allocation, else `make`'s
-/// (remembered when another patch holds the allocation too: one the patch holds alone costs
-/// no lookup).
-fn once<T, V: Copy>(
-    seen: &mut std::collections::HashMap<usize, V>,
-    a: &std::sync::Arc<T>,
-    make: impl FnOnce() -> Result<V, Error>,
-) -> Result<V, Error> {
-    if std::sync::Arc::strong_count(a) == 1 {
-        return make();
-    }
-    let key = std::sync::Arc::as_ptr(a) as usize;
-    if let Some(&v) = seen.get(&key) {
-        return Ok(v);
-    }
-    let v = make()?;
-    seen.insert(key, v);
-    Ok(v)
-}
-
 /// `p`'s [`PatchInfo`], appending to `table` what `shared` does not hold yet: one copy per
 /// allocation of fields, weights, displacement and trim, so that N instances of an object
 /// cost their N infos (and motion entries) and one copy of the rest.
