@@ -35,8 +35,9 @@ const MAX_INSTANCE_DEPTH: usize = 64;
 const MAX_BUILDS: usize = 8;
 
 /// Requests whose patches depend on the transform only through [`Interp::emit_net`]'s
-/// `ctm` (checked again for each build): kept and placed. The others (curves and points,
-/// which face the camera; everything that is not geometry) run at every replay.
+/// `ctm` (checked again for each build): kept and placed, with the quadrics
+/// ([`placeable_request`]). The others (curves and points, which face the camera; everything
+/// that is not geometry) run at every replay.
 const PLACEABLE: &[&str] = &[
     "Patch",
     "PatchMesh",
@@ -46,14 +47,12 @@ const PLACEABLE: &[&str] = &[
     "PointsPolygons",
     "PointsGeneralPolygons",
     "SubdivisionMesh",
-    "Sphere",
-    "Cylinder",
-    "Cone",
-    "Disk",
-    "Paraboloid",
-    "Hyperboloid",
-    "Torus",
 ];
+
+/// Whether request `name` is built once and placed ([`PLACEABLE`] and the quadrics).
+fn placeable_request(name: &str) -> bool {
+    PLACEABLE.contains(&name) || super::quadrics::QUADRICS.contains(&name)
+}
 
 /// The kept builds of the primitives of object definitions, and the build under way.
 #[derive(Default)]
@@ -352,7 +351,7 @@ impl Interp {
                     self.object_instance(r)?;
                 } else if r.name == "TrimCurve" {
                     self.instanced_trim_curve((at, i), r)?;
-                } else if self.motion.is_none() && PLACEABLE.contains(&r.name.as_str()) {
+                } else if self.motion.is_none() && placeable_request(&r.name) {
                     self.instanced_primitive((at, i), r)?;
                 } else {
                     self.request(r)?;
