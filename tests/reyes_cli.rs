@@ -1015,6 +1015,9 @@ fn stats_and_exr_hold_the_rendered_frame() {
     assert_eq!((typed.width, typed.height), (40, 30));
     assert_eq!(typed.strategy, "multipass");
     assert!(typed.micropolygons > 100 && typed.grids_diced > 0);
+    // The teapot's patches have no fields, weights or trims: a root item (224 bytes) and a
+    // patch info (32) each.
+    assert_eq!(typed.table_bytes, typed.patches_in as u64 * (224 + 32));
     assert_eq!(typed.runs.as_ref().unwrap().count, 2);
     assert_eq!(v["executed"]["bound"], typed.bounds);
     let docs = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/reyes.md"))

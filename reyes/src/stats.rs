@@ -36,6 +36,11 @@ pub struct FrameStats {
     pub raster: String,
     /// Root patches of the scene.
     pub patches_in: usize,
+    /// Bytes of the scene's tables that grow with its patches: root items, patch infos and
+    /// the primitive-variable table ([`crate::frame::FrameData::table_bytes`]); 0 when read
+    /// from JSON without the key.
+    #[serde(default)]
+    pub table_bytes: u64,
     /// Bound procedure executions.
     pub bounds: u64,
     /// Splits (`splits_u + splits_v`).
@@ -308,6 +313,7 @@ pub fn frame_stats(
         bound_px: (f.bound_px > 0.0).then_some(f.bound_px as f64),
         raster: RasterMode::from_gpu_code(f.raster).name().to_string(),
         patches_in: data.items.len(),
+        table_bytes: data.table_bytes(),
         bounds: executed(0),
         splits: executed(1) + executed(2),
         splits_u: executed(1),

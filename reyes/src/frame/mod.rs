@@ -268,6 +268,17 @@ pub struct FrameData {
 }
 
 impl FrameData {
+    /// Bytes of the scene's tables on the device that grow with its patches: the root
+    /// items (224 bytes each), the patch infos (32 each) and the primitive-variable table
+    /// (16 per entry: fields, weights, displacements, trims, motion). N instances of an
+    /// object add N items and infos (and motion entries) but share the rest
+    /// (docs/reyes.md, *Instances*).
+    pub fn table_bytes(&self) -> u64 {
+        (std::mem::size_of_val(self.items.as_slice())
+            + std::mem::size_of_val(self.patch_info.as_slice())
+            + std::mem::size_of_val(self.primvars.as_slice())) as u64
+    }
+
     /// What this frame needs compiled into the GPU program ([`SceneFeatures`]).
     pub fn features(&self) -> SceneFeatures {
         let os = self.patch_info.iter().any(|i| i.os != 0);
@@ -471,16 +482,9 @@ impl FrameData {
         let focal = width.min(height) as f64 / 2.0 / (fov / 2.0).tan();
         let lights = gpu_lights(scene);
         let mut primvars = Vec::new();
-        let mut maps = Vec::new();
-        let mut trims = Vec::new();
+        let mut shared = SharedEntries::default();
         let patch_info: Vec<PatchInfo> = (scene.patches.iter())
-            .map(|p| {
-                let mut info = patch_info(p, &mut primvars, &mut maps)?;
-                if let Some(t) = &p.trim {
-                    info.flags |= trim_ref(&mut primvars, &mut trims, t)?;
-                }
-                Ok(info)
-            })
+            .map(|p| patch_info(p, &mut primvars, &mut shared))
             .collect::<Result<_, Error>>()?;
         let frame = FrameUniforms {
             width,
@@ -594,28 +598,47 @@ fn gpu_lights(scene: &Scene) -> Vec<GpuLight> {
         .collect()
 }
 
+/// `p`'s [`PatchInfo`], appending to `table` what `shared` does not hold yet: one copy per
+/// allocation of fields, weights, displacement and trim, so that N instances of an object
+/// cost their N infos (and motion entries) and one copy of the rest.
 fn patch_info(
     p: &Patch,
     table: &mut Vec<[f32; 4]>,
-    maps: &mut Vec<(*const crate::scene::DisplacementMap, u32)>,
+    shared: &mut SharedEntries,
 ) -> Result<PatchInfo, Error> {
-    let mut field = |f: Option<&crate::scene::ColorField>| f.map_or(Ok(0), |f| field_ref(table, f));
-    let vars = p.primvars.as_deref();
-    let cs = field(vars.and_then(|v| v.cs.as_ref()))?;
-    let os = field(vars.and_then(|v| v.os.as_ref()))?;
-    let normal = field(vars.and_then(|v| v.n.as_ref()))?;
-    let weights = if p.is_rational() {
-        weights_ref(table, &homogeneous_points(p))?
-    } else {
-        0
+    let (cs, os, normal) = match &p.primvars {
+        None => (0, 0, 0),
+        Some(v) => once(&mut shared.primvars, v, || {
+            let mut field =
+                |f: Option<&crate::scene::ColorField>| f.map_or(Ok(0), |f| field_ref(table, f));
+            Ok((
+                field(v.cs.as_ref())?,
+                field(v.os.as_ref())?,
+                field(v.n.as_ref())?,
+            ))
+        })?,
+    };
+    let weights = match p.net.shared_weights().filter(|_| p.is_rational()) {
+        None => 0,
+        Some(w) => once(&mut shared.weights, w, || {
+            weights_ref(table, &homogeneous_points(p))
+        })?,
     };
     let displacement = match &p.displacement {
-        Some(d) => displacement_ref(table, maps, d)?,
         None => 0,
+        Some(d) => once(&mut shared.displacements, d, || {
+            displacement_ref(table, &mut shared.maps, d)
+        })?,
     };
     let motion = match &p.motion {
         Some(m) => motion_ref(table, m)?,
         None => 0,
+    };
+    let trim = match &p.trim {
+        None => 0,
+        Some(t) => once(&mut shared.trims, t, || {
+            trim_ref(table, &mut shared.loops, t)
+        })?,
     };
     Ok(PatchInfo {
         material: p.material,
@@ -627,7 +650,8 @@ fn patch_info(
             } else {
                 0
             }
-            | if p.motion.is_some() { PATCH_MOVING } else { 0 },
+            | if p.motion.is_some() { PATCH_MOVING } else { 0 }
+            | trim,
         cs,
         os,
         weights,
@@ -794,13 +818,13 @@ mod tests {
             os: Some(ColorField::Flat(DVec3::splat(0.5))),
             n: None,
         }
-        .boxed();
+        .shared();
         scene.patches[7].primvars = Primvars {
             cs: None,
             os: Some(ColorField::Bezier([DVec3::splat(0.25); 16])),
             n: None,
         }
-        .boxed();
+        .shared();
         let d = FrameData::new(&scene, &RenderOptions::default()).unwrap();
         assert_eq!(d.primvars.len(), 4 + 1 + 16);
         assert_eq!(

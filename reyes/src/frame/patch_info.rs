@@ -237,3 +237,42 @@ pub fn trim_ref(
     ]);
     Ok(PATCH_TRIMMED | (at as u32) << TRIM_SHIFT)
 }
+
+/// What the patches share ([`std::sync::Arc`]: the instances of an object, the patches of
+/// one request) and the table has once: each allocation's entries, by its address. Patches
+/// hold their allocations while the table is made, so an address names one allocation.
+#[derive(Default)]
+pub(super) struct SharedEntries {
+    /// Primitive variables: `(cs, os, normal)` references.
+    pub(super) primvars: std::collections::HashMap<usize, (u32, u32, u32)>,
+    /// Rational weights: the first entry.
+    pub(super) weights: std::collections::HashMap<usize, u32>,
+    /// Displacements: the entry.
+    pub(super) displacements: std::collections::HashMap<usize, u32>,
+    /// Trims: the flag bits of the header ([`trim_ref`]).
+    pub(super) trims: std::collections::HashMap<usize, u32>,
+    /// Displacement maps' blocks ([`displacement_ref`]).
+    pub(super) maps: Vec<(*const crate::scene::DisplacementMap, u32)>,
+    /// Trim loops' edges ([`trim_ref`]).
+    pub(super) loops: Vec<(*const crate::scene::trim::TrimLoops, u32, u32)>,
+}
+
+/// The entries of `a` in the table: those `seen` remembers for its allocation, else `make`'s
+/// (remembered when another patch holds the allocation too: one the patch holds alone costs
+/// no lookup).
+pub(super) fn once<T, V: Copy>(
+    seen: &mut std::collections::HashMap<usize, V>,
+    a: &std::sync::Arc<T>,
+    make: impl FnOnce() -> Result<V, Error>,
+) -> Result<V, Error> {
+    if std::sync::Arc::strong_count(a) == 1 {
+        return make();
+    }
+    let key = std::sync::Arc::as_ptr(a) as usize;
+    if let Some(&v) = seen.get(&key) {
+        return Ok(v);
+    }
+    let v = make()?;
+    seen.insert(key, v);
+    Ok(v)
+}

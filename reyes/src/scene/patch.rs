@@ -29,8 +29,9 @@ pub struct Patch {
     /// `Sides 2` (the default): both sides visible. `Sides 1`: back-facing parts are culled.
     pub two_sided: bool,
     /// The patch's own `"Cs"` / `"Os"` over its parameter square; `None` (no cost) when the
-    /// material's `Color` and `Opacity` apply everywhere.
-    pub primvars: Option<Box<Primvars>>,
+    /// material's `Color` and `Opacity` apply everywhere. Shared by the instances of an
+    /// object (`ObjectInstance`), and written to the GPU's tables once per allocation.
+    pub primvars: Option<Arc<Primvars>>,
     /// Displacement along the normal in DiceShade (RIB `Displacement`); `None` (no cost) for
     /// the undisplaced surface. Shared by the patches of one request.
     pub displacement: Option<Arc<Displacement>>,
@@ -98,8 +99,9 @@ impl Patch {
     }
 
     /// Bytes the host holds for this patch: the struct and what it owns alone (its net's and
-    /// motion's heap parts, its primitive variables' boxes), not what it shares with other
-    /// patches (the file name, a bilinear net's transform, a displacement).
+    /// motion's heap parts, its primitive variables unless another patch shares them), not
+    /// what it shares with other patches (the file name, a bilinear net's transform, a
+    /// displacement, an instanced object's fields and weights).
     pub fn host_bytes(&self) -> usize {
         std::mem::size_of::<Patch>()
             + self.net.heap_bytes()
@@ -107,10 +109,9 @@ impl Patch {
                 .motion
                 .as_ref()
                 .map_or(0, |_| std::mem::size_of::<DMat4>())
-            + self
-                .primvars
-                .as_ref()
-                .map_or(0, |_| std::mem::size_of::<Primvars>())
+            + self.primvars.as_ref().map_or(0, |v| {
+                (Arc::strong_count(v) == 1) as usize * std::mem::size_of::<Primvars>()
+            })
     }
 }
 
@@ -162,15 +163,31 @@ enum Net {
 #[derive(Clone, Debug)]
 struct BicubicNet {
     cp: [DVec3; 16],
-    w: Option<Box<[f64; 16]>>,
+    /// Shared by the instances of an object (the weights do not depend on the placement).
+    w: Option<Arc<[f64; 16]>>,
 }
 
 impl PatchNet {
     /// The net of 16 camera-space control points (`cp[4*v + u]`) with weights `w`; weights
     /// that are all 1 ([`Patch::POLYNOMIAL`]) are not stored.
     pub fn new(cp: [DVec3; 16], w: [f64; 16]) -> PatchNet {
-        let w = (w != Patch::POLYNOMIAL).then(|| Box::new(w));
+        let w = (w != Patch::POLYNOMIAL).then(|| Arc::new(w));
         PatchNet(Net::Bicubic(Box::new(BicubicNet { cp, w })))
+    }
+
+    /// [`PatchNet::new`] with weights another net holds already (an instance of an object
+    /// shares its weights with the object's other instances); `None` for all 1.
+    pub(crate) fn with_shared_weights(cp: [DVec3; 16], w: Option<Arc<[f64; 16]>>) -> PatchNet {
+        PatchNet(Net::Bicubic(Box::new(BicubicNet { cp, w })))
+    }
+
+    /// The weights as the net holds them: one allocation that instances share ([`Arc`]),
+    /// `None` when all are 1. The GPU's weight table has one entry per allocation.
+    pub fn shared_weights(&self) -> Option<&Arc<[f64; 16]>> {
+        match &self.0 {
+            Net::Bilinear { .. } => None,
+            Net::Bicubic(b) => b.w.as_ref(),
+        }
     }
 
     /// The net of a bilinear patch of object-space `corners` under `to_camera` (affine),
@@ -232,18 +249,23 @@ impl PatchNet {
 
     /// The 16 weights to change in place (stored from then on, all 1 at first).
     pub fn weights_mut(&mut self) -> &mut [f64; 16] {
-        self.bicubic()
-            .w
-            .get_or_insert_with(|| Box::new(Patch::POLYNOMIAL))
+        Arc::make_mut(
+            self.bicubic()
+                .w
+                .get_or_insert_with(|| Arc::new(Patch::POLYNOMIAL)),
+        )
     }
 
-    /// Bytes the net owns on the heap (0 for a bilinear net, whose transform is shared).
+    /// Bytes the net owns on the heap (0 for a bilinear net, whose transform is shared;
+    /// weights only when no other net shares them).
     pub fn heap_bytes(&self) -> usize {
         match &self.0 {
             Net::Bilinear { .. } => 0,
             Net::Bicubic(b) => {
                 std::mem::size_of::<BicubicNet>()
-                    + b.w.as_ref().map_or(0, |_| std::mem::size_of::<[f64; 16]>())
+                    + b.w.as_ref().map_or(0, |w| {
+                        (Arc::strong_count(w) == 1) as usize * std::mem::size_of::<[f64; 16]>()
+                    })
             }
         }
     }

@@ -113,9 +113,10 @@ pub struct Primvars {
 
 impl Primvars {
     /// `Some` when at least one variable is given, else `None` (a patch without primitive
-    /// variables costs nothing).
-    pub fn boxed(self) -> Option<Box<Primvars>> {
-        (self.cs.is_some() || self.os.is_some() || self.n.is_some()).then(|| Box::new(self))
+    /// variables costs nothing). One allocation that the instances of an object share.
+    pub fn shared(self) -> Option<std::sync::Arc<Primvars>> {
+        (self.cs.is_some() || self.os.is_some() || self.n.is_some())
+            .then(|| std::sync::Arc::new(self))
     }
 }
 

@@ -291,9 +291,13 @@ impl Interp {
             p.flip_normal = false;
             p.displacement = displacement;
             if n.is_some() {
-                let mut vars = p.primvars.take().map(|b| *b).unwrap_or_default();
+                let mut vars = p
+                    .primvars
+                    .take()
+                    .map(std::sync::Arc::unwrap_or_clone)
+                    .unwrap_or_default();
                 vars.n = n;
-                p.primvars = vars.boxed();
+                p.primvars = vars.shared();
             }
         }
         Ok(())

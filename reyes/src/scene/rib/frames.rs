@@ -107,6 +107,7 @@ impl Interp {
         self.frame_camera(req, &mut scene)?;
         self.materials.clear();
         self.current_material = None;
+        self.instancing.end_of_world();
         let display = self.options.display.clone();
         let unsupported = display.as_ref().filter(|d| d.is_depth_pass()).map(|d| {
             format!(

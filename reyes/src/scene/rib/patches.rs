@@ -55,6 +55,7 @@ fn max_frame_patches() -> usize {
 pub(super) struct SharedParts {
     file: Option<(std::rc::Rc<str>, std::sync::Arc<str>)>,
     ctm: Option<std::sync::Arc<DMat4>>,
+    displacement: Option<std::sync::Arc<crate::scene::Displacement>>,
 }
 
 impl SharedParts {
@@ -68,6 +69,32 @@ impl SharedParts {
                 arc
             }
         }
+    }
+
+    /// `d` shared (one allocation per displacement used in a row: the patches of a request,
+    /// the instances of an object under transforms of one scale), so that the GPU's table
+    /// holds it once (`frame::patch_info` writes one entry per allocation).
+    fn displacement(
+        &mut self,
+        d: Option<std::sync::Arc<crate::scene::Displacement>>,
+    ) -> Option<std::sync::Arc<crate::scene::Displacement>> {
+        use crate::scene::DisplacementPattern as P;
+        let d = d?;
+        if let Some(old) = &self.displacement {
+            let same_pattern = match (&old.pattern, &d.pattern) {
+                (P::Bumps { frequency: a }, P::Bumps { frequency: b }) => a == b,
+                (P::Map(a), P::Map(b)) => std::sync::Arc::ptr_eq(a, b),
+                _ => false,
+            };
+            if same_pattern
+                && old.amount.to_bits() == d.amount.to_bits()
+                && old.bound.to_bits() == d.bound.to_bits()
+            {
+                return Some(old.clone());
+            }
+        }
+        self.displacement = Some(d.clone());
+        Some(d)
     }
 
     /// `ctm` shared (one allocation per transform used in a row).
@@ -111,7 +138,7 @@ impl Interp {
         cp: [DVec3; 16],
         w: [f64; 16],
     ) -> Result<(), SceneError> {
-        self.emit_net(a, ctm, index, cp, w, None)
+        self.emit_net(a, ctm, index, cp, w, None, None)
     }
 
     /// [`Self::emit`] of the bilinear patch of object-space `corners`, elevated to bicubic
@@ -129,11 +156,16 @@ impl Interp {
             BilinearForm::Patch => bilinear_to_bezier(corners),
             BilinearForm::Polygon => crate::scene::polygon::bilinear_patch(corners),
         };
-        self.emit_net(a, ctm, index, cp, Patch::POLYNOMIAL, Some((corners, form)))
+        let bilinear = Some((corners, form));
+        self.emit_net(a, ctm, index, cp, Patch::POLYNOMIAL, bilinear, None)
     }
 
-    /// [`Self::emit`]; `bilinear` the corners the points `cp` were elevated from.
-    fn emit_net(
+    /// [`Self::emit`]; `bilinear` the corners the points `cp` were elevated from; `shared`
+    /// the weights `w` as another patch holds them (an instance of an object shares them).
+    /// While an object's primitive is built for its instances, its object-space nets are
+    /// kept ([`super::instance`]).
+    #[allow(clippy::too_many_arguments, reason = "one private path for every emit")]
+    pub(super) fn emit_net(
         &mut self,
         a: &Args,
         ctm: &DMat4,
@@ -141,6 +173,7 @@ impl Interp {
         cp: [DVec3; 16],
         w: [f64; 16],
         bilinear: Option<([DVec3; 4], BilinearForm)>,
+        shared: Option<&std::sync::Arc<[f64; 16]>>,
     ) -> Result<(), SceneError> {
         let max = max_frame_patches();
         if self.scene.patches.len() >= max {
@@ -171,6 +204,7 @@ impl Interp {
                  range the renderer computes in (the weights span too wide a range)"
             )));
         }
+        self.instancing.captured(ctm, index, &cp, bilinear);
         let cp = cp.map(|p| ctm.project_point3(p));
         if let Some((k, p)) = cp.iter().enumerate().find(|(_, p)| !p.is_finite()) {
             return Err(a.err(format!(
@@ -194,13 +228,15 @@ impl Interp {
         }
         let material = self.material();
         let displacement = self.displacement(ctm);
-        let net = match bilinear {
-            Some((corners, form)) => {
+        let displacement = self.shared.displacement(displacement);
+        let net = match (bilinear, shared) {
+            (Some((corners, form)), _) => {
                 let net = PatchNet::bilinear(corners, self.shared.ctm(ctm), form);
                 debug_assert!(net.points() == cp);
                 net
             }
-            None => PatchNet::new(cp, w),
+            (None, Some(w)) => PatchNet::with_shared_weights(cp, Some(w.clone())),
+            (None, None) => PatchNet::new(cp, w),
         };
         let file = self.shared.file(&a.req.file);
         self.scene.patches.push(Patch {
@@ -233,7 +269,7 @@ impl Interp {
     ) -> Result<(), SceneError> {
         self.emit_bilinear(a, ctm, index, corners, form)?;
         if let Some(p) = self.scene.patches.last_mut() {
-            p.primvars = Primvars { cs, os, n: None }.boxed();
+            p.primvars = Primvars { cs, os, n: None }.shared();
         }
         Ok(())
     }
@@ -250,7 +286,7 @@ impl Interp {
     ) -> Result<(), SceneError> {
         self.emit(a, ctm, index, cp, w)?;
         if let Some(p) = self.scene.patches.last_mut() {
-            p.primvars = Primvars { cs, os, n: None }.boxed();
+            p.primvars = Primvars { cs, os, n: None }.shared();
         }
         Ok(())
     }

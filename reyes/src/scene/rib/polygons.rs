@@ -189,6 +189,18 @@ impl Interp {
             [p] => Some(self.normal_var(a, p, &mesh.counts(), &ctm)?),
             _ => return Err(a.err("\"N\" given twice")),
         };
+        // Building an object's primitive for its instances: the normals as given (object
+        // space), which each instance takes to its own camera space.
+        let object_normals = match (&nvar, normals.as_slice()) {
+            (Some(v), [p]) if self.instancing.capturing() => Some(ColorVar {
+                class: v.class,
+                values: p.nums(a)?.chunks_exact(3).map(DVec3::from_slice).collect(),
+            }),
+            _ => None,
+        };
+        if let Some(v) = &object_normals {
+            self.instancing.captured_normal_values(&v.values);
+        }
         let mut skipped = 0usize;
         for (f, face) in mesh.faces.iter().enumerate() {
             let loops: Vec<&std::ops::Range<usize>> = mesh.loops[face.clone()]
@@ -225,9 +237,16 @@ impl Interp {
                 let form = BilinearForm::Polygon;
                 self.emit_bilinear_with(a, &ctm, f, corners, form, fields)?;
                 if let (Some(v), Some(p)) = (&nvar, self.scene.patches.last_mut()) {
-                    let mut vars = p.primvars.take().map(|b| *b).unwrap_or_default();
+                    let mut vars = p
+                        .primvars
+                        .take()
+                        .map(std::sync::Arc::unwrap_or_clone)
+                        .unwrap_or_default();
                     vars.n = Some(v.polygon_field(f, fv, pt));
-                    p.primvars = vars.boxed();
+                    p.primvars = vars.shared();
+                }
+                if let Some(v) = &object_normals {
+                    self.instancing.captured_normals(v.polygon_field(f, fv, pt));
                 }
             }
         }

@@ -192,6 +192,7 @@ impl Interp {
         match parse_decl(text) {
             Ok(d) => {
                 self.declared.insert(name.to_string(), d);
+                self.instancing.declared();
             }
             Err(e) => {
                 let msg = format!("skipped `Declare` of \"{}\": {e}", shown(name));

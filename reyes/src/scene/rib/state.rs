@@ -182,6 +182,8 @@ pub(super) struct Interp {
     pub(super) objects: HashMap<String, Rc<[Request]>>,
     /// `ObjectInstance` replays under way (an object may instance another).
     pub(super) instance_depth: usize,
+    /// The objects' primitives built once for their instances.
+    pub(super) instancing: super::instance::Instancing,
     /// `CoordinateSystem`s by name: the transform at shutter open and close.
     pub(super) coordinate_systems: HashMap<String, (DMat4, Option<DMat4>)>,
     /// The file name and transform the patches share.
@@ -210,6 +212,7 @@ impl Interp {
             recording: None,
             objects: HashMap::new(),
             instance_depth: 0,
+            instancing: Default::default(),
             coordinate_systems: HashMap::new(),
             shared: Default::default(),
         }
@@ -312,6 +315,7 @@ impl Interp {
         self.world_to_camera_close = None;
         self.scene = Scene::default();
         self.materials.clear();
+        self.instancing.end_of_world();
         self.motion = None;
         self.recording = None;
         self.frame = None;
