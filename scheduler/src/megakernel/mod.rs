@@ -703,9 +703,18 @@ impl Megakernel {
                 .collect();
             let expected = ctrl[g(nq, G_PENDING)] as u64 + ctrl[g(nq, G_ABANDONED)] as u64;
             if live.iter().map(|&n| n as u64).sum::<u64>() != expected {
+                // On lavapipe the likely cause is known: its loop cut ended a body's loops.
+                let hint = if gpu.is_lavapipe() {
+                    "; on lavapipe every loop of an invocation, the bodies' included, shares \
+                     one 65,535-iteration cut with the persistent loop, so a body with long \
+                     loops is cut short there (docs/scheduler.md, section 4): run it with a \
+                     multi-pass strategy on lavapipe, or with shorter loops"
+                } else {
+                    ""
+                };
                 return Err(RunError::Device(format!(
                     "queue accounting mismatch after a launch: {live:?} live by queue, \
-                     {expected} pending"
+                     {expected} pending{hint}"
                 )));
             }
             // A launch that ran out of room costs a relaunch: its queues grow fourfold.
