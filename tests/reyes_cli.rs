@@ -467,7 +467,10 @@ fn frame_sequences_write_one_image_per_frame() {
         let mut all = vec![scene.as_str(), "--frames", "1-2"];
         all.extend_from_slice(args);
         let (got, err) = render_code(&dir, &all);
-        assert!(got == code && err.contains(expected), "{args:?}: {got} {err}");
+        assert!(
+            got == code && err.contains(expected),
+            "{args:?}: {got} {err}"
+        );
     }
     assert!(!dir.join("s.json").exists() && !dir.join("teapot.0001.png").exists());
 }

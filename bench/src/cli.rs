@@ -331,12 +331,39 @@ impl Cli {
     }
 }
 
+/// `NAME=STEPS` of `--procedure-steps`: a procedure name and its steps per batch (1..=64).
+fn parse_procedure_steps(s: &str) -> Result<(String, u32), String> {
+    let (name, steps) = s
+        .split_once('=')
+        .ok_or_else(|| format!("`{s}`: expected NAME=STEPS, e.g. diceshade=4"))?;
+    let steps: u32 = steps
+        .parse()
+        .map_err(|e| format!("`{s}`: steps `{steps}` is not a number ({e})"))?;
+    if !(1..=64).contains(&steps) || name.is_empty() {
+        return Err(format!(
+            "`{s}`: expected a procedure name and steps in 1..=64"
+        ));
+    }
+    Ok((name.to_string(), steps))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn parse(args: &[&str]) -> Result<Cli, clap::Error> {
         Cli::try_parse_from(std::iter::once("schedbench").chain(args.iter().copied()))
+    }
+
+    #[test]
+    fn procedure_steps_parse_name_and_steps() {
+        assert_eq!(
+            parse_procedure_steps("diceshade=8"),
+            Ok(("diceshade".to_string(), 8))
+        );
+        for bad in ["diceshade", "=4", "leaf=0", "leaf=65", "leaf=x"] {
+            assert!(parse_procedure_steps(bad).is_err(), "{bad}");
+        }
     }
 
     #[test]
@@ -403,20 +430,4 @@ mod tests {
         let s = parse(&["--suite", "--out", "d", "--size", "small"]).unwrap();
         assert_eq!((s.size, s.out), (Scale::Small, Some(PathBuf::from("d"))));
     }
-}
-
-/// `NAME=STEPS` of `--procedure-steps`: a procedure name and its steps per batch (1..=64).
-fn parse_procedure_steps(s: &str) -> Result<(String, u32), String> {
-    let (name, steps) = s
-        .split_once('=')
-        .ok_or_else(|| format!("`{s}`: expected NAME=STEPS, e.g. diceshade=4"))?;
-    let steps: u32 = steps
-        .parse()
-        .map_err(|e| format!("`{s}`: steps `{steps}` is not a number ({e})"))?;
-    if !(1..=64).contains(&steps) || name.is_empty() {
-        return Err(format!(
-            "`{s}`: expected a procedure name and steps in 1..=64"
-        ));
-    }
-    Ok((name.to_string(), steps))
 }

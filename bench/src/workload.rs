@@ -250,8 +250,8 @@ impl<P: ScheduledProblem> Workload for ProblemWorkload<P> {
                 let have = |s: &&(String, u32, Scheduler)| s.0 == name && s.1 == capacity;
                 if !schedulers.iter().any(|s| have(&s)) {
                     let mut config = self.config.clone();
-                    config.procedure_steps = (config.procedure_steps.take())
-                        .or_else(|| Some(P::procedure_steps(gpu)));
+                    config.procedure_steps =
+                        (config.procedure_steps.take()).or_else(|| Some(P::procedure_steps(gpu)));
                     let s = compile(gpu, P::program(run), strategy, &config, capacity)?;
                     schedulers.push((name.clone(), capacity, s));
                 }
