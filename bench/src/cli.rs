@@ -128,8 +128,10 @@ pub struct Cli {
     pub batch_steps: Option<u32>,
 
     /// Megakernel steps per batch of named procedures, overriding --batch-steps for them:
-    /// `NAME=STEPS`, repeated or comma-separated (e.g. `diceshade=4,dicesmall=2`) [default: the
-    /// workload's; none for the trees and BFS].
+    /// `NAME=STEPS`, repeated or comma-separated, e.g. `leaf=4` (tree: branch, leaf; bfs:
+    /// bfs_vertex, bfs_edges; mandelbrot: ms_rect, ms_fill, ms_pixels; reyes: bound, splitu,
+    /// splitv, diceshade, dicesmall) [default: the workload's on GPUs: leaf=4 for the tree, 16
+    /// for both BFS procedures, 8 for diceshade and dicesmall; none on lavapipe].
     #[arg(long, value_delimiter = ',', value_parser = parse_procedure_steps,
           help_heading = "Scheduler")]
     pub procedure_steps: Vec<(String, u32)>,

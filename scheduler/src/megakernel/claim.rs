@@ -9,16 +9,27 @@ use crate::program::Program;
 
 /// Most items one batch of each queue holds: `items_per_step` times the procedure's steps
 /// (`MegakernelConfig::procedure_batch_steps`, else `batch_steps`), at most [`MAX_BATCH`].
-/// Errors: a name in `procedure_batch_steps` that is no procedure of `program`, or 0 steps.
+/// Errors: a name in `procedure_batch_steps` that is no procedure of `program` (the message
+/// lists the program's), a name given twice, or 0 steps.
 pub(super) fn batch_items(
     program: &Program,
     config: &MegakernelConfig,
 ) -> Result<Vec<u32>, RunError> {
     let mut steps = vec![config.batch_steps.max(1); program.queue_count()];
+    let mut named = vec![false; program.queue_count()];
     for (name, n) in &config.procedure_batch_steps {
         let q = program.index_of(name).ok_or_else(|| {
-            RunError::Program(format!("batch steps name unknown procedure `{name}`"))
+            let known: Vec<&str> = program.procs.iter().map(|p| p.proc.name.as_str()).collect();
+            RunError::Program(format!(
+                "batch steps name unknown procedure `{name}` (this program's: {})",
+                known.join(", ")
+            ))
         })?;
+        if std::mem::replace(&mut named[q], true) {
+            return Err(RunError::Program(format!(
+                "batch steps name procedure `{name}` twice"
+            )));
+        }
         if *n == 0 {
             return Err(RunError::Program(format!(
                 "batch steps of `{name}` must be at least 1"
@@ -85,6 +96,8 @@ mod tests {
         c.procedure_batch_steps = vec![("c".into(), 2)];
         assert!(batch_items(&p, &c).is_err());
         c.procedure_batch_steps = vec![("a".into(), 0)];
+        assert!(batch_items(&p, &c).is_err());
+        c.procedure_batch_steps = vec![("a".into(), 2), ("a".into(), 4)];
         assert!(batch_items(&p, &c).is_err());
     }
 }
