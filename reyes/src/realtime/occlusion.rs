@@ -16,12 +16,12 @@
 //!    (a piece crossing the near plane is never culled), or when, as a root of phase 1, it
 //!    passed the test again; Bound then sets its patch's history.
 //!
-//! The first frame's history is the first pass of the single frame ([`start_history`]): the
+//! The first frame's history is the first pass of the single frame (`start_history`): the
 //! roots [`front_items`] marks for the host's unturned roots, the nearest patch of each cell,
 //! so that the first frame's phase 1 draws about the front and phase 2 culls the rest (a
 //! history of every patch would make the first frame draw everything, the unculled frame). A
-//! frame rendered again resets it the same way from that frame's roots. The image is that of the frame without culling, bit for bit,
-//! whatever the history holds: any split of the roots between the phases draws every root
+//! frame rendered again resets it the same way from that frame's roots. The image is that of
+//! the frame without culling, bit for bit, whatever the history holds: any split of the roots between the phases draws every root
 //! once, and phase 2 tests only against a pyramid of samples really written (the argument of
 //! [`crate::stages::hiz`]). A stale or partial history (a frame rendered again, whose
 //! attempt wrote part of it) costs work, never pixels.
@@ -32,7 +32,7 @@
 //! out of room says so in its status, like a frame without culling: the frame is rendered
 //! again, and the sizes grow to that render's needs; where a phase needed more than the
 //! culled single frame measured (they split the roots differently), so that the sizes would
-//! not grow, the queues out of room (or the rounds) double instead ([`grow`]): each frame
+//! not grow, the queues out of room (or the rounds) double instead (`grow`): each frame
 //! rendered again grows them, so frames stop being rendered again once a phase fits.
 
 use crate::frame::{FrameData, FrameUniforms, PatchItem};
