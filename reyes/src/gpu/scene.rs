@@ -61,8 +61,9 @@ pub struct SceneBuffers {
     /// roots.wgsl. Only for renderers that make root items on the GPU.
     objects: Option<wgpu::Buffer>,
     /// Per patch, one u32: the occlusion history of pipelined frames that cull (`visible` in
-    /// common.wgsl, `root_visible` in roots.wgsl), every patch visible at first (the first
-    /// frame has no history); one word when the scene was uploaded without its patch table.
+    /// common.wgsl, `root_visible` in roots.wgsl), every patch visible at upload; a renderer
+    /// that culls sets the first frame's (`realtime::occlusion::start_history`); one word when
+    /// the scene was uploaded without its patch table.
     visible: wgpu::Buffer,
     /// The scene bind group last made and the target it binds ([`FrameTarget::id`]).
     bind: Option<(u64, wgpu::BindGroup)>,

@@ -233,8 +233,9 @@ impl RealtimeRenderer {
     ) -> Result<RealtimeRenderer, RunError> {
         let mut base =
             FrameData::new(scene, options).map_err(|e| RunError::Program(e.to_string()))?;
-        // The frame that sizes the pipelined run and a frame rendered again render without
-        // culling: all the work, of which each phase of a frame that culls does a part.
+        // `base.frame` has culling off: pipelined frames that cull say so per phase
+        // (`occlusion::Culling`); the frame that sizes the pipelined run and a frame rendered
+        // again set it per call (`RealtimeRenderer::render_occlusion`).
         let asked_occlusion = base.frame.occlusion;
         base.frame.occlusion = crate::stages::hiz::OCCLUSION_OFF;
         let config = RendererConfig::new(strategy).features(base.features());
@@ -334,14 +335,46 @@ impl RealtimeRenderer {
                 r.base.memory_budget.unwrap_or(0)
             ));
         } else {
-            let first = r.render_on_target(gpu, &r.base.clone())?;
-            let size = r.size_from(&first.run);
-            r.resize(gpu, size)?;
             if occlusion::wanted(&r.base, asked_occlusion) {
                 r.culling = Culling::new(gpu, &r.renderer, &r.base.frame, &r.target)?;
             }
+            // Sized by the single frame with the culling the pipelined frames will do (its
+            // passes, `stages::hiz::passes`), not by the unculled frame: on a deep scene that
+            // one is many times the work and the queues' memory.
+            let mut first = r.base.clone();
+            first.frame.occlusion = r.render_occlusion();
+            let g = r.render_on_target(gpu, &first)?;
+            let size = r.size_from(&g.run);
+            r.resize(gpu, size)?;
+            r.start_history(gpu, &r.base.items);
         }
         Ok(r)
+    }
+
+    /// `FrameUniforms::occlusion` of a frame rendered by [`GpuRenderer::render`] (the frame
+    /// that sizes the pipelined run, a frame rendered again): the options' when frames are not
+    /// pipelined; when they cull, the single frame's culling passes; else none.
+    fn render_occlusion(&self) -> u32 {
+        if self.not_pipelined.is_some() {
+            self.asked_occlusion
+        } else if self.culling.is_some() {
+            crate::stages::hiz::OCCLUSION_ON
+        } else {
+            crate::stages::hiz::OCCLUSION_OFF
+        }
+    }
+
+    /// Sets the occlusion history that the next frame submitted reads
+    /// ([`occlusion::start_history`] of `items`, this scene's untagged root items, one per
+    /// patch) when pipelined frames cull; queue order puts the write after the frames already
+    /// submitted.
+    fn start_history(&self, gpu: &Gpu, items: &[PatchItem]) {
+        if self.culling.is_none() || items.len() != self.patches as usize {
+            return;
+        }
+        let history = occlusion::start_history(&self.base, items);
+        gpu.queue
+            .write_buffer(self.scene.visible(), 0, bytemuck::cast_slice(&history));
     }
 
     /// Whether pipelined frames cull from the previous frame ([`occlusion`]): with
@@ -458,11 +491,21 @@ impl RealtimeRenderer {
         (self.renderer).render_on(gpu, &self.scene, &self.target, &bind, data, Instant::now())
     }
 
+    /// The fixed sizes for frames like `run` (a render by [`GpuRenderer::render`] of this
+    /// scene), [`HEADROOM`] above its needs. Every record (each phase of a frame that culls) is
+    /// seeded with every root, while the single frame's culling passes each seed a part: the
+    /// roots count in Bound's peak, so that the multi-pass plan has room for what they may emit.
     fn size_from(&self, run: &RunStats) -> RecordedSize {
         let program = self.renderer.scheduler.program();
         let mut seeds = vec![0; program.queue_count()];
-        seeds[program.index_of("bound").unwrap()] = self.patches;
-        RecordedSize::from_stats(program, self.kind, run, &seeds, HEADROOM)
+        let bound = program.index_of("bound").unwrap();
+        seeds[bound] = self.patches;
+        let mut run = run.clone();
+        if run.peak_occupancy.len() > bound {
+            let peak = &mut run.peak_occupancy[bound];
+            *peak = (*peak).max(self.patches as u64);
+        }
+        RecordedSize::from_stats(program, self.kind, &run, &seeds, HEADROOM)
     }
 
     /// Renders one frame per turntable angle (radians; [`orbit::orbit_transform`] about the
@@ -717,11 +760,12 @@ impl RealtimeRenderer {
             ..self.base.clone()
         };
         // A frame that is never pipelined culls as `reyes render` does; one whose pipelined
-        // attempt fell short renders all the work, which the sizes then grow to.
-        if self.recorded.is_none() {
-            data.frame.occlusion = self.asked_occlusion;
-        }
+        // attempt fell short renders with the culling passes when frames cull (the sizes then
+        // grow to its needs, or double: `occlusion::grow`), else all the work.
+        data.frame.occlusion = self.render_occlusion();
         let g = self.render_on_target(gpu, &data)?;
+        // The attempt left a partial history: start again from this frame's front roots.
+        self.start_history(gpu, &data.items);
         // The table now holds this frame's motion: the next frame writes its own.
         self.motion_written.set(transform);
         // The GPU image holds the incomplete attempt: the right frame replaces it (converted
@@ -729,7 +773,10 @@ impl RealtimeRenderer {
         let rgba8 = g.image.rgba8();
         gpu.queue.write_buffer(self.target.rgba8(), 0, &rgba8);
         if self.recorded.is_some() {
-            let size = self.size_from(&g.run).max(&self.wanted);
+            let mut size = self.size_from(&g.run).max(&self.wanted);
+            if self.culling.is_some() {
+                size = occlusion::grow(&why, &self.wanted, size);
+            }
             if size != self.wanted {
                 self.resize(gpu, size)?;
             }
