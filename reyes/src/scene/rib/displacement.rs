@@ -24,11 +24,15 @@ impl Interp {
     ) -> Result<(), SceneError> {
         let name = a.string("the shader name")?;
         if !DISPLACEMENT_NAMES.contains(&name) {
-            let msg = format!(
-                "skipped unsupported displacement shader \"{}\" (keeping the previous \
-                 displacement; built in: {})",
-                shown(name),
-                DISPLACEMENT_NAMES.join(", ")
+            let msg = super::requests::with_suggestion(
+                format!(
+                    "skipped unsupported displacement shader \"{}\" (keeping the previous \
+                     displacement; built in: {})",
+                    shown(name),
+                    DISPLACEMENT_NAMES.join(", ")
+                ),
+                name,
+                DISPLACEMENT_NAMES,
             );
             self.warn_once(req, &format!("Displacement \"{name}\""), &msg);
             return Ok(());

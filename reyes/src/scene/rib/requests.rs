@@ -394,11 +394,26 @@ impl Interp {
 /// unsupported request. Other standard requests (`Hider`, `Option`) are not that close to
 /// one the reader knows.
 fn misspelt(name: &str) -> Option<&'static str> {
+    closest(name, KNOWN)
+}
+
+/// The entry of `known` that `name` most likely misspells (case aside, or one edit from a name
+/// of 4+ characters, two from one of 8+; Damerau-Levenshtein distance), for a warning's "did you
+/// mean": requests, shader names, subdivision schemes.
+pub(super) fn closest(name: &str, known: &[&'static str]) -> Option<&'static str> {
     let close = |k: &str| {
         let d = strsim::damerau_levenshtein(name, k);
         k.eq_ignore_ascii_case(name) || (name.len() >= 4 && d == 1) || (name.len() >= 8 && d == 2)
     };
-    KNOWN.iter().copied().find(|k| close(k))
+    known.iter().copied().find(|k| close(k))
+}
+
+/// `msg` with " (did you mean `x`?)" where `name` misspells an entry of `known`.
+pub(super) fn with_suggestion(msg: String, name: &str, known: &[&'static str]) -> String {
+    match closest(name, known) {
+        Some(k) => format!("{msg} (did you mean \"{k}\"?)"),
+        None => msg,
+    }
 }
 
 fn skipped_effect(name: &str) -> Option<&'static str> {

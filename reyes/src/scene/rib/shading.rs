@@ -7,6 +7,16 @@ use super::syntax::{Arg, Args, Request};
 use crate::scene::{Light, Material, SceneError, SurfaceKind};
 use glam::DVec3;
 
+/// The surface shaders `Surface` knows (a misspelt one's warning suggests the closest).
+const SURFACE_NAMES: &[&str] = &[
+    "constant",
+    "matte",
+    "plastic",
+    "metal",
+    "shinymetal",
+    "paintedplastic",
+];
+
 impl Interp {
     pub(super) fn surface(&mut self, req: &Request, a: &mut Args) -> Result<(), SceneError> {
         let name = a.string("the shader name")?;
@@ -20,9 +30,13 @@ impl Interp {
             "shinymetal" => SurfaceKind::Metal,
             "paintedplastic" => SurfaceKind::Plastic,
             _ => {
-                let msg = format!(
-                    "skipped unsupported surface shader \"{}\" (keeping the previous surface)",
-                    shown(name)
+                let msg = super::requests::with_suggestion(
+                    format!(
+                        "skipped unsupported surface shader \"{}\" (keeping the previous surface)",
+                        shown(name)
+                    ),
+                    name,
+                    SURFACE_NAMES,
                 );
                 self.warn_once(req, &format!("Surface \"{name}\""), &msg);
                 return Ok(());

@@ -38,10 +38,14 @@ impl Interp {
     ) -> Result<(), SceneError> {
         let scheme = a.string("the subdivision scheme")?;
         if scheme != "catmull-clark" {
-            let msg = format!(
-                "skipped `SubdivisionMesh` of scheme \"{}\" (only \"catmull-clark\"): the \
-                 image lacks that mesh",
-                shown(scheme)
+            let msg = super::requests::with_suggestion(
+                format!(
+                    "skipped `SubdivisionMesh` of scheme \"{}\" (only \"catmull-clark\"): the \
+                     image lacks that mesh",
+                    shown(scheme)
+                ),
+                scheme,
+                &["catmull-clark"],
             );
             self.warn_once(req, &format!("SubdivisionMesh {scheme}"), &msg);
             return Ok(());

@@ -300,3 +300,33 @@ fn a_misspelt_request_names_the_one_meant() {
         s.warnings
     );
 }
+
+/// A misspelt shader or subdivision scheme is skipped with a warning that names the one meant;
+/// an unknown name far from every known one gets no suggestion.
+#[test]
+fn misspelt_shader_and_scheme_names_suggest_the_one_meant() {
+    let s = crate::scene::parse_rib(
+        "WorldBegin\nSurface \"plastik\"\nDisplacement \"bumbs\"\nSurface \"wood\"\n\
+         SubdivisionMesh \"catmul-clark\" [3] [0 1 2] [] [] [] [] \"P\" [0 0 5 1 0 5 0 1 5]\n\
+         WorldEnd\n",
+        "typo.rib",
+    )
+    .unwrap();
+    for (line, meant) in [(2, "plastic"), (3, "bumps"), (5, "catmull-clark")] {
+        assert!(
+            s.warnings
+                .iter()
+                .any(|w| w.contains(&format!("typo.rib:{line}"))
+                    && w.contains(&format!("did you mean \"{meant}\"?"))),
+            "{meant}: {:?}",
+            s.warnings
+        );
+    }
+    assert!(
+        s.warnings
+            .iter()
+            .any(|w| w.contains("typo.rib:4") && !w.contains("did you mean")),
+        "{:?}",
+        s.warnings
+    );
+}
