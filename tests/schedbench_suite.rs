@@ -144,3 +144,29 @@ fn trees_too_large_to_run_are_refused_naming_their_flags() {
         "{help}"
     );
 }
+
+/// `--procedure-steps` names the workload's procedures: another workload's name, or one given
+/// twice, is a usage error (exit 2) before anything runs, listing the workload's procedures.
+#[test]
+fn procedure_steps_name_the_workloads_procedures() {
+    for (args, expected) in [
+        (
+            &["--workload", "bfs", "--procedure-steps", "leaf=4"][..],
+            "bfs_vertex, bfs_edges",
+        ),
+        (
+            &["--workload", "tree", "--procedure-steps", "leaf=4,leaf=2"],
+            "given twice",
+        ),
+        (&["--procedure-steps", "diceshade=8"], "branch, leaf"),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
+            .args(["--strategy", "cpu"])
+            .args(args)
+            .output()
+            .expect("schedbench runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(expected), "{args:?}: {err}");
+    }
+}

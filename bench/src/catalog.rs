@@ -38,6 +38,16 @@ impl WorkloadName {
         }
     }
 
+    /// The names of the workload's procedures (what `--procedure-steps` may name).
+    pub fn procedures(self) -> &'static [&'static str] {
+        match self {
+            WorkloadName::Tree => &workloads::tree::PROCEDURES,
+            WorkloadName::Reyes => &reyes::gpu_render::PROCEDURES,
+            WorkloadName::Mandelbrot => &workloads::mandelbrot::PROCEDURES,
+            WorkloadName::Bfs => &workloads::bfs::PROCEDURES,
+        }
+    }
+
     /// Whether this branch has the workload's code (every workload does now; the suite's
     /// summary still lists any that would not).
     pub fn built(self) -> bool {

@@ -297,6 +297,36 @@ impl Cli {
                 );
             }
         }
+        // Procedure names are the workload's: checked here, before anything runs.
+        if self.suite && self.workload.is_none() && !self.procedure_steps.is_empty() {
+            Self::usage_error(
+                ErrorKind::ArgumentConflict,
+                "--procedure-steps with --suite needs --workload (procedures are a workload's)"
+                    .into(),
+            );
+        }
+        let known = workload.procedures();
+        let mut seen = Vec::new();
+        for (name, _) in &self.procedure_steps {
+            if !known.contains(&name.as_str()) {
+                Self::usage_error(
+                    ErrorKind::ValueValidation,
+                    format!(
+                        "--procedure-steps: `{name}` is no procedure of --workload {} (its \
+                         procedures: {})",
+                        workload.name(),
+                        known.join(", ")
+                    ),
+                );
+            }
+            if seen.contains(name) {
+                Self::usage_error(
+                    ErrorKind::ValueValidation,
+                    format!("--procedure-steps: `{name}` given twice"),
+                );
+            }
+            seen.push(name.clone());
+        }
     }
 
     /// The tree: the preset, changed by the tree options.

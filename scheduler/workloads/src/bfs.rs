@@ -61,6 +61,9 @@ pub struct BfsEdges {
     pub end: u32,
 }
 
+/// The BFS program's procedures, in registration order (`--procedure-steps` names).
+pub const PROCEDURES: [&str; 2] = ["bfs_vertex", "bfs_edges"];
+
 const VERTEX_WGSL: &str = "struct BfsVertex { v: u32, level: u32 }";
 const EDGES_WGSL: &str = "struct BfsEdges { v: u32, level: u32, begin: u32, end: u32 }";
 
@@ -401,6 +404,12 @@ pub fn megakernel_procedure_steps(gpu: &scheduler::Gpu) -> Vec<(String, u32)> {
 mod tests {
     use super::*;
     use scheduler::wgsl::struct_layout;
+    #[test]
+    fn procedures_are_named_as_listed() {
+        let program = BfsParams::graph500(8, 1).unwrap().program().unwrap();
+        let names: Vec<&str> = program.procs.iter().map(|p| p.proc.name.as_str()).collect();
+        assert_eq!(names, PROCEDURES);
+    }
 
     /// 0-1-2-3 path, 1-4 and 4-3 shortcut, 5-6 a separate component, 7 isolated.
     fn hand_made() -> Csr {

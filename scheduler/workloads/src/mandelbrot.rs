@@ -99,6 +99,9 @@ pub struct MandelRect {
     pub dwell: u32,
 }
 
+/// The Mandelbrot program's procedures, in registration order (`--procedure-steps` names).
+pub const PROCEDURES: [&str; 3] = ["ms_rect", "ms_fill", "ms_pixels"];
+
 const RECT_WGSL: &str = "struct MandelRect { x: u32, y: u32, w: u32, h: u32, dwell: u32 }";
 
 /// The host twin of WGSL `MandelCfg` (group 1, binding 1): the image and view at run time, so
@@ -577,6 +580,12 @@ impl MandelRun {
 mod tests {
     use super::*;
     use scheduler::wgsl::struct_layout;
+    #[test]
+    fn procedures_are_named_as_listed() {
+        let program = MandelParams::whole_set(64).program().unwrap();
+        let names: Vec<&str> = program.procs.iter().map(|p| p.proc.name.as_str()).collect();
+        assert_eq!(names, PROCEDURES);
+    }
 
     fn small(w: u32, h: u32) -> MandelParams {
         MandelParams {
