@@ -22,8 +22,10 @@
 //!   the world.
 //! - `Imager "background"` (RenderMan's standard imager, parameter "background", also read as
 //!   "bgcolor" or "color"; white when not given) becomes [`Scene::background`]: the resolve
-//!   composites every pixel over it and makes it opaque. `Imager "null"` turns it off; any
-//!   other imager shader is skipped with a warning naming the colour the image lacks.
+//!   composites every pixel over it and makes it opaque. `Imager "null"` turns it off. Any
+//!   other imager shader given a "bgcolor" or "background" colour is read as that background
+//!   imager under an exporter's own name (with a warning); one without is skipped with a warning
+//!   naming what the image lacks.
 
 use super::lexer::shown;
 use super::patches::MAX_COORD;
@@ -115,9 +117,27 @@ impl Interp {
                     }
                     _ => {}
                 }
-                // Another imager shader: none runs; name what the image lacks.
-                let msg = match color {
-                    Some(c) => format!(
+                // Another imager shader: none runs. One given a background colour under the
+                // standard shader's parameter names is the background imager exporters write
+                // under their own names (K-3D's "sample_buster", MeshLab's "MOSAICbackground":
+                // `Ci += (1 - alpha) * bgcolor`): composite over that colour, and say so.
+                let bg = (params.iter())
+                    .find(|p| p.name == "bgcolor" || p.name == "background")
+                    .and_then(|p| p.vec3(a).ok())
+                    .filter(|c| c.is_finite());
+                let msg = match (bg, color) {
+                    (Some(c), _) => {
+                        self.options.background = Some(c);
+                        format!(
+                            "`Imager` \"{}\" is not built in: read as the standard background \
+                             imager, compositing the image over its colour [{} {} {}]",
+                            shown(name),
+                            c.x,
+                            c.y,
+                            c.z
+                        )
+                    }
+                    (None, Some(c)) => format!(
                         "skipped unsupported request `Imager` \"{}\": the background stays transparent black (alpha \
                          0) instead of [{} {} {}]; composite the image over that colour",
                         shown(name),
@@ -125,7 +145,7 @@ impl Interp {
                         c.y,
                         c.z
                     ),
-                    None => format!(
+                    (None, None) => format!(
                         "skipped unsupported request `Imager` \"{}\": no imager shader is applied to the image",
                         shown(name)
                     ),

@@ -62,6 +62,43 @@ fn k3d_screen_window_frames_like_its_field_of_view() {
         "{:?}",
         a.warnings
     );
+    // K-3D's imager "sample_buster" with "bgcolor" [1 1 1] is a background imager under its
+    // own name: the image is composited over white, as the field README expects.
+    assert_eq!(a.background, Some(DVec3::ONE));
+    assert_eq!(b.background, Some(DVec3::ONE));
+}
+
+/// An imager shader that is not built in: with a "bgcolor" or "background" colour it is read
+/// as the background imager; without one it is skipped and the background stays transparent.
+#[test]
+fn unknown_imagers_with_a_background_colour_composite_over_it() {
+    let scene = |imager: &str| {
+        crate::scene::parse_rib(
+            &format!(
+                "{imager}\nWorldBegin\nPatch \"bilinear\" \"P\" [0 0 5 1 0 5 0 1 5 1 1 5]\nWorldEnd\n"
+            ),
+            "imager.rib",
+        )
+        .unwrap()
+    };
+    let s = scene(r#"Imager "MOSAICbackground" "color bgcolor" [0.2 0.4 0.6]"#);
+    assert_eq!(s.background, Some(DVec3::new(0.2, 0.4, 0.6)));
+    assert!(
+        s.warnings
+            .iter()
+            .any(|w| w.contains("MOSAICbackground") && w.contains("background imager")),
+        "{:?}",
+        s.warnings
+    );
+    let s = scene(r#"Imager "vignette" "float strength" [0.5]"#);
+    assert_eq!(s.background, None);
+    assert!(
+        s.warnings
+            .iter()
+            .any(|w| w.contains(r#"skipped unsupported request `Imager` "vignette""#)),
+        "{:?}",
+        s.warnings
+    );
 }
 
 #[test]
