@@ -62,7 +62,7 @@ fn q_slot_base(q: u32) -> u32 { return params[9u + q * 4u]; }
 fn q_flag_base(q: u32) -> u32 { return params[10u + q * 4u]; }
 fn prio(i: u32) -> u32 { return params[8u + NQ * 4u + i]; }
 fn ob_off(q: u32, t: u32) -> u32 { return params[8u + NQ * 5u + q * NQ + t]; }
-// Most items a batch of q claims (host twin: `batch_items` in megakernel/mod.rs, steps x
+// Most items a batch of q claims (host twin: `batch_items` in megakernel/claim.rs, steps x
 // items per step); the outbox and the queues' slack are sized for it.
 fn batch_max(q: u32) -> u32 { return params[11u + q * 4u]; }
 // Items the outbox part (q, t) holds: a batch's worst-case output to t.

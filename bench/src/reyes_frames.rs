@@ -216,8 +216,8 @@ impl Workload for ReyesWorkload {
                     config.batch_steps = config
                         .batch_steps
                         .or(Some(reyes::gpu_render::megakernel_batch_steps(gpu)));
-                    config.procedure_steps = (config.procedure_steps.take())
-                        .or_else(|| Some(reyes::gpu_render::megakernel_procedure_steps(gpu)));
+                    let config = config
+                        .or_procedure_steps(reyes::gpu_render::megakernel_procedure_steps(gpu));
                     let scheduler = compile(gpu, &program, strategy, &config, capacity)?;
                     let config = RendererConfig::new(scheduler.kind())
                         .features(features)

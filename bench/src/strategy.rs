@@ -128,8 +128,8 @@ pub struct GpuConfig {
     /// (1 but for Reyes frames: `reyes::gpu_render::megakernel_batch_steps`).
     pub batch_steps: Option<u32>,
     /// Steps per batch of named procedures (`MegakernelConfig::procedure_batch_steps`);
-    /// `None`: the workload's choice (none but for Reyes frames:
-    /// `reyes::gpu_render::megakernel_procedure_steps`).
+    /// `None`: the workload's choice ([`GpuConfig::or_procedure_steps`]; each workload's
+    /// `megakernel_procedure_steps`).
     pub procedure_steps: Option<Vec<(String, u32)>>,
     /// Longest pause of an idle megakernel workgroup (`MegakernelConfig::idle_backoff`).
     pub idle_backoff: u32,
@@ -164,6 +164,15 @@ impl Default for GpuConfig {
             local_queues: false,
             local_bytes: None,
         }
+    }
+}
+
+impl GpuConfig {
+    /// This configuration with `workload`'s batch steps per procedure where the command line
+    /// named none.
+    pub fn or_procedure_steps(mut self, workload: Vec<(String, u32)>) -> GpuConfig {
+        self.procedure_steps = self.procedure_steps.or(Some(workload));
+        self
     }
 }
 

@@ -89,14 +89,14 @@ pub trait ScheduledProblem: Clone {
         gpu: &Gpu,
         scheduler: &Scheduler,
     ) -> Result<(RunStats, Self::Output), RunError>;
-    /// Points `run` at this problem when its compiled program serves it unchanged (so the
-    /// schedulers compiled for it are kept); false (the default) builds a new run.
     /// The workload's megakernel batch steps per procedure on `gpu`
     /// (`GpuConfig::procedure_steps` when the command line gives none); default none.
     fn procedure_steps(_gpu: &Gpu) -> Vec<(String, u32)> {
         Vec::new()
     }
 
+    /// Points `run` at this problem when its compiled program serves it unchanged (so the
+    /// schedulers compiled for it are kept); false (the default) builds a new run.
     fn retarget(&self, _run: &mut Self::Run) -> bool {
         false
     }
@@ -249,9 +249,7 @@ impl<P: ScheduledProblem> Workload for ProblemWorkload<P> {
                 let capacity = self.config.capacity.unwrap_or(p.capacity(reference));
                 let have = |s: &&(String, u32, Scheduler)| s.0 == name && s.1 == capacity;
                 if !schedulers.iter().any(|s| have(&s)) {
-                    let mut config = self.config.clone();
-                    config.procedure_steps =
-                        (config.procedure_steps.take()).or_else(|| Some(P::procedure_steps(gpu)));
+                    let config = (self.config.clone()).or_procedure_steps(P::procedure_steps(gpu));
                     let s = compile(gpu, P::program(run), strategy, &config, capacity)?;
                     schedulers.push((name.clone(), capacity, s));
                 }

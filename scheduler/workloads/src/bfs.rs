@@ -404,6 +404,7 @@ pub fn megakernel_procedure_steps(gpu: &scheduler::Gpu) -> Vec<(String, u32)> {
 mod tests {
     use super::*;
     use scheduler::wgsl::struct_layout;
+
     #[test]
     fn procedures_are_named_as_listed() {
         let program = BfsParams::graph500(8, 1).unwrap().program().unwrap();

@@ -580,6 +580,7 @@ impl MandelRun {
 mod tests {
     use super::*;
     use scheduler::wgsl::struct_layout;
+
     #[test]
     fn procedures_are_named_as_listed() {
         let program = MandelParams::whole_set(64).program().unwrap();

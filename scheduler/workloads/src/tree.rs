@@ -483,10 +483,10 @@ impl TreeParams {
     }
 }
 
-// `tree_hash` is `scheduler::hash::lowbias32_wgsl`, the twin of the CPU reference's hash.
 /// The tree program's procedures, in registration order (`--procedure-steps` names).
 pub const PROCEDURES: [&str; 2] = ["branch", "leaf"];
 
+// `tree_hash` is `scheduler::hash::lowbias32_wgsl`, the twin of the CPU reference's hash.
 const TREE_WGSL: &str = r#"
 fn tree_children(id: u32, depth: u32) -> u32 {
     if depth >= tree_cfg[0] { return 0u; }
@@ -741,6 +741,7 @@ mod tests {
         };
         assert_eq!(dying.too_large(), None);
     }
+
     #[test]
     fn procedures_are_named_as_listed() {
         let program = TreePreset::Binary.params().program().unwrap();

@@ -268,9 +268,7 @@ impl Interp {
         (cs, os): (Option<ColorField>, Option<ColorField>),
     ) -> Result<(), SceneError> {
         self.emit_bilinear(a, ctm, index, corners, form)?;
-        if let Some(p) = self.scene.patches.last_mut() {
-            p.primvars = Primvars { cs, os, n: None }.shared();
-        }
+        self.colour_last_patch(cs, os);
         Ok(())
     }
 
@@ -285,10 +283,16 @@ impl Interp {
         (cs, os): (Option<ColorField>, Option<ColorField>),
     ) -> Result<(), SceneError> {
         self.emit(a, ctm, index, cp, w)?;
+        self.colour_last_patch(cs, os);
+        Ok(())
+    }
+
+    /// Gives the patch just emitted (`emit_net` pushes one whenever it succeeds) its colour
+    /// fields.
+    fn colour_last_patch(&mut self, cs: Option<ColorField>, os: Option<ColorField>) {
         if let Some(p) = self.scene.patches.last_mut() {
             p.primvars = Primvars { cs, os, n: None }.shared();
         }
-        Ok(())
     }
 
     pub(super) fn patch(&mut self, req: &Request, a: &mut Args) -> Result<(), SceneError> {
