@@ -293,6 +293,7 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
                 MultipassConfig {
                     rounds_per_submit: 3,
                     initial_capacity: 16,
+                    size_from_last_run: false,
                     ..Default::default()
                 },
             )
@@ -304,7 +305,16 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
         ));
         schedulers.push((
             "multipass-host, tiny queues".into(),
-            Scheduler::new(&gpu, &tree.program, StrategyKind::MultipassHost, 16).unwrap(),
+            Scheduler::multipass_host(
+                &gpu,
+                &tree.program,
+                HostMultipassConfig {
+                    initial_capacity: 16,
+                    size_from_last_run: false,
+                    ..Default::default()
+                },
+            )
+            .unwrap(),
         ));
         schedulers.push((
             "multipass-host".into(),
@@ -321,6 +331,7 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
                     rounds_per_submit: 3,
                     initial_capacity: 16,
                     item_layout: Some(ItemLayout::Planar),
+                    size_from_last_run: false,
                     ..Default::default()
                 },
             )
@@ -334,6 +345,7 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
                 HostMultipassConfig {
                     initial_capacity: 16,
                     item_layout: Some(ItemLayout::Planar),
+                    size_from_last_run: false,
                     ..Default::default()
                 },
             )
@@ -591,9 +603,15 @@ fn a_run_started_at_capacity_16_grows_geometrically_and_stays_exact() {
             );
             assert_eq!(result, reference, "{kind:?}");
             let growths = stats.queue_growths;
-            if again && kind == StrategyKind::Megakernel {
-                // The megakernel starts a run with the room its last run needed.
-                assert_eq!(growths, 0, "{stats:?}");
+            if again {
+                // Every strategy starts a run with the room its last run needed (the
+                // megakernel) or ended with (the multi-passes): no growth, and a multi-pass
+                // runs its rounds as the roomy one does.
+                assert_eq!(growths, 0, "{kind:?}: {stats:?}");
+                if kind == StrategyKind::MultipassHost {
+                    assert_eq!(stats.submits, stats.rounds, "{stats:?}");
+                    assert_eq!(stats.rounds, base.rounds, "{stats:?}");
+                }
                 continue;
             }
             assert!(growths >= 1, "{kind:?} never grew from 16: {stats:?}");

@@ -22,6 +22,27 @@ pub fn grow(capacity: u32, need: u64, limit: u32) -> u32 {
 /// geometrically from far too small a start is refused `O(log rounds)` times instead of once
 /// every round or two, and the next submission encodes only the rounds the new capacity is
 /// expected to hold ([`Anticipation::rounds_until_refusal`]).
+/// Slots a run allocates for a queue sized from what an earlier run needed (`need`): an eighth
+/// more, within `limit`. A run's need varies a little from run to run where its work does (BFS
+/// levels found in a different order append different counts), and every new buffer costs far
+/// more than a small run (600 MB of queues took 25-40 ms to make on the H200, against 0.4-3.4 ms
+/// of BFS; docs/results.md, 2026-12-02): with the slack, a run that needs a little more than the
+/// last keeps its buffers ([`kept_capacity`]).
+pub fn with_slack(need: u64, limit: u32) -> u32 {
+    need.saturating_add(need / 8).min(limit as u64) as u32
+}
+
+/// The capacities of the queues kept from the last run (`kept`), when they hold at least
+/// `need[q]` slots and at most `limit[q]` for every queue: a run that fits reuses them instead of
+/// making buffers of its own size (the capacity of a queue is only room; a larger one changes no
+/// result). `None` when there are none or one does not fit.
+pub fn kept_capacity(kept: Option<&[u32]>, need: &[u32], limit: &[u32]) -> Option<Vec<u32>> {
+    let kept = kept?;
+    let fits = kept.len() == need.len()
+        && (0..need.len()).all(|q| kept[q] >= need[q] && kept[q] <= limit[q]);
+    fits.then(|| kept.to_vec())
+}
+
 #[derive(Debug, Clone)]
 pub struct Anticipation {
     /// Worst-case items emitted (all targets) by the last round seen, and the round it was.
@@ -84,7 +105,25 @@ impl Anticipation {
 
 #[cfg(test)]
 mod tests {
-    use super::{Anticipation, grow};
+    use super::{Anticipation, grow, kept_capacity, with_slack};
+
+    #[test]
+    fn kept_queues_are_reused_only_when_they_hold_the_need_within_the_limit() {
+        let limit = [1000, 1000];
+        assert_eq!(kept_capacity(None, &[1, 1], &limit), None);
+        assert_eq!(
+            kept_capacity(Some(&[512, 64]), &[500, 64], &limit),
+            Some(vec![512, 64])
+        );
+        // One queue short of its need: new buffers.
+        assert_eq!(kept_capacity(Some(&[512, 64]), &[500, 65], &limit), None);
+        // A budget below the kept room (a run with less memory): new buffers within it.
+        assert_eq!(kept_capacity(Some(&[512, 64]), &[1, 1], &[256, 1000]), None);
+        assert_eq!(kept_capacity(Some(&[512]), &[1, 1], &limit), None);
+        assert_eq!(with_slack(800, 1 << 20), 900);
+        assert_eq!(with_slack(800, 850), 850);
+        assert_eq!(with_slack(u64::MAX, u32::MAX), u32::MAX);
+    }
 
     #[test]
     fn refusals_anticipate_geometric_growth_over_a_doubling_horizon() {

@@ -29,6 +29,23 @@ impl Readback {
         }
     }
 
+    /// Records the resolve of `timer`'s span `slot` and its copy here at word `dst_word`, after
+    /// the span's last pass: the span's GPU time comes back with the counters of the same
+    /// read-back, with no submission or wait of its own.
+    pub fn copy_span(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        timer: &crate::timing::SpanTimer,
+        slot: u32,
+        dst_word: u64,
+    ) {
+        assert!(
+            dst_word + crate::timing::SpanTimer::WORDS <= self.words,
+            "Readback: span copy past its end"
+        );
+        timer.copy(enc, slot, &self.buf, dst_word);
+    }
+
     /// Records a copy of `words` words of `src` from word `src_word` to word `dst_word` here.
     pub fn copy(
         &self,

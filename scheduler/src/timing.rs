@@ -248,6 +248,11 @@ impl SpanTimer {
             })
     }
 
+    /// Timestamp writes for a span of one pass (its beginning and its end).
+    pub fn whole(&self, slot: u32) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        self.writes(slot, true, true)
+    }
+
     /// Timestamp writes for the span's first pass.
     pub fn begin(&self, slot: u32) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
         self.writes(slot, true, false)

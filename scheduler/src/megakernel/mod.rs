@@ -20,14 +20,14 @@ use compact::{CompactionPass, DeviceCompaction};
 
 use crate::error::RunError;
 use crate::gpu::Gpu;
-use crate::growth::grow;
+use crate::growth::{grow, kept_capacity, with_slack};
 use crate::item_layout::ItemLayout;
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
 use crate::queue_layout::{QueueLayout, RunStart};
 use crate::readback::Readback;
 use crate::stats::RunStats;
-use crate::timing::RunTimer;
+use crate::timing::SpanTimer;
 
 /// How many workgroups a launch has.
 #[derive(Debug, Clone, PartialEq)]
@@ -581,7 +581,7 @@ impl Megakernel {
             true => self.one_launch_need.lock().unwrap().clone(),
             false => vec![0; nq],
         };
-        let mut capacity: Vec<u32> = (0..nq)
+        let need: Vec<u32> = (0..nq)
             .map(|q| {
                 let n = seeded[q];
                 let want = self.config.initial_capacity.max(n.saturating_mul(2)).max(1);
@@ -589,6 +589,18 @@ impl Megakernel {
                 want.min(max_cap[q]).max(n)
             })
             .collect();
+        let mut dq: Option<DeviceQueues> = self.cache.lock().unwrap().take();
+        // The last run's queues when they hold this run's need (no new buffers), else new ones
+        // with slack where the need came from an earlier run.
+        let kept = dq.as_ref().map(|d| d.layout.capacity.as_slice());
+        let mut capacity = kept_capacity(kept, &need, &max_cap).unwrap_or_else(|| {
+            (0..nq)
+                .map(|q| match known[q] >= need[q] as u64 && known[q] > 0 {
+                    true => with_slack(need[q] as u64, max_cap[q]).max(need[q]),
+                    false => need[q],
+                })
+                .collect()
+        });
         let mut stats = RunStats {
             strategy: "megakernel".into(),
             item_layout: self.item_layout().name().into(),
@@ -599,10 +611,12 @@ impl Megakernel {
             turn_anatomy: self.config.turn_anatomy.then(anatomy::TurnAnatomy::default),
             ..Default::default()
         };
-        let mut timer = RunTimer::new(gpu, 64);
+        // Each launch's GPU time comes back with its counters (one read-back, no extra wait).
+        let timer = SpanTimer::new(gpu, 1);
+        let tw = ctrl_words(nq) as u64;
+        let mut gpu_ms = gpu.timestamps.then_some(0.0);
         let rb = self.readback.lock().unwrap().take();
-        let rb = rb.unwrap_or_else(|| Readback::new(gpu, "ctrl read-back", ctrl_words(nq) as u64));
-        let mut dq: Option<DeviceQueues> = self.cache.lock().unwrap().take();
+        let rb = rb.unwrap_or_else(|| Readback::new(gpu, "ctrl read-back", tw + SpanTimer::WORDS));
         let mut start = Start::Upload(live);
         loop {
             let layout = QueueLayout::new(&self.program, capacity.clone())?;
@@ -647,7 +661,7 @@ impl Megakernel {
             {
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("megakernel"),
-                    timestamp_writes: timer.writes(),
+                    timestamp_writes: timer.whole(0),
                 });
                 if let Some(c) = &compaction {
                     self.compaction.record(&mut pass, c);
@@ -659,11 +673,13 @@ impl Megakernel {
                 }
                 pass.dispatch_workgroups(workgroups, 1, 1);
             }
-            rb.copy(&mut enc, &d.ctrl, 0, 0, ctrl_words(nq) as u64);
-            timer.end_submission(&mut enc);
+            rb.copy(&mut enc, &d.ctrl, 0, 0, tw);
+            rb.copy_span(&mut enc, &timer, 0, tw);
             gpu.queue.submit([enc.finish()]);
-            let ctrl = rb.read(gpu, ctrl_words(nq) as u64)?;
-            timer.after_wait(gpu)?;
+            let ctrl = rb.read(gpu, tw + SpanTimer::WORDS)?;
+            if let (Some(total), Some(ms)) = (gpu_ms.as_mut(), timer.ms(&ctrl[tw as usize..])) {
+                *total += ms;
+            }
             stats.launches += 1;
             stats.submits += 1;
             if let Start::Compact { live, .. } = &start {
@@ -804,7 +820,7 @@ impl Megakernel {
         stats.queue_bytes = dq
             .as_ref()
             .map_or(0, |d| d.layout.total_words * 4 + d.layout.total_slots * 4);
-        stats.gpu_ms = timer.finish(gpu)?;
+        stats.gpu_ms = gpu_ms;
         stats.wall_ms = start_time.elapsed().as_secs_f64() * 1e3;
         // Keep the device queues and the read-back buffer for the next run.
         *self.cache.lock().unwrap() = dq;

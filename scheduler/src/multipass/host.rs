@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use crate::error::RunError;
 use crate::gpu::Gpu;
-use crate::growth::grow;
+use crate::growth::{grow, kept_capacity};
 use crate::item_layout::ItemLayout;
 use crate::multipass::partial::{at_limit, needs_partial, partial_round};
 use crate::pipeline::{Kernels, storage_entry};
@@ -45,6 +45,12 @@ pub struct HostMultipassConfig {
     /// How the round buffers hold items; `None` (the default) picks
     /// [`ItemLayout::for_program`].
     pub item_layout: Option<ItemLayout>,
+    /// Start a run with the queues the last run of this scheduler ended with when they hold its
+    /// start (default `true`): queues that had to grow are not made small again and grown anew
+    /// (each growth a refused round and new buffers), which is how a multi-pass renderer or
+    /// graph search that runs again keeps its storage. `false` starts every run at
+    /// `initial_capacity` (tests use it to exercise growth run after run).
+    pub size_from_last_run: bool,
 }
 
 impl Default for HostMultipassConfig {
@@ -54,6 +60,7 @@ impl Default for HostMultipassConfig {
             max_capacity: 1 << 26,
             max_rounds: 100_000,
             item_layout: None,
+            size_from_last_run: true,
         }
     }
 }
@@ -235,8 +242,13 @@ impl HostMultipass {
         let rb = self.readback.lock().unwrap().take();
         let rb = rb.unwrap_or_else(|| Readback::new(gpu, "round counts read-back", count_words));
         let mut timer = RunTimer::new(gpu, 64);
+        let cached = self.cache.lock().unwrap().take();
+        if self.config.size_from_last_run {
+            let kept = cached.as_ref().map(|d| d.layout.capacity.as_slice());
+            capacity = kept_capacity(kept, &capacity, &max_cap).unwrap_or(capacity);
+        }
         let layout = QueueLayout::new(&self.program, capacity.clone())?;
-        let mut d = match self.cache.lock().unwrap().take() {
+        let mut d = match cached {
             Some(d) if d.layout == layout => d,
             _ => self.rounds_buffers(gpu, layout)?,
         };

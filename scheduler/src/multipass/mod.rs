@@ -19,7 +19,7 @@ use layout::*;
 
 use crate::error::RunError;
 use crate::gpu::Gpu;
-use crate::growth::{Anticipation, grow};
+use crate::growth::{Anticipation, grow, kept_capacity};
 use crate::item_layout::ItemLayout;
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
@@ -49,6 +49,12 @@ pub struct MultipassConfig {
     /// How the round buffers hold items; `None` (the default) picks
     /// [`ItemLayout::for_program`], as the host-driven multi-pass does.
     pub item_layout: Option<ItemLayout>,
+    /// Start a run with the queues the last run of this scheduler ended with when they hold its
+    /// start (default `true`): queues that had to grow are not made small again and grown anew
+    /// (each growth a refused round and new buffers), which is how a multi-pass renderer or
+    /// graph search that runs again keeps its storage. `false` starts every run at
+    /// `initial_capacity` (tests use it to exercise growth run after run).
+    pub size_from_last_run: bool,
 }
 
 impl Default for MultipassConfig {
@@ -60,6 +66,7 @@ impl Default for MultipassConfig {
             max_capacity: 1 << 26,
             stage_timing: false,
             item_layout: None,
+            size_from_last_run: true,
         }
     }
 }
@@ -412,9 +419,14 @@ impl Multipass {
         let mut encoded = 0u64;
         // Rounds encoded since the last upload: round r reads items[r % 2].
         let mut since_upload = 0u64;
+        let cached = self.cache.lock().unwrap().take();
+        if self.config.size_from_last_run {
+            let kept = cached.as_ref().map(|d| d.layout.capacity.as_slice());
+            capacity = kept_capacity(kept, &capacity, &max_cap).unwrap_or(capacity);
+        }
         let layout = QueueLayout::new(&self.program, capacity.clone())?;
         let at_limit = partial::at_limit(&capacity, &max_cap);
-        let mut d = match self.cache.lock().unwrap().take() {
+        let mut d = match cached {
             Some(d) if d.layout == layout && d.at_limit == at_limit => d,
             _ => self.device_rounds(gpu, layout, at_limit, MAX_CHUNK)?,
         };
