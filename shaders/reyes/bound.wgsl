@@ -380,11 +380,9 @@ fn crack_dilation(cp: ptr<function, array<f32, 48>>, w: ptr<function, array<f32,
     let slack = 2.0 * (1.0 + max(f32(frame.width), f32(frame.height)) / frame.focal);
     var packed = 0u;
     for (var e = 0u; e < 4u; e++) {
-        // Edges: rows 0 and 3 (along u), columns 0 and 3 (along v).
-        let along_u = e < 2u;
-        let start = select(select(0u, 3u, e == 3u), select(0u, 12u, e == 1u), along_u);
-        let step = select(4u, 1u, along_u);
-        let n = f32(select(nv, nu, along_u));
+        let start = edge_start(e);
+        let step = edge_step(e);
+        let n = edge_segments(e, nu, nv);
         var c2 = 0.0;
         if rational {
             let k1 = start + step;
@@ -401,11 +399,30 @@ fn crack_dilation(cp: ptr<function, array<f32, 48>>, w: ptr<function, array<f32,
             let b3 = cp_point(cp, start + 3u * step);
             c2 = 6.0 * max(length(b0 - 2.0 * b1 + b2), length(b1 - 2.0 * b2 + b3));
         }
-        let px = c2 / (8.0 * n * n) * frame.focal / zmin * slack;
-        let q = clamp(ceil(px * (255.0 / MAX_DILATE_PX)), 1.0, 255.0);
-        packed |= u32(q) << (8u * e);
+        packed |= pack_edge_dilation(c2 / (8.0 * n * n) * frame.focal / zmin * slack, e);
     }
     return packed;
+}
+
+// Boundary edge e of a 4x4 control net (0: v = 0, 1: v = 1, both along u; 2: u = 0, 3: u = 1,
+// along v): the index of its first control point, the stride to the next, and the grid's
+// segments along it.
+fn edge_start(e: u32) -> u32 {
+    return select(select(0u, 3u, e == 3u), select(0u, 12u, e == 1u), e < 2u);
+}
+
+fn edge_step(e: u32) -> u32 {
+    return select(4u, 1u, e < 2u);
+}
+
+fn edge_segments(e: u32, nu: u32, nv: u32) -> f32 {
+    return f32(select(nv, nu, e < 2u));
+}
+
+// Edge e's dilation of `px` pixels in its 8 bits of a packed crack dilation: rounded up to
+// MAX_DILATE_PX / 255 steps, at least one step, at most MAX_DILATE_PX.
+fn pack_edge_dilation(px: f32, e: u32) -> u32 {
+    return u32(clamp(ceil(px * (255.0 / MAX_DILATE_PX)), 1.0, 255.0)) << (8u * e);
 }
 
 // crack_dilation from the boundary curves as they are on screen: `pts` holds the control
@@ -420,20 +437,16 @@ fn screen_crack_dilation(pts: ptr<function, array<vec4<f32>, 16>>,
     -> u32 {
     var packed = 0u;
     for (var e = 0u; e < 4u; e++) {
-        let along_u = e < 2u;
-        let start = select(select(0u, 3u, e == 3u), select(0u, 12u, e == 1u), along_u);
-        let step = select(4u, 1u, along_u);
-        let n = f32(select(nv, nu, along_u));
+        let start = edge_start(e);
+        let step = edge_step(e);
+        let n = edge_segments(e, nu, nv);
         var q: array<vec4<f32>, 4>;
         for (var k = 0u; k < 4u; k++) {
             let i = start + k * step;
             let p = (*pts)[i];
             q[k] = vec4<f32>(p.xy, 0.0, select(1.0, (*w)[i], rational) * p.z);
         }
-        let c2 = curve_c2_rational(q[0], q[1], q[2], q[3]);
-        let px = c2 / (8.0 * n * n);
-        let qq = clamp(ceil(px * (255.0 / MAX_DILATE_PX)), 1.0, 255.0);
-        packed |= u32(qq) << (8u * e);
+        packed |= pack_edge_dilation(curve_c2_rational(q[0], q[1], q[2], q[3]) / (8.0 * n * n), e);
     }
     return packed;
 }

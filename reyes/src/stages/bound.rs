@@ -351,31 +351,41 @@ pub fn crack_dilation(
     zmin: f32,
 ) -> u32 {
     let slack = 2.0 * (1.0 + (f.width.max(f.height) as f32) / f.focal);
-    let mut packed = 0;
-    for e in 0..4 {
-        let along_u = e < 2;
-        let start = if along_u {
-            if e == 1 { 12 } else { 0 }
-        } else if e == 3 {
-            3
-        } else {
-            0
-        };
-        let step = if along_u { 1 } else { 4 };
-        let n = if along_u { nu } else { nv } as f32;
+    pack_edges(nu, nv, |points, n| {
         let c2 = if rational {
-            curve_c2_rational([0, 1, 2, 3].map(|k| cp_h(cp, w, start + k * step)))
+            curve_c2_rational(points.map(|i| cp_h(cp, w, i)))
         } else {
-            let b: Vec<_> = (0..4).map(|k| cp_point(cp, start + k * step)).collect();
+            let b = points.map(|i| cp_point(cp, i));
             6.0 * (b[0] - 2.0 * b[1] + b[2])
                 .length()
                 .max((b[1] - 2.0 * b[2] + b[3]).length())
         };
-        let px = c2 / (8.0 * n * n) * f.focal / zmin * slack;
-        let q = (px * (255.0 / MAX_DILATE_PX)).ceil().clamp(1.0, 255.0);
-        packed |= (q as u32) << (8 * e);
-    }
-    packed
+        c2 / (8.0 * n * n) * f.focal / zmin * slack
+    })
+}
+
+/// Packs a crack dilation: for each boundary edge `e` of a 4x4 control net (0: v = 0, 1: v = 1,
+/// both along u; 2: u = 0, 3: u = 1, along v; `edge_start`, `edge_step` and `edge_segments` in
+/// bound.wgsl), `px(points, n)` gets the edge's four control point indices and the grid's
+/// segments along it and gives its dilation in pixels, packed in 8 bits rounded up to
+/// [`MAX_DILATE_PX`] / 255 steps, at least one step, at most `MAX_DILATE_PX`
+/// (`pack_edge_dilation`).
+fn pack_edges(nu: u32, nv: u32, mut px: impl FnMut([usize; 4], f32) -> f32) -> u32 {
+    (0..4).fold(0, |packed, e| {
+        let along_u = e < 2;
+        let start = match e {
+            1 => 12,
+            3 => 3,
+            _ => 0,
+        };
+        let step = if along_u { 1 } else { 4 };
+        let n = if along_u { nu } else { nv } as f32;
+        let points = [0, 1, 2, 3].map(|k| start + k * step);
+        let q = (px(points, n) * (255.0 / MAX_DILATE_PX))
+            .ceil()
+            .clamp(1.0, 255.0);
+        packed | (q as u32) << (8 * e)
+    })
 }
 
 /// `screen_crack_dilation` in bound.wgsl: the crack dilation of each boundary edge, packed as
@@ -386,27 +396,13 @@ pub fn crack_dilation(
 /// w_i b_i.z, so [`curve_c2_rational`] bounds |C''| in pixels directly, and a chord over a
 /// parameter step 1/n deviates at most |C''| / (8 n^2) pixels from it.
 pub fn screen_crack_dilation(pts: &[(Vec2, f32)], w: &Weights, nu: u32, nv: u32) -> u32 {
-    let mut packed = 0;
-    for e in 0..4 {
-        let along_u = e < 2;
-        let start = if along_u {
-            if e == 1 { 12 } else { 0 }
-        } else if e == 3 {
-            3
-        } else {
-            0
-        };
-        let step = if along_u { 1 } else { 4 };
-        let n = if along_u { nu } else { nv } as f32;
-        let c2 = curve_c2_rational([0, 1, 2, 3].map(|k| {
-            let (s, z) = pts[start + k * step];
-            Vec4::new(s.x, s.y, 0.0, w[start + k * step] * z)
+    pack_edges(nu, nv, |points, n| {
+        let c2 = curve_c2_rational(points.map(|i| {
+            let (s, z) = pts[i];
+            Vec4::new(s.x, s.y, 0.0, w[i] * z)
         }));
-        let px = c2 / (8.0 * n * n);
-        let q = (px * (255.0 / MAX_DILATE_PX)).ceil().clamp(1.0, 255.0);
-        packed |= (q as u32) << (8 * e);
-    }
-    packed
+        c2 / (8.0 * n * n)
+    })
 }
 
 /// `packed_min` in bound.wgsl: the smaller of two packed crack dilations, edge by edge.
