@@ -407,15 +407,21 @@ pub(crate) fn print_table(r: &BenchReport) {
 
 /// Why "wall - GPU" can be below 0. It is printed as measured rather than clamped at 0: a clamp
 /// would bias its median and p95 upwards and hide the frames where the two clocks disagree.
-pub const WALL_BELOW_GPU: &str = "note: wall - GPU below 0: a frame's GPU time spans its first \
+pub const WALL_BELOW_GPU: &str = "a frame's GPU time spans its first \
 pass's start to its last pass's end on the GPU's timestamp clock, its wall time the host's \
 interval between two frame completions; with frames in flight together (pipelined) or clocks \
 that drift (a CPU adapter's timestamps), the first can exceed the second. Shown as measured, \
 not clamped.";
 
-/// The note printed under the table when any frame's wall - GPU time was below 0.
-fn wall_minus_gpu_note(s: Option<&Summary>) -> Option<&'static str> {
-    s.filter(|s| s.min < 0.0).map(|_| WALL_BELOW_GPU)
+/// The note printed under the table when any frame's wall - GPU time was below 0: it names the
+/// smallest, which the table (median, p95) may not show, then says why.
+fn wall_minus_gpu_note(s: Option<&Summary>) -> Option<String> {
+    s.filter(|s| s.min < 0.0).map(|s| {
+        format!(
+            "note: wall - GPU below 0 in some frames (smallest {:.3} ms): {WALL_BELOW_GPU}",
+            s.min
+        )
+    })
 }
 
 fn print_peer(p: &PeerReport) {
@@ -485,7 +491,11 @@ mod tests {
         let diff: Vec<f64> = wall.iter().zip(gpu).map(|(w, g)| w - g).collect();
         let s = Summary::of(&diff).unwrap();
         assert_eq!(s.min, -0.5);
-        assert_eq!(wall_minus_gpu_note(Some(&s)), Some(WALL_BELOW_GPU));
+        let note = wall_minus_gpu_note(Some(&s)).unwrap();
+        assert!(
+            note.contains("smallest -0.500 ms") && note.ends_with(WALL_BELOW_GPU),
+            "{note}"
+        );
         let s = Summary::of(&[0.0, 3.0]).unwrap();
         assert_eq!(wall_minus_gpu_note(Some(&s)), None);
         assert_eq!(wall_minus_gpu_note(None), None);
