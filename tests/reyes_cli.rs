@@ -142,7 +142,7 @@ fn bad_options_are_clear_errors() {
         ),
         (
             &["--frames", "2"][..],
-            "--frames selects none of the file's frames (1)",
+            "--frames selects none of the scene's frames (1)",
             2,
         ),
     ] {

@@ -170,3 +170,20 @@ fn procedure_steps_name_the_workloads_procedures() {
         assert!(err.contains(expected), "{args:?}: {err}");
     }
 }
+
+/// A scene file that cannot be read is an input error, not a usage error: exit 1, the file
+/// named once.
+#[test]
+fn an_unreadable_scene_names_its_file_once_and_exits_1() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("absent.rib");
+    let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
+        .args(["--workload", "reyes", "--strategy", "cpu", "--scene"])
+        .arg(&missing)
+        .output()
+        .expect("schedbench runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    let name = missing.display().to_string();
+    assert_eq!(err.matches(&name).count(), 1, "{err}");
+}

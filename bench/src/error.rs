@@ -18,8 +18,9 @@ pub enum Error {
     /// The renderer library's error: a frame's options out of range.
     #[error(transparent)]
     Reyes(#[from] reyes::Error),
-    /// A scene file that could not be read or parsed.
-    #[error("{}: {source}", path.display())]
+    /// A scene file that could not be read or parsed (the reader's error names the file and
+    /// line).
+    #[error("{source}")]
     SceneFile {
         /// The scene's file.
         path: PathBuf,

@@ -22,36 +22,39 @@ pub const DEFAULT_SIZE_PX: u32 = 1024;
 /// BFS's R-MAT scale when `--scale` is not given.
 pub const DEFAULT_SCALE: u32 = 20;
 
-/// The workload the command line describes; usage errors exit with status 2.
-fn workload(cli: &Cli) -> Box<dyn Workload> {
+/// The workload the command line describes; usage errors exit with status 2, a scene file
+/// that cannot be read or parsed is an error (status 1, naming the file and line).
+fn workload(cli: &Cli) -> Result<Box<dyn Workload>, Error> {
     let config = cli.gpu_config();
     match cli.workload.unwrap_or(WorkloadName::Tree) {
-        WorkloadName::Tree => Box::new(crate::tree::single_workload(cli.tree(), config)),
+        WorkloadName::Tree => Ok(Box::new(crate::tree::single_workload(cli.tree(), config))),
         WorkloadName::Reyes => {
             let scene = match cli.scene.as_str() {
-                "teapot" => Ok(scene::builtin_teapot()),
-                "killeroo" => load_scene(&reyes::shared_data_dir().join("rib/killeroo.rib")),
-                path => load_scene(Path::new(path)),
+                "teapot" => scene::builtin_teapot(),
+                "killeroo" => load_scene(&reyes::shared_data_dir().join("rib/killeroo.rib"))?,
+                path => load_scene(Path::new(path))?,
             };
-            let scene = scene.unwrap_or_else(|e| {
-                Cli::usage_error(ErrorKind::InvalidValue, format!("--scene: {e}"))
-            });
             let size = match (cli.width, cli.height) {
                 (None, None) => None,
                 (w, h) => Some((w.unwrap_or(scene.width), h.unwrap_or(scene.height))),
             };
             let name = format!("reyes-{}", cli.scene);
-            Box::new(ReyesWorkload::new(name, scene, vec![size], config))
+            Ok(Box::new(ReyesWorkload::new(
+                name,
+                scene,
+                vec![size],
+                config,
+            )))
         }
-        WorkloadName::Mandelbrot => Box::new(crate::mandelbrot::single_workload(
+        WorkloadName::Mandelbrot => Ok(Box::new(crate::mandelbrot::single_workload(
             cli.size_px.unwrap_or(DEFAULT_SIZE_PX),
             config,
-        )),
-        WorkloadName::Bfs => Box::new(
+        ))),
+        WorkloadName::Bfs => Ok(Box::new(
             crate::bfs::single_workload(cli.scale.unwrap_or(DEFAULT_SCALE), config).unwrap_or_else(
                 |e| Cli::usage_error(ErrorKind::InvalidValue, format!("--scale: {e}")),
             ),
-        ),
+        )),
     }
 }
 
@@ -87,7 +90,7 @@ fn strategies(cli: &Cli, w: &dyn Workload) -> Vec<Strategy> {
 
 /// Runs and prints; Ok(true) when every run was verified.
 pub fn run(cli: &Cli) -> Result<bool, Error> {
-    let mut w = workload(cli);
+    let mut w = workload(cli)?;
     let strategies = strategies(cli, w.as_ref());
     let gpu = if cli.workload == Some(WorkloadName::Reyes) {
         Gpu::from_env_requiring(reyes::gpu_render::required_features())

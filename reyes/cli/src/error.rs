@@ -54,8 +54,8 @@ pub enum CliError {
         /// The frame's width and height.
         frame: (u32, u32),
     },
-    /// `--frames` selects none of the file's frames.
-    #[error("--frames selects none of the file's frames ({numbers})")]
+    /// `--frames` selects none of the scene's frames (a file's, or the built-in teapot's one).
+    #[error("--frames selects none of the scene's frames ({numbers})")]
     NoFrameSelected {
         /// The file's frame numbers, comma-separated.
         numbers: String,
