@@ -1,11 +1,12 @@
 // Device-driven multi-pass (Patney & Owens 2008, without their read-back per round): rounds of
-// one indirect dispatch per procedure, every round of a submission recorded up front and sized
-// on the device. Compaction is fused into the producing pass, as in the host-driven variant
-// (`multipass_host.wgsl`): `enqueue_<t>` appends the item straight into queue t's region of the
-// next round's input buffer with one atomicAdd on t's count, so a round has no flags, no scan
-// and no scatter. The plan (`plan_round`) turns the previous round's counts into this round's
-// dispatch sizes: for a chunk's first round a one-thread dispatch (`mp_plan`), for every other
-// round the last workgroup of the round before, when it finishes. An empty queue gets 0
+// one indirect dispatch per procedure (or one for all of them: fused rounds, `mp_round` below),
+// every round of a submission recorded up front and sized on the device. Compaction is fused
+// into the producing pass, as in the host-driven variant (`multipass_host.wgsl`): `enqueue_<t>`
+// appends the item straight into queue t's region of the next round's input buffer with one
+// atomicAdd on t's count, so a round has no flags, no scan and no scatter. The plan
+// (`plan_round`) turns the previous round's counts into this round's dispatch sizes: for a
+// chunk's first round a one-thread dispatch (`mp_plan`), for every other round the last
+// workgroup of the round before, when it finishes. An empty queue gets 0
 // workgroups; an empty round is never planned, so it and every round after it in the chunk keep
 // the zeroed arguments the host cleared. Order within a queue is not kept.
 // Generated before this file: tables, procedures, `mp_in_*` / `mp_out_*` accessors,
@@ -183,13 +184,16 @@ fn plan_round(k: u32) {
         }
     }
     // A halted round leaves the whole round's worst case in C_EMITS, for the host's growth.
+    // Fused rounds (FUSED, `MultipassConfig::fused_rounds`) dispatch every procedure's
+    // workgroups together, so each gets at most its share of the dispatch's 65,535.
+    let max_wgs = select(65535u, 65535u / NQ, FUSED);
     var all_wgs = 0u;
     for (var q = 0u; q < NQ; q++) {
         let n = atomicLoad(&mp_ctrl[cw(q, C_COUNT)]);
         let per_step = 256u / THREADS[q];
         // Every input is visited: run, or copied to the front of the next round's inputs.
-        let wgs = select(0u, min((n + per_step - 1u) / per_step, 65535u), ok);
-        set_args((k / 2u) * NQ + q, wgs);
+        let wgs = select(0u, min((n + per_step - 1u) / per_step, max_wgs), ok);
+        if !FUSED { set_args((k / 2u) * NQ + q, wgs); }
         all_wgs += wgs;
         if ok {
             atomicStore(&mp_ctrl[cw(q, C_WGS)], wgs);
@@ -201,6 +205,7 @@ fn plan_round(k: u32) {
             atomicStore(&mp_ctrl[cw(q, C_NEXT)], n - run[q]);
         }
     }
+    if FUSED { set_args((k / 2u) * NQ, all_wgs); }
     if ok { atomicAdd(&mp_ctrl[gw(G_PLANNED)], 1u); }
     if ok && total > 0u { atomicAdd(&mp_ctrl[gw(G_ROUNDS)], 1u); }
     atomicStore(&mp_ctrl[gw(G_DONE)], 0u);
@@ -265,4 +270,24 @@ fn run_procedure(q: u32, lid: u32, wid: u32) {
         workgroupBarrier();
     }
     finish_workgroup(lid);
+}
+
+// A fused round (`MultipassConfig::fused_rounds`): one dispatch of every procedure's workgroups,
+// procedure 0's first (C_WGS of each), so a round costs one indirect dispatch instead of NQ.
+var<workgroup> wg_pick: vec2<u32>;
+@compute @workgroup_size(256)
+fn mp_round(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>) {
+    if lid == 0u {
+        var first = 0u;
+        var q = 0u;
+        loop {
+            let n = atomicLoad(&mp_ctrl[cw(q, C_WGS)]);
+            if wid.x < first + n || q + 1u == NQ { break; }
+            first += n;
+            q += 1u;
+        }
+        wg_pick = vec2<u32>(q, wid.x - first);
+    }
+    let pick = workgroupUniformLoad(&wg_pick);
+    run_procedure(pick.x, lid, pick.y);
 }

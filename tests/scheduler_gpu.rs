@@ -304,6 +304,23 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
             Scheduler::new(&gpu, &tree.program, StrategyKind::Multipass, 1 << 12).unwrap(),
         ));
         schedulers.push((
+            // One dispatch per procedure (the others fuse each round's procedures into one
+            // dispatch, the default), growth and partial rounds as above.
+            "multipass, a dispatch per procedure, tiny queues".into(),
+            Scheduler::multipass(
+                &gpu,
+                &tree.program,
+                MultipassConfig {
+                    rounds_per_submit: 3,
+                    initial_capacity: 16,
+                    size_from_last_run: false,
+                    fused_rounds: false,
+                    ..Default::default()
+                },
+            )
+            .unwrap(),
+        ));
+        schedulers.push((
             "multipass-host, tiny queues".into(),
             Scheduler::multipass_host(
                 &gpu,
@@ -510,7 +527,8 @@ fn a_queue_that_cannot_hold_live_work_reports_overflow() {
 
 /// A multi-pass round whose worst case does not fit a queue at its limit runs in part and
 /// carries the rest (`scheduler::multipass::partial`): a tree that needs far more room breadth
-/// first than its queues may have completes exactly, on both multi-pass strategies.
+/// first than its queues may have completes exactly, on both multi-pass strategies (the
+/// device-driven one with and without fused rounds).
 #[test]
 fn multi_pass_rounds_that_cannot_fit_a_queue_at_its_limit_run_in_part_and_stay_exact() {
     let gpu = gpu();
@@ -528,16 +546,19 @@ fn multi_pass_rounds_that_cannot_fit_a_queue_at_its_limit_run_in_part_and_stay_e
     let roomy = Scheduler::new(&gpu, &run.program, StrategyKind::MultipassHost, 1 << 16).unwrap();
     let (wide, _) = run.run(&gpu, &roomy).unwrap();
     assert!(wide.peak_occupancy[0] > 4 * 32, "{wide:?}");
-    let mp = Scheduler::multipass(
-        &gpu,
-        &run.program,
-        MultipassConfig {
-            initial_capacity: 16,
-            max_capacity: 32,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let mp = |fused_rounds| {
+        Scheduler::multipass(
+            &gpu,
+            &run.program,
+            MultipassConfig {
+                initial_capacity: 16,
+                max_capacity: 32,
+                fused_rounds,
+                ..Default::default()
+            },
+        )
+        .unwrap()
+    };
     let mph = |item_layout| {
         Scheduler::multipass_host(
             &gpu,
@@ -551,7 +572,12 @@ fn multi_pass_rounds_that_cannot_fit_a_queue_at_its_limit_run_in_part_and_stay_e
         )
         .unwrap()
     };
-    for s in [mp, mph(ItemLayout::Interleaved), mph(ItemLayout::Planar)] {
+    for s in [
+        mp(false),
+        mp(true),
+        mph(ItemLayout::Interleaved),
+        mph(ItemLayout::Planar),
+    ] {
         let (stats, result) = run.run(&gpu, &s).unwrap();
         assert_eq!(result, reference, "{stats:?}");
         assert!(stats.partial_rounds > 0, "{stats:?}");
@@ -733,16 +759,19 @@ fn device_driven_multipass_counts_its_rounds_and_dispatches() {
     assert_eq!(result, reference);
     let rounds = base.rounds;
     assert!(rounds > 3, "{base:?}");
-    for chunk in [16, 2] {
+    // Fused rounds: one indirect dispatch a round for all procedures, the same rounds.
+    for (chunk, fused) in [(16, false), (2, false), (16, true), (2, true)] {
         let s = Scheduler::multipass(
             &gpu,
             &run.program,
             MultipassConfig {
                 rounds_per_submit: chunk,
+                fused_rounds: fused,
                 ..Default::default()
             },
         )
         .unwrap();
+        let nq = if fused { 1 } else { nq };
         let (first, result) = run.run(&gpu, &s).unwrap();
         assert_eq!(result, reference, "chunk {chunk}, first run");
         assert_eq!(first.rounds, rounds, "{first:?}");

@@ -175,6 +175,12 @@ pub struct Cli {
     #[arg(long, help_heading = "Scheduler")]
     pub local_queues: bool,
 
+    /// The device-driven multi-pass dispatches each procedure of a round on its own, one
+    /// indirect dispatch per procedure, instead of the default fused round (one dispatch of all
+    /// procedures' workgroups; `MultipassConfig::fused_rounds`).
+    #[arg(long, help_heading = "Scheduler")]
+    pub dispatch_per_procedure: bool,
+
     /// Workgroup memory for the megakernel's local queues, in bytes
     /// (`MegakernelConfig::local_bytes`; default 16384, less where the device leaves less).
     #[arg(long, value_name = "BYTES", help_heading = "Scheduler")]
@@ -359,6 +365,7 @@ impl Cli {
             direct_enqueue: self.enqueue.map(|e| e == Enqueue::Direct),
             local_queues: self.local_queues,
             local_bytes: self.local_bytes,
+            fused_rounds: !self.dispatch_per_procedure,
         }
     }
 }

@@ -147,6 +147,8 @@ pub struct GpuConfig {
     pub local_queues: bool,
     /// `MegakernelConfig::local_bytes`; `None`: its default.
     pub local_bytes: Option<u32>,
+    /// `MultipassConfig::fused_rounds` (the device-driven multi-pass; default `true`).
+    pub fused_rounds: bool,
 }
 
 impl Default for GpuConfig {
@@ -163,6 +165,7 @@ impl Default for GpuConfig {
             subgroups: Some(false),
             local_queues: false,
             local_bytes: None,
+            fused_rounds: true,
         }
     }
 }
@@ -218,6 +221,7 @@ pub fn compile(
             program,
             MultipassConfig {
                 initial_capacity: capacity,
+                fused_rounds: config.fused_rounds,
                 ..Default::default()
             },
         ),

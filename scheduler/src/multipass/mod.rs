@@ -55,6 +55,15 @@ pub struct MultipassConfig {
     /// graph search that runs again keeps its storage. `false` starts every run at
     /// `initial_capacity` (tests use it to exercise growth run after run).
     pub size_from_last_run: bool,
+    /// Dispatch a round's procedures together, one indirect dispatch a round
+    /// (`mp_round` in `shaders/multipass.wgsl`: each workgroup finds its procedure from the
+    /// plan's workgroup counts), instead of one indirect dispatch per procedure. Fewer dispatches
+    /// and barriers (and fewer of wgpu's indirect-validation dispatches), one kernel holding
+    /// every procedure's code. Default `true`: on the H200 it was faster on every workload but
+    /// the large-payload tree (3% slower), e.g. the teapot frame 2.18 -> 1.43 ms, the deep tree
+    /// 4.48 -> 3.01 (docs/results.md, 2026-12-02, "Fused rounds"). Ignored with `stage_timing`,
+    /// which times each procedure's dispatches apart (docs/scheduler.md 5.1).
+    pub fused_rounds: bool,
 }
 
 impl Default for MultipassConfig {
@@ -67,6 +76,7 @@ impl Default for MultipassConfig {
             stage_timing: false,
             item_layout: None,
             size_from_last_run: true,
+            fused_rounds: true,
         }
     }
 }
@@ -123,9 +133,11 @@ impl Multipass {
                 "the multi-pass strategy supports at most 16 procedures".into(),
             ));
         }
-        let source = wgsl::source(program, items);
+        let fused = config.fused_rounds && !config.stage_timing;
+        config.fused_rounds = fused;
+        let source = wgsl::source(program, items, fused);
         let entries: Vec<_> = (0..4).map(|b| storage_entry(b, b == 3)).collect();
-        let eps = wgsl::entry_points(program);
+        let eps = wgsl::entry_points(program, fused);
         let eps: Vec<&str> = eps.iter().map(|s| s.as_str()).collect();
         let group2 = [storage_entry(0, false)];
         let kernels = Kernels::new(
@@ -266,10 +278,19 @@ impl Multipass {
         gpu.queue.submit([enc.finish()]);
     }
 
+    /// Indirect dispatches of one round: one per procedure, or one with fused rounds.
+    fn dispatches_per_round(&self) -> u64 {
+        match self.config.fused_rounds {
+            true => 1,
+            false => self.program.queue_count() as u64,
+        }
+    }
+
     /// Encodes a chunk of `rounds` rounds (at most `d.max_chunk`): the arguments cleared, the
     /// first round's plan (one thread, a direct dispatch), then per round one indirect dispatch
-    /// per procedure; the last workgroup of each round plans the next (`shaders/multipass.wgsl`),
-    /// so the chunk is `1 + rounds × NQ` dispatches. `mp_ctrl`'s `G_CHUNK` must hold `rounds`.
+    /// per procedure (or one for all, with fused rounds); the last workgroup of each round plans
+    /// the next (`shaders/multipass.wgsl`), so the chunk is `1 + rounds × NQ` dispatches (`1 +
+    /// rounds` fused). `mp_ctrl`'s `G_CHUNK` must hold `rounds`.
     /// With `stages`, each procedure's dispatches are timed as their own passes and the plan is
     /// counted to the last stage; else one pass.
     #[allow(clippy::too_many_arguments)]
@@ -333,6 +354,11 @@ impl Multipass {
         plan(&mut pass);
         for k in 0..rounds as usize {
             round(&mut pass, k);
+            if self.config.fused_rounds {
+                pass.set_pipeline(&p[1 + nq]);
+                pass.dispatch_workgroups_indirect(&d.args[k % 2], args(k, 0));
+                continue;
+            }
             for q in 0..nq {
                 pass.set_pipeline(&p[1 + q]);
                 pass.dispatch_workgroups_indirect(&d.args[k % 2], args(k, q));
@@ -454,7 +480,7 @@ impl Multipass {
             }
             gpu.queue.submit([enc.finish()]);
             stats.submits += 1;
-            stats.launches += 1 + rounds as u64 * nq as u64;
+            stats.launches += 1 + rounds as u64 * self.dispatches_per_round();
             encoded += rounds as u64;
             since_upload += rounds as u64;
             let ctrl = gpu.read_words(&d.ctrl, 0, ctrl_words(nq) as u64)?;

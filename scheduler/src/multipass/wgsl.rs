@@ -7,8 +7,9 @@ use crate::program::Program;
 
 pub const TEMPLATE: &str = include_str!("../../../shaders/multipass.wgsl");
 
-/// Entry points in pipeline order: the plan, then the procedures.
-pub fn entry_points(program: &Program) -> Vec<String> {
+/// Entry points in pipeline order: the plan, then the procedures, then (`fused`) the fused
+/// round.
+pub fn entry_points(program: &Program, fused: bool) -> Vec<String> {
     let mut e = vec!["mp_plan".to_string()];
     e.extend(
         program
@@ -16,12 +17,16 @@ pub fn entry_points(program: &Program) -> Vec<String> {
             .iter()
             .map(|p| format!("mp_proc_{}", p.proc.name)),
     );
+    if fused {
+        e.push("mp_round".into());
+    }
     e
 }
 
 /// The WGSL for `program` with its queues laid out as `items` (the same layout in the round
-/// buffers of every queue).
-pub fn source(program: &Program, items: ItemLayout) -> String {
+/// buffers of every queue); `fused`: rounds are planned for one dispatch of all procedures
+/// (`MultipassConfig::fused_rounds`).
+pub fn source(program: &Program, items: ItemLayout, fused: bool) -> String {
     let args = "@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>";
     let mut s = rounds_source(program, items, "mp_proc", args, "lid, wid.x");
     // Word `w` of item `at` of queue `t` (the carried inputs' copy).
@@ -30,6 +35,7 @@ pub fn source(program: &Program, items: ItemLayout) -> String {
         ItemLayout::Planar => "q_base(t) + w * q_cap(t) + at",
     };
     s += &format!("fn mp_word_at(t: u32, at: u32, w: u32) -> u32 {{ return {word_at}; }}\n");
+    s += &format!("const FUSED: bool = {fused};\n");
     s += TEMPLATE;
     s
 }
