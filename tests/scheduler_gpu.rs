@@ -285,8 +285,9 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
         );
         assert!(subgroups.contains(&false), "{subgroups:?}");
         assert_eq!(subgroups.contains(&true), gpu.subgroups, "{subgroups:?}");
-        schedulers.push((
-            "multipass, tiny queues".into(),
+        // Device-driven multi-passes that start every run at 16 slots: growth and partial
+        // rounds in most runs.
+        let tiny_multipass = |fused_rounds, item_layout| {
             Scheduler::multipass(
                 &gpu,
                 &tree.program,
@@ -294,11 +295,14 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
                     rounds_per_submit: 3,
                     initial_capacity: 16,
                     size_from_last_run: false,
+                    fused_rounds,
+                    item_layout,
                     ..Default::default()
                 },
             )
-            .unwrap(),
-        ));
+            .unwrap()
+        };
+        schedulers.push(("multipass, tiny queues".into(), tiny_multipass(true, None)));
         schedulers.push((
             "multipass".into(),
             Scheduler::new(&gpu, &tree.program, StrategyKind::Multipass, 1 << 12).unwrap(),
@@ -307,18 +311,7 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
             // One dispatch per procedure (the others fuse each round's procedures into one
             // dispatch, the default), growth and partial rounds as above.
             "multipass, a dispatch per procedure, tiny queues".into(),
-            Scheduler::multipass(
-                &gpu,
-                &tree.program,
-                MultipassConfig {
-                    rounds_per_submit: 3,
-                    initial_capacity: 16,
-                    size_from_last_run: false,
-                    fused_rounds: false,
-                    ..Default::default()
-                },
-            )
-            .unwrap(),
+            tiny_multipass(false, None),
         ));
         schedulers.push((
             "multipass-host, tiny queues".into(),
@@ -341,18 +334,7 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
             // Planar items: carried inputs copied word by word, growth moves them plane by
             // plane on the device.
             "multipass, planar items, tiny queues".into(),
-            Scheduler::multipass(
-                &gpu,
-                &tree.program,
-                MultipassConfig {
-                    rounds_per_submit: 3,
-                    initial_capacity: 16,
-                    item_layout: Some(ItemLayout::Planar),
-                    size_from_last_run: false,
-                    ..Default::default()
-                },
-            )
-            .unwrap(),
+            tiny_multipass(true, Some(ItemLayout::Planar)),
         ));
         schedulers.push((
             "multipass-host, planar items, tiny queues".into(),
