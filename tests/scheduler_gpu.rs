@@ -295,7 +295,7 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
                     rounds_per_submit: 3,
                     initial_capacity: 16,
                     size_from_last_run: false,
-                    fused_rounds,
+                    fused_rounds: Some(fused_rounds),
                     item_layout,
                     ..Default::default()
                 },
@@ -308,8 +308,8 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
             Scheduler::new(&gpu, &tree.program, StrategyKind::Multipass, 1 << 12).unwrap(),
         ));
         schedulers.push((
-            // One dispatch per procedure (the others fuse each round's procedures into one
-            // dispatch, the default), growth and partial rounds as above.
+            // One dispatch per procedure (the tiny ones above and the planar one fuse each
+            // round's procedures into one dispatch), growth and partial rounds as above.
             "multipass, a dispatch per procedure, tiny queues".into(),
             tiny_multipass(false, None),
         ));
@@ -535,7 +535,7 @@ fn multi_pass_rounds_that_cannot_fit_a_queue_at_its_limit_run_in_part_and_stay_e
             MultipassConfig {
                 initial_capacity: 16,
                 max_capacity: 32,
-                fused_rounds,
+                fused_rounds: Some(fused_rounds),
                 ..Default::default()
             },
         )
@@ -748,7 +748,7 @@ fn device_driven_multipass_counts_its_rounds_and_dispatches() {
             &run.program,
             MultipassConfig {
                 rounds_per_submit: chunk,
-                fused_rounds: fused,
+                fused_rounds: Some(fused),
                 ..Default::default()
             },
         )

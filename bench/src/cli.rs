@@ -175,16 +175,27 @@ pub struct Cli {
     #[arg(long, help_heading = "Scheduler")]
     pub local_queues: bool,
 
-    /// The device-driven multi-pass dispatches each procedure of a round on its own, one
-    /// indirect dispatch per procedure, instead of the default fused round (one dispatch of all
-    /// procedures' workgroups; `MultipassConfig::fused_rounds`).
-    #[arg(long, help_heading = "Scheduler")]
-    pub dispatch_per_procedure: bool,
+    /// How the device-driven multi-pass dispatches a round (`MultipassConfig::fused_rounds`):
+    /// `on`, one indirect dispatch of every procedure's workgroups; `off`, one per procedure;
+    /// `auto`, on for GPUs and off for CPU adapters such as lavapipe (docs/scheduler.md 5.1).
+    #[arg(long, value_enum, default_value = "auto", help_heading = "Scheduler")]
+    pub fused_rounds: FusedRounds,
 
     /// Workgroup memory for the megakernel's local queues, in bytes
     /// (`MegakernelConfig::local_bytes`; default 16384, less where the device leaves less).
     #[arg(long, value_name = "BYTES", help_heading = "Scheduler")]
     pub local_bytes: Option<u32>,
+}
+
+/// `--fused-rounds`: how the device-driven multi-pass dispatches a round.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum FusedRounds {
+    /// On for GPUs, off for CPU adapters.
+    Auto,
+    /// One indirect dispatch of every procedure's workgroups.
+    On,
+    /// One indirect dispatch per procedure.
+    Off,
 }
 
 /// `--enqueue`: how megakernel items reach their queue.
@@ -365,7 +376,11 @@ impl Cli {
             direct_enqueue: self.enqueue.map(|e| e == Enqueue::Direct),
             local_queues: self.local_queues,
             local_bytes: self.local_bytes,
-            fused_rounds: !self.dispatch_per_procedure,
+            fused_rounds: match self.fused_rounds {
+                FusedRounds::Auto => None,
+                FusedRounds::On => Some(true),
+                FusedRounds::Off => Some(false),
+            },
         }
     }
 }

@@ -147,8 +147,8 @@ pub struct GpuConfig {
     pub local_queues: bool,
     /// `MegakernelConfig::local_bytes`; `None`: its default.
     pub local_bytes: Option<u32>,
-    /// `MultipassConfig::fused_rounds` (the device-driven multi-pass; default `true`).
-    pub fused_rounds: bool,
+    /// `MultipassConfig::fused_rounds` (the device-driven multi-pass); `None`: by adapter.
+    pub fused_rounds: Option<bool>,
 }
 
 impl Default for GpuConfig {
@@ -165,7 +165,7 @@ impl Default for GpuConfig {
             subgroups: Some(false),
             local_queues: false,
             local_bytes: None,
-            fused_rounds: true,
+            fused_rounds: None,
         }
     }
 }

@@ -59,11 +59,13 @@ pub struct MultipassConfig {
     /// (`mp_round` in `shaders/multipass.wgsl`: each workgroup finds its procedure from the
     /// plan's workgroup counts), instead of one indirect dispatch per procedure. Fewer dispatches
     /// and barriers (and fewer of wgpu's indirect-validation dispatches), one kernel holding
-    /// every procedure's code. Default `true`: on the H200 it was faster on every workload but
-    /// the large-payload tree (3% slower), e.g. the teapot frame 2.18 -> 1.43 ms, the deep tree
-    /// 4.48 -> 3.01 (docs/results.md, 2026-12-02, "Fused rounds"). Ignored with `stage_timing`,
-    /// which times each procedure's dispatches apart (docs/scheduler.md 5.1).
-    pub fused_rounds: bool,
+    /// every procedure's code. `None` (the default): fused on GPUs, a dispatch per procedure on
+    /// CPU adapters. On the H200 fused rounds were faster on all but two workloads, e.g. the
+    /// teapot frame 2.18 -> 1.43 ms, the deep tree 4.48 -> 3.01; the large-payload tree and BFS
+    /// at scale 20 2-3% slower (docs/results.md, 2026-12-02, "Fused rounds"). On lavapipe the
+    /// kernel holding every procedure ran 1.3-2x slower. Ignored with `stage_timing`, which
+    /// times each procedure's dispatches apart (docs/scheduler.md 5.1).
+    pub fused_rounds: Option<bool>,
 }
 
 impl Default for MultipassConfig {
@@ -76,7 +78,7 @@ impl Default for MultipassConfig {
             stage_timing: false,
             item_layout: None,
             size_from_last_run: true,
-            fused_rounds: true,
+            fused_rounds: None,
         }
     }
 }
@@ -133,8 +135,8 @@ impl Multipass {
                 "the multi-pass strategy supports at most 16 procedures".into(),
             ));
         }
-        let fused = config.fused_rounds && !config.stage_timing;
-        config.fused_rounds = fused;
+        let fused = config.fused_rounds.unwrap_or(!gpu.is_cpu_adapter()) && !config.stage_timing;
+        config.fused_rounds = Some(fused);
         let source = wgsl::source(program, items, fused);
         let entries: Vec<_> = (0..4).map(|b| storage_entry(b, b == 3)).collect();
         let eps = wgsl::entry_points(program, fused);
@@ -281,8 +283,8 @@ impl Multipass {
     /// Indirect dispatches of one round: one per procedure, or one with fused rounds.
     fn dispatches_per_round(&self) -> u64 {
         match self.config.fused_rounds {
-            true => 1,
-            false => self.program.queue_count() as u64,
+            Some(true) => 1,
+            _ => self.program.queue_count() as u64,
         }
     }
 
@@ -354,7 +356,7 @@ impl Multipass {
         plan(&mut pass);
         for k in 0..rounds as usize {
             round(&mut pass, k);
-            if self.config.fused_rounds {
+            if self.config.fused_rounds == Some(true) {
                 pass.set_pipeline(&p[1 + nq]);
                 pass.dispatch_workgroups_indirect(&d.args[k % 2], args(k, 0));
                 continue;
