@@ -187,3 +187,33 @@ fn an_unreadable_scene_names_its_file_once_and_exits_1() {
     let name = missing.display().to_string();
     assert_eq!(err.matches(&name).count(), 1, "{err}");
 }
+
+/// An option of one workload given to another is a usage error (exit 2) naming the option and
+/// its workload, never silently ignored; `--preset` and `--scene`, which have defaults, count as
+/// given when they name something else.
+#[test]
+fn another_workloads_option_is_a_usage_error() {
+    for (args, expected) in [
+        (
+            &["--workload", "bfs", "--preset", "deep"][..],
+            "--preset applies to --workload tree",
+        ),
+        (
+            &["--workload", "tree", "--scene", "killeroo"],
+            "--scene applies to --workload reyes",
+        ),
+        (
+            &["--workload", "tree", "--scale", "12"],
+            "--scale applies to --workload bfs",
+        ),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
+            .args(["--strategy", "cpu"])
+            .args(args)
+            .output()
+            .expect("schedbench runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(expected), "{args:?}: {err}");
+    }
+}

@@ -251,7 +251,9 @@ impl Cli {
     /// Checks what clap's attributes cannot say: options of one workload with another.
     pub fn check(&self) {
         let workload = self.workload.unwrap_or(WorkloadName::Tree);
+        // --preset and --scene have defaults: another value is what counts as given.
         let tree_flags = [
+            ("--preset", self.preset != TreePreset::Binary),
             ("--roots", self.roots.is_some()),
             ("--depth", self.depth.is_some()),
             ("--fanout", self.fanout.is_some()),
@@ -260,6 +262,7 @@ impl Cli {
             ("--seed", self.seed.is_some()),
         ];
         let reyes_flags = [
+            ("--scene", self.scene != "teapot"),
             ("--width", self.width.is_some()),
             ("--height", self.height.is_some()),
         ];
@@ -293,7 +296,7 @@ impl Cli {
         {
             let given: Vec<&str> = tree_flags
                 .iter()
-                .filter(|(f, given)| *given && *f != "--payload" && *f != "--seed")
+                .filter(|(f, given)| *given && !["--preset", "--payload", "--seed"].contains(f))
                 .map(|(f, _)| *f)
                 .collect();
             let flags = if given.is_empty() {
