@@ -160,15 +160,20 @@ fn procedure_steps_name_the_workloads_procedures() {
         ),
         (&["--procedure-steps", "diceshade=8"], "branch, leaf"),
     ] {
-        let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
-            .args(["--strategy", "cpu"])
-            .args(args)
-            .output()
-            .expect("schedbench runs");
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
-        assert!(err.contains(expected), "{args:?}: {err}");
+        assert_usage_error(args, expected);
     }
+}
+
+/// `schedbench --strategy cpu ARGS` exits 2 (a usage error) with `expected` in its message.
+fn assert_usage_error(args: &[&str], expected: &str) {
+    let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
+        .args(["--strategy", "cpu"])
+        .args(args)
+        .output()
+        .expect("schedbench runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+    assert!(err.contains(expected), "{args:?}: {err}");
 }
 
 /// A scene file that cannot be read is an input error, not a usage error: exit 1, the file
@@ -207,13 +212,6 @@ fn another_workloads_option_is_a_usage_error() {
             "--scale applies to --workload bfs",
         ),
     ] {
-        let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
-            .args(["--strategy", "cpu"])
-            .args(args)
-            .output()
-            .expect("schedbench runs");
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
-        assert!(err.contains(expected), "{args:?}: {err}");
+        assert_usage_error(args, expected);
     }
 }
