@@ -309,6 +309,17 @@ impl Gpu {
         bind_buffers(&self.device, label, layout, buffers)
     }
 
+    /// A bind group of whole storage buffers at the given bindings (`(binding, buffer)`), for
+    /// layouts whose bindings are not 0, 1, 2, ... in order.
+    pub fn bind_buffers_at(
+        &self,
+        label: &str,
+        layout: &wgpu::BindGroupLayout,
+        buffers: &[(u32, &wgpu::Buffer)],
+    ) -> wgpu::BindGroup {
+        bind_buffers_at(&self.device, label, layout, buffers)
+    }
+
     /// Compiles WGSL, turning a validation error into a `RunError` that carries the message
     /// (naga's error names the line), instead of a panic in wgpu's error handler.
     #[allow(
@@ -398,11 +409,21 @@ pub(crate) fn bind_buffers(
     layout: &wgpu::BindGroupLayout,
     buffers: &[&wgpu::Buffer],
 ) -> wgpu::BindGroup {
+    let at: Vec<(u32, &wgpu::Buffer)> = (0..).zip(buffers.iter().copied()).collect();
+    bind_buffers_at(device, label, layout, &at)
+}
+
+/// A bind group of whole buffers at the given bindings (see [`Gpu::bind_buffers_at`]).
+pub(crate) fn bind_buffers_at(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &[(u32, &wgpu::Buffer)],
+) -> wgpu::BindGroup {
     let entries: Vec<_> = buffers
         .iter()
-        .enumerate()
-        .map(|(i, b)| wgpu::BindGroupEntry {
-            binding: i as u32,
+        .map(|&(binding, b)| wgpu::BindGroupEntry {
+            binding,
             resource: b.as_entire_binding(),
         })
         .collect();

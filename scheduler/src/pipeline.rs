@@ -95,18 +95,7 @@ impl Kernels {
     }
 
     pub fn bind_group0(&self, gpu: &Gpu, buffers: &[(u32, &wgpu::Buffer)]) -> wgpu::BindGroup {
-        let entries: Vec<wgpu::BindGroupEntry> = buffers
-            .iter()
-            .map(|(b, buf)| wgpu::BindGroupEntry {
-                binding: *b,
-                resource: buf.as_entire_binding(),
-            })
-            .collect();
-        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: None,
-            layout: &self.group0,
-            entries: &entries,
-        })
+        gpu.bind_buffers_at("scheduler group 0", &self.group0, buffers)
     }
 
     /// Checks that the user supplied a bind group exactly when the program declared one.

@@ -96,17 +96,8 @@ impl HizPipelines {
             } else {
                 (&self.reduce, vec![(0, &buf), (2, hiz)])
             };
-            let entries: Vec<wgpu::BindGroupEntry> = (entries.iter())
-                .map(|(b, buf)| wgpu::BindGroupEntry {
-                    binding: *b,
-                    resource: buf.as_entire_binding(),
-                })
-                .collect();
-            let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("reyes hiz"),
-                layout: &pipeline.get_bind_group_layout(0),
-                entries: &entries,
-            });
+            let bind =
+                gpu.bind_buffers_at("reyes hiz", &pipeline.get_bind_group_layout(0), &entries);
             passes.push((k == 0, bind, [l[0].div_ceil(8), l[1].div_ceil(8)]));
         }
         Ok(Some(HizPasses { passes }))

@@ -104,26 +104,21 @@ impl RasterPeer {
         tables: &SceneBuffers,
         g: &Geometry,
     ) -> wgpu::BindGroup {
-        let entries = [
-            (0, orbit),
-            (1, tables.objects()),
-            (3, &g.params),
-            (4, &g.vertices),
-            (5, &g.indices),
-            (6, &g.counts),
-            (7, &g.grids),
-            (8, &g.draw_args),
-            (9, &g.tiles),
-        ]
-        .map(|(binding, b)| wgpu::BindGroupEntry {
-            binding,
-            resource: b.as_entire_binding(),
-        });
-        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("raster tessellate"),
+        gpu.bind_buffers_at(
+            "raster tessellate",
             layout,
-            entries: &entries,
-        })
+            &[
+                (0, orbit),
+                (1, tables.objects()),
+                (3, &g.params),
+                (4, &g.vertices),
+                (5, &g.indices),
+                (6, &g.counts),
+                (7, &g.grids),
+                (8, &g.draw_args),
+                (9, &g.tiles),
+            ],
+        )
     }
 
     /// Grows the geometry buffers to [`HEADROOM`] above `counts`' needs when they do not hold

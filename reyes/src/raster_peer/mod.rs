@@ -246,14 +246,8 @@ impl RasterPeer {
         let tables = SceneBuffers::with_patches(gpu, scene, &base)?;
         let raster = pipelines.raster(gpu, base.features(), samples)?;
         let rgba8_pipeline = pipelines.rgba8(gpu)?.clone();
-        let scene_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("raster scene"),
-            layout: &raster.scene_layout,
-            entries: &tables.tables().map(|(binding, b)| wgpu::BindGroupEntry {
-                binding,
-                resource: b.as_entire_binding(),
-            }),
-        });
+        let scene_bind =
+            gpu.bind_buffers_at("raster scene", &raster.scene_layout, &tables.tables());
         let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
         let binding = wgpu::TextureUsages::TEXTURE_BINDING;
         let mut textures = vec![target(

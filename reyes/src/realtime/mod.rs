@@ -268,23 +268,16 @@ impl RealtimeRenderer {
         for _ in 0..IN_FLIGHT {
             let orbit = gpu.storage_buffer("orbit", (size_of::<Orbit>() / 4) as u64)?;
             let roots = gpu.upload("roots", &vec![PatchItem::zeroed(); n as usize])?;
-            let buffers = [
-                &orbit,
-                scene_buffers.objects(),
-                &roots,
-                scene_buffers.visible(),
-            ];
-            let entries: Vec<wgpu::BindGroupEntry> = ([0, 1, 2, 10].into_iter().zip(buffers))
-                .map(|(binding, b)| wgpu::BindGroupEntry {
-                    binding,
-                    resource: b.as_entire_binding(),
-                })
-                .collect();
-            let roots_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("roots"),
-                layout: &roots_pipeline.get_bind_group_layout(0),
-                entries: &entries,
-            });
+            let roots_bind = gpu.bind_buffers_at(
+                "roots",
+                &roots_pipeline.get_bind_group_layout(0),
+                &[
+                    (0, &orbit),
+                    (1, scene_buffers.objects()),
+                    (2, &roots),
+                    (10, scene_buffers.visible()),
+                ],
+            );
             slots.push(Slot {
                 orbit,
                 roots,
