@@ -6,9 +6,9 @@
 // atomicAdd on t's count, so a round has no flags, no scan and no scatter. The plan
 // (`plan_round`) turns the previous round's counts into this round's dispatch sizes: for a
 // chunk's first round a one-thread dispatch (`mp_plan`), for every other round the last
-// workgroup of the round before, when it finishes. An empty queue gets 0
-// workgroups; an empty round is never planned, so it and every round after it in the chunk keep
-// the zeroed arguments the host cleared. Order within a queue is not kept.
+// workgroup of the round before, when it finishes. An empty queue gets 0 workgroups; an empty
+// round is never planned, so it and every round after it in the chunk keep the zeroed
+// arguments the host cleared. Order within a queue is not kept.
 // Generated before this file: tables, procedures, `mp_in_*` / `mp_out_*` accessors,
 // `sched_execute`, `mp_execute` (item i of queue q's region) and `mp_word_at` (word w of it),
 // both in the run's item layout (scheduler/src/item_layout.rs), `enqueue_*`, and the

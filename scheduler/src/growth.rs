@@ -14,20 +14,12 @@ pub fn grow(capacity: u32, need: u64, limit: u32) -> u32 {
         .max(capacity as u64) as u32
 }
 
-/// Growth of a multi-pass run's refused rounds, whose cost is a submission: the host waits for
-/// it, makes new buffers, and the rounds encoded after the refused one run empty (about as
-/// long as a small full round: their dispatches and barriers remain). Each refusal therefore
-/// grows the queues for the rounds after it too, by the work's own growth per round measured
-/// so far, over a horizon that doubles with every refusal (1, 2, 4, … rounds): work growing
-/// geometrically from far too small a start is refused `O(log rounds)` times instead of once
-/// every round or two, and the next submission encodes only the rounds the new capacity is
-/// expected to hold ([`Anticipation::rounds_until_refusal`]).
 /// Slots a run allocates for a queue sized from what an earlier run needed (`need`): an eighth
 /// more, within `limit`. A run's need varies a little from run to run where its work does (BFS
 /// levels found in a different order append different counts), and every new buffer costs far
-/// more than a small run (600 MB of queues took 25-40 ms to make on the H200, against 0.4-3.4 ms
-/// of BFS; docs/results.md, 2026-12-02): with the slack, a run that needs a little more than the
-/// last keeps its buffers ([`kept_capacity`]).
+/// more than a small run (600-800 MB of queues took 22-45 ms to make on the H200, against
+/// 0.4-3.4 ms of BFS; docs/results.md, 2026-12-02): with the slack, a run that needs a little
+/// more than the last keeps its buffers ([`kept_capacity`]).
 pub fn with_slack(need: u64, limit: u32) -> u32 {
     need.saturating_add(need / 8).min(limit as u64) as u32
 }
@@ -43,6 +35,28 @@ pub fn kept_capacity(kept: Option<&[u32]>, need: &[u32], limit: &[u32]) -> Optio
     fits.then(|| kept.to_vec())
 }
 
+/// The capacities a multi-pass run starts with: those of the queues kept from its last run
+/// when `reuse` (`size_from_last_run`) and they hold `start` ([`kept_capacity`]), else `start`.
+pub fn start_capacity(
+    reuse: bool,
+    kept: Option<&[u32]>,
+    start: Vec<u32>,
+    limit: &[u32],
+) -> Vec<u32> {
+    match reuse {
+        true => kept_capacity(kept, &start, limit).unwrap_or(start),
+        false => start,
+    }
+}
+
+/// Growth of a multi-pass run's refused rounds, whose cost is a submission: the host waits for
+/// it, makes new buffers, and the rounds encoded after the refused one run empty (about as
+/// long as a small full round: their dispatches and barriers remain). Each refusal therefore
+/// grows the queues for the rounds after it too, by the work's own growth per round measured
+/// so far, over a horizon that doubles with every refusal (1, 2, 4, … rounds): work growing
+/// geometrically from far too small a start is refused `O(log rounds)` times instead of once
+/// every round or two, and the next submission encodes only the rounds the new capacity is
+/// expected to hold ([`Anticipation::rounds_until_refusal`]).
 #[derive(Debug, Clone)]
 pub struct Anticipation {
     /// Worst-case items emitted (all targets) by the last round seen, and the round it was.
@@ -105,7 +119,7 @@ impl Anticipation {
 
 #[cfg(test)]
 mod tests {
-    use super::{Anticipation, grow, kept_capacity, with_slack};
+    use super::{Anticipation, grow, kept_capacity, start_capacity, with_slack};
 
     #[test]
     fn kept_queues_are_reused_only_when_they_hold_the_need_within_the_limit() {
@@ -120,6 +134,20 @@ mod tests {
         // A budget below the kept room (a run with less memory): new buffers within it.
         assert_eq!(kept_capacity(Some(&[512, 64]), &[1, 1], &[256, 1000]), None);
         assert_eq!(kept_capacity(Some(&[512]), &[1, 1], &limit), None);
+        // A multi-pass run: the kept queues when reused and they fit, else its own start.
+        let kept: &[u32] = &[512, 64];
+        assert_eq!(
+            start_capacity(true, Some(kept), vec![16, 16], &limit),
+            [512, 64]
+        );
+        assert_eq!(
+            start_capacity(false, Some(kept), vec![16, 16], &limit),
+            [16, 16]
+        );
+        assert_eq!(
+            start_capacity(true, Some(kept), vec![16, 128], &limit),
+            [16, 128]
+        );
         assert_eq!(with_slack(800, 1 << 20), 900);
         assert_eq!(with_slack(800, 850), 850);
         assert_eq!(with_slack(u64::MAX, u32::MAX), u32::MAX);

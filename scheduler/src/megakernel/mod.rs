@@ -193,8 +193,10 @@ pub struct Megakernel {
     batch: Vec<u32>,
     /// Buffers of the last run, reused when the next run needs the same layout.
     cache: std::sync::Mutex<Option<DeviceQueues>>,
-    /// The mapped buffer ctrl is read back through after each launch, kept between runs.
-    readback: std::sync::Mutex<Option<Readback>>,
+    /// The mapped buffer ctrl is read back through after each launch, and the timer whose
+    /// timestamps come back with it, kept between runs (boxed: `Scheduler`'s variants stay
+    /// near one size).
+    readback: std::sync::Mutex<Option<Box<(Readback, SpanTimer)>>>,
     compaction: DeviceCompaction,
     /// Slots per queue that the largest run so far needed to finish in one launch (see
     /// [`Megakernel::run`]); the next run starts with at least this much, within its limits.
@@ -612,11 +614,13 @@ impl Megakernel {
             ..Default::default()
         };
         // Each launch's GPU time comes back with its counters (one read-back, no extra wait).
-        let timer = SpanTimer::new(gpu, 1);
         let tw = ctrl_words(nq) as u64;
         let mut gpu_ms = gpu.timestamps.then_some(0.0);
-        let rb = self.readback.lock().unwrap().take();
-        let rb = rb.unwrap_or_else(|| Readback::new(gpu, "ctrl read-back", tw + SpanTimer::WORDS));
+        let kept = self.readback.lock().unwrap().take();
+        let (rb, timer) = *kept.unwrap_or_else(|| {
+            let rb = Readback::new(gpu, "ctrl read-back", tw + SpanTimer::WORDS);
+            Box::new((rb, SpanTimer::new(gpu, 1)))
+        });
         let mut start = Start::Upload(live);
         loop {
             let layout = QueueLayout::new(&self.program, capacity.clone())?;
@@ -824,7 +828,7 @@ impl Megakernel {
         stats.wall_ms = start_time.elapsed().as_secs_f64() * 1e3;
         // Keep the device queues and the read-back buffer for the next run.
         *self.cache.lock().unwrap() = dq;
-        *self.readback.lock().unwrap() = Some(rb);
+        *self.readback.lock().unwrap() = Some(Box::new((rb, timer)));
         Ok(stats)
     }
 }

@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use crate::error::RunError;
 use crate::gpu::Gpu;
-use crate::growth::{grow, kept_capacity};
+use crate::growth::{grow, start_capacity};
 use crate::item_layout::ItemLayout;
 use crate::multipass::partial::{at_limit, needs_partial, partial_round};
 use crate::pipeline::{Kernels, storage_entry};
@@ -243,10 +243,8 @@ impl HostMultipass {
         let rb = rb.unwrap_or_else(|| Readback::new(gpu, "round counts read-back", count_words));
         let mut timer = RunTimer::new(gpu, 64);
         let cached = self.cache.lock().unwrap().take();
-        if self.config.size_from_last_run {
-            let kept = cached.as_ref().map(|d| d.layout.capacity.as_slice());
-            capacity = kept_capacity(kept, &capacity, &max_cap).unwrap_or(capacity);
-        }
+        let kept = cached.as_ref().map(|d| d.layout.capacity.as_slice());
+        capacity = start_capacity(self.config.size_from_last_run, kept, capacity, &max_cap);
         let layout = QueueLayout::new(&self.program, capacity.clone())?;
         let mut d = match cached {
             Some(d) if d.layout == layout => d,

@@ -19,7 +19,7 @@ use layout::*;
 
 use crate::error::RunError;
 use crate::gpu::Gpu;
-use crate::growth::{Anticipation, grow, kept_capacity};
+use crate::growth::{Anticipation, grow, start_capacity};
 use crate::item_layout::ItemLayout;
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
@@ -63,7 +63,7 @@ pub struct MultipassConfig {
     /// CPU adapters. On the H200 fused rounds were faster on all but two workloads, e.g. the
     /// teapot frame 2.18 -> 1.43 ms, the deep tree 4.48 -> 3.01; the large-payload tree and BFS
     /// at scale 20 2-3% slower (docs/results.md, 2026-12-02, "Fused rounds"). On lavapipe the
-    /// kernel holding every procedure ran 1.3-2x slower. Ignored with `stage_timing`, which
+    /// kernel holding every procedure ran 1.25-1.5x slower (docs/scheduler.md 5.1). Ignored with `stage_timing`, which
     /// times each procedure's dispatches apart (docs/scheduler.md 5.1).
     pub fused_rounds: Option<bool>,
 }
@@ -448,10 +448,8 @@ impl Multipass {
         // Rounds encoded since the last upload: round r reads items[r % 2].
         let mut since_upload = 0u64;
         let cached = self.cache.lock().unwrap().take();
-        if self.config.size_from_last_run {
-            let kept = cached.as_ref().map(|d| d.layout.capacity.as_slice());
-            capacity = kept_capacity(kept, &capacity, &max_cap).unwrap_or(capacity);
-        }
+        let kept = cached.as_ref().map(|d| d.layout.capacity.as_slice());
+        capacity = start_capacity(self.config.size_from_last_run, kept, capacity, &max_cap);
         let layout = QueueLayout::new(&self.program, capacity.clone())?;
         let at_limit = partial::at_limit(&capacity, &max_cap);
         let mut d = match cached {
