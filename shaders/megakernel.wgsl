@@ -7,37 +7,42 @@
 // are in the program's item layout: scheduler/src/item_layout.rs), and `enqueue_*`.
 
 // ---- ctrl layout (u32 words); host twin: scheduler/src/megakernel/layout.rs ----
-const QSTRIDE: u32 = 16u;
+// Each word that many workgroups touch every turn has a 128-byte L2 line of its own (32 words):
+// a queue's reserve, head, count and budget; pending, stop, the FIFO sequence and the idle
+// count. Every probe loads the counts and pending, every claim and publish adds to them; on one
+// line the atomics queued behind the loads (H200: binary tree 0.222 -> 0.201 ms, deep 2.27 ->
+// 1.87; docs/results.md, 2026-12-02, "Turn: hot words apart").
+const QSTRIDE: u32 = 128u;
 const Q_RESERVE: u32 = 0u;   // tickets handed to producers (linear within a launch)
-const Q_HEAD: u32 = 1u;      // tickets handed to consumers
-const Q_COUNT: u32 = 2u;     // written, unclaimed items (i32; may dip below 0 transiently)
-const Q_BUDGET: u32 = 3u;    // tickets appended + worst-case tickets promised to running batches
-const Q_PEAK: u32 = 4u;      // most items waiting at once
-const Q_EXECUTED: u32 = 5u;
-const Q_BATCHES: u32 = 6u;
-const Q_BLOCKED: u32 = 7u;   // 1 when a batch was refused for lack of room in this queue
-const Q_DEMAND: u32 = 8u;    // largest worst-case output to this queue of a batch refused for room
-// Q_KEPT = 9: written only by the device compaction (megakernel_compact.wgsl)
-const Q_LOCAL: u32 = 10u;    // items run from the workgroup's local queue (never ticketed)
+const Q_HEAD: u32 = 32u;   // tickets handed to consumers
+const Q_COUNT: u32 = 64u;  // written, unclaimed items (i32; may dip below 0 transiently)
+const Q_BUDGET: u32 = 96u; // tickets appended + worst-case tickets promised to running batches
+const Q_PEAK: u32 = 97u;   // most items waiting at once
+const Q_EXECUTED: u32 = 98u;
+const Q_BATCHES: u32 = 99u;
+const Q_BLOCKED: u32 = 100u; // 1 when a batch was refused for lack of room in this queue
+const Q_DEMAND: u32 = 101u; // largest worst-case output to this queue of a batch refused for room
+// Q_KEPT = 102: written only by the device compaction (megakernel_compact.wgsl)
+const Q_LOCAL: u32 = 103u; // items run from the workgroup's local queue (never ticketed)
 fn gw(i: u32) -> u32 { return NQ * QSTRIDE + i; }
 const G_PENDING: u32 = 0u;   // items appended and neither processed nor abandoned in this launch
-const G_STOP: u32 = 1u;
-const G_ERROR: u32 = 2u;
-const G_ERR_A: u32 = 3u;
-const G_ERR_B: u32 = 4u;
-const G_IDLE: u32 = 5u;
-const G_SEQ: u32 = 6u;
-const G_ABANDONED: u32 = 7u;
-const G_PROBE_STARTED: u32 = 8u;
-const G_PROBE_FINISHED: u32 = 9u;
-const G_PROBE_RESIDENT: u32 = 10u;
-const G_ITER_EXITS: u32 = 11u;
-// G_LOST = 12: written only by the device compaction (megakernel_compact.wgsl)
-const G_IDLE_NOW: u32 = 13u; // workgroups idle right now (LOCAL only)
+const G_STOP: u32 = 32u;
+const G_ERROR: u32 = 33u;
+const G_ERR_A: u32 = 34u;
+const G_ERR_B: u32 = 35u;
+const G_IDLE: u32 = 36u;
+const G_SEQ: u32 = 64u;
+const G_ABANDONED: u32 = 37u;
+const G_PROBE_STARTED: u32 = 38u;
+const G_PROBE_FINISHED: u32 = 39u;
+const G_PROBE_RESIDENT: u32 = 40u;
+const G_ITER_EXITS: u32 = 41u;
+// G_LOST = 42: written only by the device compaction (megakernel_compact.wgsl)
+const G_IDLE_NOW: u32 = 96u; // workgroups idle right now (LOCAL only)
 // Turn anatomy (TURN_ANATOMY; host twin: scheduler/src/megakernel/anatomy.rs): per phase, the
 // leader's (lane 0's) count of global memory operations or loop trips on the turn's critical
 // path, kept in lane 0's registers and added once when the workgroup leaves its loop.
-const G_AN: u32 = 16u;
+const G_AN: u32 = 128u;
 const AN_TURNS: u32 = 0u;    // loop turns (batches, idle turns and the exit turn)
 const AN_CLAIM: u32 = 1u;    // global atomics of the claim (every turn, idle ones included)
 const AN_WAIT: u32 = 2u;     // flag polls of the slowest lane, summed over batches
@@ -139,6 +144,15 @@ fn idle_pause(trips: u32) {
     var x = sched_pause_sink;
     for (var i = 0u; i < trips; i++) { x = x * 1664525u + 1013904223u; }
     sched_pause_sink = x;
+}
+
+// A pause of `trips` drawn from [trips / 2, trips * 3 / 2], by workgroup and turn: workgroups
+// that went idle together would otherwise double their pauses in step and poll in bursts.
+fn jitter(trips: u32, wg: u32, turn: u32) -> u32 {
+    var x = (wg * 0x9e3779b1u) ^ (turn * 0x85ebca6bu);
+    x = (x ^ (x >> 15u)) * 0x2c1b3c6du;
+    x ^= x >> 12u;
+    return trips / 2u + x % (trips + 1u);
 }
 
 fn sched_raise(code: u32, a: u32, b: u32) {
@@ -391,7 +405,7 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         if cmd == CMD_IDLE {
             idle++;
             streak = min(streak * 2u + 1u, params[P_IDLE_BACKOFF]);
-            idle_pause(streak);
+            idle_pause(jitter(streak, wid.x, iter));
             continue;
         }
         streak = 0u;
@@ -477,7 +491,10 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
             // The next step may reuse the body's workgroup memory: all threads finish this one first.
             workgroupBarrier();
         }
-        storageBarrier(); // outbox writes visible to the whole workgroup
+        // The outbox's writes visible to the whole workgroup, for the copy. Direct enqueue wrote
+        // the slots themselves: the release barrier before the flags orders them, and the
+        // step's workgroupBarrier above is all the workgroup needs (a device-scope fence less).
+        if !DIRECT_ENQUEUE { storageBarrier(); }
 
         // 3. Reserve tickets for what was emitted: lane t for target queue t, all in parallel;
         //    lane q counts the batch in its statistics (registers, added to ctrl at exit).
@@ -616,7 +633,11 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         for (var i = lid; i < n && !from_local; i += 256u) {
             if wg_ready[i] != 0u { atomicStore(&flags[q_flag_base(q) + h + i], CONSUMED); }
         }
-        storageBarrier();
+        // Every lane's flag stores issued before any count add. No device-scope fence: the count
+        // only says how many items to claim; a claimer that sees it before a flag waits for
+        // the flag (bounded), and the flag is what orders the payload (the release barrier
+        // above, the claimer's acquire barrier after its wait).
+        workgroupBarrier();
         // The new items become claimable: lane t adds target t's, all in parallel.
         if lid < NQ && wg_emit_n[lid] > 0u {
             atomicAdd(&ctrl[lid * QSTRIDE + Q_COUNT], wg_emit_n[lid]);

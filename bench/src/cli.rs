@@ -150,7 +150,7 @@ pub struct Cli {
 
     /// The megakernel enqueues straight into the target queue's slots (`direct`, when a batch's
     /// worst case fits a ticket list in workgroup memory) or through a per-workgroup outbox
-    /// copied out after each batch (`outbox`) [default: direct for items of 16+ words].
+    /// copied out after each batch (`outbox`) [default: direct wherever a batch's tickets fit].
     #[arg(long, value_enum, help_heading = "Scheduler")]
     pub enqueue: Option<Enqueue>,
 

@@ -135,7 +135,7 @@ pub struct GpuConfig {
     pub idle_backoff: u32,
     /// How the queues hold items (`MegakernelConfig::item_layout`); `None`: `ItemLayout::for_program`.
     pub item_layout: Option<ItemLayout>,
-    /// `MegakernelConfig::direct_enqueue`; `None`: by item size.
+    /// `MegakernelConfig::direct_enqueue`; `None`: direct wherever a batch's tickets fit.
     pub direct_enqueue: Option<bool>,
     /// Queue slots at the start of a run; `None` lets the workload choose from its size.
     pub capacity: Option<u32>,

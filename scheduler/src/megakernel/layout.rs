@@ -1,41 +1,44 @@
 //! Host twin of the ctrl and params word layouts in `shaders/megakernel.wgsl`.
-//! A test compiles the shader and checks each constant against these.
+//! A test compiles the shader and checks each constant against these. The words every turn
+//! touches (a queue's reserve, head, count and budget; pending, stop, the FIFO sequence, the
+//! idle count) sit 32 words (a 128-byte L2 line) apart, so that the probes' loads do not queue
+//! the claims' atomics behind them (the shader's layout comment has the measurement).
 #![allow(dead_code)] // the whole host twin of the layout: not every word is read by the host
 
-pub const QSTRIDE: usize = 16;
+pub const QSTRIDE: usize = 128;
 pub const Q_RESERVE: usize = 0;
-pub const Q_HEAD: usize = 1;
-pub const Q_COUNT: usize = 2;
-pub const Q_BUDGET: usize = 3;
-pub const Q_PEAK: usize = 4;
-pub const Q_EXECUTED: usize = 5;
-pub const Q_BATCHES: usize = 6;
-pub const Q_BLOCKED: usize = 7;
+pub const Q_HEAD: usize = 32;
+pub const Q_COUNT: usize = 64;
+pub const Q_BUDGET: usize = 96;
+pub const Q_PEAK: usize = 97;
+pub const Q_EXECUTED: usize = 98;
+pub const Q_BATCHES: usize = 99;
+pub const Q_BLOCKED: usize = 100;
 /// Largest worst-case output to this queue of a batch refused for lack of room (in any queue).
-pub const Q_DEMAND: usize = 8;
+pub const Q_DEMAND: usize = 101;
 /// Items the device compaction kept in this queue (written only by `megakernel_compact.wgsl`).
-pub const Q_KEPT: usize = 9;
+pub const Q_KEPT: usize = 102;
 /// Items run from the workgroups' local queues (never ticketed in this queue).
-pub const Q_LOCAL: usize = 10;
+pub const Q_LOCAL: usize = 103;
 
 pub const G_PENDING: usize = 0;
-pub const G_STOP: usize = 1;
-pub const G_ERROR: usize = 2;
-pub const G_ERR_A: usize = 3;
-pub const G_ERR_B: usize = 4;
-pub const G_IDLE: usize = 5;
-pub const G_SEQ: usize = 6;
-pub const G_ABANDONED: usize = 7;
-pub const G_PROBE_STARTED: usize = 8;
-pub const G_PROBE_FINISHED: usize = 9;
-pub const G_PROBE_RESIDENT: usize = 10;
-pub const G_ITER_EXITS: usize = 11;
+pub const G_STOP: usize = 32;
+pub const G_ERROR: usize = 33;
+pub const G_ERR_A: usize = 34;
+pub const G_ERR_B: usize = 35;
+pub const G_IDLE: usize = 36;
+pub const G_SEQ: usize = 64;
+pub const G_ABANDONED: usize = 37;
+pub const G_PROBE_STARTED: usize = 38;
+pub const G_PROBE_FINISHED: usize = 39;
+pub const G_PROBE_RESIDENT: usize = 40;
+pub const G_ITER_EXITS: usize = 41;
 /// Slots the device compaction found reserved but unpublished, or could not place.
-pub const G_LOST: usize = 12;
+pub const G_LOST: usize = 42;
 /// Workgroups idle right now (local queues only).
-pub const G_IDLE_NOW: usize = 13;
+pub const G_IDLE_NOW: usize = 96;
 /// First of the turn anatomy's counters (`anatomy::TurnAnatomy`, `AN_*` in the shader).
-pub const G_AN: usize = 16;
+pub const G_AN: usize = 128;
 pub const AN_WORDS: usize = 8;
 pub const GLOBAL_WORDS: usize = G_AN + AN_WORDS;
 
@@ -78,6 +81,22 @@ mod tests {
             .find(|l| l.starts_with(&format!("const {name}: u32 = ")))?;
         let v = line.split('=').nth(1)?.trim().split('u').next()?;
         v.parse().ok()
+    }
+
+    #[test]
+    fn hot_words_have_lines_of_their_own() {
+        const LINE: usize = 32; // 128 bytes
+        let lines = |words: &[usize]| {
+            let mut l: Vec<usize> = words.iter().map(|w| w / LINE).collect();
+            l.sort();
+            l.dedup();
+            l.len() == words.len()
+        };
+        assert!(lines(&[Q_RESERVE, Q_HEAD, Q_COUNT, Q_BUDGET]));
+        assert!(lines(&[G_PENDING, G_STOP, G_SEQ, G_IDLE_NOW, G_AN]));
+        // Queue blocks and the global block start on a line, for any queue count.
+        assert_eq!(QSTRIDE % LINE, 0);
+        assert!([Q_LOCAL, Q_KEPT, Q_DEMAND].iter().all(|&w| w < QSTRIDE));
     }
 
     #[test]

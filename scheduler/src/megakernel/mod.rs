@@ -88,8 +88,10 @@ pub struct MegakernelConfig {
     /// Polls of one slot's flag before it is abandoned to the next launch.
     pub spin_limit: u32,
     /// Longest pause of an idle workgroup between two polls for work, in trips of a loop of
-    /// one multiply-add (about 4 clocks each); the pause doubles per idle turn up to this and
-    /// ends at the first claimed batch. Idle workgroups polling without a pause crowd the L2
+    /// one multiply-add (about 4 clocks each); the pause doubles per idle turn up to this
+    /// (each pause jittered between half and one and a half times its length, so that
+    /// workgroups idle since the same turn do not poll in step) and ends at the first claimed
+    /// batch. Idle workgroups polling without a pause crowd the L2
     /// lines of the queue counters that every claim needs: on the H200, 64 made the deep tree
     /// 25% faster and no tree slower (docs/results.md, "A megakernel turn's latency, and idle
     /// workgroups pausing"). 0 polls without a pause
@@ -109,10 +111,11 @@ pub struct MegakernelConfig {
     /// listed in workgroup memory for publishing) instead of into a per-workgroup outbox copied
     /// out after the batch: saves a write and a read of every item, costs an atomic per item
     /// instead of one per batch. Only where a batch's worst-case emits fit
-    /// [`MAX_DIRECT_EMITS`]. `None` (the default): where the largest item has
-    /// [`DIRECT_MIN_WORDS`] words or more. Measured on the H200 (docs/results.md, "Direct
-    /// enqueue in the megakernel"):
-    /// 64-word items 1.17 -> 0.80 ms, Reyes frames 1-4% faster; 3-word items 6-25% slower.
+    /// [`MAX_DIRECT_EMITS`]. `None` (the default): wherever a batch's tickets fit. Measured on
+    /// the H200: 64-word items 1.17 -> 0.80 ms, Reyes frames 1-4% faster (docs/results.md,
+    /// "Direct enqueue in the megakernel"); 3-word items were 6-25% slower until the turn lost
+    /// its fence after the run, and are now 2-7% faster on four trees of five (irregular 2%
+    /// slower; docs/results.md, 2026-12-02, "Turn: hot words apart").
     pub direct_enqueue: Option<bool>,
     /// Count what each loop turn spends per phase (claim, wait for flags, execute, reserve,
     /// copy, publish) and report it in [`RunStats::turn_anatomy`]: a few registers and one
@@ -149,9 +152,6 @@ pub struct MegakernelConfig {
 /// 8 KiB of workgroup memory, beside the 4 KiB of `wg_ready`, within the 16 KiB every Vulkan
 /// device offers.
 pub const MAX_DIRECT_EMITS: u32 = 2048;
-
-/// Smallest largest item, in words, for which the megakernel enqueues directly by default.
-pub const DIRECT_MIN_WORDS: u32 = 16;
 
 impl Default for MegakernelConfig {
     fn default() -> Self {
@@ -283,8 +283,7 @@ impl Megakernel {
             outbox_stride = outbox_stride.max(off).next_multiple_of(4);
             emit_slots = emit_slots.max(es);
         }
-        let largest = program.procs.iter().map(|p| p.words()).max().unwrap_or(0);
-        let wanted = config.direct_enqueue.unwrap_or(largest >= DIRECT_MIN_WORDS);
+        let wanted = config.direct_enqueue.unwrap_or(true);
         let direct = wanted && emit_slots <= MAX_DIRECT_EMITS;
         if direct {
             // Items go straight to their slots: no outbox.
