@@ -11,7 +11,7 @@
 // a queue's reserve, head, count and budget; pending, stop, the FIFO sequence and the idle
 // count. Every probe loads the counts and pending, every claim and publish adds to them; on one
 // line the atomics queued behind the loads (H200: binary tree 0.222 -> 0.201 ms, deep 2.27 ->
-// 1.87; docs/results.md, 2026-12-02, "Turn: hot words apart").
+// 1.87; docs/results.md, 2026-12-02, "A cheaper megakernel turn").
 const QSTRIDE: u32 = 128u;
 const Q_RESERVE: u32 = 0u;   // tickets handed to producers (linear within a launch)
 const Q_HEAD: u32 = 32u;   // tickets handed to consumers

@@ -160,7 +160,7 @@ pub struct Cli {
     pub capacity: Option<u32>,
 
     /// Count what the megakernel's loop turns spend per phase (claim, wait for flags, execute,
-    /// reserve, copy, publish) and print the table after the runs (`MegakernelConfig::turn_anatomy`).
+    /// enqueue, reserve, copy, publish) and print the table after the runs (`MegakernelConfig::turn_anatomy`).
     #[arg(long, help_heading = "Scheduler")]
     pub turn_anatomy: bool,
 

@@ -95,9 +95,15 @@ impl FrameImage {
         }
     }
 
-    /// Pixels with any coverage.
+    /// Pixels with any coverage: a surface's depth, not the background's 3e38. Not alpha,
+    /// which an `Imager "background"` makes 1 everywhere; alpha only for an image without
+    /// depth.
     pub fn covered_pixels(&self) -> usize {
-        self.rgba.iter().filter(|p| p[3] > 0.0).count()
+        if self.depth.len() == self.rgba.len() {
+            self.depth.iter().filter(|&&z| z < 3.0e38).count()
+        } else {
+            self.rgba.iter().filter(|p| p[3] > 0.0).count()
+        }
     }
 
     /// Writes [`FrameImage::rgba8`] to `path` as a PNG, atomically (a temporary file renamed).
@@ -237,6 +243,32 @@ impl FrameImage {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Coverage is counted from depth: the same frame composited over an `Imager
+    /// "background"` (every pixel opaque) has as many covered pixels as without it.
+    #[test]
+    fn covered_pixels_are_the_same_with_a_background_imager() {
+        let keys = |covered: bool| {
+            let hi = if covered { !1.5f32.to_bits() } else { 0 };
+            (u64::from(hi) << 32) | 0x3ff
+        };
+        // 3 x 2 pixels, 2 samples each: two pixels covered (one at the edge), four not.
+        let samples = [
+            true, true, false, true, false, false, false, false, false, false, false, false,
+        ];
+        let k: Vec<u64> = samples.iter().map(|&c| keys(c)).collect();
+        let (plain, depth) = crate::stages::resolve::resolve(&k, 3, 2, 2, None);
+        let (opaque, depth_bg) = crate::stages::resolve::resolve(&k, 3, 2, 2, Some([1.0; 3]));
+        let image = |rgba, depth| FrameImage {
+            width: 3,
+            height: 2,
+            rgba,
+            depth,
+        };
+        assert!(opaque.iter().all(|p| p[3] == 1.0));
+        assert_eq!(image(plain, depth).covered_pixels(), 2);
+        assert_eq!(image(opaque, depth_bg).covered_pixels(), 2);
+    }
 
     /// The OpenEXR file reads back (with the `exr` crate) as the image's channels, exactly:
     /// premultiplied colour, coverage, depth with the background at +inf.

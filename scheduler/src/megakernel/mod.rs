@@ -111,14 +111,15 @@ pub struct MegakernelConfig {
     /// listed in workgroup memory for publishing) instead of into a per-workgroup outbox copied
     /// out after the batch: saves a write and a read of every item, costs an atomic per item
     /// instead of one per batch. Only where a batch's worst-case emits fit
-    /// [`MAX_DIRECT_EMITS`]. `None` (the default): wherever a batch's tickets fit. Measured on
+    /// [`MAX_DIRECT_EMITS`] (`Some(true)` where they do not: the outbox, with a warning).
+    /// `None` (the default): wherever a batch's tickets fit. Measured on
     /// the H200: 64-word items 1.17 -> 0.80 ms, Reyes frames 1-4% faster (docs/results.md,
     /// "Direct enqueue in the megakernel"); 3-word items were 6-25% slower until the turn lost
     /// its fence after the run, and are now 2-7% faster on four trees of five (irregular 2%
-    /// slower; docs/results.md, 2026-12-02, "Turn: hot words apart").
+    /// slower; docs/results.md, 2026-12-02, "A cheaper megakernel turn").
     pub direct_enqueue: Option<bool>,
-    /// Count what each loop turn spends per phase (claim, wait for flags, execute, reserve,
-    /// copy, publish) and report it in [`RunStats::turn_anatomy`]: a few registers and one
+    /// Count what each loop turn spends per phase (claim, wait for flags, execute, enqueue,
+    /// reserve, copy, publish) and report it in [`RunStats::turn_anatomy`]: a few registers and one
     /// atomic per counter per workgroup at exit. Off by default; when off the counters are
     /// compiled out.
     pub turn_anatomy: bool,
@@ -285,6 +286,11 @@ impl Megakernel {
         }
         let wanted = config.direct_enqueue.unwrap_or(true);
         let direct = wanted && emit_slots <= MAX_DIRECT_EMITS;
+        if config.direct_enqueue == Some(true) && !direct {
+            log::warn!(
+                "megakernel: direct enqueue was asked for, but a batch may emit {emit_slots}                  items, more than the {MAX_DIRECT_EMITS} tickets it can list: enqueueing                  through the outbox (fewer batch steps would fit)"
+            );
+        }
         if direct {
             // Items go straight to their slots: no outbox.
             outbox_stride = 4;
