@@ -105,7 +105,7 @@ fn stress_configs() -> Vec<(&'static str, MegakernelConfig)> {
             },
         ),
         (
-            // Direct enqueue, whatever the item size (by default only items of 16+ words), on
+            // Direct enqueue (the default wherever a batch's tickets fit), on
             // one-step batches (the two-step ones above are too large for it: outbox), tiny
             // queues and impatient waits.
             "direct enqueue, tiny queues, short launches, impatient waits",

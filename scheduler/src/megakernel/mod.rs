@@ -288,7 +288,9 @@ impl Megakernel {
         let direct = wanted && emit_slots <= MAX_DIRECT_EMITS;
         if config.direct_enqueue == Some(true) && !direct {
             log::warn!(
-                "megakernel: direct enqueue was asked for, but a batch may emit {emit_slots}                  items, more than the {MAX_DIRECT_EMITS} tickets it can list: enqueueing                  through the outbox (fewer batch steps would fit)"
+                "megakernel: direct enqueue was asked for, but a batch may emit {emit_slots} \
+                 items, more than the {MAX_DIRECT_EMITS} tickets it can list: enqueueing \
+                 through the outbox (fewer batch steps would fit)"
             );
         }
         if direct {
