@@ -148,11 +148,9 @@ fn idle_pause(trips: u32) {
 
 // A pause of `trips` drawn from [trips / 2, trips * 3 / 2], by workgroup and turn: workgroups
 // that went idle together would otherwise double their pauses in step and poll in bursts.
+// `sched_hash` (generated before this file) is the project's `lowbias32` (scheduler/src/hash.rs).
 fn jitter(trips: u32, wg: u32, turn: u32) -> u32 {
-    var x = (wg * 0x9e3779b1u) ^ (turn * 0x85ebca6bu);
-    x = (x ^ (x >> 15u)) * 0x2c1b3c6du;
-    x ^= x >> 12u;
-    return trips / 2u + x % (trips + 1u);
+    return trips / 2u + sched_hash((wg * 0x9e3779b1u) ^ turn) % (trips + 1u);
 }
 
 fn sched_raise(code: u32, a: u32, b: u32) {

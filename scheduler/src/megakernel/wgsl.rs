@@ -59,6 +59,7 @@ pub fn source(
     }
     s += &crate::wgsl::vec4_word_accessors("sched_ob", "outbox");
     s += if subgroups { TAKE_SUBGROUP } else { TAKE_ONE };
+    s += &crate::hash::lowbias32_wgsl("sched_hash");
     if local.active() {
         // Bodies read their items through `sched_in`: the slots, or in a local batch the
         // workgroup's input buffer; local emits are stored through `sched_loc`.
