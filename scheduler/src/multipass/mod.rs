@@ -280,11 +280,17 @@ impl Multipass {
         gpu.queue.submit([enc.finish()]);
     }
 
+    /// Whether rounds are fused (`new` settled `config.fused_rounds` from the adapter).
+    fn fused(&self) -> bool {
+        self.config.fused_rounds == Some(true)
+    }
+
     /// Indirect dispatches of one round: one per procedure, or one with fused rounds.
     fn dispatches_per_round(&self) -> u64 {
-        match self.config.fused_rounds {
-            Some(true) => 1,
-            _ => self.program.queue_count() as u64,
+        if self.fused() {
+            1
+        } else {
+            self.program.queue_count() as u64
         }
     }
 
@@ -356,7 +362,7 @@ impl Multipass {
         plan(&mut pass);
         for k in 0..rounds as usize {
             round(&mut pass, k);
-            if self.config.fused_rounds == Some(true) {
+            if self.fused() {
                 pass.set_pipeline(&p[1 + nq]);
                 pass.dispatch_workgroups_indirect(&d.args[k % 2], args(k, 0));
                 continue;
