@@ -120,10 +120,13 @@ var<private> sched_proc: u32;
 var<private> sched_active: bool;
 var<private> sched_batch_n: u32;
 var<private> sched_outbox: u32;
-var<private> sched_blocked: bool;
+var<private> sched_blocked: bool; // some queue refused this workgroup room in this launch
 var<private> sched_pause_sink: u32;
 // Statistics of the lane's own queue (lane t < NQ: queue t), added to ctrl once at exit.
 var<private> st_peak: u32;
+// The last batch's reserve end and head of the lane's queue, not yet folded into st_peak.
+var<private> st_peak_end: u32;
+var<private> st_peak_head: u32;
 var<private> st_executed: u32;
 var<private> st_batches: u32;
 var<private> st_local: u32;
@@ -133,6 +136,11 @@ var<private> sched_from_local: bool;
 var<private> sched_idle_reg: bool;
 var<private> an: array<u32, AN_WORDS>;
 var<workgroup> wg_an_wait: atomic<u32>;
+
+// Items waiting in the lane's queue at its last batch, into the peak.
+fn fold_peak() {
+    st_peak = max(st_peak, st_peak_end - min(st_peak_head, st_peak_end));
+}
 
 fn an_add(k: u32, v: u32) {
     if TURN_ANATOMY { an[k] += v; }
@@ -191,58 +199,41 @@ fn sched_direct_slot(t: u32) -> u32 {
     return s;
 }
 
-fn release_budget(q: u32, n: u32, upto: u32) {
-    for (var t = 0u; t < upto; t++) {
-        let e = EMITS[q * NQ + t];
-        if e > 0u { atomicSub(&ctrl[t * QSTRIDE + Q_BUDGET], n * e); }
-    }
-}
-
-// Reserves room for the worst-case output of n items of q in every target queue, or nothing.
-fn reserve_budget(q: u32, n: u32) -> bool {
-    for (var t = 0u; t < NQ; t++) {
-        let e = EMITS[q * NQ + t];
-        if e == 0u { continue; }
-        let need = n * e;
-        an_add(AN_CLAIM, 1u);
-        let old = atomicAdd(&ctrl[t * QSTRIDE + Q_BUDGET], need);
-        if old + need > q_cap(t) {
-            atomicSub(&ctrl[t * QSTRIDE + Q_BUDGET], need);
-            release_budget(q, n, t);
-            atomicStore(&ctrl[t * QSTRIDE + Q_BLOCKED], 1u);
-            // What the refused batch needed in every target, so the host can grow them all.
-            for (var u = 0u; u < NQ; u++) {
-                let eu = EMITS[q * NQ + u];
-                if eu > 0u { atomicMax(&ctrl[u * QSTRIDE + Q_DEMAND], n * eu); }
-            }
-            sched_blocked = true;
-            return false;
-        }
-    }
-    return true;
-}
+// Generated before this file: `reserve_budget(q, n) -> bool`, which reserves room for the
+// worst-case output of n items of q in every target queue, or nothing: every target's add is
+// issued before any is checked (straight-line code per target, no array: one round trip
+// however many targets), a refusal undoes them all, sets Q_BLOCKED of the queues without room
+// and raises every target's Q_DEMAND to what the batch needed there. And `sched_refused(q)` /
+// `sched_refuse(q)`, the queues that refused this workgroup room in this launch (a bitmask
+// in a register where there are at most 32 queues).
 
 // Leader only. Claims up to a batch of written items of q, of which `avail` were seen
-// (Q_COUNT, read by the turn's probe): an optimistic decrement of the count (undone in part if
-// it overshot, as when the probe's read is stale), then tickets from head. Claimed tickets were all reserved
-// before, since the count only grows after items are written.
+// (Q_COUNT, read by the turn's probe), in two round trips: an optimistic decrement of the
+// count (the overshoot given back, as when the probe's read is stale); then, issued together,
+// the tickets from head and the room for the batch's worst case in every target. Claimed
+// tickets were all reserved before, since the count only grows after items are written. A
+// batch refused room is abandoned to the next launch (its slots stay published and
+// unconsumed, so compaction keeps them; it leaves pending for G_ABANDONED), and this
+// workgroup claims from q no more in this launch.
 fn try_claim(q: u32, avail: i32) -> bool {
-    if avail <= 0 { return false; }
+    if avail <= 0 || sched_refused(q) { return false; }
     let want = min(u32(avail), batch_max(q));
-    if !reserve_budget(q, want) { return false; }
-    an_add(AN_CLAIM, 1u);
+    an_add(AN_CLAIM, 2u);
     let old = bitcast<i32>(atomicSub(&ctrl[q * QSTRIDE + Q_COUNT], want));
     let got = u32(clamp(old, 0, i32(want)));
-    if got < want {
-        an_add(AN_CLAIM, 2u);
-        atomicAdd(&ctrl[q * QSTRIDE + Q_COUNT], want - got);
-        release_budget(q, want - got, NQ);
-    }
+    if got < want { atomicAdd(&ctrl[q * QSTRIDE + Q_COUNT], want - got); }
     if got == 0u { return false; }
+    let h = atomicAdd(&ctrl[q * QSTRIDE + Q_HEAD], got);
+    if !reserve_budget(q, got) {
+        atomicSub(&ctrl[gw(G_PENDING)], got);
+        atomicAdd(&ctrl[gw(G_ABANDONED)], got);
+        sched_refuse(q);
+        sched_blocked = true;
+        return false;
+    }
     wg_q = q;
     wg_n = got;
-    an_add(AN_CLAIM, 1u);
-    wg_h = atomicAdd(&ctrl[q * QSTRIDE + Q_HEAD], got);
+    wg_h = h;
     return true;
 }
 
@@ -266,7 +257,6 @@ fn leader_decide() -> u32 {
     an_add(AN_TURNS, 1u);
     an_add(AN_CLAIM, 1u); // the probe: one round of parallel loads
     if wg_stop != 0u { return CMD_EXIT; }
-    sched_blocked = false;
     // Work held in the workgroup runs first, in priority order: no global atomic to claim it.
     for (var i = 0u; i < NQ && LOCAL; i++) {
         let m = atomicLoad(&wg_local_n[prio(i)]);
@@ -294,7 +284,9 @@ fn leader_decide() -> u32 {
     // taken before the claims, decides as well as a fresh one.
     if wg_pending == 0u { return CMD_EXIT; }
     if sched_blocked {
-        // Work waits for room that only compaction between launches can give: end the launch.
+        // A queue refused this workgroup room in this launch (its batch was abandoned) and
+        // nothing else is claimable: work waits for room that only growth between launches
+        // can give, so end the launch.
         atomicStore(&ctrl[gw(G_STOP)], 1u);
         return CMD_EXIT;
     }
@@ -521,7 +513,11 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
                     wg_emit_base[t] = base;
                     end = base + k;
                 }
-                st_peak = max(st_peak, end - min(atomicLoad(&ctrl[t * QSTRIDE + Q_HEAD]), end));
+                // The peak's loads are folded in at the next batch (or the exit), so that no
+                // lane waits for them on the turn's path.
+                fold_peak();
+                st_peak_end = end;
+                st_peak_head = atomicLoad(&ctrl[t * QSTRIDE + Q_HEAD]);
                 atomicAdd(&wg_emitted, k);
             }
             // Unused promised room goes back, and a local batch's own insurance.
@@ -649,6 +645,7 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
     // Statistics, once per workgroup and launch. Every exit of the loop passes here, lavapipe's
     // silent loop cut included, so the host's accounting (executed per queue) stays exact.
     if lid < NQ {
+        fold_peak();
         if st_local > 0u { atomicAdd(&ctrl[lid * QSTRIDE + Q_LOCAL], st_local); }
         if st_executed > 0u { atomicAdd(&ctrl[lid * QSTRIDE + Q_EXECUTED], st_executed); }
         if st_batches > 0u { atomicAdd(&ctrl[lid * QSTRIDE + Q_BATCHES], st_batches); }

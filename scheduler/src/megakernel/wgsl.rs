@@ -60,6 +60,7 @@ pub fn source(
     s += &crate::wgsl::vec4_word_accessors("sched_ob", "outbox");
     s += if subgroups { TAKE_SUBGROUP } else { TAKE_ONE };
     s += &crate::hash::lowbias32_wgsl("sched_hash");
+    s += &claim_wgsl(nq);
     if local.active() {
         // Bodies read their items through `sched_in`: the slots, or in a local batch the
         // workgroup's input buffer; local emits are stored through `sched_loc`.
@@ -167,6 +168,44 @@ pub fn source(
         );
     }
     s += TEMPLATE;
+    s
+}
+
+/// `reserve_budget` and the refused-queue set of `try_claim` (`shaders/megakernel.wgsl`) for
+/// `nq` queues, as straight-line code: arrays indexed at run time would live in local memory,
+/// a round trip of their own on every claim.
+fn claim_wgsl(nq: usize) -> String {
+    let mut s = String::from("fn reserve_budget(q: u32, n: u32) -> bool {\n");
+    for t in 0..nq {
+        s += &format!(
+            "    let e{t} = EMITS[q * NQ + {t}u] * n;\n    var o{t} = 0u;\n    \
+             if e{t} > 0u {{ o{t} = atomicAdd(&ctrl[{t}u * QSTRIDE + Q_BUDGET], e{t}); }}\n"
+        );
+    }
+    s += "    var ok = true;\n";
+    for t in 0..nq {
+        s += &format!(
+            "    if e{t} > 0u && o{t} + e{t} > q_cap({t}u) {{\n        \
+             atomicStore(&ctrl[{t}u * QSTRIDE + Q_BLOCKED], 1u);\n        ok = false;\n    }}\n"
+        );
+    }
+    s += "    if ok { return true; }\n";
+    for t in 0..nq {
+        s += &format!(
+            "    if e{t} > 0u {{\n        atomicSub(&ctrl[{t}u * QSTRIDE + Q_BUDGET], e{t});\n        \
+             atomicMax(&ctrl[{t}u * QSTRIDE + Q_DEMAND], e{t});\n    }}\n"
+        );
+    }
+    s += "    return false;\n}\n";
+    if nq <= 32 {
+        s += "var<private> sched_refused_mask: u32;\n\
+              fn sched_refused(q: u32) -> bool { return (sched_refused_mask & (1u << q)) != 0u; }\n\
+              fn sched_refuse(q: u32) { sched_refused_mask |= 1u << q; }\n";
+    } else {
+        s += "var<private> sched_refused_set: array<bool, NQ>;\n\
+              fn sched_refused(q: u32) -> bool { return sched_refused_set[q]; }\n\
+              fn sched_refuse(q: u32) { sched_refused_set[q] = true; }\n";
+    }
     s
 }
 
