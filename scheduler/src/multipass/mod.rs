@@ -24,8 +24,8 @@ use crate::item_layout::ItemLayout;
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
 use crate::queue_layout::{QueueLayout, RunStart};
-use crate::stats::RunStats;
 use crate::readback::Readback;
+use crate::stats::RunStats;
 use crate::timing::{SpanTimer, StageTimer};
 
 /// Settings of [`Multipass::new`]; [`Default`] gives the documented defaults.
@@ -508,7 +508,9 @@ impl Multipass {
             let ctrl = d.readback.read(gpu, tw + SpanTimer::WORDS)?;
             if let Some(st) = &mut stage_timer {
                 st.collect(gpu)?;
-            } else if let (Some(total), Some(ms)) = (gpu_ms.as_mut(), d.span.ms(&ctrl[tw as usize..])) {
+            } else if let (Some(total), Some(ms)) =
+                (gpu_ms.as_mut(), d.span.ms(&ctrl[tw as usize..]))
+            {
                 *total += ms;
             }
             let error = ctrl[g(nq, G_ERROR)];
