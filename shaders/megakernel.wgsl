@@ -218,11 +218,12 @@ fn sched_direct_slot(t: u32) -> u32 {
 fn try_claim(q: u32, avail: i32) -> bool {
     if avail <= 0 || sched_refused(q) { return false; }
     let want = min(u32(avail), batch_max(q));
-    an_add(AN_CLAIM, 2u);
+    an_add(AN_CLAIM, 1u);
     let old = bitcast<i32>(atomicSub(&ctrl[q * QSTRIDE + Q_COUNT], want));
     let got = u32(clamp(old, 0, i32(want)));
     if got < want { atomicAdd(&ctrl[q * QSTRIDE + Q_COUNT], want - got); }
     if got == 0u { return false; }
+    an_add(AN_CLAIM, 1u); // the head add and the budget adds, one round
     let h = atomicAdd(&ctrl[q * QSTRIDE + Q_HEAD], got);
     if !reserve_budget(q, got) {
         atomicSub(&ctrl[gw(G_PENDING)], got);
@@ -550,11 +551,13 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
             if TURN_ANATOMY {
                 an_add(AN_WAIT, atomicLoad(&wg_an_wait));
                 an_add(AN_EXEC, (n + per_step - 1u) / per_step);
-                // The longest lane's chain; then the pending atomic and, under FIFO, the stamp.
+                // The longest lane's chain (the outbox's ticket add, a refund of unused room;
+                // the peak's loads are folded in at the next batch, off the path); then the
+                // pending atomic and, under FIFO, the stamp.
                 var chain = 0u;
                 for (var t = 0u; t < NQ; t++) {
                     let k = wg_emit_n[t];
-                    chain = max(chain, 3u * u32(k > 0u) + u32(n * EMITS[q * NQ + t] > k));
+                    chain = max(chain, u32(k > 0u && !DIRECT_ENQUEUE) + u32(n * EMITS[q * NQ + t] > k));
                     if DIRECT_ENQUEUE { an_add(AN_ENQUEUE, k); }
                     if !DIRECT_ENQUEUE {
                         if ITEMS_PLANAR {

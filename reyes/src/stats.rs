@@ -80,7 +80,8 @@ pub struct FrameStats {
     pub wall_ms: f64,
     /// Compute dispatches.
     pub launches: u64,
-    /// Workgroups of the megakernel launch or of a multi-pass round's widest dispatch.
+    /// Workgroups of the megakernel launch; 0 for the multi-passes, whose dispatches are sized
+    /// round by round.
     pub workgroups: u32,
     /// Multi-pass rounds (0 for the megakernel).
     pub rounds: u64,
@@ -90,7 +91,7 @@ pub struct FrameStats {
     pub partial_rounds: u64,
     /// Most items held at once, per queue (in `executed`'s order).
     pub peak_queue_items: Vec<u64>,
-    /// `peak_queue_items` in bytes (288 per item), summed.
+    /// `peak_queue_items` in bytes (`size_of::<PatchItem>()`, 224, per item), summed.
     pub peak_queue_bytes: u64,
     /// Bytes of queue storage allocated.
     pub queue_bytes_allocated: u64,

@@ -42,7 +42,7 @@ pub struct RunStats {
     pub peak_occupancy: Vec<u64>,
     /// Bytes of queue storage allocated at the end of the run.
     pub queue_bytes: u64,
-    /// Megakernel: workgroups per launch (probed or configured).
+    /// Megakernel: workgroups per launch (probed or configured); 0 for the multi-passes.
     pub workgroups: u32,
     /// GPU time from timestamp queries, when the adapter has them.
     pub gpu_ms: Option<f64>,

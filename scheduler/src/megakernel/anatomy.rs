@@ -22,8 +22,9 @@ pub struct TurnAnatomy {
     pub execute: u64,
     /// Direct enqueue: ticket atomics taken item by item inside the bodies (all lanes).
     pub enqueue: u64,
-    /// Global atomics after a batch and before its copy (tickets, peaks, budgets, pending,
-    /// sequence and statistics).
+    /// Global atomics after a batch and before its copy on the longest lane's path (the
+    /// outbox's ticket add, a refund of unused promised room), the pending atomic and the FIFO
+    /// sequence; the peak statistic's loads are folded in at the next batch, off the path.
     pub reserve: u64,
     /// Loop trips of a lane copying outbox items to the queues.
     pub copy: u64,
@@ -103,11 +104,12 @@ impl TurnAnatomy {
             }
         };
         let mut s = format!(
-            "turn anatomy: {} turns, {} batches, {} idle or exit turns, {} workgroups\n",
+            "turn anatomy: {} turns, {} batches, {} idle or exit turns, {} workgroup{}\n",
             self.turns,
             batches,
             self.turns.saturating_sub(batches),
-            workgroups
+            workgroups,
+            if workgroups == 1 { "" } else { "s" }
         );
         s += &format!(
             "{:<8} {:<16} {:>12} {:>10} {:>10}\n",
