@@ -24,9 +24,8 @@ use crate::item_layout::ItemLayout;
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
 use crate::queue_layout::{QueueLayout, RunStart};
-use crate::readback::Readback;
 use crate::stats::RunStats;
-use crate::timing::{SpanTimer, StageTimer};
+use crate::timing::{PassTimer, StageTimer};
 
 /// Settings of [`Multipass::new`]; [`Default`] gives the documented defaults.
 #[derive(Debug, Clone)]
@@ -116,11 +115,6 @@ struct DeviceRounds {
     max_chunk: u32,
     /// `bind[parity]`: round r reads `items[r % 2]` and writes `items[(r + 1) % 2]`.
     bind: [wgpu::BindGroup; 2],
-    /// Each submission's ctrl words and GPU time come back together: one copy recorded after
-    /// the rounds, one bounded wait, no staging buffer made per submission.
-    readback: Readback,
-    /// The submission's one pass, timed (without `stage_timing`).
-    span: SpanTimer,
 }
 
 impl Multipass {
@@ -242,12 +236,6 @@ impl Multipass {
             args_bind,
             max_chunk,
             bind,
-            readback: Readback::new(
-                gpu,
-                "multipass ctrl read-back",
-                ctrl_words(self.program.queue_count()) as u64 + SpanTimer::WORDS,
-            ),
-            span: SpanTimer::new(gpu, 1),
         })
     }
 
@@ -320,7 +308,7 @@ impl Multipass {
         d: &DeviceRounds,
         rounds: u32,
         first_round: u64,
-        timer: Option<&SpanTimer>,
+        timer: Option<&PassTimer>,
         stages: Option<&StageTimer>,
         user: Option<&wgpu::BindGroup>,
     ) {
@@ -333,7 +321,7 @@ impl Multipass {
         let begin = |enc: &mut wgpu::CommandEncoder, stage: usize| {
             let writes = match stages {
                 Some(st) => st.writes(stage),
-                None => timer.and_then(|t| t.whole(0)),
+                None => timer.and_then(|t| t.writes()),
             };
             let mut pass = enc
                 .begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -457,8 +445,7 @@ impl Multipass {
             peak_occupancy: vec![0; nq],
             ..Default::default()
         };
-        let mut gpu_ms = gpu.timestamps.then_some(0.0);
-        let tw = ctrl_words(nq) as u64;
+        let mut timer = PassTimer::new(gpu);
         let mut stage_timer = self
             .config
             .stage_timing
@@ -489,29 +476,24 @@ impl Multipass {
                 &d,
                 rounds,
                 since_upload,
-                Some(&d.span),
+                Some(&timer),
                 stage_timer.as_ref(),
                 user,
             );
+            timer.resolve(&mut enc);
             if let Some(st) = &stage_timer {
                 st.resolve(&mut enc);
-            }
-            d.readback.copy(&mut enc, &d.ctrl, 0, 0, tw);
-            if stage_timer.is_none() {
-                d.readback.copy_span(&mut enc, &d.span, 0, tw);
             }
             gpu.queue.submit([enc.finish()]);
             stats.submits += 1;
             stats.launches += 1 + rounds as u64 * self.dispatches_per_round();
             encoded += rounds as u64;
             since_upload += rounds as u64;
-            let ctrl = d.readback.read(gpu, tw + SpanTimer::WORDS)?;
+            let ctrl = gpu.read_words(&d.ctrl, 0, ctrl_words(nq) as u64)?;
             if let Some(st) = &mut stage_timer {
                 st.collect(gpu)?;
-            } else if let (Some(total), Some(ms)) =
-                (gpu_ms.as_mut(), d.span.ms(&ctrl[tw as usize..]))
-            {
-                *total += ms;
+            } else {
+                timer.collect(gpu)?;
             }
             let error = ctrl[g(nq, G_ERROR)];
             let (a, b) = (ctrl[g(nq, G_ERR_A)] as usize, ctrl[g(nq, G_ERR_B)]);
@@ -594,7 +576,7 @@ impl Multipass {
             stats.rounds.clamp(1, MAX_LEARNED_ROUNDS as u64) as u32,
             std::sync::atomic::Ordering::Relaxed,
         );
-        stats.gpu_ms = gpu_ms;
+        stats.gpu_ms = timer.total_ms();
         if let Some(ms) = stage_timer.and_then(|st| st.stage_ms()) {
             stats.gpu_ms = Some(ms.iter().sum());
             stats.stage_gpu_ms = ms;
