@@ -338,6 +338,27 @@ fn spill_local(lid: u32) {
     workgroupBarrier();
 }
 
+// The turn's probe, lane by lane, all in one round trip: lane i < NQ loads the count of queue
+// prio(i), lane 255 G_STOP, lane 254 G_PENDING, lane 253 G_IDLE_NOW (LOCAL).
+fn probe_load(lid: u32) -> u32 {
+    if lid < NQ { return atomicLoad(&ctrl[prio(lid) * QSTRIDE + Q_COUNT]); }
+    if lid == 255u { return atomicLoad(&ctrl[gw(G_STOP)]); }
+    if lid == 254u { return atomicLoad(&ctrl[gw(G_PENDING)]); }
+    if LOCAL && lid == 253u { return atomicLoad(&ctrl[gw(G_IDLE_NOW)]); }
+    return 0u;
+}
+
+// What probe_load read, for the leader's decision; `own`: items of the lane's queue this
+// workgroup published after the load (an early probe's), added to the count it saw. A probe read
+// during a batch sees G_PENDING before the batch left it, never 0: the exit then takes an idle
+// turn with a fresh probe.
+fn probe_store(lid: u32, v: u32, own: u32) {
+    if lid < NQ { wg_avail[lid] = bitcast<i32>(v + own); }
+    if lid == 255u { wg_stop = v; }
+    if lid == 254u { wg_pending = v; }
+    if LOCAL && lid == 253u { wg_idle_now = v; }
+}
+
 // Co-residency probe: a workgroup that starts before any workgroup has finished runs at the
 // same time as every workgroup that started before it.
 fn probe(lid: u32) {
@@ -364,16 +385,16 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
     var idle = 0u;
     var streak = 0u;
     var iter = 0u;
+    var probed = false;
     // Bounded far below lavapipe's silent 65,535-iteration cut; the host relaunches if needed.
     for (; iter < params[P_MAX_ITERS]; iter++) {
         // The probe: lanes read every queue's count, the stop and pending words in parallel
-        // (one round trip instead of one per queue, in turn, on the leader).
-        if lid < NQ {
-            wg_avail[lid] = bitcast<i32>(atomicLoad(&ctrl[prio(lid) * QSTRIDE + Q_COUNT]));
+        // (one round trip instead of one per queue, in turn, on the leader). After a batch it
+        // was read during the batch's publish (early_probe below).
+        if !probed {
+            probe_store(lid, probe_load(lid), 0u);
         }
-        if lid == 255u { wg_stop = atomicLoad(&ctrl[gw(G_STOP)]); }
-        if lid == 254u { wg_pending = atomicLoad(&ctrl[gw(G_PENDING)]); }
-        if LOCAL && lid == 253u { wg_idle_now = atomicLoad(&ctrl[gw(G_IDLE_NOW)]); }
+        probed = false;
         workgroupBarrier();
         if lid == 0u {
             wg_cmd = leader_decide();
@@ -536,6 +557,10 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
             if params[P_POLICY] == 1u { wg_stamp = atomicAdd(&ctrl[gw(G_SEQ)], 1u) + 2u; }
             if abandoned > 0u { atomicAdd(&ctrl[gw(G_ABANDONED)], abandoned); }
         }
+        // The next turn's probe, issued now: its round trip overlaps the release fence and the
+        // publish instead of opening the next turn. Kept in a register until the count adds
+        // are issued, then completed with this batch's own published items.
+        let early = probe_load(lid);
         workgroupBarrier();
         if lid == 0u {
             // Pending: + the children, - this batch, in one atomic. The children are counted
@@ -639,6 +664,10 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         if lid < NQ && wg_emit_n[lid] > 0u {
             atomicAdd(&ctrl[lid * QSTRIDE + Q_COUNT], wg_emit_n[lid]);
         }
+        var own = 0u;
+        if lid < NQ { own = wg_emit_n[prio(lid)]; }
+        probe_store(lid, early, own);
+        probed = true;
     }
     // Items still held locally go to the global queues for the next launch.
     if LOCAL {
