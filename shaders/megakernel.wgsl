@@ -256,7 +256,6 @@ fn fifo_pick() -> u32 {
 
 fn leader_decide() -> u32 {
     an_add(AN_TURNS, 1u);
-    an_add(AN_CLAIM, 1u); // the probe: one round of parallel loads
     if wg_stop != 0u { return CMD_EXIT; }
     // Work held in the workgroup runs first, in priority order: no global atomic to claim it.
     for (var i = 0u; i < NQ && LOCAL; i++) {
@@ -390,9 +389,10 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
     for (; iter < params[P_MAX_ITERS]; iter++) {
         // The probe: lanes read every queue's count, the stop and pending words in parallel
         // (one round trip instead of one per queue, in turn, on the leader). After a batch it
-        // was read during the batch's publish (early_probe below).
+        // was read during the batch's publish (the `early` load in step 3 below), off the path.
         if !probed {
             probe_store(lid, probe_load(lid), 0u);
+            if lid == 0u { an_add(AN_CLAIM, 1u); } // the probe: one round of parallel loads
         }
         probed = false;
         workgroupBarrier();
