@@ -19,8 +19,12 @@ pub struct ImageDifference {
     pub max: u8,
 }
 
+/// The depth of a pixel where the background shows ("nothing here"): what resolve writes when
+/// no sample was hit, and what the depth files turn into +inf.
+pub const BACKGROUND_DEPTH: f32 = 3.0e38;
+
 /// Straight (not premultiplied) linear RGBA with coverage as alpha, and the nearest depth per
-/// pixel (3e38 where the background shows).
+/// pixel ([`BACKGROUND_DEPTH`] where the background shows).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FrameImage {
     /// Image width in pixels.
@@ -95,12 +99,12 @@ impl FrameImage {
         }
     }
 
-    /// Pixels with any coverage: a surface's depth, not the background's 3e38. Not alpha,
+    /// Pixels with any coverage: a surface's depth, not [`BACKGROUND_DEPTH`]. Not alpha,
     /// which an `Imager "background"` makes 1 everywhere; alpha only for an image without
     /// depth.
     pub fn covered_pixels(&self) -> usize {
         if self.depth.len() == self.rgba.len() {
-            self.depth.iter().filter(|&&z| z < 3.0e38).count()
+            self.depth.iter().filter(|&&z| z < BACKGROUND_DEPTH).count()
         } else {
             self.rgba.iter().filter(|p| p[3] > 0.0).count()
         }
@@ -124,9 +128,9 @@ impl FrameImage {
         self.pfm(path, 1, |p, _| self.file_depth(p))
     }
 
-    /// Background depth in the files: +inf (the renderer's 3e38 "nothing here").
+    /// Background depth in the files: +inf (the renderer's [`BACKGROUND_DEPTH`]).
     fn file_depth(&self, p: usize) -> f32 {
-        if self.depth[p] >= 3.0e38 {
+        if self.depth[p] >= BACKGROUND_DEPTH {
             f32::INFINITY
         } else {
             self.depth[p]
@@ -201,7 +205,7 @@ impl FrameImage {
             .collect();
         let depth = z
             .iter()
-            .map(|&z| if z.is_finite() { z } else { 3e38 })
+            .map(|&z| if z.is_finite() { z } else { BACKGROUND_DEPTH })
             .collect();
         Ok(FrameImage {
             width: w as u32,

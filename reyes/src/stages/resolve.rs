@@ -1,8 +1,10 @@
 //! Twin of `shaders/reyes/resolve.wgsl`: sub-samples to pixels (linear colour, coverage alpha).
 
 use super::shade::srgb_decode;
+use crate::image::BACKGROUND_DEPTH;
 
-/// Straight (not premultiplied) linear RGBA and nearest depth (3e38 where nothing was hit).
+/// Straight (not premultiplied) linear RGBA and nearest depth ([`BACKGROUND_DEPTH`] where
+/// nothing was hit).
 /// With a `background` (`Imager "background"`) every pixel is composited over it and opaque:
 /// `c alpha + background (1 - alpha)`, alpha 1.
 pub fn resolve(
@@ -15,7 +17,7 @@ pub fn resolve(
     let n = (width * height) as usize;
     let (mut rgba, mut depth) = (Vec::with_capacity(n), Vec::with_capacity(n));
     for p in 0..n {
-        let (mut sum, mut covered, mut zmin) = ([0f32; 3], 0u32, 3.0e38f32);
+        let (mut sum, mut covered, mut zmin) = ([0f32; 3], 0u32, BACKGROUND_DEPTH);
         for &k in &keys[p * spp as usize..(p + 1) * spp as usize] {
             let (lo, hi) = (k as u32, (k >> 32) as u32);
             if hi == 0 {
