@@ -349,8 +349,8 @@ fn probe_load(lid: u32) -> u32 {
 
 // What probe_load read, for the leader's decision; `own`: items of the lane's queue this
 // workgroup published after the load (an early probe's), added to the count it saw. A probe read
-// during a batch sees G_PENDING before the batch left it, never 0: the exit then takes an idle
-// turn with a fresh probe.
+// during a batch sees G_PENDING before the batch left it, never 0: the workgroup then leaves
+// through an idle turn and an exit turn whose fresh probe reads 0.
 fn probe_store(lid: u32, v: u32, own: u32) {
     if lid < NQ { wg_avail[lid] = bitcast<i32>(v + own); }
     if lid == 255u { wg_stop = v; }

@@ -174,9 +174,9 @@ pub fn source(
 /// `reserve_budget` and the refused-queue set of `try_claim` (`shaders/megakernel.wgsl`) for
 /// `nq` queues, as straight-line code: arrays indexed at run time likely live in local memory,
 /// a round trip of their own on every claim (the first version, with such arrays, was slower
-/// on the H200; the compiled code could not be read to confirm why). The refused queues are a register bitmask up to 32
-/// queues; past that (no workload has so many) a private array, indexed only when a queue
-/// refuses room or a claim checks it.
+/// on the H200; the compiled code could not be read to confirm why). The refused queues are a
+/// register bitmask up to 32 queues; past that (no workload has so many) a private array,
+/// indexed only when a queue refuses room or a claim checks it.
 fn claim_wgsl(nq: usize) -> String {
     let mut s = String::from("fn reserve_budget(q: u32, n: u32) -> bool {\n");
     for t in 0..nq {
