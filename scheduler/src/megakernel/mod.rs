@@ -88,7 +88,8 @@ pub struct MegakernelConfig {
     /// Polls of one slot's flag before it is abandoned to the next launch.
     pub spin_limit: u32,
     /// Longest pause of an idle workgroup between two polls for work, in trips of a loop of
-    /// one multiply-add (about 4 clocks each); the pause doubles per idle turn up to this
+    /// one multiply-add (about 4 clocks each) run by one warp, lanes 0-31, while the others
+    /// wait at a barrier (docs/scheduler.md 2.2); the pause doubles per idle turn up to this
     /// (each pause jittered between half and one and a half times its length, so that
     /// workgroups idle since the same turn do not poll in step) and ends at the first claimed
     /// batch. Idle workgroups polling without a pause crowd the L2
