@@ -417,9 +417,10 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         if cmd == CMD_IDLE {
             idle++;
             streak = min(streak * 2u + 1u, params[P_IDLE_BACKOFF]);
-            // One warp pauses; the workgroup's other warps wait at the next turn's barrier,
-            // where they issue nothing. Paused by every lane, the idle workgroups sharing an
-            // SM with a busy one took its issue slots.
+            // One warp pauses; the other warps run on to the next turn's first barrier (the
+            // last one issuing the probe's stop and pending loads, only staler for it) and wait
+            // there, issuing nothing. Paused by every lane, the idle workgroups sharing an SM
+            // with a busy one took its issue slots (docs/scheduler.md 2.2).
             if lid < 32u { idle_pause(jitter(streak, wid.x, iter)); }
             continue;
         }

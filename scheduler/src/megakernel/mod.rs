@@ -92,10 +92,8 @@ pub struct MegakernelConfig {
     /// wait at a barrier (docs/scheduler.md 2.2); the pause doubles per idle turn up to this
     /// (each pause jittered between half and one and a half times its length, so that
     /// workgroups idle since the same turn do not poll in step) and ends at the first claimed
-    /// batch. Idle workgroups polling without a pause crowd the L2
-    /// lines of the queue counters that every claim needs: on the H200, 64 made the deep tree
-    /// 25% faster and no tree slower (docs/results.md, "A megakernel turn's latency, and idle
-    /// workgroups pausing"). 0 polls without a pause
+    /// batch. On the H200 64 is better than no pause (deep tree 1.449 against 1.518 ms) and
+    /// within 1% of the best bound measured (docs/scheduler.md 2.2). 0 polls without a pause
     /// (and is what lavapipe gets: its loop limiter counts the pause's trips).
     pub idle_backoff: u32,
     /// Slots per queue at the start of a run (at least twice the seeds).
