@@ -215,3 +215,38 @@ fn another_workloads_option_is_a_usage_error() {
         assert_usage_error(args, expected);
     }
 }
+
+/// `SCHED_DUMP_WGSL` writes every module the scheduler compiles, whole: each dumped file is a
+/// complete WGSL module that naga validates on its own (what `pipestats` is given).
+#[test]
+fn dumped_wgsl_modules_are_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let status = Command::new(env!("CARGO_BIN_EXE_schedbench"))
+        .args([
+            "--workload",
+            "tree",
+            "--roots",
+            "4",
+            "--depth",
+            "4",
+            "--runs",
+            "1",
+        ])
+        .args(["--strategy", "megakernel", "--workgroups", "2"])
+        .env(scheduler::gpu::DUMP_WGSL_ENV, dir.path())
+        .status()
+        .expect("schedbench runs");
+    assert!(status.success(), "schedbench failed: {status}");
+    let mut names = Vec::new();
+    for entry in std::fs::read_dir(dir.path()).unwrap() {
+        let path = entry.unwrap().path();
+        let source = std::fs::read_to_string(&path).unwrap();
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        scheduler::wgsl::validate(&name, &source).unwrap_or_else(|e| panic!("{name}: {e}"));
+        names.push(name);
+    }
+    assert!(
+        names.iter().any(|n| n == "megakernel.wgsl"),
+        "dumped: {names:?}"
+    );
+}

@@ -329,6 +329,7 @@ impl Gpu {
     pub fn shader(&self, label: &str, source: &str) -> Result<wgpu::ShaderModule, RunError> {
         let start = std::time::Instant::now();
         crate::wgsl::validate(label, source)?;
+        dump_wgsl(label, source);
         let desc = wgpu::ShaderModuleDescriptor {
             label: Some(label),
             source: wgpu::ShaderSource::Wgsl(source.into()),
@@ -449,5 +450,34 @@ impl Gpu {
     /// instead (see [`Gpu::driver_bounds_loops`] for the Vulkan-only consequence).
     pub fn is_lavapipe(&self) -> bool {
         self.info.name.contains("llvmpipe")
+    }
+}
+
+/// Environment variable naming a folder where [`Gpu::shader`] writes every WGSL module it
+/// compiles, as `LABEL.wgsl`: the generated megakernel and multi-pass sources, to read or to
+/// hand to `pipestats` (the driver's register and instruction counts, docs/scheduler.md 2.6).
+pub const DUMP_WGSL_ENV: &str = "SCHED_DUMP_WGSL";
+
+/// Writes `source` to `$SCHED_DUMP_WGSL/LABEL.wgsl` when the variable is set; a failed write is
+/// logged, never fatal (the dump is a diagnostic).
+fn dump_wgsl(label: &str, source: &str) {
+    let Some(dir) = std::env::var_os(DUMP_WGSL_ENV) else {
+        return;
+    };
+    let name: String = label
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    let path = std::path::Path::new(&dir).join(format!("{name}.wgsl"));
+    let written = std::fs::create_dir_all(&dir).and_then(|()| std::fs::write(&path, source));
+    match written {
+        Ok(()) => log::info!("shader module `{label}` written to {}", path.display()),
+        Err(e) => log::warn!("{DUMP_WGSL_ENV}: could not write {}: {e}", path.display()),
     }
 }
