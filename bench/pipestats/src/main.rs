@@ -17,8 +17,10 @@
 //! ```
 //!
 //! `--loop-bounding off` matches pipelines made by `create_shader_module_trusted` with
-//! `force_loop_bounding: false` (the scheduler's megakernel). The device is chosen by `--adapter`,
-//! else `WGPU_ADAPTER_NAME`, else the first discrete GPU. Exit status: 0, 1 on any error (bad
+//! `force_loop_bounding: false` (every scheduler module on lavapipe, `Gpu::shader`); wgpu's
+//! default, and the scheduler's on other drivers, is on. Dump the scheduler's generated modules
+//! with `SCHED_DUMP_WGSL=DIR` (`scheduler::gpu::DUMP_WGSL_ENV`). The device is chosen by
+//! `--adapter`, else `WGPU_ADAPTER_NAME`, else the first discrete GPU. Exit status: 0, 1 on any error (bad
 //! WGSL, no device, missing extension, a failed Vulkan call), 2 on a bad command line.
 #![allow(
     unsafe_code,
@@ -38,7 +40,8 @@ use serde::Serialize;
 #[derive(Parser)]
 #[command(about = "What the Vulkan driver's compiler made of WGSL compute shaders")]
 struct Args {
-    /// wgpu's `force_loop_bounding` (on by default, as in wgpu; off as the megakernel's module).
+    /// wgpu's `force_loop_bounding`: on by default, as wgpu compiles every module on NVIDIA; off as
+    /// `create_shader_module_trusted` compiles them (the scheduler's modules on lavapipe).
     #[arg(long, value_enum, default_value_t = OnOff::On)]
     loop_bounding: OnOff,
     /// Write everything as JSON here (text representations go beside it unless `--ir`).
