@@ -35,7 +35,16 @@ fn trees() -> Vec<(&'static str, TreeParams)> {
 }
 
 fn bench(c: &mut Criterion) {
-    let gpu = Gpu::from_env().expect("benches need a GPU adapter");
+    let mut gpu = Gpu::from_env().expect("benches need a GPU adapter");
+    // SAFETY: the trees' procedures and the scheduler's modules end every loop
+    // (`Gpu::trust_loops`), as in schedbench.
+    #[allow(
+        unsafe_code,
+        reason = "Gpu::trust_loops: every loop of this device's shaders ends"
+    )]
+    unsafe {
+        gpu.trust_loops()
+    };
     for (name, params) in trees() {
         let reference = params.reference();
         let tree = TreeRun::new(&gpu, params).unwrap();

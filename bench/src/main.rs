@@ -34,11 +34,20 @@ use std::process::ExitCode;
 fn run_suite(cli: &Cli) -> Result<bool, Error> {
     let only: Vec<WorkloadName> = cli.workload.into_iter().collect();
     let needs_reyes = only.is_empty() || only.contains(&WorkloadName::Reyes);
-    let gpu = if needs_reyes {
+    let mut gpu = if needs_reyes {
         Gpu::from_env_requiring(reyes::gpu_render::required_features())
     } else {
         Gpu::from_env()
     }?;
+    // SAFETY: the suite compiles the scheduler's, its workloads' and reyes's shaders only,
+    // whose loops all end (`Gpu::trust_loops`, docs/scheduler.md 4).
+    #[allow(
+        unsafe_code,
+        reason = "Gpu::trust_loops: every loop of this device's shaders ends"
+    )]
+    unsafe {
+        gpu.trust_loops()
+    };
     let options = suite::SuiteOptions {
         out: cli.out.clone().expect("clap requires --out with --suite"),
         scale: cli.size,

@@ -176,7 +176,16 @@ pub fn open(
                 entry.describe()
             )));
         }
-        let gpu = Gpu::from_adapter(entry.adapter.clone(), required)?;
+        let mut gpu = Gpu::from_adapter(entry.adapter.clone(), required)?;
+        // SAFETY: these devices render reyes frames only: the scheduler's and reyes's shaders,
+        // whose loops all end (`Gpu::trust_loops`, docs/scheduler.md 4).
+        #[allow(
+            unsafe_code,
+            reason = "Gpu::trust_loops: every loop of this device's shaders ends"
+        )]
+        unsafe {
+            gpu.trust_loops()
+        };
         out.push(OpenedDevice { adapter: i, gpu });
     }
     Ok(out)

@@ -38,6 +38,8 @@ pub struct Gpu {
     /// default handler panics; this device records them instead and [`Gpu::wait`] reports the
     /// first as [`RunError::Device`], so a bad dispatch is an error of the run, never a panic.
     uncaptured: Arc<Mutex<Vec<String>>>,
+    /// Every loop of every module compiled on this device ends by itself ([`Gpu::trust_loops`]).
+    loops_trusted: bool,
 }
 
 impl Gpu {
@@ -157,6 +159,7 @@ impl Gpu {
             queue,
             info,
             timeout: DEFAULT_GPU_TIMEOUT,
+            loops_trusted: false,
         })
     }
 
@@ -321,10 +324,11 @@ impl Gpu {
     }
 
     /// Compiles WGSL, turning a validation error into a `RunError` that carries the message
-    /// (naga's error names the line), instead of a panic in wgpu's error handler.
+    /// (naga's error names the line), instead of a panic in wgpu's error handler. Naga's loop
+    /// bounding is left out where [`Gpu::bounds_loops`] says so.
     #[allow(
         unsafe_code,
-        reason = "a shader module without naga's loop bounding where the driver bounds every loop itself"
+        reason = "a shader module without naga's loop bounding, where the driver bounds every loop itself or the owner of the device vouched that every loop ends (Gpu::trust_loops)"
     )]
     pub fn shader(&self, label: &str, source: &str) -> Result<wgpu::ShaderModule, RunError> {
         let start = std::time::Instant::now();
@@ -334,9 +338,13 @@ impl Gpu {
             label: Some(label),
             source: wgpu::ShaderSource::Wgsl(source.into()),
         };
-        let module = if self.driver_bounds_loops() {
-            // SAFETY: wgpu requires that no loop of the shader runs forever without naga's
-            // bounding; the driver stops every loop itself (see `driver_bounds_loops`).
+        let module = if self.bounds_loops() {
+            self.device.create_shader_module(desc)
+        } else {
+            // SAFETY: wgpu requires that no loop of the shader runs forever once naga's bounding
+            // is gone. Either the driver stops every loop itself (`driver_bounds_loops`) or
+            // the caller of the unsafe `trust_loops` took on that every loop ends. Bounds
+            // checks stay (`checked()`).
             unsafe {
                 self.device.create_shader_module_trusted(
                     desc,
@@ -346,8 +354,6 @@ impl Gpu {
                     },
                 )
             }
-        } else {
-            self.device.create_shader_module(desc)
         };
         log::debug!(
             "shader module `{label}` ({} bytes of WGSL): {:.1} ms",
@@ -355,6 +361,39 @@ impl Gpu {
             start.elapsed().as_secs_f64() * 1e3
         );
         Ok(module)
+    }
+
+    /// Leaves naga's loop bounding out of every module this device compiles from now on (unless
+    /// `SCHED_LOOP_BOUNDING=on`, [`LOOP_BOUNDING_ENV`]). wgpu turns it on for Vulkan on NVIDIA:
+    /// a 64-bit counter and a break in every loop, which on an H200 makes a Reyes frame about
+    /// 1.6 times slower (Killeroo at 1920x1080, megakernel 1.55 -> 0.97 ms, host-driven
+    /// multi-pass 1.40 -> 0.81 ms; docs/results.md, 2026-12-03) and does not stop a hang: a loop
+    /// that runs on is cut only after 2^64 trips. What it does prevent is the driver compiler
+    /// treating a loop that never ends as unreachable code.
+    ///
+    /// # Safety
+    /// Every loop of every WGSL module compiled on this device, through [`Gpu::shader`] and
+    /// [`Gpu::compute_pipeline`], the scheduler's generated modules with the user's procedure
+    /// bodies included, must end after a number of trips bounded by its data. The scheduler's
+    /// own loops are (the megakernel's persistent loop by its `max_iters` parameter, its waits
+    /// by the spin parameter, every other loop by a queue count or a constant); reyes's shaders
+    /// are (docs/scheduler.md 4). A procedure body that could loop forever would hang the
+    /// megakernel either way; without the bounding it is also undefined behaviour.
+    #[allow(
+        unsafe_code,
+        reason = "the caller vouches that every loop ends; see # Safety"
+    )]
+    pub unsafe fn trust_loops(&mut self) {
+        self.loops_trusted = true;
+    }
+
+    /// True when [`Gpu::shader`] keeps naga's loop bounding (`ShaderRuntimeChecks::
+    /// force_loop_bounding`, which wgpu turns on for every backend but lavapipe's compiler
+    /// makes moot): unless the driver bounds every loop itself ([`Gpu::driver_bounds_loops`]),
+    /// or the loops are trusted ([`Gpu::trust_loops`]) and `SCHED_LOOP_BOUNDING` is not `on`.
+    pub fn bounds_loops(&self) -> bool {
+        let forced = std::env::var(LOOP_BOUNDING_ENV).is_ok_and(|v| v == "on");
+        !(self.driver_bounds_loops() || (self.loops_trusted && !forced))
     }
 
     /// True when the driver bounds every loop itself, which makes naga's loop bounding
@@ -453,9 +492,13 @@ impl Gpu {
     }
 }
 
+/// Environment variable that, set to `on`, keeps naga's loop bounding in the modules of a device
+/// whose loops are trusted ([`Gpu::trust_loops`]): the A/B switch of its measurements.
+pub const LOOP_BOUNDING_ENV: &str = "SCHED_LOOP_BOUNDING";
+
 /// Environment variable naming a folder where [`Gpu::shader`] writes every WGSL module it
 /// compiles, as `LABEL.wgsl`: the generated megakernel and multi-pass sources, to read or to
-/// hand to `pipestats` (the driver's register and instruction counts, docs/scheduler.md 2.6).
+/// hand to `pipestats` (the driver's register and instruction counts, docs/scheduler.md 4).
 pub const DUMP_WGSL_ENV: &str = "SCHED_DUMP_WGSL";
 
 /// Writes `source` to `$SCHED_DUMP_WGSL/LABEL.wgsl` when the variable is set; a failed write is

@@ -9,6 +9,16 @@ use scheduler::Gpu;
 /// A new device on the environment's adapter with `features`; panics naming the cause when
 /// there is none (e.g. no Vulkan driver: `apt-get install mesa-vulkan-drivers`).
 pub fn open_gpu(features: scheduler::wgpu::Features) -> Gpu {
-    Gpu::from_env_requiring(features)
-        .unwrap_or_else(|e| panic!("GPU tests need an adapter with {features:?}: {e}"))
+    let mut gpu = Gpu::from_env_requiring(features)
+        .unwrap_or_else(|e| panic!("GPU tests need an adapter with {features:?}: {e}"));
+    // SAFETY: the tests compile the scheduler's, its workloads' and reyes's shaders and test
+    // procedures whose loops all end (`Gpu::trust_loops`): they test what the commands run.
+    #[allow(
+        unsafe_code,
+        reason = "Gpu::trust_loops: every loop of this device's shaders ends"
+    )]
+    unsafe {
+        gpu.trust_loops()
+    };
+    gpu
 }

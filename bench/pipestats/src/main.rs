@@ -13,12 +13,13 @@
 //! target/release/pipestats --json stats.json --ir ir/ --spv spv/ shader.wgsl
 //! # on the NVIDIA machine, where the ICD is not in a standard place:
 //! VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json \
-//!     target/release/pipestats --loop-bounding off megakernel.wgsl
+//!     target/release/pipestats megakernel.wgsl
 //! ```
 //!
-//! `--loop-bounding off` matches pipelines made by `create_shader_module_trusted` with
-//! `force_loop_bounding: false` (every scheduler module on lavapipe, `Gpu::shader`); wgpu's
-//! default, and the scheduler's on other drivers, is on. Dump the scheduler's generated modules
+//! `--loop-bounding off`, the default, matches pipelines made by `create_shader_module_trusted`
+//! with `force_loop_bounding: false`: every module of the project's commands and tests, whose
+//! devices trust their loops (`Gpu::trust_loops`), and every module on lavapipe. `on` matches
+//! wgpu's default, a library user's device that has not vouched for its loops. Dump the scheduler's generated modules
 //! with `SCHED_DUMP_WGSL=DIR` (`scheduler::gpu::DUMP_WGSL_ENV`). The device is chosen by
 //! `--adapter`, else `WGPU_ADAPTER_NAME`, else the first discrete GPU. Exit status: 0, 1 on any error (bad
 //! WGSL, no device, missing extension, a failed Vulkan call), 2 on a bad command line.
@@ -40,9 +41,9 @@ use serde::Serialize;
 #[derive(Parser)]
 #[command(about = "What the Vulkan driver's compiler made of WGSL compute shaders")]
 struct Args {
-    /// wgpu's `force_loop_bounding`: on by default, as wgpu compiles every module on NVIDIA; off as
-    /// `create_shader_module_trusted` compiles them (the scheduler's modules on lavapipe).
-    #[arg(long, value_enum, default_value_t = OnOff::On)]
+    /// wgpu's `force_loop_bounding`: off by default, as the project's commands compile every
+    /// module (`Gpu::trust_loops`); on as wgpu compiles a module by default.
+    #[arg(long, value_enum, default_value_t = OnOff::Off)]
     loop_bounding: OnOff,
     /// Write everything as JSON here (text representations go beside it unless `--ir`).
     #[arg(long, value_name = "OUT.json")]

@@ -89,7 +89,17 @@ impl Setup {
 /// The GPU from the environment, with the features the Reyes pipeline needs. Errors: no
 /// adapter, or one without them.
 pub fn open_gpu() -> Result<Gpu, CliError> {
-    Ok(Gpu::from_env_requiring(required_features())?)
+    let mut gpu = Gpu::from_env_requiring(required_features())?;
+    // SAFETY: the command compiles the scheduler's and reyes's shaders only, whose loops all
+    // end (`Gpu::trust_loops`, docs/scheduler.md 4).
+    #[allow(
+        unsafe_code,
+        reason = "Gpu::trust_loops: every loop of this device's shaders ends"
+    )]
+    unsafe {
+        gpu.trust_loops()
+    };
+    Ok(gpu)
 }
 
 /// The offline renderer of `config` on `gpu`. Errors: the device's.
