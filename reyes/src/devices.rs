@@ -140,7 +140,8 @@ impl OpenedDevice {
 /// Opens the devices of `selection` with the `required` features, in its order (the
 /// adapters of [`Gpu::instance_from_env`]). Errors ([`RunError::NoAdapter`]): no adapter can
 /// render, an index beyond the list, an adapter lacking a feature (named), or a device that
-/// cannot be opened.
+/// cannot be opened. The devices keep naga's loop bounding until their owner trusts their loops
+/// ([`Gpu::trust_loops`]), as the `reyes` command does.
 pub fn open(
     selection: &DeviceSelection,
     required: wgpu::Features,
@@ -176,16 +177,7 @@ pub fn open(
                 entry.describe()
             )));
         }
-        let mut gpu = Gpu::from_adapter(entry.adapter.clone(), required)?;
-        // SAFETY: these devices render reyes frames only: the scheduler's and reyes's shaders,
-        // whose loops all end (`Gpu::trust_loops`, docs/scheduler.md 4).
-        #[allow(
-            unsafe_code,
-            reason = "Gpu::trust_loops: every loop of this device's shaders ends"
-        )]
-        unsafe {
-            gpu.trust_loops()
-        };
+        let gpu = Gpu::from_adapter(entry.adapter.clone(), required)?;
         out.push(OpenedDevice { adapter: i, gpu });
     }
     Ok(out)

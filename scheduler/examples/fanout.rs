@@ -160,7 +160,16 @@ impl From<RunError> for FanoutError {
 /// Runs the tree on every strategy and checks each against the CPU reference; prints the
 /// results and statistics when `print`.
 fn run(print: bool) -> Result<(), FanoutError> {
-    let gpu = Gpu::from_env()?;
+    let mut gpu = Gpu::from_env()?;
+    // SAFETY: the example's bodies have no loops, and the scheduler's own loops all end
+    // (`Gpu::trust_loops`): naga's loop counter can go.
+    #[allow(
+        unsafe_code,
+        reason = "Gpu::trust_loops: every loop of this device's shaders ends"
+    )]
+    unsafe {
+        gpu.trust_loops()
+    };
     let program = program()?;
     let layout = scheduler::wgsl::struct_layout(NODE_WGSL, "Node")?;
     if layout.size as usize != size_of::<Node>() {

@@ -356,29 +356,35 @@ impl Gpu {
             }
         };
         log::debug!(
-            "shader module `{label}` ({} bytes of WGSL): {:.1} ms",
+            "shader module `{label}` ({} bytes of WGSL, naga loop bounding {}): {:.1} ms",
             source.len(),
+            if self.bounds_loops() { "on" } else { "off" },
             start.elapsed().as_secs_f64() * 1e3
         );
         Ok(module)
     }
 
     /// Leaves naga's loop bounding out of every module this device compiles from now on (unless
-    /// `SCHED_LOOP_BOUNDING=on`, [`LOOP_BOUNDING_ENV`]). wgpu turns it on for Vulkan on NVIDIA:
-    /// a 64-bit counter and a break in every loop, which on an H200 makes a Reyes frame about
-    /// 1.6 times slower (Killeroo at 1920x1080, megakernel 1.55 -> 0.97 ms, host-driven
-    /// multi-pass 1.40 -> 0.81 ms; docs/results.md, 2026-12-03) and does not stop a hang: a loop
-    /// that runs on is cut only after 2^64 trips. What it does prevent is the driver compiler
-    /// treating a loop that never ends as unreachable code.
+    /// `SCHED_LOOP_BOUNDING=on`, [`LOOP_BOUNDING_ENV`]). Call it right after opening the device,
+    /// before building schedulers on it. wgpu adds the bounding on every backend: a 64-bit
+    /// counter and a break in every loop, which on an H200 makes a Reyes frame about 1.6 times
+    /// slower (Killeroo at 1920x1080, megakernel 1.557 -> 0.981 ms, host-driven multi-pass
+    /// 1.405 -> 0.812 ms; docs/results.md, 2026-12-03; other GPUs not measured) and does not
+    /// stop a hang: a loop that runs on is cut only after 2^64 trips. What it does prevent is
+    /// the driver's compiler treating a loop that never ends as unreachable code.
     ///
     /// # Safety
     /// Every loop of every WGSL module compiled on this device, through [`Gpu::shader`] and
     /// [`Gpu::compute_pipeline`], the scheduler's generated modules with the user's procedure
-    /// bodies included, must end after a number of trips bounded by its data. The scheduler's
-    /// own loops are (the megakernel's persistent loop by its `max_iters` parameter, its waits
-    /// by the spin parameter, every other loop by a queue count or a constant); reyes's shaders
-    /// are (docs/scheduler.md 4). A procedure body that could loop forever would hang the
-    /// megakernel either way; without the bounding it is also undefined behaviour.
+    /// bodies included, must end on every input. A trip count read from a buffer is fine when
+    /// the loop's own test ends it (`for (var i = 0u; i < n; i++)`); a loop that waits for
+    /// another workgroup (a spin on an atomic) must also give up after a bounded number of
+    /// trips, as the scheduler's waits do, since nothing guarantees that the workgroup it waits
+    /// for is running. The scheduler's own loops end (the megakernel's persistent loop at its
+    /// `max_iters` parameter, its waits at the spin limit, every other loop at a queue count, a
+    /// word count or a constant); so do reyes's shaders' (docs/scheduler.md 4). A procedure body
+    /// that could loop forever would hang the megakernel either way; without the bounding it is
+    /// also undefined behaviour.
     #[allow(
         unsafe_code,
         reason = "the caller vouches that every loop ends; see # Safety"
@@ -493,7 +499,9 @@ impl Gpu {
 }
 
 /// Environment variable that, set to `on`, keeps naga's loop bounding in the modules of a device
-/// whose loops are trusted ([`Gpu::trust_loops`]): the A/B switch of its measurements.
+/// whose loops are trusted ([`Gpu::trust_loops`]): the A/B switch of its measurements. Other
+/// values, and unset, leave the choice to `trust_loops`; lavapipe never gets the bounding
+/// ([`Gpu::driver_bounds_loops`]).
 pub const LOOP_BOUNDING_ENV: &str = "SCHED_LOOP_BOUNDING";
 
 /// Environment variable naming a folder where [`Gpu::shader`] writes every WGSL module it

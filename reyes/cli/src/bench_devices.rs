@@ -54,7 +54,10 @@ pub fn main(a: BenchCmd) -> Result<(), CliError> {
         name,
         options,
     } = crate::setup::Setup::load(a.scene.as_deref(), &a.render)?;
-    let opened = devices::open(&selection, required_features())?;
+    let mut opened = devices::open(&selection, required_features())?;
+    for d in &mut opened {
+        crate::setup::trust_loops(&mut d.gpu);
+    }
     let step = if a.turntable {
         360.0 / a.frames as f64
     } else {

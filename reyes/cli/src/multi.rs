@@ -183,8 +183,11 @@ impl<'scope, 'env> Pool<'scope, 'env> {
     /// opened (an error of the run), a split frame that fails (the frame's).
     pub fn dispatch(&mut self, p: Prepared) -> Result<(), (Option<u32>, CliError)> {
         if let State::Unopened = self.state {
-            let opened = devices::open(&self.selection, required_features())
+            let mut opened = devices::open(&self.selection, required_features())
                 .map_err(|e| (None, e.into()))?;
+            for d in &mut opened {
+                crate::setup::trust_loops(&mut d.gpu);
+            }
             let slots: Vec<Slot> = (opened.into_iter().enumerate())
                 .map(|(slot, device)| Slot {
                     slot,

@@ -90,8 +90,15 @@ impl Setup {
 /// adapter, or one without them.
 pub fn open_gpu() -> Result<Gpu, CliError> {
     let mut gpu = Gpu::from_env_requiring(required_features())?;
+    trust_loops(&mut gpu);
+    Ok(gpu)
+}
+
+/// Leaves naga's loop bounding out of the modules `gpu` compiles ([`Gpu::trust_loops`]; a
+/// third of a frame's GPU time on NVIDIA). For the command's own devices only.
+pub(crate) fn trust_loops(gpu: &mut Gpu) {
     // SAFETY: the command compiles the scheduler's and reyes's shaders only, whose loops all
-    // end (`Gpu::trust_loops`, docs/scheduler.md 4).
+    // end (docs/scheduler.md 4, "Naga's loop bounding").
     #[allow(
         unsafe_code,
         reason = "Gpu::trust_loops: every loop of this device's shaders ends"
@@ -99,7 +106,6 @@ pub fn open_gpu() -> Result<Gpu, CliError> {
     unsafe {
         gpu.trust_loops()
     };
-    Ok(gpu)
 }
 
 /// The offline renderer of `config` on `gpu`. Errors: the device's.

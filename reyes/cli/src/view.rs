@@ -181,15 +181,7 @@ impl Viewer {
             .create_surface(window.clone())
             .map_err(CliError::Surface)?;
         let mut gpu = Gpu::from_env_for_surface(&instance, &surface, required_features())?;
-        // SAFETY: the viewer compiles the scheduler's and reyes's shaders only, whose loops
-        // all end (`Gpu::trust_loops`, docs/scheduler.md 4).
-        #[allow(
-            unsafe_code,
-            reason = "Gpu::trust_loops: every loop of this device's shaders ends"
-        )]
-        unsafe {
-            gpu.trust_loops()
-        };
+        crate::setup::trust_loops(&mut gpu);
         let caps = surface.get_capabilities(&gpu.adapter);
         // An 8-bit UNORM format shows the image's sRGB bytes as they are; an sRGB one makes the
         // draw decode them first (present.wgsl).
