@@ -359,7 +359,9 @@ fn probe_store(lid: u32, v: u32, own: u32) {
 }
 
 // Co-residency probe: a workgroup that starts before any workgroup has finished runs at the
-// same time as every workgroup that started before it.
+// same time as every workgroup that started before it. Every lane waits for lane 0 at the end,
+// as in a run, where no warp leaves before its workgroup: a driver may start another workgroup
+// in the registers of warps that have left.
 fn probe(lid: u32) {
     if lid == 0u {
         let t = atomicAdd(&ctrl[gw(G_PROBE_STARTED)], 1u);
@@ -371,6 +373,7 @@ fn probe(lid: u32) {
         }
         atomicAdd(&ctrl[gw(G_PROBE_FINISHED)], 1u);
     }
+    workgroupBarrier();
 }
 
 @compute @workgroup_size(256)
