@@ -1027,3 +1027,20 @@ fn tiny_size() -> RecordedSize {
         rounds: 1,
     }
 }
+
+/// Naga's loop bounding (`Gpu::bounds_loops`): a device keeps wgpu's default until its owner
+/// trusts its loops, except where the driver bounds loops itself (lavapipe); once trusted, it
+/// is left out unless `SCHED_LOOP_BOUNDING=on` asks for it back. (Every other test here runs on
+/// a trusted device: `adapter::open_gpu`.)
+#[test]
+fn loop_bounding_follows_trust_and_the_driver() {
+    let mut gpu = Gpu::from_env().expect("GPU tests need an adapter");
+    assert_eq!(gpu.bounds_loops(), !gpu.driver_bounds_loops());
+    // SAFETY: the device compiles nothing here.
+    #[allow(unsafe_code, reason = "the test of Gpu::trust_loops")]
+    unsafe {
+        gpu.trust_loops()
+    };
+    let forced = std::env::var(scheduler::gpu::LOOP_BOUNDING_ENV).is_ok_and(|v| v == "on");
+    assert_eq!(gpu.bounds_loops(), forced && !gpu.driver_bounds_loops());
+}
