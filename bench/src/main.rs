@@ -31,16 +31,16 @@ use error::Error;
 use scheduler::Gpu;
 use std::process::ExitCode;
 
-fn run_suite(cli: &Cli) -> Result<bool, Error> {
-    let only: Vec<WorkloadName> = cli.workload.into_iter().collect();
-    let needs_reyes = only.is_empty() || only.contains(&WorkloadName::Reyes);
+/// The environment's GPU, with the features reyes needs when `needs_reyes`, its loops trusted
+/// (`Gpu::trust_loops`). Errors: no adapter, or one without the features.
+fn open_gpu(needs_reyes: bool) -> Result<Gpu, Error> {
     let mut gpu = if needs_reyes {
         Gpu::from_env_requiring(reyes::gpu_render::required_features())
     } else {
         Gpu::from_env()
     }?;
-    // SAFETY: the suite compiles the scheduler's, its workloads' and reyes's shaders only,
-    // whose loops all end (`Gpu::trust_loops`, docs/scheduler.md 4).
+    // SAFETY: schedbench compiles the scheduler's, its workloads' and reyes's shaders only,
+    // whose loops all end (docs/scheduler.md 4, "Naga's loop bounding").
     #[allow(
         unsafe_code,
         reason = "Gpu::trust_loops: every loop of this device's shaders ends"
@@ -48,6 +48,13 @@ fn run_suite(cli: &Cli) -> Result<bool, Error> {
     unsafe {
         gpu.trust_loops()
     };
+    Ok(gpu)
+}
+
+fn run_suite(cli: &Cli) -> Result<bool, Error> {
+    let only: Vec<WorkloadName> = cli.workload.into_iter().collect();
+    let needs_reyes = only.is_empty() || only.contains(&WorkloadName::Reyes);
+    let gpu = open_gpu(needs_reyes)?;
     let options = suite::SuiteOptions {
         out: cli.out.clone().expect("clap requires --out with --suite"),
         scale: cli.size,

@@ -92,20 +92,7 @@ fn strategies(cli: &Cli, w: &dyn Workload) -> Vec<Strategy> {
 pub fn run(cli: &Cli) -> Result<bool, Error> {
     let mut w = workload(cli)?;
     let strategies = strategies(cli, w.as_ref());
-    let mut gpu = if cli.workload == Some(WorkloadName::Reyes) {
-        Gpu::from_env_requiring(reyes::gpu_render::required_features())
-    } else {
-        Gpu::from_env()
-    }?;
-    // SAFETY: the suite compiles the scheduler's, its workloads' and reyes's shaders only,
-    // whose loops all end (`Gpu::trust_loops`, docs/scheduler.md 4).
-    #[allow(
-        unsafe_code,
-        reason = "Gpu::trust_loops: every loop of this device's shaders ends"
-    )]
-    unsafe {
-        gpu.trust_loops()
-    };
+    let gpu = crate::open_gpu(cli.workload == Some(WorkloadName::Reyes))?;
     let prepared = w.prepare(&gpu, 0)?;
     let runs = cli.runs.unwrap_or(DEFAULT_RUNS);
     let mut records: Vec<RunRecord> = Vec::new();

@@ -338,7 +338,8 @@ impl Gpu {
             label: Some(label),
             source: wgpu::ShaderSource::Wgsl(source.into()),
         };
-        let module = if self.bounds_loops() {
+        let bounded = self.bounds_loops();
+        let module = if bounded {
             self.device.create_shader_module(desc)
         } else {
             // SAFETY: wgpu requires that no loop of the shader runs forever once naga's bounding
@@ -358,7 +359,7 @@ impl Gpu {
         log::debug!(
             "shader module `{label}` ({} bytes of WGSL, naga loop bounding {}): {:.1} ms",
             source.len(),
-            if self.bounds_loops() { "on" } else { "off" },
+            if bounded { "on" } else { "off" },
             start.elapsed().as_secs_f64() * 1e3
         );
         Ok(module)

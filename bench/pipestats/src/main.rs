@@ -19,10 +19,11 @@
 //! `--loop-bounding off`, the default, matches pipelines made by `create_shader_module_trusted`
 //! with `force_loop_bounding: false`: every module of the project's commands and tests, whose
 //! devices trust their loops (`Gpu::trust_loops`), and every module on lavapipe. `on` matches
-//! wgpu's default, a library user's device that has not vouched for its loops. Dump the scheduler's generated modules
-//! with `SCHED_DUMP_WGSL=DIR` (`scheduler::gpu::DUMP_WGSL_ENV`). The device is chosen by
-//! `--adapter`, else `WGPU_ADAPTER_NAME`, else the first discrete GPU. Exit status: 0, 1 on any error (bad
-//! WGSL, no device, missing extension, a failed Vulkan call), 2 on a bad command line.
+//! wgpu's default, a library user's device that has not vouched for its loops. Dump the
+//! scheduler's generated modules with `SCHED_DUMP_WGSL=DIR` (`scheduler::gpu::DUMP_WGSL_ENV`).
+//! The device is chosen by `--adapter`, else `WGPU_ADAPTER_NAME`, else the first discrete GPU.
+//! Exit status: 0, 1 on any error (bad WGSL, no device, missing extension, a failed Vulkan
+//! call), 2 on a bad command line.
 #![allow(
     unsafe_code,
     reason = "Vulkan through ash: wgpu has no way to read the driver's pipeline statistics"
