@@ -108,7 +108,9 @@ impl Interp {
 
     /// `Attribute "displacementbound" "sphere" [r] ["coordinatesystem" "space"]`, r in
     /// `"object"` space (the default; also `"shader"`), `"world"` or `"camera"` (also
-    /// `"current"`); other attributes are skipped with a warning.
+    /// `"current"`); `Attribute "identifier"` (the object's name, which exporters write for
+    /// every object and nothing in the image depends on) is read without a word; other
+    /// attributes are skipped with a warning.
     pub(super) fn attribute_request(
         &mut self,
         req: &Request,
@@ -118,6 +120,9 @@ impl Interp {
         let params = a.params()?;
         if name == "trimcurve" {
             return self.trim_attribute(req, a, &params);
+        }
+        if name == "identifier" {
+            return Ok(());
         }
         if name != "displacementbound" {
             let msg = format!("skipped unsupported attribute \"{}\"", shown(name));

@@ -51,12 +51,14 @@ fn a_bound_in_world_or_camera_space() {
 #[test]
 fn unknown_displacements_and_attributes_are_skipped_with_a_warning() {
     let s = parse(&world(&format!(
-        "Displacement \"dented\" \"Km\" 2\nAttribute \"identifier\" \"name\" \"x\"\n{QUAD}"
+        "Displacement \"dented\" \"Km\" 2\nAttribute \"render\" \"integer diffuse\" [1]\n\
+         Attribute \"identifier\" \"name\" \"x\"\n{QUAD}"
     )));
     assert!(s.patches[0].displacement.is_none());
+    // `identifier` names the object and changes nothing in the image: no warning for it.
     assert_eq!(s.warnings.len(), 2, "{:?}", s.warnings);
     assert!(s.warnings[0].contains("t.rib:2") && s.warnings[0].contains("\"dented\""));
-    assert!(s.warnings[1].contains("t.rib:3") && s.warnings[1].contains("\"identifier\""));
+    assert!(s.warnings[1].contains("t.rib:3") && s.warnings[1].contains("\"render\""));
 }
 
 #[test]
