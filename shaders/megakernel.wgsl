@@ -61,7 +61,8 @@ const P_SPIN: u32 = 1u;
 const P_PROBE: u32 = 2u;
 const P_POLICY: u32 = 3u;      // 0 = priority order, 1 = oldest batch first (FIFO)
 const P_OUTBOX_STRIDE: u32 = 4u;
-const P_IDLE_BACKOFF: u32 = 6u; // longest pause of an idle workgroup between polls (loop trips)
+const P_PAUSE_LINK: u32 = 5u;   // always 0: the idle pause's chain of loads (idle_pause)
+const P_IDLE_BACKOFF: u32 = 6u; // longest pause of an idle workgroup between polls (load trips)
 fn q_cap(q: u32) -> u32 { return params[8u + q * 4u]; }
 fn q_slot_base(q: u32) -> u32 { return params[9u + q * 4u]; }
 fn q_flag_base(q: u32) -> u32 { return params[10u + q * 4u]; }
@@ -146,12 +147,16 @@ fn an_add(k: u32, v: u32) {
     if TURN_ANATOMY { an[k] += v; }
 }
 
-// An idle workgroup's pause before it polls again: a loop of `trips` dependent multiply-adds,
-// touching no memory, so idle workgroups do not crowd the L2 lines every claim needs.
+// An idle workgroup's pause before it polls again: `trips` loads of the params word
+// P_PAUSE_LINK (always 0), each at an index that adds the last one's value, so each waits for
+// the one before (an L1 hit's latency) while its warp issues almost nothing; after the first,
+// no L2 line is touched. A pause of dependent multiply-adds, as long in fewer trips, issued an
+// instruction every few clocks on the SM a busy workgroup shares (H200 deep tree 1.52 -> 1.35 ms;
+// docs/scheduler.md 2.2).
 fn idle_pause(trips: u32) {
-    var x = sched_pause_sink;
-    for (var i = 0u; i < trips; i++) { x = x * 1664525u + 1013904223u; }
-    sched_pause_sink = x;
+    var z = 0u;
+    for (var i = 0u; i < trips; i++) { z = params[P_PAUSE_LINK + z]; }
+    sched_pause_sink += z;
 }
 
 // A pause of `trips` drawn from [trips / 2, trips * 3 / 2], by workgroup and turn: workgroups

@@ -136,9 +136,10 @@ pub struct Cli {
           help_heading = "Scheduler")]
     pub procedure_steps: Vec<(String, u32)>,
 
-    /// Longest pause of an idle megakernel workgroup between polls, in loop trips (0: none).
-    #[arg(long, default_value_t = 64, value_parser = value_parser!(u32).range(0..=30000),
-          help_heading = "Scheduler")]
+    /// Longest pause of an idle megakernel workgroup between polls, in trips of a chain of
+    /// dependent loads (0: none).
+    #[arg(long, default_value_t = scheduler::MegakernelConfig::default().idle_backoff,
+          value_parser = value_parser!(u32).range(0..=30000), help_heading = "Scheduler")]
     pub idle_backoff: u32,
 
     /// How the megakernel's and multipass-host's queues hold items: `interleaved` (item after

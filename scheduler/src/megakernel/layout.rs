@@ -49,6 +49,8 @@ pub const P_SPIN: usize = 1;
 pub const P_PROBE: usize = 2;
 pub const P_POLICY: usize = 3;
 pub const P_OUTBOX_STRIDE: usize = 4;
+/// Always 0: the idle pause loads it through its own last value, a chain of dependent loads.
+pub const P_PAUSE_LINK: usize = 5;
 pub const P_IDLE_BACKOFF: usize = 6;
 pub const P_QUEUES: usize = 8;
 
@@ -130,6 +132,7 @@ mod tests {
             ("G_AN", G_AN),
             ("AN_WORDS", AN_WORDS),
             ("P_MAX_ITERS", P_MAX_ITERS),
+            ("P_PAUSE_LINK", P_PAUSE_LINK),
             ("P_IDLE_BACKOFF", P_IDLE_BACKOFF),
         ] {
             assert_eq!(wgsl_const(src, name), Some(host), "{name}");

@@ -87,14 +87,16 @@ pub struct MegakernelConfig {
     pub max_iterations: u32,
     /// Polls of one slot's flag before it is abandoned to the next launch.
     pub spin_limit: u32,
-    /// Longest pause of an idle workgroup between two polls for work, in trips of a loop of
-    /// one multiply-add (about 4 clocks each) run by one warp, lanes 0-31, while the others
-    /// wait at a barrier (docs/scheduler.md 2.2); the pause doubles per idle turn up to this
-    /// (each pause jittered between half and one and a half times its length, so that
-    /// workgroups idle since the same turn do not poll in step) and ends at the first claimed
-    /// batch. On the H200 64 is better than no pause (deep tree 1.449 against 1.518 ms) and
-    /// within 1% of the best bound measured (docs/scheduler.md 2.2). 0 polls without a pause
-    /// (and is what lavapipe gets: its loop limiter counts the pause's trips).
+    /// Longest pause of an idle workgroup between two polls for work, in trips of a chain of
+    /// dependent loads (each an L1 hit's latency, during which the warp issues nothing) run by
+    /// one warp, lanes 0-31, while the others wait at a barrier (docs/scheduler.md 2.2); the
+    /// pause doubles per idle turn up to this (each pause jittered between half and one and a
+    /// half times its length, so that workgroups idle since the same turn do not poll in step)
+    /// and ends at the first claimed batch. On the H200 32 is the best bound measured or within
+    /// 2% of it on every tree, and the load chain beat the earlier multiply-add pause by up to
+    /// 11% (deep tree; docs/results.md, 2026-12-03, "An idle pause that waits on memory").
+    /// 0 polls without a pause (and is what lavapipe gets: its loop limiter counts the pause's
+    /// trips).
     pub idle_backoff: u32,
     /// Slots per queue at the start of a run (at least twice the seeds).
     pub initial_capacity: u32,
@@ -162,7 +164,7 @@ impl Default for MegakernelConfig {
             procedure_batch_steps: Vec::new(),
             max_iterations: 16_384,
             spin_limit: 4096,
-            idle_backoff: 64,
+            idle_backoff: 32,
             initial_capacity: 1 << 16,
             max_capacity: 1 << 26,
             max_launches: 10_000,
@@ -469,6 +471,7 @@ impl Megakernel {
         p[P_POLICY] = matches!(self.config.policy, QueuePolicy::Fifo) as u32;
         p[P_OUTBOX_STRIDE] = self.outbox_stride;
         p[P_IDLE_BACKOFF] = self.config.idle_backoff;
+        p[P_PAUSE_LINK] = 0; // the pause's chain stays on this word
         for q in 0..nq {
             p[P_QUEUES + q * 4] = layout.capacity[q];
             p[P_QUEUES + q * 4 + 1] = layout.slot_base[q];
