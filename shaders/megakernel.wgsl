@@ -150,9 +150,9 @@ fn an_add(k: u32, v: u32) {
 // An idle workgroup's pause before it polls again: `trips` loads of the params word
 // P_PAUSE_LINK (always 0), each at an index that adds the last one's value, so each waits for
 // the one before (an L1 hit's latency) while its warp issues almost nothing; after the first,
-// no L2 line is touched. A pause of dependent multiply-adds, as long in fewer trips, issued an
-// instruction every few clocks on the SM a busy workgroup shares (H200 deep tree 1.52 -> 1.35 ms;
-// docs/scheduler.md 2.2).
+// no L2 line is touched. The pause it replaced, a loop of dependent multiply-adds, likely
+// issued an instruction every few clocks on the SM a busy workgroup shares (H200 deep tree
+// 1.52 -> 1.35 ms; docs/scheduler.md 2.2).
 fn idle_pause(trips: u32) {
     var z = 0u;
     for (var i = 0u; i < trips; i++) { z = params[P_PAUSE_LINK + z]; }

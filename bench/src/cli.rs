@@ -137,7 +137,7 @@ pub struct Cli {
     pub procedure_steps: Vec<(String, u32)>,
 
     /// Longest pause of an idle megakernel workgroup between polls, in trips of a chain of
-    /// dependent loads (0: none).
+    /// dependent loads (0: none; lavapipe always runs 0, whatever is given).
     #[arg(long, default_value_t = scheduler::MegakernelConfig::default().idle_backoff,
           value_parser = value_parser!(u32).range(0..=30000), help_heading = "Scheduler")]
     pub idle_backoff: u32,
