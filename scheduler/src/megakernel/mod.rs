@@ -90,13 +90,13 @@ pub struct MegakernelConfig {
     /// Longest pause of an idle workgroup between two polls for work, in trips of a chain of
     /// dependent loads (each an L1 hit's latency, during which the warp issues almost nothing)
     /// run by one warp, lanes 0-31, while the others wait at a barrier (docs/scheduler.md 2.2);
-    /// the pause doubles per idle turn up to this (each pause jittered between half and one and a
-    /// half times its length, so that workgroups idle since the same turn do not poll in step)
-    /// and ends at the first claimed batch. On the H200 32 is the best bound measured or within
-    /// about 2% of it on every tree, better than no pause (deep tree 1.364 against 1.588 ms),
-    /// and the load chain beat the earlier multiply-add pause by up to 11% (deep tree; docs/results.md, 2026-12-03 (second session), "an idle pause that
-    /// waits on memory").
-    /// 0 polls without a pause (and is what lavapipe gets: its loop limiter counts the pause's
+    /// the pause doubles per idle turn up to this (each pause jittered between half and one and
+    /// a half times its length, so that workgroups idle since the same turn do not poll in
+    /// step) and ends at the first claimed batch. On the H200 32 is the best bound measured or
+    /// within about 2% of it on every tree, better than no pause (deep tree 1.364 against 1.588
+    /// ms), and the load chain beat the earlier multiply-add pause by up to 11% (deep tree;
+    /// docs/results.md, 2026-12-03 (second session), "an idle pause that waits on memory"). 0
+    /// polls without a pause (and is what lavapipe gets: its loop limiter counts the pause's
     /// trips).
     pub idle_backoff: u32,
     /// Slots per queue at the start of a run (at least twice the seeds).
