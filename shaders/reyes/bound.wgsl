@@ -53,11 +53,12 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
         to_euclidean(&cp, &w);
     }
 
-    var pts: array<vec4<f32>, 16>;
-    for (var k = 0u; k < 16u; k++) { pts[k] = bound_shared[base + k]; }
-    var zmin = pts[0].z;
-    var zmax = pts[0].z;
-    for (var k = 1u; k < 16u; k++) { zmin = min(zmin, pts[k].z); zmax = max(zmax, pts[k].z); }
+    var zmin = bound_point(base, 0u).z;
+    var zmax = bound_point(base, 0u).z;
+    for (var k = 1u; k < 16u; k++) {
+        zmin = min(zmin, bound_point(base, k).z);
+        zmax = max(zmax, bound_point(base, k).z);
+    }
     // A displaced patch: each point moves at most r (camera space; "displacementbound"), so
     // its bound is the control points' hull grown by a ball of radius r: depths by r, and the
     // screen bound below by the most any control point's ball can reach on screen.
@@ -86,7 +87,7 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
     }
     // (A displaced surface may face the eye where its patch does not; a moving one may turn.)
     var all_back = one_sided && r == 0.0 && !moving;
-    for (var k = 0u; k < 16u; k++) { all_back = all_back && pts[k].w >= 2.0; }
+    for (var k = 0u; k < 16u; k++) { all_back = all_back && bound_point(base, k).w >= 2.0; }
     if all_back {
         count_cull(C_CULL_BACKFACE, retest);
         return;
@@ -161,7 +162,8 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
         // seen only in a few pixels at the view axis (docs/reyes.md, near plane).
         var zfront = zmax;
         for (var k = 0u; k < 16u; k++) {
-            if pts[k].z >= frame.near { zfront = min(zfront, pts[k].z); }
+            let z = bound_point(base, k).z;
+            if z >= frame.near { zfront = min(zfront, z); }
         }
         g.dilate = select(0u, crack_dilation(&cp, &w, rational, frame.grid_max, frame.grid_max,
             zfront),
@@ -173,9 +175,12 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
         }
         return;
     }
-    var lo = pts[0].xy;
-    var hi = pts[0].xy;
-    for (var k = 1u; k < 16u; k++) { lo = min(lo, pts[k].xy); hi = max(hi, pts[k].xy); }
+    var lo = bound_point(base, 0u).xy;
+    var hi = bound_point(base, 0u).xy;
+    for (var k = 1u; k < 16u; k++) {
+        lo = min(lo, bound_point(base, k).xy);
+        hi = max(hi, bound_point(base, k).xy);
+    }
     // The extent a split decides by (bound_px): the undisplaced one, which halves as the
     // piece splits; the growth below does not (it would split to max_depth).
     let extent = hi - lo;
@@ -221,8 +226,10 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
         var su = 0.0;
         var sv = 0.0;
         for (var i = 0u; i < 3u; i++) {
-            su += distance(pts[4u * r + i].xy, pts[4u * r + i + 1u].xy);
-            sv += distance(pts[4u * i + r].xy, pts[4u * (i + 1u) + r].xy);
+            su += distance(bound_point(base, 4u * r + i).xy,
+                           bound_point(base, 4u * r + i + 1u).xy);
+            sv += distance(bound_point(base, 4u * i + r).xy,
+                           bound_point(base, 4u * (i + 1u) + r).xy);
         }
         lu = max(lu, su);
         lv = max(lv, sv);
@@ -242,7 +249,7 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
         g.dilate = crack_dilation(&cp, &w, rational, d.y, d.z, zmin);
         // Undisplaced and seen through the pinhole at one time: the tighter bound on screen.
         if r == 0.0 && !(SCENE_UVT && frame.uvt != UVT_OFF) {
-            g.dilate = packed_min(g.dilate, screen_crack_dilation(&pts, &w, rational, d.y, d.z));
+            g.dilate = packed_min(g.dilate, screen_crack_dilation(base, &w, rational, d.y, d.z));
         }
     } else {
         g.dilate = 0u;
@@ -252,6 +259,15 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
     } else {
         enqueue_diceshade(g);
     }
+}
+
+// Control point k of the patch whose 16 points Bound's threads stored from `base`: (x, y) in
+// pixels, camera depth, flags (bound_execute's first comment). Thread 0 reads them where it
+// needs them instead of copying all 16 into a private array, which the whole decision held
+// (H200: Bound 196 -> 127 registers, the host-driven Bound kernel 180 -> 128; a megakernel has
+// the register count of its largest procedure; docs/scheduler.md 4).
+fn bound_point(base: u32, k: u32) -> vec4<f32> {
+    return bound_shared[base + k];
 }
 
 // A piece culled in Bound, counted unless it is a root only tested again (bound_execute's
@@ -425,16 +441,16 @@ fn pack_edge_dilation(px: f32, e: u32) -> u32 {
     return u32(clamp(ceil(px * (255.0 / MAX_DILATE_PX)), 1.0, 255.0)) << (8u * e);
 }
 
-// crack_dilation from the boundary curves as they are on screen: `pts` holds the control
-// points projected (xy, pixels) with their camera depths (z), all in front of the eye. The
-// perspective image of a rational curve with points b_i and weights w_i is the rational curve
-// with points project(b_i) and weights w_i b_i.z (a polynomial curve: weights b_i.z), so
+// crack_dilation from the boundary curves as they are on screen: workgroup memory from `base`
+// holds the control points projected (xy, pixels) with their camera depths (z), all in front
+// of the eye (`bound_point`). The perspective image of a rational curve with points b_i and
+// weights w_i is the rational curve with points project(b_i) and weights w_i b_i.z (a
+// polynomial curve: weights b_i.z), so
 // curve_c2_rational bounds |C''| in pixels, with no allowance for the view (crack_dilation's
 // slack, about 3.5 at a 40 degree view): rims and seams of thin surfaces grow by their own
 // chords' sagitta, |C''| / (8 n^2), and no more. Rust twin: stages::bound.
-fn screen_crack_dilation(pts: ptr<function, array<vec4<f32>, 16>>,
-                         w: ptr<function, array<f32, 16>>, rational: bool, nu: u32, nv: u32)
-    -> u32 {
+fn screen_crack_dilation(base: u32, w: ptr<function, array<f32, 16>>, rational: bool, nu: u32,
+                         nv: u32) -> u32 {
     var packed = 0u;
     for (var e = 0u; e < 4u; e++) {
         let start = edge_start(e);
@@ -443,7 +459,7 @@ fn screen_crack_dilation(pts: ptr<function, array<vec4<f32>, 16>>,
         var q: array<vec4<f32>, 4>;
         for (var k = 0u; k < 4u; k++) {
             let i = start + k * step;
-            let p = (*pts)[i];
+            let p = bound_point(base, i);
             q[k] = vec4<f32>(p.xy, 0.0, select(1.0, (*w)[i], rational) * p.z);
         }
         packed |= pack_edge_dilation(curve_c2_rational(q[0], q[1], q[2], q[3]) / (8.0 * n * n), e);

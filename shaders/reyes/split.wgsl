@@ -20,20 +20,22 @@ fn half_curve(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>, p3: vec3<f32>, second
     return array<vec3<f32>, 4>(p0, a, d, m);
 }
 
-// Half of `item` along u (step 1 within rows of 4) or v (step 4 within columns).
+// Half of `item` along u (step 1 within rows of 4) or v (step 4 within columns). Each row (or
+// column) is halved in place: it reads only its own four points, so the child's net needs no
+// second array beside the parent's (H200: the Reyes megakernel's local memory 1,392 -> 1,200
+// bytes; docs/scheduler.md 4).
 fn split_half(item: PatchItem, along_u: bool, second: bool) -> PatchItem {
     var cp = item.cp;
-    var out = item.cp;
-    var child = item;
     let step = select(4u, 1u, along_u);
     let across = select(1u, 4u, along_u);
     for (var r = 0u; r < 4u; r++) {
         let o = r * across;
         let h = half_curve(cp_point(&cp, o), cp_point(&cp, o + step), cp_point(&cp, o + 2u * step),
                            cp_point(&cp, o + 3u * step), second);
-        for (var i = 0u; i < 4u; i++) { set_cp_point(&out, o + i * step, h[i]); }
+        for (var i = 0u; i < 4u; i++) { set_cp_point(&cp, o + i * step, h[i]); }
     }
-    child.cp = out;
+    var child = item;
+    child.cp = cp;
     if along_u {
         let m = (item.uv.x + item.uv.y) * 0.5;
         if second { child.uv.x = m; } else { child.uv.y = m; }
