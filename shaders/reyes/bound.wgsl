@@ -263,9 +263,9 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
 
 // Control point k of the patch whose 16 points Bound's threads stored from `base`: (x, y) in
 // pixels, camera depth, flags (bound_execute's first comment). Thread 0 reads them where it
-// needs them instead of copying all 16 into a private array, which the whole decision held
-// (H200: Bound 196 -> 127 registers, the host-driven Bound kernel 180 -> 128; a megakernel has
-// the register count of its largest procedure; docs/scheduler.md 4).
+// needs them instead of copying all 16 into a private array, which stayed live through the
+// whole decision (H200: a megakernel with Bound alone 196 -> 128 registers, the host-driven
+// Bound kernel 180 -> 128; docs/scheduler.md 4).
 fn bound_point(base: u32, k: u32) -> vec4<f32> {
     return bound_shared[base + k];
 }
