@@ -54,10 +54,11 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
     }
 
     var zmin = bound_point(base, 0u).z;
-    var zmax = bound_point(base, 0u).z;
+    var zmax = zmin;
     for (var k = 1u; k < 16u; k++) {
-        zmin = min(zmin, bound_point(base, k).z);
-        zmax = max(zmax, bound_point(base, k).z);
+        let z = bound_point(base, k).z;
+        zmin = min(zmin, z);
+        zmax = max(zmax, z);
     }
     // A displaced patch: each point moves at most r (camera space; "displacementbound"), so
     // its bound is the control points' hull grown by a ball of radius r: depths by r, and the
@@ -176,10 +177,11 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
         return;
     }
     var lo = bound_point(base, 0u).xy;
-    var hi = bound_point(base, 0u).xy;
+    var hi = lo;
     for (var k = 1u; k < 16u; k++) {
-        lo = min(lo, bound_point(base, k).xy);
-        hi = max(hi, bound_point(base, k).xy);
+        let xy = bound_point(base, k).xy;
+        lo = min(lo, xy);
+        hi = max(hi, xy);
     }
     // The extent a split decides by (bound_px): the undisplaced one, which halves as the
     // piece splits; the growth below does not (it would split to max_depth).
