@@ -41,7 +41,6 @@ def drop_calls(s, names):
     return s
 
 
-PROCS = {"bound": "bound_execute", "split": None, "dice": "diceshade_execute"}
 ALL = ["bound_execute", "splitu_execute", "splitv_execute", "diceshade_execute"]
 only = {
     "bound": drop_calls(src, ["splitu_execute", "splitv_execute", "diceshade_execute"]),
