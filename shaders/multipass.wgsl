@@ -12,7 +12,7 @@
 // Generated before this file: tables, procedures, `mp_in_*` / `mp_out_*` accessors,
 // `sched_execute`, `mp_execute` (item i of queue q's region) and `mp_word_at` (word w of it),
 // both in the run's item layout (scheduler/src/item_layout.rs), `enqueue_*`, and the
-// per-procedure entry points.
+// per-procedure entry points, each with its own copy of `run_procedure` (multipass_run.wgsl).
 
 // ---- mp_ctrl layout; host twin: scheduler/src/multipass/layout.rs ----
 const CSTRIDE: u32 = 8u;
@@ -230,46 +230,6 @@ fn finish_workgroup(lid: u32) {
         let k = atomicLoad(&mp_ctrl[gw(G_K)]) + 1u;
         if k < atomicLoad(&mp_ctrl[gw(G_CHUNK)]) { plan_round(k); }
     }
-}
-
-// Runs procedure q over this round's inputs, grid-stride, items_per_step items per step. The
-// workgroup count comes from mp_ctrl, not @builtin(num_workgroups), which D3D12 reports as 0
-// for indirect dispatches when wgpu's indirect validation is off. Only the newest C_RUN inputs
-// run (the outputs of the last rounds, so a partial round goes depth first and its live work
-// stays bounded); the older ones are copied, in place, to the front of the next round's inputs.
-fn run_procedure(q: u32, lid: u32, wid: u32) {
-    if lid == 0u {
-        wg_round = vec3<u32>(
-            atomicLoad(&mp_ctrl[cw(q, C_COUNT)]),
-            atomicLoad(&mp_ctrl[cw(q, C_RUN)]),
-            atomicLoad(&mp_ctrl[cw(q, C_WGS)]),
-        );
-    }
-    let round = workgroupUniformLoad(&wg_round);
-    let n = round.x;
-    let keep = n - round.y;
-    let nwg = max(round.z, 1u);
-    let per_step = 256u / THREADS[q];
-    let slot = lid / THREADS[q];
-    let thread = lid % THREADS[q];
-    for (var first = wid * per_step; first < n; first += nwg * per_step) {
-        let idx = first + slot;
-        let live = idx >= keep && idx < n;
-        if idx < keep {
-            for (var w = thread; w < WORDS[q]; w += THREADS[q]) {
-                let at = mp_word_at(q, idx, w);
-                mp_out_store_word(at, mp_in_load_word(at));
-            }
-        }
-        for (var t = thread; t < NQ; t += THREADS[q]) { atomicStore(&wg_item_emits[slot * NQ + t], 0u); }
-        workgroupBarrier();
-        sched_proc = q;
-        sched_slot = slot;
-        sched_active = live;
-        mp_execute(q, idx, Invocation(thread, slot, live, THREADS[q]));
-        workgroupBarrier();
-    }
-    finish_workgroup(lid);
 }
 
 // A fused round (`MultipassConfig::fused_rounds`): one dispatch of every procedure's workgroups,

@@ -6,8 +6,9 @@
 // can hold the round's worst case (sum over procedures of inputs x declared emits) and grows it
 // first if not, so an append never passes the capacity. Order within a queue is not kept.
 // Generated before this file: tables, procedures, `mp_in_*` / `mp_out_*` accessors,
-// `sched_execute`, `mp_execute` (item i of queue q's region, in the program's item layout:
-// scheduler/src/item_layout.rs), `enqueue_*`, and one entry point per procedure.
+// `mp_execute_<t>` (item i of queue t's region, in the program's item layout:
+// scheduler/src/item_layout.rs), `enqueue_*`, and one entry point per procedure with its own
+// loop (multipass_host_run.wgsl).
 
 // ---- counts buffers; host twin: scheduler/src/multipass/host.rs ----
 // counts_in[q]: inputs of queue q this round runs (the previous round's appends, or the host's
@@ -30,7 +31,6 @@ fn q_base(q: u32) -> u32 { return params[q * 4u + 1u]; }
 @group(0) @binding(2) var<storage, read_write> items_in: array<vec4<u32>>;
 @group(0) @binding(3) var<storage, read_write> items_out: array<vec4<u32>>;
 @group(0) @binding(4) var<storage, read> params: array<u32>;
-
 
 var<workgroup> wg_n: u32;
 var<workgroup> wg_item_emits: array<atomic<u32>, 256u * NQ>;
@@ -62,24 +62,3 @@ fn sched_append_slot(t: u32) -> u32 {
     return at;
 }
 
-// Runs procedure q over this round's counts_in[q] inputs, grid-stride, items_per_step items per
-// step (the host dispatches min(ceil(n / items_per_step), 65535) workgroups).
-fn run_procedure(q: u32, lid: u32, wid: u32, nwg: u32) {
-    if lid == 0u { wg_n = counts_in[q]; }
-    let n = workgroupUniformLoad(&wg_n);
-    let skip = counts_in[H_SKIP + q];
-    let per_step = 256u / THREADS[q];
-    let slot = lid / THREADS[q];
-    let thread = lid % THREADS[q];
-    for (var first = wid * per_step; first < n; first += nwg * per_step) {
-        let idx = first + slot;
-        let live = idx < n;
-        for (var t = thread; t < NQ; t += THREADS[q]) { atomicStore(&wg_item_emits[slot * NQ + t], 0u); }
-        workgroupBarrier();
-        sched_proc = q;
-        sched_slot = slot;
-        sched_active = live;
-        mp_execute(q, skip + idx, Invocation(thread, slot, live, THREADS[q]));
-        workgroupBarrier();
-    }
-}

@@ -21,6 +21,8 @@ use crate::stats::RunStats;
 use crate::timing::RunTimer;
 
 pub(crate) const TEMPLATE: &str = include_str!("../../../shaders/multipass_host.wgsl");
+/// The loop over one procedure's round inputs, instantiated per procedure (`rounds_source`).
+const RUN: &str = include_str!("../../../shaders/multipass_host_run.wgsl");
 
 // Words after the per-queue counts in each counts buffer (host twin of `H_*` in the shader).
 const H_ERROR: usize = 0;
@@ -94,13 +96,14 @@ struct HostRounds {
     bind: [wgpu::BindGroup; 2],
 }
 
-/// The WGSL of the host-driven multi-pass: shared program code, `mp_execute` (runs item `i` of
-/// a queue's region), append-style enqueue functions, one entry point per procedure
-/// (`mp_host_<name>`), then the template.
+/// The WGSL of the host-driven multi-pass: shared program code, append-style enqueue functions,
+/// one entry point per procedure (`mp_host_<name>`) with its own loop (`run_procedure_<t>`,
+/// reaching only that procedure's body), then the template.
 pub(crate) fn source(program: &Program, items: ItemLayout) -> String {
     let args = "@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>, \
                 @builtin(num_workgroups) nwg: vec3<u32>";
-    super::wgsl::rounds_source(program, items, "mp_host", args, "lid, wid.x, nwg.x") + TEMPLATE
+    super::wgsl::rounds_source(program, items, "mp_host", args, "lid, wid.x, nwg.x", RUN, false)
+        + TEMPLATE
 }
 
 impl HostMultipass {

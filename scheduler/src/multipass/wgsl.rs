@@ -6,6 +6,9 @@ use crate::item_layout::{ItemLayout, planar_load_store_fns};
 use crate::program::Program;
 
 pub const TEMPLATE: &str = include_str!("../../../shaders/multipass.wgsl");
+/// The device-driven loop over one procedure's round inputs, instantiated per procedure and
+/// once for any procedure (`rounds_source`).
+const RUN: &str = include_str!("../../../shaders/multipass_run.wgsl");
 
 /// Entry points in pipeline order: the plan, then the procedures, then (`fused`) the fused
 /// round.
@@ -28,7 +31,7 @@ pub fn entry_points(program: &Program, fused: bool) -> Vec<String> {
 /// (`MultipassConfig::fused_rounds`).
 pub fn source(program: &Program, items: ItemLayout, fused: bool) -> String {
     let args = "@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>";
-    let mut s = rounds_source(program, items, "mp_proc", args, "lid, wid.x");
+    let mut s = rounds_source(program, items, "mp_proc", args, "lid, wid.x", RUN, true);
     // Word `w` of item `at` of queue `t` (the carried inputs' copy).
     let word_at = match items {
         ItemLayout::Interleaved => "q_base(t) + at * WORDS[t] + w",
@@ -42,15 +45,21 @@ pub fn source(program: &Program, items: ItemLayout, fused: bool) -> String {
 
 /// The WGSL both multi-passes share (the device-driven one above, the host-driven one in
 /// `host.rs`), before their templates: the program's code, accessors of the round buffers
-/// `mp_in`/`mp_out` in the layout `items`, `mp_execute` (runs item `at` of queue `t`'s
-/// inputs), and per procedure an append-style `enqueue_<name>` and the entry point
-/// `{entry}_<name>({args})`, which calls `run_procedure(t, {call})`.
+/// `mp_in`/`mp_out` in the layout `items`, and per procedure `t` an append-style
+/// `enqueue_<name>`, `mp_execute_<t>` (runs item `at` of t's inputs through t's body alone),
+/// `run`'s loop instantiated as `run_procedure_<t>`, and the entry point
+/// `{entry}_<name>({args})`, which calls `run_procedure_<t>(t, {call})`. With `generic`, also
+/// `mp_execute` and `run_procedure` for any procedure, by `q` (through `sched_execute`'s
+/// switch). Each entry point reaches only its own procedure's code, so the driver allocates
+/// registers and workgroup memory for that procedure alone (`shaders/multipass_run.wgsl`).
 pub(super) fn rounds_source(
     program: &Program,
     items: ItemLayout,
     entry: &str,
     args: &str,
     call: &str,
+    run: &str,
+    generic: bool,
 ) -> String {
     let mut s = program.tables_wgsl();
     s += &program.common_wgsl();
@@ -72,20 +81,34 @@ pub(super) fn rounds_source(
         ItemLayout::Interleaved => format!("q_base({t}) + at * WORDS[{t}]"),
         ItemLayout::Planar => format!("q_base({t}) + at, q_cap({t})"),
     };
-    s += &format!(
-        "fn mp_execute(t: u32, at: u32, inv: Invocation) {{ sched_execute(t, {}, inv); }}\n",
-        item_at("t")
-    );
+    // The loop, its item runner named `mp_execute{suffix}`, as `run_procedure{suffix}`.
+    let instantiate = |suffix: &str| {
+        run.replace("RUN_PROCEDURE", &format!("run_procedure{suffix}"))
+            .replace("MP_EXECUTE", &format!("mp_execute{suffix}"))
+    };
+    if generic {
+        s += &format!(
+            "fn mp_execute(t: u32, at: u32, inv: Invocation) {{ sched_execute(t, {}, inv); }}\n",
+            item_at("t")
+        );
+        s += &instantiate("");
+    }
     for (t, p) in program.procs.iter().enumerate() {
         s += &format!(
             "fn enqueue_{name}(item: {ty}) {{\n    if !sched_active {{ return; }}\n    \
              let at = sched_append_slot({t}u);\n    if at == 0xffffffffu {{ return; }}\n    \
              mp_out_store_{ty}({store_at}, item);\n}}\n\
-             @compute @workgroup_size(256) fn {entry}_{name}({args}) {{ run_procedure({t}u, {call}); }}\n",
+             fn mp_execute_{t}(t: u32, at: u32, inv: Invocation) {{\n    \
+             var it: {ty};\n    if inv.live {{ it = mp_in_load_{ty}({load_at}); }}\n    \
+             {body}(it, inv);\n}}\n\
+             @compute @workgroup_size(256) fn {entry}_{name}({args}) {{ run_procedure_{t}({t}u, {call}); }}\n",
             name = p.proc.name,
             ty = p.layout.name,
             store_at = item_at(&format!("{t}u")),
+            load_at = item_at("t"),
+            body = p.proc.execute_fn(),
         );
+        s += &instantiate(&format!("_{t}"));
     }
     s
 }
