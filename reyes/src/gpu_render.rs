@@ -58,7 +58,8 @@ pub fn program() -> Result<Program, RunError> {
 pub fn program_for(features: SceneFeatures) -> Result<Program, RunError> {
     let item = ItemType::new("PatchItem", shaders::PATCH_ITEM);
     let bound = Procedure::new("bound", item.clone(), 16)
-        .shared("vec4<f32>", 16)
+        // Per patch: its projected control points and its net (bound.wgsl's first comment).
+        .shared("vec4<f32>", 32)
         .emits("splitu", 1)
         .emits("splitv", 1)
         .emits("diceshade", 1)

@@ -9,8 +9,13 @@
 // thread 0 all 16 for its reduction. The back-face test runs on the homogeneous xyz and the
 // crack bound has a rational form (their comments say why).
 
-// Workgroup memory per item: 16 control points as (x, y) in pixels, z in camera space,
-// w = 1 (in front of the near plane) + 2 (this thread's back-face terms all hold).
+// Workgroup memory per item (32 vec4): from `base`, the 16 control points as (x, y) in pixels,
+// z in camera space, w = 1 (in front of the near plane) + 2 (this thread's back-face terms all
+// hold); from `base + 16`, the item's 16 control points as they came (homogeneous for a rational
+// patch) with their weights (1 for a polynomial patch). Thread 0's decision reads the net there
+// (`net_point`, `net_weight`) and its children take it back from there (`bound_child`), so that
+// no thread holds the item's 48 control-point words past the barrier: Bound's register count
+// is the megakernel's floor (docs/scheduler.md 4).
 fn bound_execute(item_in: PatchItem, inv: Invocation) {
     // `var`: trimming may mark the item TRIM_INSIDE before it is split or diced.
     var item = item_in;
@@ -20,16 +25,20 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
     let rational = SCENE_RATIONAL && (info.flags & PATCH_RATIONAL) != 0u;
     // This thread's Euclidean control point (a polynomial patch's cp are the points: no weight,
     // no division).
-    var p = cp_point(&cp, t);
-    if rational { p = p / rational_weight(info.weights, item.uv, t % 4u, t / 4u); }
+    let h = cp_point(&cp, t);
+    var wt = 1.0;
+    if rational { wt = rational_weight(info.weights, item.uv, t % 4u, t / 4u); }
+    var p = h;
+    if rational { p = h / wt; }
     let front = p.z >= frame.near;
     var s = vec2<f32>(0.0);
     if front { s = project(p); }
     let one_sided = (info.flags & 2u) == 0u;
     var back = false;
     if one_sided { back = backfacing_terms(&cp, t, (info.flags & 1u) != 0u); }
-    let base = inv.slot * 16u;
+    let base = inv.slot * 32u;
     bound_shared[base + t] = vec4<f32>(s, p.z, select(0.0, 1.0, front) + select(0.0, 2.0, back));
+    bound_shared[base + 16u + t] = vec4<f32>(h, wt);
     workgroupBarrier();
     if !inv.live || t != 0u { return; }
     // Pipelined frames that cull from the previous frame (roots tagged by make_roots in
@@ -46,13 +55,6 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
     let testing = frame.occlusion == OCCLUSION_TEST;
     if history && root && !testing && !was_visible { return; }
     let retest = history && root && testing && was_visible;
-    // From here on cp holds the Euclidean points, and w their weights (rational only).
-    var w: array<f32, 16>;
-    if rational {
-        w = rational_weights(info.weights, item.uv);
-        to_euclidean(&cp, &w);
-    }
-
     var zmin = bound_point(base, 0u).z;
     var zmax = zmin;
     for (var k = 1u; k < 16u; k++) {
@@ -77,7 +79,7 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
     var ucoc = 0.0;
     if SCENE_UVT && frame.uvt != UVT_OFF {
         moving = (info.flags & PATCH_MOVING) != 0u;
-        let u = uvt_bound(&cp, info, r, zmin, zmax);
+        let u = uvt_bound(base, rational, info, r, zmin, zmax);
         ub = array<vec2<f32>, 2>(u[0].xy, u[0].zw);
         uz = u[1].xy;
         ucoc = u[1].z;
@@ -111,7 +113,7 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
     if zmin < frame.near {
         // Crossing the near plane: only the part in front can be seen, and its screen bound
         // decides whether anything of it reaches the bucket.
-        let undisplaced = near_visible_bound(&cp);
+        let undisplaced = near_visible_bound(base, rational);
         var vis = undisplaced;
         // Displaced: a ball reaching the near plane reaches the whole image (and so may a
         // patch that moves or is blurred by the lens).
@@ -141,10 +143,11 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
         let grid_px = select(f32(frame.grid_max) * frame.mp_size, frame.bound_px,
             frame.bound_px > 0.0);
         if max(seen.x, seen.y) > grid_px && eye < frame.max_eye_splits && depth < frame.max_depth {
-            var e = item;
+            var e = bound_child(item, base);
             e.depth = item.depth + 256u;
             atomicAdd(&counters[C_EYE_SPLITS], 1u);
-            if polygon_length(&cp, 1u, 4u) >= polygon_length(&cp, 4u, 1u) {
+            if polygon_length(base, rational, 1u, 4u)
+                >= polygon_length(base, rational, 4u, 1u) {
                 enqueue_splitu(e);
             } else {
                 enqueue_splitv(e);
@@ -156,7 +159,7 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
         atomicAdd(&counters[C_NEAR_CLIPPED], 1u);
         atomicMax(&counters[C_MAX_DEPTH], depth);
         if history && testing { mark_visible(item.patch_id); }
-        var g = item;
+        var g = bound_child(item, base);
         g.rates = frame.grid_max | (frame.grid_max << 8u) | NEAR_CLIP_GRID;
         // The dilation bound at the nearest front control point, not at the near plane (where
         // it would always be the cap): what lies nearer is a sliver whose chord error is
@@ -166,7 +169,7 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
             let z = bound_point(base, k).z;
             if z >= frame.near { zfront = min(zfront, z); }
         }
-        g.dilate = select(0u, crack_dilation(&cp, &w, rational, frame.grid_max, frame.grid_max,
+        g.dilate = select(0u, crack_dilation(base, rational, frame.grid_max, frame.grid_max,
             zfront),
             frame.crack_dilation != 0u);
         if (frame.grid_max + 1u) * (frame.grid_max + 1u) <= SMALL_GRID_POINTS {
@@ -193,7 +196,7 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
         // Perspective maps the hull of the balls onto the hull of their images.
         var g = 0.0;
         for (var k = 0u; k < 16u; k++) {
-            let q = cp_point(&cp, k);
+            let q = net_point(base, k, rational);
             g = max(g, length(q) / (q.z * (q.z - r)));
         }
         lo -= vec2<f32>(frame.focal * r * g);
@@ -238,20 +241,24 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
     }
     let d = dice_decision(lu, lv, extent);
     if d.x != 0u && depth < frame.max_depth {
-        if d.x == 1u { enqueue_splitu(item); } else { enqueue_splitv(item); }
+        if d.x == 1u {
+            enqueue_splitu(bound_child(item, base));
+        } else {
+            enqueue_splitv(bound_child(item, base));
+        }
         return;
     }
     if d.x != 0u { atomicAdd(&counters[C_DEPTH_LIMIT], 1u); }
     atomicMax(&counters[C_MAX_DEPTH], depth);
     // Diced after passing the occlusion test: visible, for the next frame's phase 1.
     if history && testing { mark_visible(item.patch_id); }
-    var g = item;
+    var g = bound_child(item, base);
     g.rates = d.y | (d.z << 8u);
     if frame.crack_dilation != 0u {
-        g.dilate = crack_dilation(&cp, &w, rational, d.y, d.z, zmin);
+        g.dilate = crack_dilation(base, rational, d.y, d.z, zmin);
         // Undisplaced and seen through the pinhole at one time: the tighter bound on screen.
         if r == 0.0 && !(SCENE_UVT && frame.uvt != UVT_OFF) {
-            g.dilate = packed_min(g.dilate, screen_crack_dilation(base, &w, rational, d.y, d.z));
+            g.dilate = packed_min(g.dilate, screen_crack_dilation(base, rational, d.y, d.z));
         }
     } else {
         g.dilate = 0u;
@@ -270,6 +277,29 @@ fn bound_execute(item_in: PatchItem, inv: Invocation) {
 // Bound kernel 180 -> 128; docs/scheduler.md 4).
 fn bound_point(base: u32, k: u32) -> vec4<f32> {
     return bound_shared[base + k];
+}
+
+// Euclidean control point k of the item at `base` (bound_execute's first comment): a rational
+// patch's homogeneous point divided by its weight.
+fn net_point(base: u32, k: u32, rational: bool) -> vec3<f32> {
+    let h = bound_shared[base + 16u + k];
+    if rational { return h.xyz / h.w; }
+    return h.xyz;
+}
+
+// The weight of control point k of the item at `base` (1 for a polynomial patch).
+fn net_weight(base: u32, k: u32) -> f32 {
+    return bound_shared[base + 16u + k].w;
+}
+
+// `item` with its control points taken back from workgroup memory (the same words it came
+// with), for the child Bound enqueues.
+fn bound_child(item: PatchItem, base: u32) -> PatchItem {
+    var cp: array<f32, 48>;
+    for (var k = 0u; k < 16u; k++) { set_cp_point(&cp, k, bound_shared[base + 16u + k].xyz); }
+    var c = item;
+    c.cp = cp;
+    return c;
 }
 
 // A piece culled in Bound, counted unless it is a root only tested again (bound_execute's
@@ -292,8 +322,9 @@ fn mark_visible(id: u32) {
 // between its two positions, the bound holds both. The screen bound then grows by the largest
 // circle of confusion over the depth range (|coc| is monotonic in depth on either side of the
 // focal plane). A shutter-close point behind the near plane: the whole image.
-// `cp`: Euclidean points; (zmin, zmax): the depths at shutter open, displacement included.
-fn uvt_bound(cp: ptr<function, array<f32, 48>>, info: PatchInfo, r: f32, zmin: f32, zmax: f32)
+// The item's net at `base` (net_point); (zmin, zmax): the depths at shutter open, displacement
+// included.
+fn uvt_bound(base: u32, rational: bool, info: PatchInfo, r: f32, zmin: f32, zmax: f32)
     -> array<vec4<f32>, 2> {
     var lo = vec2<f32>(3.0e38);
     var hi = vec2<f32>(-3.0e38);
@@ -306,7 +337,7 @@ fn uvt_bound(cp: ptr<function, array<f32, 48>>, info: PatchInfo, r: f32, zmin: f
         var g = 0.0;
         var near = false;
         for (var k = 0u; k < 16u; k++) {
-            let q = moved_point(info.motion, cp_point(cp, k));
+            let q = moved_point(info.motion, net_point(base, k, rational));
             z = vec2<f32>(min(z.x, q.z - r1), max(z.y, q.z + r1));
             if q.z - r1 < frame.near { near = true; continue; }
             let s = project(q);
@@ -332,17 +363,17 @@ fn uvt_bound(cp: ptr<function, array<f32, 48>>, info: PatchInfo, r: f32, zmin: f
 // point cross the plane; and perspective projection maps a convex set in front of the eye onto
 // the convex hull of its vertices' projections. Coordinates may be huge (a point at the near
 // plane far off the view axis), never NaN: near > 0.
-fn near_visible_bound(cp: ptr<function, array<f32, 48>>) -> array<vec2<f32>, 2> {
+fn near_visible_bound(base: u32, rational: bool) -> array<vec2<f32>, 2> {
     var lo = vec2<f32>(3.0e38);
     var hi = vec2<f32>(-3.0e38);
     for (var a = 0u; a < 16u; a++) {
-        let p = cp_point(cp, a);
+        let p = net_point(base, a, rational);
         if p.z < frame.near { continue; }
         let s = project(p);
         lo = min(lo, s);
         hi = max(hi, s);
         for (var b = 0u; b < 16u; b++) {
-            let q = cp_point(cp, b);
+            let q = net_point(base, b, rational);
             if q.z >= frame.near { continue; }
             let x = p + (q - p) * ((p.z - frame.near) / (p.z - q.z));
             let c = project(vec3<f32>(x.xy, frame.near));
@@ -355,12 +386,13 @@ fn near_visible_bound(cp: ptr<function, array<f32, 48>>) -> array<vec2<f32>, 2> 
 
 // Sum of |P[i+1] - P[i]| over a row (step along u = 1) or column (step = 4), in camera space,
 // maximised over the 4 rows/columns (`across` = 4 or 1).
-fn polygon_length(cp: ptr<function, array<f32, 48>>, step: u32, across: u32) -> f32 {
+fn polygon_length(base: u32, rational: bool, step: u32, across: u32) -> f32 {
     var best = 0.0;
     for (var r = 0u; r < 4u; r++) {
         var s = 0.0;
         for (var i = 0u; i < 3u; i++) {
-            s += distance(cp_point(cp, r * across + i * step), cp_point(cp, r * across + (i + 1u) * step));
+            s += distance(net_point(base, r * across + i * step, rational),
+                          net_point(base, r * across + (i + 1u) * step, rational));
         }
         best = max(best, s);
     }
@@ -392,9 +424,9 @@ fn dice_decision(lu: f32, lv: f32, extent: vec2<f32>) -> vec3<u32> {
 // gaps between grids diced at different rates close: a gap can exist only there. Packed 8 bits
 // per edge (v = 0, v = 1, u = 0, u = 1), rounded up; each at most MAX_DILATE_PX (a grid that
 // coarse is far above any sane micropolygon size), at least one step (float rounding).
-// `cp` holds Euclidean points (to_euclidean) and `w` their weights (read only if rational).
-fn crack_dilation(cp: ptr<function, array<f32, 48>>, w: ptr<function, array<f32, 16>>,
-                  rational: bool, nu: u32, nv: u32, zmin: f32) -> u32 {
+// The item's net and weights are at `base` (net_point, net_weight; the weights read only if
+// rational).
+fn crack_dilation(base: u32, rational: bool, nu: u32, nv: u32, zmin: f32) -> u32 {
     let slack = 2.0 * (1.0 + max(f32(frame.width), f32(frame.height)) / frame.focal);
     var packed = 0u;
     for (var e = 0u; e < 4u; e++) {
@@ -406,15 +438,16 @@ fn crack_dilation(cp: ptr<function, array<f32, 48>>, w: ptr<function, array<f32,
             let k1 = start + step;
             let k2 = start + 2u * step;
             let k3 = start + 3u * step;
-            c2 = curve_c2_rational(vec4<f32>(cp_point(cp, start), (*w)[start]),
-                                   vec4<f32>(cp_point(cp, k1), (*w)[k1]),
-                                   vec4<f32>(cp_point(cp, k2), (*w)[k2]),
-                                   vec4<f32>(cp_point(cp, k3), (*w)[k3]));
+            c2 = curve_c2_rational(
+                vec4<f32>(net_point(base, start, rational), net_weight(base, start)),
+                vec4<f32>(net_point(base, k1, rational), net_weight(base, k1)),
+                vec4<f32>(net_point(base, k2, rational), net_weight(base, k2)),
+                vec4<f32>(net_point(base, k3, rational), net_weight(base, k3)));
         } else {
-            let b0 = cp_point(cp, start);
-            let b1 = cp_point(cp, start + step);
-            let b2 = cp_point(cp, start + 2u * step);
-            let b3 = cp_point(cp, start + 3u * step);
+            let b0 = net_point(base, start, rational);
+            let b1 = net_point(base, start + step, rational);
+            let b2 = net_point(base, start + 2u * step, rational);
+            let b3 = net_point(base, start + 3u * step, rational);
             c2 = 6.0 * max(length(b0 - 2.0 * b1 + b2), length(b1 - 2.0 * b2 + b3));
         }
         packed |= pack_edge_dilation(c2 / (8.0 * n * n) * frame.focal / zmin * slack, e);
@@ -451,8 +484,7 @@ fn pack_edge_dilation(px: f32, e: u32) -> u32 {
 // curve_c2_rational bounds |C''| in pixels, with no allowance for the view (crack_dilation's
 // slack, about 3.5 at a 40 degree view): rims and seams of thin surfaces grow by their own
 // chords' sagitta, |C''| / (8 n^2), and no more. Rust twin: stages::bound.
-fn screen_crack_dilation(base: u32, w: ptr<function, array<f32, 16>>, rational: bool, nu: u32,
-                         nv: u32) -> u32 {
+fn screen_crack_dilation(base: u32, rational: bool, nu: u32, nv: u32) -> u32 {
     var packed = 0u;
     for (var e = 0u; e < 4u; e++) {
         let start = edge_start(e);
@@ -462,7 +494,7 @@ fn screen_crack_dilation(base: u32, w: ptr<function, array<f32, 16>>, rational: 
         for (var k = 0u; k < 4u; k++) {
             let i = start + k * step;
             let p = bound_point(base, i);
-            q[k] = vec4<f32>(p.xy, 0.0, select(1.0, (*w)[i], rational) * p.z);
+            q[k] = vec4<f32>(p.xy, 0.0, select(1.0, net_weight(base, i), rational) * p.z);
         }
         packed |= pack_edge_dilation(curve_c2_rational(q[0], q[1], q[2], q[3]) / (8.0 * n * n), e);
     }

@@ -235,13 +235,6 @@ fn rational_weights(at: u32, uv: vec4<f32>) -> array<f32, 16> {
     return w;
 }
 
-// A rational net made Euclidean: each x w, y w, z w divided by its weight.
-fn to_euclidean(cp: ptr<function, array<f32, 48>>, w: ptr<function, array<f32, 16>>) {
-    for (var k = 0u; k < 16u; k++) {
-        set_cp_point(cp, k, cp_point(cp, k) / (*w)[k]);
-    }
-}
-
 // Camera space to pixels; only meaningful for z > 0.
 fn project(p: vec3<f32>) -> vec2<f32> {
     return vec2<f32>(

@@ -81,7 +81,7 @@ pub fn cp_h(cp: &ControlNet, w: &Weights, i: usize) -> Vec4 {
     cp_point(cp, i).extend(w[i])
 }
 
-/// `to_euclidean` in common.wgsl: each homogeneous point divided by its weight.
+/// `net_point` in bound.wgsl: each homogeneous point divided by its weight.
 #[allow(
     clippy::needless_range_loop,
     reason = "the index form of the WGSL twin"
