@@ -81,7 +81,9 @@ pub(super) fn rounds_source(
         ItemLayout::Interleaved => format!("q_base({t}) + at * WORDS[{t}]"),
         ItemLayout::Planar => format!("q_base({t}) + at, q_cap({t})"),
     };
-    // The loop, its item runner named `mp_execute{suffix}`, as `run_procedure{suffix}`.
+    // The loop, its item runner named `mp_execute{suffix}`, as `run_procedure{suffix}` (the
+    // file's header comment, up to its first blank line, stays out of the copies).
+    let run = run.split_once("\n\n").map_or(run, |(_, body)| body);
     let instantiate = |suffix: &str| {
         run.replace("RUN_PROCEDURE", &format!("run_procedure{suffix}"))
             .replace("MP_EXECUTE", &format!("mp_execute{suffix}"))
