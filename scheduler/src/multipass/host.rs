@@ -102,8 +102,15 @@ struct HostRounds {
 pub(crate) fn source(program: &Program, items: ItemLayout) -> String {
     let args = "@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>, \
                 @builtin(num_workgroups) nwg: vec3<u32>";
-    super::wgsl::rounds_source(program, items, "mp_host", args, "lid, wid.x, nwg.x", RUN, false)
-        + TEMPLATE
+    super::wgsl::rounds_source(
+        program,
+        items,
+        "mp_host",
+        args,
+        "lid, wid.x, nwg.x",
+        RUN,
+        false,
+    ) + TEMPLATE
 }
 
 impl HostMultipass {
