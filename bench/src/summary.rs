@@ -172,13 +172,21 @@ pub fn why(mk: &Cell, best: &Cell, multipass: Option<&Cell>, cpu_adapter: bool) 
         best.strategy
     );
     if let Some(mp) = multipass {
-        let _ = write!(s, "; multi-pass needed {} rounds", count(mp.rounds));
+        let _ = write!(
+            s,
+            "; the device-driven multi-pass needed {} rounds",
+            count(mp.rounds)
+        );
         if let (Some(a), Some(b)) = (mk.gpu, mp.gpu) {
             let _ = write!(
                 s,
                 ", its GPU time {:.3} ms against the megakernel's {:.3} ms",
                 b.0, a.0
             );
+            // The best baseline's GPU time too, when it is another GPU strategy.
+            if let Some(g) = best.gpu.filter(|_| best.strategy != mp.strategy) {
+                let _ = write!(s, " ({}'s {:.3} ms)", best.strategy, g.0);
+            }
         }
     }
     let _ = write!(
@@ -454,6 +462,29 @@ mod tests {
     }
 
     #[test]
+    fn the_best_baselines_gpu_time_is_named_beside_the_device_driven_ones() {
+        let timed = |strategy: &str, mk: bool, wall: f64, rounds: u64, gpu: f64| RunRecord {
+            gpu_ms: Some(gpu),
+            ..rec(strategy, mk, wall, rounds, true)
+        };
+        let records = vec![
+            timed("megakernel", true, 3.0, 0, 1.0),
+            timed("multipass", false, 4.0, 15, 2.0),
+            timed("multipass-host", false, 2.5, 15, 0.9),
+        ];
+        let all = cells(&records);
+        let here: Vec<&Cell> = all[0].1.iter().collect();
+        let text = why(here[0], here[2], Some(here[1]), false);
+        assert!(
+            text.contains("its GPU time 2.000 ms against the megakernel's 1.000 ms (multipass-host's 0.900 ms)"),
+            "{text}"
+        );
+        // Where the best baseline is the device-driven one, it is not named twice.
+        let text = why(here[0], here[1], Some(here[1]), false);
+        assert!(!text.contains("'s 2.000"), "{text}");
+    }
+
+    #[test]
     fn a_slow_megakernel_on_deep_work_is_explained_from_its_counters() {
         let records = vec![
             rec("megakernel", true, 3.0, 0, true),
@@ -464,7 +495,10 @@ mod tests {
         let here: Vec<&Cell> = all[0].1.iter().collect();
         let text = why(here[0], here[2], Some(here[1]), false);
         assert!(text.contains("0.67x the speed of cpu"), "{text}");
-        assert!(text.contains("multi-pass needed 15 rounds"), "{text}");
+        assert!(
+            text.contains("device-driven multi-pass needed 15 rounds"),
+            "{text}"
+        );
         assert!(text.contains("50 idle polls (5.00 per batch)"), "{text}");
         assert!(text.contains("more loop turns finding nothing"), "{text}");
         assert!(text.contains("underfilled"), "{text}");
