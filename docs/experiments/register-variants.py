@@ -19,7 +19,10 @@ Each variant is a text edit of the dump; they compile but do not render (calls a
                                             so that no load of them is hoisted out of the loop
   bound_nocrack, bound_noscreencrack, bound_nonear, bound_noback, bound_nocrack_nonear
                                             minimal_bound without parts of Bound's decision
+  bound_zerochild                           minimal_bound, its children's nets not rebuilt
 An edit that no longer matches the dump (the shaders changed) stops the script with its text.
+The edits match dumps of main from 480d655 (Bound's net in workgroup memory; the third
+session's figures came from fc7ad12, whose Bound called crack_dilation(&cp, &w, ...)).
 """
 import os
 import sys
@@ -117,8 +120,9 @@ V["dice_params_rw"] = must(only["dice"], PARAMS, rw(PARAMS))
 V["full_params_rw"] = must(src, PARAMS, rw(PARAMS))
 V["full_frame_rw"] = must(V["full_params_rw"], FRAME, rw(FRAME))
 mb = V["minimal_bound"]
-CRACK = "        g.dilate = crack_dilation(&cp, &w, rational, d.y, d.z, zmin);"
-SCREEN = "            g.dilate = packed_min(g.dilate, screen_crack_dilation(base, &w, rational, d.y, d.z));"
+CRACK = "        g.dilate = crack_dilation(base, rational, d.y, d.z, zmin);"
+SCREEN = "            g.dilate = packed_min(g.dilate, screen_crack_dilation(base, rational, d.y, d.z));"
+CHILD = "    c.cp = cp;\n    return c;"
 NEAR = "    if zmin < frame.near {"
 NEVER = "    if zmin < frame.near && frame.width == 77777u {"
 V["bound_nocrack"] = must(must(mb, CRACK, "        g.dilate = 0u;"), SCREEN, "")
@@ -126,6 +130,8 @@ V["bound_noscreencrack"] = must(mb, SCREEN, "")
 V["bound_nonear"] = must(mb, NEAR, NEVER)
 V["bound_noback"] = must(mb, "    if one_sided { back = backfacing_terms(&cp, t, (info.flags & 1u) != 0u); }", "")
 V["bound_nocrack_nonear"] = must(V["bound_nocrack"], NEAR, NEVER)
+# The children's net written as zeros instead of rebuilt from workgroup memory (bound_child).
+V["bound_zerochild"] = must(mb, CHILD, "    c.cp = array<f32, 48>();\n    return c;")
 for k, v in V.items():
     open(os.path.join(out, k + ".wgsl"), "w").write(v)
 print("register-variants: %d files in %s" % (len(V), out))
