@@ -71,19 +71,8 @@ impl ItemLayout {
     /// body of procedure `q`. With [`ItemLayout::Planar`] it is `sched_execute(q, base, stride,
     /// inv)` (word `k` of the item at `base + k × stride`).
     pub(crate) fn execute_switch(self, program: &Program, prefix: &str) -> String {
-        let items = self;
-        let planar = items == ItemLayout::Planar;
-        let mut s = String::new();
-        let mut seen = Vec::new();
-        for p in &program.procs {
-            if !seen.contains(&p.layout.name) {
-                seen.push(p.layout.name.clone());
-                s += &match items {
-                    ItemLayout::Interleaved => load_store_fns(&p.layout, prefix),
-                    ItemLayout::Planar => planar_load_store_fns(&p.layout, prefix),
-                };
-            }
-        }
+        let planar = self == ItemLayout::Planar;
+        let mut s = self.typed_fns(program, prefix);
         let (stride_param, stride) = if planar {
             ("stride: u32, ", ", stride")
         } else {
@@ -104,13 +93,30 @@ impl ItemLayout {
                 .map(|(i, _)| format!("{i}u"))
                 .collect();
             s += &format!(
-                "        case {qs}: {{ var it: {t}; if inv.live {{ it = {prefix}_load_{t}(base{stride}); }} {f}(it, inv); }}\n",
+                "        case {qs}: {{ {} }}\n",
+                run_item(&p.layout.name, prefix, &format!("base{stride}"), &f),
                 qs = qs.join(", "),
-                t = p.layout.name,
             );
             done.push(f);
         }
         s += "        default: {}\n    }\n}\n";
+        s
+    }
+
+    /// `{prefix}_load_<T>` and `{prefix}_store_<T>` in this layout, once per item type of
+    /// `program`'s procedures.
+    pub(crate) fn typed_fns(self, program: &Program, prefix: &str) -> String {
+        let mut s = String::new();
+        let mut seen = Vec::new();
+        for p in &program.procs {
+            if !seen.contains(&p.layout.name) {
+                seen.push(p.layout.name.clone());
+                s += &match self {
+                    ItemLayout::Interleaved => load_store_fns(&p.layout, prefix),
+                    ItemLayout::Planar => planar_load_store_fns(&p.layout, prefix),
+                };
+            }
+        }
         s
     }
 
@@ -277,6 +283,14 @@ impl PlanarScatter {
 /// `fn {prefix}_store_{T}(base: u32, stride: u32, v: T)` for the planar layout: word `k` of the
 /// item at `base + k × stride` (`stride` = the region's capacity), over the word accessors
 /// `{prefix}_load_word` / `{prefix}_store_word`. Padding words are not stored.
+/// WGSL statements that run body `f` on an item of type `ty`, loaded with
+/// `{prefix}_load_<ty>({at})` for active invocations only (`at`: the item's first word, and in
+/// the planar layout its stride): one case of `sched_execute`, or a multi-pass entry point's
+/// `mp_execute_<t>`.
+pub(crate) fn run_item(ty: &str, prefix: &str, at: &str, f: &str) -> String {
+    format!("var it: {ty}; if inv.live {{ it = {prefix}_load_{ty}({at}); }} {f}(it, inv);")
+}
+
 pub(crate) fn planar_load_store_fns(layout: &StructLayout, prefix: &str) -> String {
     let t = &layout.name;
     let mut s =

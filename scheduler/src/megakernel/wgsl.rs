@@ -120,15 +120,8 @@ pub fn source(
     );
     // Typed outbox stores, only where items go through the outbox (direct enqueue stores with
     // the `sched_slot_store_*` that come with `ItemLayout::execute_switch`'s loads).
-    let mut seen = Vec::new();
-    for p in program.procs.iter().filter(|_| direct.is_none()) {
-        if !seen.contains(&p.layout.name) {
-            seen.push(p.layout.name.clone());
-            s += &match items {
-                ItemLayout::Interleaved => crate::wgsl::load_store_fns(&p.layout, "sched_ob"),
-                ItemLayout::Planar => planar_load_store_fns(&p.layout, "sched_ob"),
-            };
-        }
+    if direct.is_none() {
+        s += &items.typed_fns(program, "sched_ob");
     }
     for (t, p) in program.procs.iter().enumerate() {
         let ty = &p.layout.name;

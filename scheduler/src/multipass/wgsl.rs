@@ -2,7 +2,7 @@
 //! the run's item layout, enqueue functions that append to the next round's inputs, one entry
 //! point per procedure, and `shaders/multipass.wgsl`.
 
-use crate::item_layout::{ItemLayout, planar_load_store_fns};
+use crate::item_layout::{ItemLayout, run_item};
 use crate::program::Program;
 
 pub const TEMPLATE: &str = include_str!("../../../shaders/multipass.wgsl");
@@ -65,17 +65,14 @@ pub(super) fn rounds_source(
     s += &program.common_wgsl();
     s += &crate::wgsl::vec4_word_accessors("mp_in", "items_in");
     s += &crate::wgsl::vec4_word_accessors("mp_out", "items_out");
-    s += &items.execute_switch(program, "mp_in");
-    let mut seen = Vec::new();
-    for p in &program.procs {
-        if !seen.contains(&p.layout.name) {
-            seen.push(p.layout.name.clone());
-            s += &match items {
-                ItemLayout::Interleaved => crate::wgsl::load_store_fns(&p.layout, "mp_out"),
-                ItemLayout::Planar => planar_load_store_fns(&p.layout, "mp_out"),
-            };
-        }
-    }
+    // The item loads; with `generic`, `sched_execute`'s switch too (only the generic loop
+    // calls it).
+    s += &if generic {
+        items.execute_switch(program, "mp_in")
+    } else {
+        items.typed_fns(program, "mp_in")
+    };
+    s += &items.typed_fns(program, "mp_out");
     // Where item `at` of queue `t` starts, and (planar) the stride between its words.
     let item_at = |t: &str| match items {
         ItemLayout::Interleaved => format!("q_base({t}) + at * WORDS[{t}]"),
@@ -100,15 +97,12 @@ pub(super) fn rounds_source(
             "fn enqueue_{name}(item: {ty}) {{\n    if !sched_active {{ return; }}\n    \
              let at = sched_append_slot({t}u);\n    if at == 0xffffffffu {{ return; }}\n    \
              mp_out_store_{ty}({store_at}, item);\n}}\n\
-             fn mp_execute_{t}(t: u32, at: u32, inv: Invocation) {{\n    \
-             var it: {ty};\n    if inv.live {{ it = mp_in_load_{ty}({load_at}); }}\n    \
-             {body}(it, inv);\n}}\n\
+             fn mp_execute_{t}(t: u32, at: u32, inv: Invocation) {{ {run_item} }}\n\
              @compute @workgroup_size(256) fn {entry}_{name}({args}) {{ run_procedure_{t}({t}u, {call}); }}\n",
             name = p.proc.name,
             ty = p.layout.name,
             store_at = item_at(&format!("{t}u")),
-            load_at = item_at("t"),
-            body = p.proc.execute_fn(),
+            run_item = run_item(&p.layout.name, "mp_in", &item_at("t"), &p.proc.execute_fn()),
         );
         s += &instantiate(&format!("_{t}"));
     }
