@@ -317,7 +317,7 @@ fn spill_local(lid: u32) {
     for (var t = 0u; t < NQ; t++) {
         let m = wg_emit_n[t];
         let base = wg_emit_base[t];
-        for (var i = lid; i < m * WORDS[t]; i += 256u) {
+        for (var i = lid; i < m * WORDS[t]; i += WG_SIZE) {
             if ITEMS_PLANAR {
                 let plane = i / m;
                 let j = i % m;
@@ -330,7 +330,7 @@ fn spill_local(lid: u32) {
     }
     storageBarrier();
     for (var t = 0u; t < NQ; t++) {
-        for (var j = lid; j < wg_emit_n[t]; j += 256u) {
+        for (var j = lid; j < wg_emit_n[t]; j += WG_SIZE) {
             atomicStore(&flags[q_flag_base(t) + wg_emit_base[t] + j], wg_stamp);
         }
     }
@@ -381,7 +381,7 @@ fn probe(lid: u32) {
     workgroupBarrier();
 }
 
-@compute @workgroup_size(256)
+@compute @workgroup_size(WG_SIZE)
 fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>) {
     if params[P_PROBE] != 0u {
         probe(lid);
@@ -457,14 +457,14 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
             }
             // The batch moves to wg_local_in (same layout), freeing its region for new emits.
             let words = n * WORDS[q];
-            for (var i = lid; i < words; i += 256u) {
+            for (var i = lid; i < words; i += WG_SIZE) {
                 var at = LOCAL_OFF[q] + i;
                 if ITEMS_PLANAR { at = LOCAL_OFF[q] + (i / n) * LOCAL_CAP[q] + i % n; }
                 var to = i;
                 if ITEMS_PLANAR { to = (i / n) * LOCAL_CAP[q] + i % n; }
                 wg_local_in[to] = wg_local_out[at];
             }
-            for (var i = lid; i < n; i += 256u) { wg_ready[i] = 1u; }
+            for (var i = lid; i < n; i += WG_SIZE) { wg_ready[i] = 1u; }
             workgroupBarrier();
             if lid == 0u { atomicStore(&wg_local_n[q], 0u); }
             workgroupBarrier();
@@ -478,7 +478,7 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
             var lim = held;
             if LOCAL_EDGE[q * NQ + lid] != 0u {
                 var want = LOCAL_CAP[lid];
-                if wg_idle_now != 0u { want = min(want, 256u / THREADS[lid]); }
+                if wg_idle_now != 0u { want = min(want, WG_SIZE / THREADS[lid]); }
                 lim = max(held, want);
             }
             wg_local_lim[lid] = lim;
@@ -487,7 +487,7 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         // 1. Wait, bounded, for each claimed slot's producer to publish it. A slot whose wait
         //    runs out is abandoned to the compaction between launches: never lost.
         var polls = 0u;
-        for (var i = lid; i < n && !from_local; i += 256u) {
+        for (var i = lid; i < n && !from_local; i += WG_SIZE) {
             var ok = 0u;
             var s = 0u;
             for (; s < params[P_SPIN]; s++) {
@@ -504,7 +504,7 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         workgroupBarrier();
 
         // 2. Run the batch, items_per_step items at a time.
-        let per_step = 256u / THREADS[q];
+        let per_step = WG_SIZE / THREADS[q];
         let slot = lid / THREADS[q];
         sched_proc = q;
         sched_batch_n = n;
@@ -598,18 +598,18 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
                     if DIRECT_ENQUEUE { an_add(AN_ENQUEUE, k); }
                     if !DIRECT_ENQUEUE {
                         if ITEMS_PLANAR {
-                            an_add(AN_COPY, ((k + 255u) / 256u) * WORDS[t]);
+                            an_add(AN_COPY, ((k + WG_SIZE - 1u) / WG_SIZE) * WORDS[t]);
                         } else if WORDS[t] % 4u == 0u {
-                            an_add(AN_COPY, (k * WORDS[t] + 1023u) / 1024u);
+                            an_add(AN_COPY, (k * WORDS[t] + 4u * WG_SIZE - 1u) / (4u * WG_SIZE));
                         } else {
-                            an_add(AN_COPY, (k * WORDS[t] + 255u) / 256u);
+                            an_add(AN_COPY, (k * WORDS[t] + WG_SIZE - 1u) / WG_SIZE);
                         }
                     }
-                    an_add(AN_PUBLISH, (k + 255u) / 256u);
+                    an_add(AN_PUBLISH, (k + WG_SIZE - 1u) / WG_SIZE);
                 }
                 an_add(AN_RESERVE, chain + u32(emitted != n) + params[P_POLICY] + u32(abandoned > 0u));
                 // Flag stores of the inputs, then one round of parallel count adds.
-                an_add(AN_PUBLISH, (n + 255u) / 256u + 1u);
+                an_add(AN_PUBLISH, (n + WG_SIZE - 1u) / WG_SIZE + 1u);
             }
         }
 
@@ -628,7 +628,7 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
                 let to = q_slot_base(t) + wg_emit_base[t];
                 var plane = 0u;
                 for (; plane + 4u <= WORDS[t]; plane += 4u) {
-                    for (var j = lid; j < k; j += 256u) {
+                    for (var j = lid; j < k; j += WG_SIZE) {
                         let a = sched_ob_load_word(src + plane * ob + j);
                         let b = sched_ob_load_word(src + (plane + 1u) * ob + j);
                         let c = sched_ob_load_word(src + (plane + 2u) * ob + j);
@@ -640,16 +640,16 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
                     }
                 }
                 for (; plane < WORDS[t]; plane++) {
-                    for (var j = lid; j < k; j += 256u) {
+                    for (var j = lid; j < k; j += WG_SIZE) {
                         sched_slot_store_word(to + plane * cap + j, sched_ob_load_word(src + plane * ob + j));
                     }
                 }
             } else if WORDS[t] % 4u == 0u {
-                for (var w = lid * 4u; w < words; w += 1024u) {
+                for (var w = lid * 4u; w < words; w += 4u * WG_SIZE) {
                     sched_slot_store_vec4(dst + w, sched_ob_load_vec4(src + w));
                 }
             } else {
-                for (var w = lid; w < words; w += 256u) {
+                for (var w = lid; w < words; w += WG_SIZE) {
                     sched_slot_store_word(dst + w, sched_ob_load_word(src + w));
                 }
             }
@@ -658,13 +658,13 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
 
         // 5. Publish: flag new slots with the batch stamp, mark processed inputs consumed.
         for (var t = 0u; t < NQ; t++) {
-            for (var j = lid; j < wg_emit_n[t]; j += 256u) {
+            for (var j = lid; j < wg_emit_n[t]; j += WG_SIZE) {
                 var s = wg_emit_base[t] + j;
                 if DIRECT_ENQUEUE { s = wg_emit_slot[ES_OFF[q * NQ + t] + j]; }
                 atomicStore(&flags[q_flag_base(t) + s], wg_stamp);
             }
         }
-        for (var i = lid; i < n && !from_local; i += 256u) {
+        for (var i = lid; i < n && !from_local; i += WG_SIZE) {
             if wg_ready[i] != 0u { atomicStore(&flags[q_flag_base(q) + h + i], CONSUMED); }
         }
         // Every lane's flag stores issued before any count add. No device-scope fence: the count

@@ -206,6 +206,31 @@ fn stress_configs() -> Vec<(&'static str, MegakernelConfig)> {
             },
         ),
         (
+            // Workgroups of 768 threads: three times the items per step and per batch (the
+            // lanes of the turn's probe, 253-255, are inside the first 256).
+            "768-thread workgroups, tiny queues, short launches, impatient waits",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(2),
+                workgroup_size: 768,
+                max_iterations: 24,
+                spin_limit: 1,
+                initial_capacity: 16,
+                ..base.clone()
+            },
+        ),
+        (
+            "1024-thread workgroups, planar items, FIFO, tiny queues",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(2),
+                workgroup_size: 1024,
+                policy: QueuePolicy::Fifo,
+                max_iterations: 40,
+                initial_capacity: 16,
+                item_layout: Some(ItemLayout::Planar),
+                ..base.clone()
+            },
+        ),
+        (
             "oversubscribed",
             MegakernelConfig {
                 workgroups: Workgroups::Fixed(24),

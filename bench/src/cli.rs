@@ -118,6 +118,11 @@ pub struct Cli {
     #[arg(long, value_parser = value_parser!(u32).range(1..=65535), help_heading = "Scheduler")]
     pub workgroups: Option<u32>,
 
+    /// Threads per megakernel workgroup: 256, 512, 768 or 1024 (`MegakernelConfig::workgroup_size`)
+    /// [default: 256].
+    #[arg(long, value_name = "THREADS", value_parser = parse_workgroup_size, help_heading = "Scheduler")]
+    pub workgroup_size: Option<u32>,
+
     /// The megakernel's queue policy (for --strategy megakernel and all).
     #[arg(long, value_enum, default_value_t = Policy::Priority, help_heading = "Scheduler")]
     pub policy: Policy,
@@ -215,6 +220,15 @@ pub enum Enqueue {
 fn parse_item_layout(s: &str) -> Result<ItemLayout, String> {
     ItemLayout::parse(s)
         .ok_or_else(|| format!("unknown item layout `{s}` (known: interleaved, planar)"))
+}
+
+fn parse_workgroup_size(s: &str) -> Result<u32, String> {
+    match s.parse::<u32>() {
+        Ok(n @ (256 | 512 | 768 | 1024)) => Ok(n),
+        _ => Err(format!(
+            "`{s}` is no megakernel workgroup size (256, 512, 768 or 1024)"
+        )),
+    }
 }
 
 fn parse_preset(s: &str) -> Result<TreePreset, String> {
@@ -366,6 +380,7 @@ impl Cli {
     pub fn gpu_config(&self) -> GpuConfig {
         GpuConfig {
             workgroups: self.workgroups,
+            workgroup_size: self.workgroup_size,
             batch_steps: self.batch_steps,
             procedure_steps: (!self.procedure_steps.is_empty())
                 .then(|| self.procedure_steps.clone()),
@@ -429,6 +444,8 @@ mod tests {
         for bad in [
             &["--workgroups", "0"][..],
             &["--batch-steps", "0"],
+            &["--workgroup-size", "384"],
+            &["--workgroup-size", "2048"],
             &["--runs", "0"],
             &["--payload", "0"],
             &["--fanout", "fixed:0"],
@@ -446,6 +463,8 @@ mod tests {
         }
         let e = parse(&["--workgroups", "0"]).unwrap_err().to_string();
         assert!(e.contains("--workgroups"), "{e}");
+        let c = parse(&["--workgroup-size", "768"]).unwrap();
+        assert_eq!(c.gpu_config().workgroup_size, Some(768));
         assert_eq!(parse(&["--help"]).unwrap_err().exit_code(), 0);
     }
 

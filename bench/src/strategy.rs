@@ -124,6 +124,9 @@ impl Strategy {
 pub struct GpuConfig {
     /// Megakernel workgroups; `None` probes the co-resident count.
     pub workgroups: Option<u32>,
+    /// Threads per megakernel workgroup (`MegakernelConfig::workgroup_size`); `None`: its
+    /// default (256).
+    pub workgroup_size: Option<u32>,
     /// Megakernel workgroup steps per claimed batch (at least 1); `None`: the workload's choice
     /// (1 but for Reyes frames: `reyes::gpu_render::megakernel_batch_steps`).
     pub batch_steps: Option<u32>,
@@ -155,6 +158,7 @@ impl Default for GpuConfig {
     fn default() -> Self {
         GpuConfig {
             workgroups: None,
+            workgroup_size: None,
             batch_steps: None,
             procedure_steps: None,
             idle_backoff: MegakernelConfig::default().idle_backoff,
@@ -200,6 +204,9 @@ pub fn compile(
                 workgroups: config
                     .workgroups
                     .map_or(Workgroups::Probe { max: 4096 }, Workgroups::Fixed),
+                workgroup_size: config
+                    .workgroup_size
+                    .unwrap_or(MegakernelConfig::default().workgroup_size),
                 policy: policy.queue_policy(),
                 batch_steps: config.batch_steps.unwrap_or(1),
                 procedure_batch_steps: config.procedure_steps.clone().unwrap_or_default(),

@@ -131,8 +131,11 @@ impl Gpu {
                 .max_storage_buffers_per_shader_stage
                 .min(16),
             max_compute_workgroup_storage_size: alimits.max_compute_workgroup_storage_size,
-            max_compute_invocations_per_workgroup: 256,
-            max_compute_workgroup_size_x: 256,
+            // Up to 1,024 (the megakernel's `workgroup_size`); other kernels use 256.
+            max_compute_invocations_per_workgroup: alimits
+                .max_compute_invocations_per_workgroup
+                .clamp(256, 1024),
+            max_compute_workgroup_size_x: alimits.max_compute_workgroup_size_x.clamp(256, 1024),
             ..wgpu::Limits::default()
         };
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {

@@ -23,7 +23,7 @@ use crate::gpu::Gpu;
 use crate::growth::{grow, kept_capacity, with_slack};
 use crate::item_layout::ItemLayout;
 use crate::pipeline::{Kernels, storage_entry};
-use crate::program::{Program, Seed};
+use crate::program::{Program, Seed, WORKGROUP_SIZE};
 use crate::queue_layout::{QueueLayout, RunStart};
 use crate::readback::Readback;
 use crate::stats::RunStats;
@@ -71,8 +71,15 @@ pub struct MegakernelConfig {
     pub workgroups: Workgroups,
     /// Which queue a workgroup takes its next batch from (default: later procedures first).
     pub policy: QueuePolicy,
-    /// Workgroup steps per claimed batch (a step runs 256 / threads_per_item items), for every
-    /// procedure not named in `procedure_batch_steps`.
+    /// Threads per workgroup: a multiple of 256 up to 1,024 and the device's
+    /// `max_compute_invocations_per_workgroup` (default 256). Every procedure's items per step
+    /// and `.shared` array scale with it. Larger workgroups bound the registers each thread may
+    /// take (the 65,536 of an NVIDIA SM shared by at least one workgroup: 768 threads get at
+    /// most 80): a way to run more warps per SM where the driver's compiler would otherwise
+    /// give a large kernel 128 registers and two workgroups of 256 (docs/scheduler.md 4).
+    pub workgroup_size: u32,
+    /// Workgroup steps per claimed batch (a step runs `workgroup_size / threads_per_item`
+    /// items), for every procedure not named in `procedure_batch_steps`.
     pub batch_steps: u32,
     /// Workgroup steps per batch of the procedures named here (`(name, steps)`), overriding
     /// `batch_steps` for them: a batch's turn costs the same scheduling atomics however many
@@ -151,15 +158,17 @@ pub struct MegakernelConfig {
     pub local_bytes: u32,
 }
 
-/// Most tickets one batch may list for direct enqueue (`MegakernelConfig::direct_enqueue`):
-/// 8 KiB of workgroup memory, beside the 4 KiB of `wg_ready`, within the 16 KiB every Vulkan
-/// device offers.
+/// Most tickets one batch of a 256-thread workgroup may list for direct enqueue
+/// (`MegakernelConfig::direct_enqueue`): 8 KiB of workgroup memory, beside the 4 KiB of
+/// `wg_ready`, within the 16 KiB every Vulkan device offers. Larger workgroups may list this
+/// many per 256 threads, where the whole kernel's workgroup memory fits the device's limit.
 pub const MAX_DIRECT_EMITS: u32 = 2048;
 
 impl Default for MegakernelConfig {
     fn default() -> Self {
         MegakernelConfig {
             workgroups: Workgroups::Probe { max: 4096 },
+            workgroup_size: WORKGROUP_SIZE,
             policy: QueuePolicy::Priority(Vec::new()),
             batch_steps: 1,
             procedure_batch_steps: Vec::new(),
@@ -263,6 +272,17 @@ impl Megakernel {
         if config.spin_limit == 0 || config.spin_limit > 30_000 {
             return Err(RunError::Program("spin_limit must be 1..=30000".into()));
         }
+        let most = gpu.device.limits().max_compute_invocations_per_workgroup;
+        if config.workgroup_size > most {
+            return Err(RunError::Program(format!(
+                "megakernel workgroup size {} is more than {} allows ({most} invocations)",
+                config.workgroup_size,
+                gpu.adapter_name()
+            )));
+        }
+        // The megakernel's own view of the program: items per step and `.shared` arrays for
+        // its workgroup size.
+        let program = &program.with_workgroup_size(config.workgroup_size)?;
         let nq = program.queue_count();
         let priority = claim::priority_order(program, &config.policy)?;
         let batch = claim::batch_items(program, &config)?;
@@ -286,30 +306,23 @@ impl Megakernel {
             outbox_stride = outbox_stride.max(off).next_multiple_of(4);
             emit_slots = emit_slots.max(es);
         }
+        // Tickets a batch may list: MAX_DIRECT_EMITS per 256 threads (the list grows with the
+        // batch), and only while the whole kernel's workgroup memory fits the device's limit
+        // (checked on the generated source below).
+        let most_tickets = MAX_DIRECT_EMITS * (program.workgroup_size() / WORKGROUP_SIZE);
         let wanted = config.direct_enqueue.unwrap_or(true);
-        let direct = wanted && emit_slots <= MAX_DIRECT_EMITS;
+        let mut direct = wanted && emit_slots <= most_tickets;
         if config.direct_enqueue == Some(true) && !direct {
             log::warn!(
                 "megakernel: direct enqueue was asked for, but a batch may emit {emit_slots} \
-                 items, more than the {MAX_DIRECT_EMITS} tickets it can list: enqueueing \
+                 items, more than the {most_tickets} tickets it can list: enqueueing \
                  through the outbox (fewer batch steps would fit)"
             );
         }
-        if direct {
-            // Items go straight to their slots: no outbox.
-            outbox_stride = 4;
-        }
-        config.direct_enqueue = Some(direct);
-        log::debug!(
-            "megakernel: {} enqueue (a batch emits at most {emit_slots} items; direct up to \
-             {MAX_DIRECT_EMITS})",
-            if direct { "direct" } else { "outbox" }
-        );
         let items = config
             .item_layout
             .unwrap_or_else(|| ItemLayout::for_program(gpu, program));
         config.item_layout = Some(items);
-        let direct = direct.then_some((emit_slots, es_off.as_slice()));
         if config.subgroups == Some(true) && !gpu.subgroups {
             return Err(RunError::Program(format!(
                 "subgroups asked for, but {} lacks wgpu's SUBGROUP feature",
@@ -318,27 +331,49 @@ impl Megakernel {
         }
         let subgroups = config.subgroups.unwrap_or(gpu.subgroups);
         config.subgroups = Some(subgroups);
-        let generate = |plan: &local::LocalPlan| {
+        let limit = gpu.device.limits().max_compute_workgroup_storage_size;
+        let generate = |plan: &local::LocalPlan, direct: bool| {
             wgsl::source(
                 program,
                 gpu.coherent,
                 items,
-                direct,
+                direct.then_some((emit_slots, es_off.as_slice())),
                 config.turn_anatomy,
                 subgroups,
                 plan,
             )
         };
         let mut plan = local::LocalPlan::none(nq);
-        let mut source = generate(&plan);
+        let mut source = generate(&plan, direct);
+        if direct && local::workgroup_bytes(&source)? > limit {
+            if config.direct_enqueue == Some(true) {
+                log::warn!(
+                    "megakernel: direct enqueue was asked for, but its list of {emit_slots} \
+                     tickets does not fit {}'s {limit} bytes of workgroup memory beside the \
+                     rest: enqueueing through the outbox",
+                    gpu.adapter_name()
+                );
+            }
+            direct = false;
+            source = generate(&plan, direct);
+        }
+        if direct {
+            // Items go straight to their slots: no outbox.
+            outbox_stride = 4;
+        }
+        config.direct_enqueue = Some(direct);
+        log::debug!(
+            "megakernel: {} enqueue (a batch emits at most {emit_slots} items; direct up to \
+             {most_tickets})",
+            if direct { "direct" } else { "outbox" }
+        );
         if config.local_queues && program.has_local() {
             // The local queues take what the rest of the kernel leaves of the device's limit.
             let used = local::workgroup_bytes(&source)?;
-            let limit = gpu.device.limits().max_compute_workgroup_storage_size;
             let bytes = config.local_bytes.min(limit.saturating_sub(used));
             plan = local::LocalPlan::new(program, bytes);
             if plan.active() {
-                source = generate(&plan);
+                source = generate(&plan, direct);
             }
             log::debug!(
                 "megakernel: local queues of {:?} items ({} bytes; {used} bytes used otherwise)",

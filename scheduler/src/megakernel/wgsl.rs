@@ -9,7 +9,7 @@ use crate::program::Program;
 
 pub const TEMPLATE: &str = include_str!("../../../shaders/megakernel.wgsl");
 
-/// The megakernel's WGSL for `program`, with `slots` read through `@coherent` loads where the
+/// The megakernel's WGSL for `program` (workgroups of [`Program::workgroup_size`] threads), with `slots` read through `@coherent` loads where the
 /// device has them, and queues and outboxes holding items as `items` says. `direct`: enqueue
 /// straight into the slots, with the longest ticket list of a batch and each (source, target)
 /// part's offset in it (`MegakernelConfig::direct_enqueue`). `anatomy`: count each turn's
@@ -29,6 +29,7 @@ pub fn source(
     let mut s = program.tables_wgsl();
     s += &format!("const ITEMS_PLANAR: bool = {planar};\n");
     s += &format!("const TURN_ANATOMY: bool = {anatomy};\n");
+    s += &format!("const WG_SIZE: u32 = {}u;\n", program.workgroup_size());
     let (slots, offsets) = direct.unwrap_or((1, &[]));
     let nq = program.queue_count();
     let es: Vec<String> = (0..nq * nq)
@@ -289,5 +290,43 @@ mod tests {
         );
         assert_eq!(src.matches("one_execute(it, inv)").count(), 1, "{src}");
         assert!(src.contains("case 0u, 2u:"), "{src}");
+    }
+
+    #[test]
+    fn a_workgroup_size_scales_items_per_step_and_shared_arrays() {
+        let word = ItemType::new("Word", "struct Word { v: u32 }");
+        let grid = Procedure::new("grid", word.clone(), 64)
+            .shared("vec4<f32>", 3)
+            .body("fn grid_execute(item: Word, inv: Invocation) {}");
+        let leaf =
+            Procedure::new("leaf", word, 1).body("fn leaf_execute(item: Word, inv: Invocation) {}");
+        let p = Program::new(vec![grid, leaf], UserBindings::none()).unwrap();
+        assert_eq!(p.workgroup_size(), 256);
+        assert!(p.with_workgroup_size(384).is_err());
+        assert!(p.with_workgroup_size(0).is_err());
+        assert!(p.with_workgroup_size(2048).is_err());
+        let big = p.with_workgroup_size(768).unwrap();
+        let steps: Vec<u32> = big.procs.iter().map(|i| i.items_per_step).collect();
+        assert_eq!(steps, [12, 768]);
+        // The original keeps its own.
+        assert_eq!(p.procs[0].items_per_step, 4);
+        let src = super::source(
+            &big,
+            false,
+            ItemLayout::Interleaved,
+            None,
+            false,
+            false,
+            &super::LocalPlan::none(2),
+        );
+        assert!(src.contains("const WG_SIZE: u32 = 768u;"), "{src}");
+        assert!(
+            src.contains("var<workgroup> grid_shared: array<vec4<f32>, 36>;"),
+            "{src}"
+        );
+        assert!(src.contains("@workgroup_size(WG_SIZE)"), "{src}");
+        // Every loop over the workgroup's lanes strides by WG_SIZE, none by a literal size.
+        assert!(!src.contains("+= 256u"), "{src}");
+        naga::front::wgsl::parse_str(&src).unwrap();
     }
 }

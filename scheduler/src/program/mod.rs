@@ -25,7 +25,9 @@ pub(crate) enum Part {
     Body(usize),
 }
 
-/// Workgroup size of every scheduler kernel; threads per item divide it.
+/// Workgroup size of every scheduler kernel but a megakernel given another
+/// (`MegakernelConfig::workgroup_size`, [`Program::with_workgroup_size`]); threads per item
+/// divide it.
 pub const WORKGROUP_SIZE: u32 = 256;
 
 /// A procedure after validation: its declaration, item layout and resolved emit table. Its
@@ -36,7 +38,7 @@ pub struct ProcInfo {
     pub proc: Procedure,
     /// Its item struct's layout as naga computes it (size, offsets, every scalar).
     pub layout: StructLayout,
-    /// Items one workgroup step runs: `WORKGROUP_SIZE / threads_per_item`.
+    /// Items one workgroup step runs: [`Program::workgroup_size`] / `threads_per_item`.
     pub items_per_step: u32,
     /// `emits[t]`: worst-case items emitted to queue `t` per executed item.
     pub emits: Vec<u32>,
@@ -63,6 +65,9 @@ pub struct Program {
     pub user: UserBindings,
     /// Performance notes on the bodies, found by [`Program::new`] (see [`Program::notes`]).
     notes: Vec<String>,
+    /// Threads per workgroup of the kernels compiled from this program: [`WORKGROUP_SIZE`]
+    /// unless [`Program::with_workgroup_size`] says otherwise.
+    workgroup_size: u32,
 }
 
 impl Program {
@@ -175,6 +180,7 @@ impl Program {
             procs,
             user,
             notes: Vec::new(),
+            workgroup_size: WORKGROUP_SIZE,
         };
         // Compile the shared part once on its own, so that an error names the procedure and a
         // line of its body, not a line of a strategy's generated shader; then check what naga
@@ -199,6 +205,30 @@ impl Program {
     /// Whether some procedure keeps some of its emits local ([`Procedure::local`]).
     pub fn has_local(&self) -> bool {
         self.procs.iter().any(|p| p.local.iter().any(|&l| l))
+    }
+
+    /// Threads per workgroup of the kernels compiled from this program (default
+    /// [`WORKGROUP_SIZE`]).
+    pub fn workgroup_size(&self) -> u32 {
+        self.workgroup_size
+    }
+
+    /// This program for kernels of `size` threads per workgroup: every procedure's
+    /// `items_per_step` and `.shared` array scale with it. Errors: a size that is not a
+    /// multiple of [`WORKGROUP_SIZE`] (every procedure's threads per item must divide it, and
+    /// the scheduler's own lanes 253-255 must exist) or above 1,024.
+    pub fn with_workgroup_size(&self, size: u32) -> Result<Program, RunError> {
+        if size == 0 || !size.is_multiple_of(WORKGROUP_SIZE) || size > 1024 {
+            return Err(RunError::Program(format!(
+                "workgroup size must be a multiple of {WORKGROUP_SIZE} up to 1024, got {size}"
+            )));
+        }
+        let mut p = self.clone();
+        p.workgroup_size = size;
+        for info in &mut p.procs {
+            info.items_per_step = size / info.proc.threads_per_item;
+        }
+        Ok(p)
     }
 
     /// Number of procedures, which is the number of queues.
