@@ -76,7 +76,10 @@ pub struct MegakernelConfig {
     /// and `.shared` array scale with it. Larger workgroups bound the registers each thread may
     /// take (the 65,536 of an NVIDIA SM shared by at least one workgroup: 768 threads get at
     /// most 80): a way to run more warps per SM where the driver's compiler would otherwise
-    /// give a large kernel 128 registers and two workgroups of 256 (docs/scheduler.md 4).
+    /// give a large kernel 128 registers and two workgroups of 256. Measured on the H200 it
+    /// made no workload's default faster at every size: Reyes frames as fast or slower at 768,
+    /// most trees slower; the large-payload tree faster at 512 at one size of four
+    /// (docs/scheduler.md 4; docs/results.md, 2026-12-03 (fifth session)).
     pub workgroup_size: u32,
     /// Workgroup steps per claimed batch (a step runs `workgroup_size / threads_per_item`
     /// items), for every procedure not named in `procedure_batch_steps`.
