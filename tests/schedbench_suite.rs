@@ -59,6 +59,12 @@ fn small_suite_verifies_every_run_and_writes_its_report() {
             // Graph runs give GTEPS (the Graph500 traversed edges over the run's time).
             assert!(r["gteps"].as_f64().unwrap() > 0.0, "{s} {size}: no gteps");
         }
+        // The megakernel's records say what it ran with; the multi-passes' do not.
+        if s.starts_with("megakernel") {
+            assert_eq!(r["workgroup_size"], 256, "{w} {s} {size}");
+        } else {
+            assert!(r.get("workgroup_size").is_none(), "{w} {s} {size}");
+        }
         if s == "multipass" && w.starts_with("tree") {
             assert!(r["rounds"].as_u64().unwrap() > 0, "{w} {size}: no rounds");
         }

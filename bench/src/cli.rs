@@ -118,8 +118,10 @@ pub struct Cli {
     #[arg(long, value_parser = value_parser!(u32).range(1..=65535), help_heading = "Scheduler")]
     pub workgroups: Option<u32>,
 
-    /// Threads per megakernel workgroup: 256, 512, 768 or 1024 (`MegakernelConfig::workgroup_size`)
-    /// [default: 256].
+    /// Threads per megakernel workgroup (for --strategy megakernel and all): 256, 512, 768 or
+    /// 1024, within the adapter's limit. Larger workgroups limit the registers each thread may
+    /// use (on NVIDIA 80 at 768 threads, 64 at 1024); measured, no workload's default ran
+    /// faster with them (docs/scheduler.md 4) [default: 256].
     #[arg(long, value_name = "THREADS", value_parser = parse_workgroup_size, help_heading = "Scheduler")]
     pub workgroup_size: Option<u32>,
 
@@ -226,7 +228,7 @@ fn parse_workgroup_size(s: &str) -> Result<u32, String> {
     match s.parse::<u32>() {
         Ok(n @ (256 | 512 | 768 | 1024)) => Ok(n),
         _ => Err(format!(
-            "`{s}` is no megakernel workgroup size (256, 512, 768 or 1024)"
+            "`{s}` is not a megakernel workgroup size (use 256, 512, 768 or 1024)"
         )),
     }
 }

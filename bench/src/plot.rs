@@ -214,6 +214,7 @@ mod tests {
             params: String::new(),
             item_layout: None,
             enqueue: None,
+            workgroup_size: None,
             adapter: String::new(),
             run: 0,
             items,

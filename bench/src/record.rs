@@ -25,6 +25,9 @@ pub struct RunRecord {
     /// The megakernel's enqueue (`direct`, `outbox`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub enqueue: Option<String>,
+    /// The megakernel's threads per workgroup (`--workgroup-size`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub workgroup_size: Option<u32>,
     pub adapter: String,
     /// Index of the timed run (0-based; the untimed warm-up run is not recorded).
     pub run: u32,
@@ -111,6 +114,7 @@ impl RunRecord {
             }),
             item_layout: (!s.item_layout.is_empty()).then(|| s.item_layout.clone()),
             enqueue: (!s.enqueue.is_empty()).then(|| s.enqueue.clone()),
+            workgroup_size: (s.workgroup_size > 0).then_some(s.workgroup_size),
             ..Self::failed(k, String::new())
         }
     }
@@ -125,6 +129,7 @@ impl RunRecord {
             params: k.prepared.params.clone(),
             item_layout: None,
             enqueue: None,
+            workgroup_size: None,
             adapter: k.adapter.to_string(),
             run: k.run,
             items: 0,

@@ -159,7 +159,8 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
             c.rounds
         );
     }
-    // What each scheduler strategy ran with (item layout, the megakernel's enqueue).
+    // What each scheduler strategy ran with (item layout, the megakernel's enqueue and
+    // workgroup size).
     let mut queues: Vec<String> = Vec::new();
     for r in records {
         if let Some(l) = &r.item_layout {
@@ -167,7 +168,10 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
                 .enqueue
                 .as_ref()
                 .map_or(String::new(), |e| format!(", {e} enqueue"));
-            let line = format!("{}: {l} items{e}", r.strategy);
+            let w = r
+                .workgroup_size
+                .map_or(String::new(), |w| format!(", {w} threads per workgroup"));
+            let line = format!("{}: {l} items{e}{w}", r.strategy);
             if !queues.contains(&line) {
                 queues.push(line);
             }

@@ -405,6 +405,7 @@ mod tests {
             params: "p".into(),
             item_layout: None,
             enqueue: None,
+            workgroup_size: None,
             adapter: "a".into(),
             run: 0,
             items: 1000,

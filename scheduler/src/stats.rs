@@ -44,6 +44,9 @@ pub struct RunStats {
     pub queue_bytes: u64,
     /// Megakernel: workgroups per launch (probed or configured); 0 for the multi-passes.
     pub workgroups: u32,
+    /// Megakernel: threads per workgroup (`MegakernelConfig::workgroup_size`); 0 for the
+    /// multi-passes.
+    pub workgroup_size: u32,
     /// GPU time from timestamp queries, when the adapter has them.
     pub gpu_ms: Option<f64>,
     /// Multi-pass with stage timing: GPU ms per procedure (program order), then the queue
@@ -84,6 +87,7 @@ impl RunStats {
         self.partial_rounds += o.partial_rounds;
         self.queue_bytes = self.queue_bytes.max(o.queue_bytes);
         self.workgroups = self.workgroups.max(o.workgroups);
+        self.workgroup_size = self.workgroup_size.max(o.workgroup_size);
         self.gpu_ms = self.gpu_ms.zip(o.gpu_ms).map(|(a, b)| a + b);
         self.wall_ms += o.wall_ms;
         match (&mut self.turn_anatomy, &o.turn_anatomy) {

@@ -658,6 +658,7 @@ impl Megakernel {
             executed: vec![0; nq],
             peak_occupancy: vec![0; nq],
             workgroups,
+            workgroup_size: self.config.workgroup_size,
             turn_anatomy: self.config.turn_anatomy.then(anatomy::TurnAnatomy::default),
             ..Default::default()
         };

@@ -25,6 +25,7 @@ pub(crate) struct RecordedLaunch {
     scatter: Option<PlanarScatter>,
     item_layout: ItemLayout,
     direct: bool,
+    workgroup_size: u32,
 }
 
 impl Megakernel {
@@ -90,6 +91,7 @@ impl Megakernel {
             scatter,
             item_layout: self.item_layout(),
             direct: self.direct_enqueue(),
+            workgroup_size: self.config.workgroup_size,
         };
         Ok((r, capacity))
     }
@@ -200,6 +202,7 @@ impl RecordedLaunch {
             idle_polls: ctrl[g(nq, G_IDLE)] as u64,
             launches: 1,
             workgroups: self.workgroups,
+            workgroup_size: self.workgroup_size,
             queue_bytes: self.dq.layout.total_words * 4 + self.dq.layout.total_slots * 4,
             ..Default::default()
         };

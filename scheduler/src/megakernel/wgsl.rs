@@ -269,6 +269,13 @@ fn sched_take(t: u32, direct: bool) -> vec2<u32> {
 mod tests {
     use crate::{ItemLayout, ItemType, Procedure, Program, UserBindings};
 
+    /// The megakernel of `p` with interleaved items, outbox enqueue, no anatomy, subgroups or
+    /// local queues.
+    fn plain_source(p: &Program) -> String {
+        let plan = super::LocalPlan::none(p.queue_count());
+        super::source(p, false, ItemLayout::Interleaved, None, false, false, &plan)
+    }
+
     #[test]
     fn procedures_sharing_an_execute_function_share_one_call_site() {
         let word = ItemType::new("Word", "struct Word { v: u32 }");
@@ -278,16 +285,7 @@ mod tests {
             .body("fn sink_execute(item: Word, inv: Invocation) {}");
         let two = Procedure::new("two", word, 2).execute_of("one");
         let p = Program::new(vec![one, sink, two], UserBindings::none()).unwrap();
-        let plan = super::LocalPlan::none(3);
-        let src = super::source(
-            &p,
-            false,
-            ItemLayout::Interleaved,
-            None,
-            false,
-            false,
-            &plan,
-        );
+        let src = plain_source(&p);
         assert_eq!(src.matches("one_execute(it, inv)").count(), 1, "{src}");
         assert!(src.contains("case 0u, 2u:"), "{src}");
     }
@@ -310,15 +308,7 @@ mod tests {
         assert_eq!(steps, [12, 768]);
         // The original keeps its own.
         assert_eq!(p.procs[0].items_per_step, 4);
-        let src = super::source(
-            &big,
-            false,
-            ItemLayout::Interleaved,
-            None,
-            false,
-            false,
-            &super::LocalPlan::none(2),
-        );
+        let src = plain_source(&big);
         assert!(src.contains("const WG_SIZE: u32 = 768u;"), "{src}");
         assert!(
             src.contains("var<workgroup> grid_shared: array<vec4<f32>, 36>;"),
