@@ -279,10 +279,6 @@ impl PlanarScatter {
     }
 }
 
-/// Generates `fn {prefix}_load_{T}(base: u32, stride: u32) -> T` and
-/// `fn {prefix}_store_{T}(base: u32, stride: u32, v: T)` for the planar layout: word `k` of the
-/// item at `base + k × stride` (`stride` = the region's capacity), over the word accessors
-/// `{prefix}_load_word` / `{prefix}_store_word`. Padding words are not stored.
 /// WGSL statements that run body `f` on an item of type `ty`, loaded with
 /// `{prefix}_load_<ty>({at})` for active invocations only (`at`: the item's first word, and in
 /// the planar layout its stride): one case of `sched_execute`, or a multi-pass entry point's
@@ -291,6 +287,10 @@ pub(crate) fn run_item(ty: &str, prefix: &str, at: &str, f: &str) -> String {
     format!("var it: {ty}; if inv.live {{ it = {prefix}_load_{ty}({at}); }} {f}(it, inv);")
 }
 
+/// Generates `fn {prefix}_load_{T}(base: u32, stride: u32) -> T` and
+/// `fn {prefix}_store_{T}(base: u32, stride: u32, v: T)` for the planar layout: word `k` of the
+/// item at `base + k × stride` (`stride` = the region's capacity), over the word accessors
+/// `{prefix}_load_word` / `{prefix}_store_word`. Padding words are not stored.
 pub(crate) fn planar_load_store_fns(layout: &StructLayout, prefix: &str) -> String {
     let t = &layout.name;
     let mut s =

@@ -9,8 +9,9 @@ use crate::program::Program;
 
 pub const TEMPLATE: &str = include_str!("../../../shaders/megakernel.wgsl");
 
-/// The megakernel's WGSL for `program` (workgroups of [`Program::workgroup_size`] threads), with `slots` read through `@coherent` loads where the
-/// device has them, and queues and outboxes holding items as `items` says. `direct`: enqueue
+/// The megakernel's WGSL for `program` (workgroups of [`Program::workgroup_size`] threads),
+/// with `slots` read through `@coherent` loads where the device has them, and queues and
+/// outboxes holding items as `items` says. `direct`: enqueue
 /// straight into the slots, with the longest ticket list of a batch and each (source, target)
 /// part's offset in it (`MegakernelConfig::direct_enqueue`). `anatomy`: count each turn's
 /// phases (`MegakernelConfig::turn_anatomy`). `subgroups`: take enqueue tickets once per
