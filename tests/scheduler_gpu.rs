@@ -450,6 +450,40 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
     );
 }
 
+/// A megakernel whose workgroup memory would pass the device's limit (`.shared` arrays grow
+/// with the workgroup size) is refused when it is built, naming the bytes; the same program
+/// at 256 threads builds.
+#[test]
+fn a_megakernel_past_the_workgroup_memory_limit_is_refused() {
+    let gpu = gpu();
+    let limit = gpu.device.limits().max_compute_workgroup_storage_size;
+    let item = ItemType::new("Word", "struct Word { v: u32 }");
+    // Half the limit at 256 threads (one thread per item, 16-byte elements), twice it at
+    // 1,024.
+    let per_item = (limit / (16 * 256 * 2)).max(1);
+    let wide = Procedure::new("wide", item, 1)
+        .shared("vec4<f32>", per_item)
+        .body("fn wide_execute(item: Word, inv: Invocation) { wide_shared[inv.slot] = vec4<f32>(1.0); }");
+    let program = Program::new(vec![wide], UserBindings::default()).unwrap();
+    let at = |size| {
+        Scheduler::megakernel(
+            &gpu,
+            &program,
+            MegakernelConfig {
+                workgroup_size: size,
+                ..Default::default()
+            },
+        )
+    };
+    let err = at(1024).err().expect("a kernel past the limit was built");
+    let msg = err.to_string();
+    assert!(
+        msg.contains("workgroup memory") && msg.contains(&limit.to_string()),
+        "{msg}"
+    );
+    at(256).unwrap();
+}
+
 #[test]
 fn emitting_more_than_declared_is_an_error_not_a_silent_drop() {
     let gpu = gpu();

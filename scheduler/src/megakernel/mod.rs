@@ -385,6 +385,18 @@ impl Megakernel {
             );
         }
         config.local_queues = plan.active();
+        // Checked here, with the sizes that made it: neither wgpu nor every driver refuses a
+        // kernel that declares more (lavapipe ran one of 52 KB against its 32 KB).
+        let used = local::workgroup_bytes(&source)?;
+        if used > limit {
+            return Err(RunError::Program(format!(
+                "megakernel: {used} bytes of workgroup memory at {} threads per workgroup, more \
+                 than {}'s {limit} (the procedures' `.shared` arrays scale with the workgroup \
+                 size: a smaller one fits)",
+                program.workgroup_size(),
+                gpu.adapter_name()
+            )));
+        }
         let entries = [
             storage_entry(0, false),
             storage_entry(1, false),
