@@ -63,6 +63,7 @@ const P_POLICY: u32 = 3u;      // 0 = priority order, 1 = oldest batch first (FI
 const P_OUTBOX_STRIDE: u32 = 4u;
 const P_PAUSE_LINK: u32 = 5u;   // always 0: the idle pause's chain of loads (idle_pause)
 const P_IDLE_BACKOFF: u32 = 6u; // longest pause of an idle workgroup between polls (load trips)
+const P_LOCAL_BASE: u32 = 7u;   // first word of the workgroups' local areas in `slots` (LOCAL)
 fn q_cap(q: u32) -> u32 { return params[8u + q * 4u]; }
 fn q_slot_base(q: u32) -> u32 { return params[9u + q * 4u]; }
 fn q_flag_base(q: u32) -> u32 { return params[10u + q * 4u]; }
@@ -106,11 +107,13 @@ var<workgroup> wg_stop: u32;
 var<workgroup> wg_pending: u32;
 // Direct enqueue: the tickets this batch took, per target from ES_OFF[q * NQ + t].
 var<workgroup> wg_emit_slot: array<u32, EMIT_SLOTS>;
-// Local queues (LOCAL; sizes and regions: scheduler/src/megakernel/local.rs). Region t of
-// wg_local_out holds wg_local_n[t] items of queue t, kept by earlier batches; while a batch runs,
-// its emits to t may fill it up to wg_local_lim[t] (the count may pass the limit: the emits past
-// it went to the global queue, and the count is cut back after the batch). Every held item is
-// pending and insured: its room stays reserved in t's budget, so a spill never lacks a ticket.
+// Local queues (LOCAL; sizes and buffers: scheduler/src/megakernel/local.rs). In the workgroup's
+// area of `slots` (past every queue's slots), t's filling buffer (`sched_local_out`) holds
+// wg_local_n[t] items of queue t, kept by earlier batches; while a batch runs, its emits to t
+// may fill it up to wg_local_lim[t] (the count may pass the limit: the emits past it went to the
+// global queue, and the count is cut back after the batch). A local batch of t runs from that
+// buffer while t's other one fills (`sched_local_par`). Every held item is pending and insured:
+// its room stays reserved in t's budget, so a spill never lacks a ticket.
 var<workgroup> wg_local_n: array<atomic<u32>, NQ>;
 var<workgroup> wg_local_lim: array<u32, NQ>;
 var<workgroup> wg_local_held: array<u32, NQ>;
@@ -131,10 +134,17 @@ var<private> st_peak_head: u32;
 var<private> st_executed: u32;
 var<private> st_batches: u32;
 var<private> st_local: u32;
-// The running batch reads its items from wg_local_in (a local batch).
+// The running batch reads its items from a local buffer (a local batch).
 var<private> sched_from_local: bool;
+// This workgroup's local area in `slots`, and per queue t (bit t) which of t's two buffers fills.
+var<private> sched_local_wg: u32;
+var<private> sched_local_par: u32;
 // The leader counts itself in G_IDLE_NOW.
 var<private> sched_idle_reg: bool;
+// Lane t < NQ (LOCAL): room in queue t's budget this workgroup reserved and has not promised
+// (what its batches left unused), for its next local batches: in a steady run of local batches
+// their promises need no budget atomics. At most LOCAL_CREDIT_MAX[t]; given back at a spill.
+var<private> sched_credit: u32;
 var<private> an: array<u32, AN_WORDS>;
 var<workgroup> wg_an_wait: atomic<u32>;
 
@@ -142,6 +152,15 @@ var<workgroup> wg_an_wait: atomic<u32>;
 fn fold_peak() {
     st_peak = max(st_peak, st_peak_end - min(st_peak_head, st_peak_end));
 }
+
+// The first word of t's local buffer `b` (0 or 1) in this workgroup's area.
+fn sched_local_buffer(t: u32, b: u32) -> u32 {
+    return sched_local_wg + LOCAL_OFF[t] + b * LOCAL_STRIDE[t];
+}
+
+// t's filling buffer, and the one a local batch of t runs from (the other).
+fn sched_local_out(t: u32) -> u32 { return sched_local_buffer(t, (sched_local_par >> t) & 1u); }
+fn sched_local_in(t: u32) -> u32 { return sched_local_buffer(t, ((sched_local_par >> t) & 1u) ^ 1u); }
 
 fn an_add(k: u32, v: u32) {
     if TURN_ANATOMY { an[k] += v; }
@@ -308,6 +327,10 @@ fn spill_local(lid: u32) {
         let m = atomicLoad(&wg_local_n[lid]);
         wg_emit_n[lid] = m;
         if m > 0u { wg_emit_base[lid] = atomicAdd(&ctrl[lid * QSTRIDE + Q_RESERVE], m); }
+        if sched_credit > 0u {
+            atomicSub(&ctrl[lid * QSTRIDE + Q_BUDGET], sched_credit);
+            sched_credit = 0u;
+        }
     }
     if lid == 0u {
         wg_stamp = 2u;
@@ -317,14 +340,15 @@ fn spill_local(lid: u32) {
     for (var t = 0u; t < NQ; t++) {
         let m = wg_emit_n[t];
         let base = wg_emit_base[t];
+        let held_at = sched_local_out(t);
         for (var i = lid; i < m * WORDS[t]; i += WG_SIZE) {
             if ITEMS_PLANAR {
                 let plane = i / m;
                 let j = i % m;
                 sched_slot_store_word(q_slot_base(t) + plane * q_cap(t) + base + j,
-                    wg_local_out[LOCAL_OFF[t] + plane * LOCAL_CAP[t] + j]);
+                    sched_slot_load_word(held_at + plane * LOCAL_CAP[t] + j));
             } else {
-                sched_slot_store_word(q_slot_base(t) + base * WORDS[t] + i, wg_local_out[LOCAL_OFF[t] + i]);
+                sched_slot_store_word(q_slot_base(t) + base * WORDS[t] + i, sched_slot_load_word(held_at + i));
             }
         }
     }
@@ -388,6 +412,7 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         return;
     }
     sched_outbox = wid.x * params[P_OUTBOX_STRIDE];
+    sched_local_wg = params[P_LOCAL_BASE] + wid.x * LOCAL_WG_WORDS;
     if LOCAL && lid < NQ { atomicStore(&wg_local_n[lid], 0u); } // ordered by the probe's barrier
     var idle = 0u;
     var streak = 0u;
@@ -439,33 +464,30 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         let from_local = LOCAL && cmd == CMD_LOCAL;
         sched_from_local = from_local;
         if from_local {
-            // 0. A local batch: reserve its worst-case output in every target, lanes in
-            //    parallel; without room, spill what the workgroup holds and claim as usual.
+            // 0. A local batch: its worst-case output in every target promised from the
+            //    workgroup's credit, lanes in parallel, the shortfall reserved in the budget;
+            //    without room, spill what the workgroup holds and claim as usual.
             var need = 0u;
             if lid < NQ { need = n * EMITS[q * NQ + lid]; }
-            var old = 0u;
-            if need > 0u {
-                old = atomicAdd(&ctrl[lid * QSTRIDE + Q_BUDGET], need);
-                if old + need > q_cap(lid) { atomicStore(&wg_local_fail, 1u); }
+            var took = 0u;
+            if need > sched_credit {
+                took = need - sched_credit;
+                let old = atomicAdd(&ctrl[lid * QSTRIDE + Q_BUDGET], took);
+                if old + took > q_cap(lid) { atomicStore(&wg_local_fail, 1u); }
             }
             workgroupBarrier();
             if lid == 0u { wg_cmd = atomicLoad(&wg_local_fail); }
             if workgroupUniformLoad(&wg_cmd) != 0u {
-                if need > 0u { atomicSub(&ctrl[lid * QSTRIDE + Q_BUDGET], need); }
+                if took > 0u { atomicSub(&ctrl[lid * QSTRIDE + Q_BUDGET], took); }
                 spill_local(lid);
                 continue;
             }
-            // The batch moves to wg_local_in (same layout), freeing its region for new emits.
-            let words = n * WORDS[q];
-            for (var i = lid; i < words; i += WG_SIZE) {
-                var at = LOCAL_OFF[q] + i;
-                if ITEMS_PLANAR { at = LOCAL_OFF[q] + (i / n) * LOCAL_CAP[q] + i % n; }
-                var to = i;
-                if ITEMS_PLANAR { to = (i / n) * LOCAL_CAP[q] + i % n; }
-                wg_local_in[to] = wg_local_out[at];
-            }
+            sched_credit = sched_credit + took - need;
+            // The batch runs from the buffer it filled (`sched_local_in`), while q's emits fill
+            // the other. Its items were written before the last batch's release barrier, which
+            // every lane passed: visible here.
+            sched_local_par ^= 1u << q;
             for (var i = lid; i < n; i += WG_SIZE) { wg_ready[i] = 1u; }
-            workgroupBarrier();
             if lid == 0u { atomicStore(&wg_local_n[q], 0u); }
             workgroupBarrier();
         }
@@ -557,7 +579,16 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
             // Unused promised room goes back, and a local batch's own insurance.
             var refund = promised - k - min(kept_new, promised - k);
             if from_local && t == q { refund += n; }
-            if refund > 0u { atomicSub(&ctrl[t * QSTRIDE + Q_BUDGET], refund); }
+            if LOCAL {
+                // Kept as credit for the next local batches, up to a cap.
+                sched_credit += refund;
+                if sched_credit > LOCAL_CREDIT_MAX[t] {
+                    atomicSub(&ctrl[t * QSTRIDE + Q_BUDGET], sched_credit - LOCAL_CREDIT_MAX[t]);
+                    sched_credit = LOCAL_CREDIT_MAX[t];
+                }
+            } else if refund > 0u {
+                atomicSub(&ctrl[t * QSTRIDE + Q_BUDGET], refund);
+            }
             if t == q {
                 if from_local { st_local += n; } else { st_executed += n - abandoned; }
                 st_batches += 1u;

@@ -206,6 +206,20 @@ fn stress_configs() -> Vec<(&'static str, MegakernelConfig)> {
             },
         ),
         (
+            // A local batch of 1,024-thread workgroups holds four times the items, in buffers
+            // of the slots buffer sized from the batch; emits go through the outbox.
+            "local queues, 1,024-thread workgroups, outbox enqueue, short launches",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(2),
+                workgroup_size: 1024,
+                max_iterations: 40,
+                initial_capacity: 16,
+                local_queues: true,
+                direct_enqueue: Some(false),
+                ..base.clone()
+            },
+        ),
+        (
             // Workgroups of 768 threads: three times the items per step and per batch (the
             // lanes of the turn's probe, 253-255, are inside the first 256).
             "768-thread workgroups, tiny queues, short launches, impatient waits",

@@ -52,6 +52,8 @@ pub const P_OUTBOX_STRIDE: usize = 4;
 /// Always 0: the idle pause loads it through its own last value, a chain of dependent loads.
 pub const P_PAUSE_LINK: usize = 5;
 pub const P_IDLE_BACKOFF: usize = 6;
+/// First word of the workgroups' local areas in the slots buffer (past every queue's slots).
+pub const P_LOCAL_BASE: usize = 7;
 pub const P_QUEUES: usize = 8;
 
 pub const MAX_BATCH: u32 = 1024;

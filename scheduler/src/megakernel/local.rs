@@ -1,43 +1,49 @@
 //! Local queues: where a workgroup keeps the items its batches emit to a target declared with
-//! [`crate::Procedure::local`], in its own workgroup memory, to run them as its next batch
-//! (Whippletree's shared-memory queues, Steinberger et al. 2014, section 4). This module sizes
-//! the regions from the workgroup memory the rest of the kernel leaves and writes their WGSL
-//! constants; the protocol is in `shaders/megakernel.wgsl` (`LOCAL`) and docs/scheduler.md 2.7.
+//! [`crate::Procedure::local`], to run them as its next batch (Whippletree's per-block queues,
+//! Steinberger et al. 2014, section 4; Micropolis' local bound-and-split, Weber et al. 2015).
+//! The items stay in a region of the slots buffer that only this workgroup touches, past the
+//! queues' own slots: no workgroup memory (which cost co-resident workgroups, and with them the
+//! regions' size, docs/scheduler.md 2.7), no global ticket, no flag, and the bodies read a local
+//! batch through the same slot accessors as a claimed one, from another base. This module sizes
+//! the regions and writes their WGSL constants; the protocol is in `shaders/megakernel.wgsl`
+//! (`LOCAL`).
 
 use crate::error::RunError;
 use crate::program::Program;
 
-/// Most bytes of workgroup memory the local regions and the input buffer take together, so that
-/// a workgroup's memory does not cut how many workgroups an SM holds at once (the H200 gives
-/// 228 KiB per SM, at most 48 KiB per workgroup under Vulkan).
-pub const LOCAL_MAX_BYTES: u32 = 16 * 1024;
+/// Default most bytes of one workgroup's local regions (both buffers of every local target):
+/// each target gets a full batch of its procedure per buffer where this allows.
+pub const LOCAL_MAX_BYTES: u32 = 1 << 20;
 
-/// Where each target's items stay in a workgroup: `cap[t]` items of queue `t` in the words
-/// `off[t]..off[t] + cap[t] * words[t]` of `wg_local_out` (0 items: `t` is nobody's local
-/// target, or its item does not fit), and `wg_local_in`, the batch being run, as large as the
-/// largest region.
+/// Where each target's items stay in a workgroup's area of the slots buffer: two buffers of
+/// `cap[t]` items of queue `t` each (0: `t` is nobody's local target), from word `off[t]` of the
+/// area; the buffer a workgroup fills while the other is the batch being run swap at each local
+/// batch of `t`. `wg_words`: the area's words per workgroup (a multiple of 4, so that every
+/// area and region starts 16-byte aligned). `credit_max[t]`: most room in `t`'s budget a
+/// workgroup keeps reserved for its next local batches, the largest worst-case output of one
+/// batch to `t` (queues keep that much slack per workgroup: megakernel/record.rs).
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct LocalPlan {
     pub cap: Vec<u32>,
     pub off: Vec<u32>,
-    pub out_words: u32,
-    pub in_words: u32,
+    pub wg_words: u32,
+    pub credit_max: Vec<u32>,
 }
 
 impl LocalPlan {
-    /// No local queue: every constant that keeps the template compiling, arrays of one word.
+    /// No local queue: every constant that keeps the template compiling.
     pub fn none(nq: usize) -> LocalPlan {
         LocalPlan {
             cap: vec![0; nq],
             off: vec![0; nq],
-            out_words: 1,
-            in_words: 1,
+            wg_words: 0,
+            credit_max: vec![0; nq],
         }
     }
 
-    /// Regions for the program's local targets within `bytes` of workgroup memory: half for the
-    /// regions (split evenly between the targets), half for the input buffer.
-    pub fn new(program: &Program, bytes: u32) -> LocalPlan {
+    /// Regions for the program's local targets: a full batch (`batch[t]` items, megakernel/
+    /// claim.rs) per buffer, lowered evenly where the whole area would pass `bytes`.
+    pub fn new(program: &Program, batch: &[u32], bytes: u32) -> LocalPlan {
         let nq = program.queue_count();
         let targets: Vec<usize> = (0..nq)
             .filter(|&t| program.procs.iter().any(|p| p.local[t]))
@@ -46,18 +52,25 @@ impl LocalPlan {
         if targets.is_empty() {
             return plan;
         }
-        let region_words = bytes / 8 / targets.len() as u32;
+        // Words of one buffer of each target, at most.
+        let share = bytes / 4 / 2 / targets.len() as u32;
         let mut off = 0;
         for &t in &targets {
             let words = program.procs[t].words();
-            // At most one batch of t: more would never run as one batch.
-            let cap = (region_words / words).min(crate::megakernel::layout::MAX_BATCH);
+            let cap = batch[t].min(share / words);
             plan.cap[t] = cap;
             plan.off[t] = off;
-            off += cap * words;
-            plan.in_words = plan.in_words.max(cap * words);
+            off += 2 * (cap * words).next_multiple_of(4);
         }
-        plan.out_words = off.max(1);
+        plan.wg_words = off;
+        plan.credit_max = (0..nq)
+            .map(|t| {
+                (program.procs.iter().zip(batch))
+                    .map(|(p, &b)| b.saturating_mul(p.emits[t]))
+                    .max()
+                    .unwrap_or(0)
+            })
+            .collect();
         plan
     }
 
@@ -66,12 +79,12 @@ impl LocalPlan {
         self.cap.iter().any(|&c| c > 0)
     }
 
-    /// Bytes of workgroup memory the plan takes.
-    pub fn bytes(&self) -> u32 {
-        (self.out_words + self.in_words) * 4
+    /// Words from target `t`'s first buffer to its second (16-byte aligned).
+    pub fn buffer_words(&self, program: &Program, t: usize) -> u32 {
+        (self.cap[t] * program.procs[t].words()).next_multiple_of(4)
     }
 
-    /// Its WGSL constants and workgroup arrays; `edge[q * NQ + t]` from the program.
+    /// Its WGSL constants; `edge[q * NQ + t]` from the program.
     pub fn wgsl(&self, program: &Program) -> String {
         let nq = program.queue_count();
         let on = self.active();
@@ -86,20 +99,25 @@ impl LocalPlan {
             .iter()
             .flat_map(|p| (0..nq).map(|t| (on && p.local[t] && self.cap[t] > 0) as u32))
             .collect();
+        let stride: Vec<u32> = (0..nq).map(|t| self.buffer_words(program, t)).collect();
         format!(
             "const LOCAL: bool = {on};\n\
              // LOCAL_EDGE[q * NQ + t]: 1 when q's emits to t may stay in the workgroup\n\
              const LOCAL_EDGE: array<u32, {n2}> = array<u32, {n2}>({});\n\
-             // Items of queue t its local region holds, and the region's first word\n\
+             // Items of queue t one local buffer holds, where t's two buffers start in a\n\
+             // workgroup's area, and the words from one buffer to the other\n\
              const LOCAL_CAP: array<u32, {nq}> = array<u32, {nq}>({});\n\
              const LOCAL_OFF: array<u32, {nq}> = array<u32, {nq}>({});\n\
-             var<workgroup> wg_local_out: array<u32, {}>;\n\
-             var<workgroup> wg_local_in: array<u32, {}>;\n",
+             const LOCAL_STRIDE: array<u32, {nq}> = array<u32, {nq}>({});\n\
+             const LOCAL_WG_WORDS: u32 = {}u;\n\
+             // Most unpromised budget room of queue t a workgroup keeps (`sched_credit`)\n\
+             const LOCAL_CREDIT_MAX: array<u32, {nq}> = array<u32, {nq}>({});\n",
             list(&edge),
             list(&self.cap),
             list(&self.off),
-            self.out_words,
-            self.in_words,
+            list(&stride),
+            self.wg_words,
+            list(&self.credit_max),
             n2 = nq * nq,
         )
     }
@@ -144,12 +162,14 @@ mod tests {
     #[test]
     fn regions_fit_the_bytes_given_and_only_local_targets_get_one() {
         let p = program();
-        let plan = LocalPlan::new(&p, 8192);
-        // Half of 8 KiB for the one region: 1024 words of 4-word items.
+        // A full batch per buffer where the bytes allow it.
+        let plan = LocalPlan::new(&p, &[256, 1024], 1 << 20);
         assert_eq!(plan.cap, vec![256, 0]);
-        assert_eq!(plan.out_words, 1024);
-        assert_eq!(plan.in_words, 1024);
-        assert!(plan.bytes() <= 8192);
+        assert_eq!(plan.wg_words, 2 * 256 * 4);
+        // Fewer where they do not: half of 4 KiB per buffer, 128 items of 4 words.
+        let small = LocalPlan::new(&p, &[256, 1024], 4096);
+        assert_eq!(small.cap, vec![128, 0]);
+        assert!(small.wg_words * 4 <= 4096);
         assert!(
             plan.wgsl(&p)
                 .contains("LOCAL_EDGE: array<u32, 4> = array<u32, 4>(1u, 0u, 0u, 0u)")

@@ -148,16 +148,18 @@ pub struct MegakernelConfig {
     /// round trip) are not shrunk back to `initial_capacity`. `false` starts every run at
     /// `initial_capacity` (tests use it to exercise growth run after run).
     pub size_from_last_run: bool,
-    /// Keep the emits that procedures declare local ([`crate::Procedure::local`]) in each
-    /// workgroup's memory and run them there next: up to `local_bytes` bytes of workgroup memory
-    /// (less where the device's limit leaves less), split between the regions of the local
-    /// targets and the buffer of the batch being run. No effect on a program that declares
-    /// nothing local. Default `false`: measured on the H200 (docs/results.md, 2026-12-02, "Local
-    /// queues") every tree preset and Reyes ran 1.1-2.4x slower with them, as the kernel's
-    /// co-resident workgroups fell from 8 to 2-4 per SM and batches got smaller
-    /// (docs/scheduler.md 2.7).
+    /// Keep the emits that procedures declare local ([`crate::Procedure::local`]) in the
+    /// workgroup's own area of the slots buffer and run them there next, before claiming from
+    /// the global queues (no ticket, flag or claim for them; docs/scheduler.md 2.7). No effect on
+    /// a program that declares nothing local. Default `false`: it pays where a batch's children
+    /// fill the workgroup's next step (H200: trees of a fixed fan-out of 2, binary 0.160 ->
+    /// 0.128 ms, heavy work 0.184 -> 0.172) and costs where lineages thin out (random
+    /// fan-out: deep 1.35 -> 1.69 ms; Reyes frames 3-5%); docs/results.md, 2026-12-03, "Local
+    /// queues in the slots buffer".
     pub local_queues: bool,
-    /// Workgroup memory for the local queues, in bytes (default [`LOCAL_MAX_BYTES`]).
+    /// Most bytes of one workgroup's local area, both buffers of every local target (default
+    /// [`LOCAL_MAX_BYTES`]: a full batch per buffer where it fits). Global memory: the slots
+    /// buffer grows by this times the workgroups.
     pub local_bytes: u32,
 }
 
@@ -206,6 +208,9 @@ pub struct Megakernel {
     priority: Vec<u32>,
     /// Most items a batch of each queue holds ([`batch_items`]).
     batch: Vec<u32>,
+    /// Words of each workgroup's local area, past the queues in the slots buffer (0 without
+    /// local queues; `local::LocalPlan`).
+    local_wg_words: u32,
     /// Buffers of the last run, reused when the next run needs the same layout.
     cache: std::sync::Mutex<Option<DeviceQueues>>,
     /// The mapped buffer ctrl is read back through after each launch, and the timer whose
@@ -371,17 +376,15 @@ impl Megakernel {
             if direct { "direct" } else { "outbox" }
         );
         if config.local_queues && program.has_local() {
-            // The local queues take what the rest of the kernel leaves of the device's limit.
-            let used = local::workgroup_bytes(&source)?;
-            let bytes = config.local_bytes.min(limit.saturating_sub(used));
-            plan = local::LocalPlan::new(program, bytes);
+            // In the slots buffer, past the queues: no workgroup memory.
+            plan = local::LocalPlan::new(program, &batch, config.local_bytes);
             if plan.active() {
                 source = generate(&plan, direct);
             }
             log::debug!(
-                "megakernel: local queues of {:?} items ({} bytes; {used} bytes used otherwise)",
+                "megakernel: local queues of {:?} items per buffer ({} bytes per workgroup)",
                 plan.cap,
-                plan.bytes()
+                plan.wg_words * 4
             );
         }
         config.local_queues = plan.active();
@@ -430,6 +433,7 @@ impl Megakernel {
             readback: Default::default(),
             compaction: DeviceCompaction::new(gpu)?,
             one_launch_need: std::sync::Mutex::new(vec![0; nq]),
+            local_wg_words: plan.wg_words,
         })
     }
 
@@ -514,6 +518,13 @@ impl Megakernel {
         Ok(ctrl[g(nq, G_PROBE_RESIDENT)].clamp(1, max))
     }
 
+    /// Most bytes the queues' slots may take in the slots binding: the device's limit less the
+    /// workgroups' local areas that follow them.
+    fn queue_binding_bytes(&self, gpu: &Gpu, workgroups: u32) -> u64 {
+        let local = workgroups as u64 * self.local_wg_words as u64 * 4;
+        gpu.max_binding_bytes().saturating_sub(local)
+    }
+
     fn params(&self, layout: &QueueLayout) -> Vec<u32> {
         let nq = self.program.queue_count();
         let mut p = vec![0u32; P_QUEUES + nq * 5 + nq * nq];
@@ -523,6 +534,7 @@ impl Megakernel {
         p[P_OUTBOX_STRIDE] = self.outbox_stride;
         p[P_IDLE_BACKOFF] = self.config.idle_backoff;
         p[P_PAUSE_LINK] = 0; // the pause's chain stays on this word
+        p[P_LOCAL_BASE] = layout.total_words as u32;
         for q in 0..nq {
             p[P_QUEUES + q * 4] = layout.capacity[q];
             p[P_QUEUES + q * 4 + 1] = layout.slot_base[q];
@@ -544,7 +556,8 @@ impl Megakernel {
     ) -> Result<DeviceQueues, RunError> {
         let nq = self.program.queue_count();
         let ctrl = gpu.storage_buffer("ctrl", ctrl_words(nq) as u64)?;
-        let slots = gpu.storage_buffer("slots", layout.total_words)?;
+        let local_words = workgroups as u64 * self.local_wg_words as u64;
+        let slots = gpu.storage_buffer("slots", layout.total_words + local_words)?;
         let flags = gpu.storage_buffer("flags", layout.total_slots)?;
         let outbox = match outbox {
             Some(o) => o,
@@ -631,7 +644,7 @@ impl Megakernel {
         } = QueueLayout::run_start(
             &self.program,
             seeds,
-            gpu.max_binding_bytes(),
+            self.queue_binding_bytes(gpu, workgroups),
             self.config.max_capacity,
             max_queue_bytes,
             1,

@@ -47,7 +47,7 @@ impl Megakernel {
             &self.program,
             QueueLayout::capacity_limits(
                 &self.program,
-                gpu.max_binding_bytes(),
+                self.queue_binding_bytes(gpu, workgroups),
                 self.config.max_capacity,
             ),
             max_queue_bytes,

@@ -4,7 +4,7 @@
 //! `shaders/megakernel.wgsl`.
 
 use super::local::LocalPlan;
-use crate::item_layout::{ItemLayout, planar_load_store_fns};
+use crate::item_layout::ItemLayout;
 use crate::program::Program;
 
 pub const TEMPLATE: &str = include_str!("../../../shaders/megakernel.wgsl");
@@ -63,31 +63,9 @@ pub fn source(
     s += if subgroups { TAKE_SUBGROUP } else { TAKE_ONE };
     s += &crate::hash::lowbias32_wgsl("sched_hash");
     s += &claim_wgsl(nq);
-    if local.active() {
-        // Bodies read their items through `sched_in`: the slots, or in a local batch the
-        // workgroup's input buffer; local emits are stored through `sched_loc`.
-        s += LOCAL_ACCESSORS;
-        s += &items.execute_switch(program, "sched_in");
-        let mut seen = Vec::new();
-        for (t, p) in program.procs.iter().enumerate() {
-            let typed = |prefix: &str| match items {
-                ItemLayout::Interleaved => crate::wgsl::load_store_fns(&p.layout, prefix),
-                ItemLayout::Planar => planar_load_store_fns(&p.layout, prefix),
-            };
-            if !seen.contains(&p.layout.name) {
-                seen.push(p.layout.name.clone());
-                if direct.is_some() {
-                    s += &typed("sched_slot");
-                }
-            }
-            if local.cap[t] > 0 && !seen.contains(&format!("loc {}", p.layout.name)) {
-                seen.push(format!("loc {}", p.layout.name));
-                s += &typed("sched_loc");
-            }
-        }
-    } else {
-        s += &items.execute_switch(program, "sched_slot");
-    }
+    // Bodies read their items through the slot accessors, a local batch's from its buffer in
+    // the workgroup's area of the slots (`mk_execute`); local emits are stored with them too.
+    s += &items.execute_switch(program, "sched_slot");
     // Where item `s` of queue `q`'s slots starts (planar: and its stride).
     let slot_at = |q: &str| {
         if planar {
@@ -102,12 +80,16 @@ pub fn source(
     } else {
         ("sched_outbox + ob_off(q, t) + j * WORDS[t]", "1u")
     };
-    // A local batch's item `s` in `wg_local_in`: the local region's layout (planar: stride the
-    // region's capacity). One call site of `sched_execute` either way (lavapipe inlines it).
+    // A local batch's item `s` in the buffer it was kept in (planar: stride the buffer's
+    // capacity). One call site of `sched_execute` either way (lavapipe inlines it).
     let (base, local_base, stride_arg) = if planar {
-        ("q_slot_base(q) + s", "s", ", stride")
+        ("q_slot_base(q) + s", "sched_local_in(q) + s", ", stride")
     } else {
-        ("q_slot_base(q) + s * WORDS[q]", "s * WORDS[q]", "")
+        (
+            "q_slot_base(q) + s * WORDS[q]",
+            "sched_local_in(q) + s * WORDS[q]",
+            "",
+        )
     };
     s += &format!(
         "fn mk_execute(q: u32, s: u32, inv: Invocation) {{\n    \
@@ -120,24 +102,25 @@ pub fn source(
         "fn mk_outbox_item(q: u32, t: u32, j: u32) -> u32 {{ return {ob_at}; }}\n\
          fn mk_outbox_stride(q: u32, t: u32) -> u32 {{ return {ob_stride}; }}\n"
     );
-    // Typed outbox stores, only where items go through the outbox (direct enqueue stores with
-    // the `sched_slot_store_*` that come with `ItemLayout::execute_switch`'s loads).
+    // Typed outbox stores, only where items go through the outbox (direct enqueue and local
+    // emits store with the `sched_slot_store_*` that come with `ItemLayout::execute_switch`'s
+    // loads).
     if direct.is_none() {
         s += &items.typed_fns(program, "sched_ob");
     }
     for (t, p) in program.procs.iter().enumerate() {
         let ty = &p.layout.name;
-        // Local first, where q keeps its emits to t and the region has room this batch.
+        // Local first, where q keeps its emits to t and the buffer has room this batch.
         let local_store = if local.cap[t] > 0 {
             let at = if planar {
-                format!("LOCAL_OFF[{t}u] + l, LOCAL_CAP[{t}u]")
+                format!("sched_local_out({t}u) + l, LOCAL_CAP[{t}u]")
             } else {
-                format!("LOCAL_OFF[{t}u] + l * WORDS[{t}u]")
+                format!("sched_local_out({t}u) + l * WORDS[{t}u]")
             };
             format!(
                 "if LOCAL_EDGE[sched_proc * NQ + {t}u] != 0u {{\n        \
                      let l = atomicAdd(&wg_local_n[{t}u], 1u);\n        \
-                     if l < wg_local_lim[{t}u] {{ sched_loc_store_{ty}({at}, item); return; }}\n    }}\n    "
+                     if l < wg_local_lim[{t}u] {{ sched_slot_store_{ty}({at}, item); return; }}\n    }}\n    "
             )
         } else {
             String::new()
@@ -206,30 +189,6 @@ fn claim_wgsl(nq: usize) -> String {
     }
     s
 }
-
-/// Word accessors of local queues: `sched_in` reads a batch's items from the slots or, in a
-/// local batch, from `wg_local_in` (its stores are never called: bodies only load);
-/// `sched_loc` writes local emits into `wg_local_out`.
-const LOCAL_ACCESSORS: &str = "\
-fn sched_in_load_word(i: u32) -> u32 {
-    if sched_from_local { return wg_local_in[i]; }
-    return sched_slot_load_word(i);
-}
-fn sched_in_load_vec4(i: u32) -> vec4<u32> {
-    if sched_from_local { return vec4<u32>(wg_local_in[i], wg_local_in[i + 1u], wg_local_in[i + 2u], wg_local_in[i + 3u]); }
-    return sched_slot_load_vec4(i);
-}
-fn sched_in_store_word(i: u32, w: u32) { sched_slot_store_word(i, w); }
-fn sched_in_store_vec4(i: u32, v: vec4<u32>) { sched_slot_store_vec4(i, v); }
-fn sched_loc_load_word(i: u32) -> u32 { return wg_local_out[i]; }
-fn sched_loc_store_word(i: u32, w: u32) { wg_local_out[i] = w; }
-fn sched_loc_load_vec4(i: u32) -> vec4<u32> {
-    return vec4<u32>(wg_local_out[i], wg_local_out[i + 1u], wg_local_out[i + 2u], wg_local_out[i + 3u]);
-}
-fn sched_loc_store_vec4(i: u32, v: vec4<u32>) {
-    wg_local_out[i] = v.x; wg_local_out[i + 1u] = v.y; wg_local_out[i + 2u] = v.z; wg_local_out[i + 3u] = v.w;
-}
-";
 
 /// `sched_take` (see `shaders/megakernel.wgsl`): every emitting lane takes its own index and
 /// ticket.
