@@ -178,10 +178,15 @@ pub struct Cli {
     pub subgroups: bool,
 
     /// The megakernel keeps the emits a workload declares local (the tree's children, Reyes'
-    /// Bound and Split pieces) in workgroup memory and runs them next on the same workgroup
-    /// (`MegakernelConfig::local_queues`; off by default, slower on the H200 so far).
-    #[arg(long, help_heading = "Scheduler")]
+    /// Bound and Split pieces) in its workgroup's area of the queue buffer and runs them next on
+    /// the same workgroup (`MegakernelConfig::local_queues`). Default: the workload's choice, on
+    /// for trees of a fixed fan-out of 2 or more, off elsewhere (docs/scheduler.md 2.7).
+    #[arg(long, help_heading = "Scheduler", conflicts_with = "no_local_queues")]
     pub local_queues: bool,
+
+    /// The megakernel runs without local queues, whatever the workload would choose.
+    #[arg(long, help_heading = "Scheduler")]
+    pub no_local_queues: bool,
 
     /// How the device-driven multi-pass dispatches a round (`MultipassConfig::fused_rounds`):
     /// `on`, one indirect dispatch of every procedure's workgroups; `off`, one per procedure;
@@ -189,8 +194,8 @@ pub struct Cli {
     #[arg(long, value_enum, default_value = "auto", help_heading = "Scheduler")]
     pub fused_rounds: FusedRounds,
 
-    /// Workgroup memory for the megakernel's local queues, in bytes
-    /// (`MegakernelConfig::local_bytes`; default 16384, less where the device leaves less).
+    /// Most bytes of one megakernel workgroup's local queues (`MegakernelConfig::local_bytes`;
+    /// default 1 MiB: a full batch per buffer of every local target where it fits).
     #[arg(long, value_name = "BYTES", help_heading = "Scheduler")]
     pub local_bytes: Option<u32>,
 }
@@ -395,7 +400,11 @@ impl Cli {
             },
             item_layout: self.item_layout,
             direct_enqueue: self.enqueue.map(|e| e == Enqueue::Direct),
-            local_queues: self.local_queues,
+            local_queues: match (self.local_queues, self.no_local_queues) {
+                (true, _) => Some(true),
+                (_, true) => Some(false),
+                _ => None,
+            },
             local_bytes: self.local_bytes,
             fused_rounds: match self.fused_rounds {
                 FusedRounds::Auto => None,

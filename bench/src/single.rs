@@ -171,7 +171,11 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
             let w = r
                 .workgroup_size
                 .map_or(String::new(), |w| format!(", {w} threads per workgroup"));
-            let line = format!("{}: {l} items{e}{w}", r.strategy);
+            let local = match r.local_items {
+                0 => "",
+                _ => ", local queues",
+            };
+            let line = format!("{}: {l} items{e}{w}{local}", r.strategy);
             if !queues.contains(&line) {
                 queues.push(line);
             }

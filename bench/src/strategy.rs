@@ -146,8 +146,9 @@ pub struct GpuConfig {
     pub turn_anatomy: bool,
     /// `MegakernelConfig::subgroups`; `None`: where the adapter has them; default `Some(false)`.
     pub subgroups: Option<bool>,
-    /// `MegakernelConfig::local_queues`.
-    pub local_queues: bool,
+    /// `MegakernelConfig::local_queues`; `None`: the workload's choice
+    /// ([`GpuConfig::or_local_queues`]; off where a workload makes none).
+    pub local_queues: Option<bool>,
     /// `MegakernelConfig::local_bytes`; `None`: its default.
     pub local_bytes: Option<u32>,
     /// `MultipassConfig::fused_rounds` (the device-driven multi-pass); `None`: by adapter.
@@ -167,7 +168,7 @@ impl Default for GpuConfig {
             capacity: None,
             turn_anatomy: false,
             subgroups: Some(false),
-            local_queues: false,
+            local_queues: None,
             local_bytes: None,
             fused_rounds: None,
         }
@@ -179,6 +180,13 @@ impl GpuConfig {
     /// named none.
     pub fn or_procedure_steps(mut self, workload: Vec<(String, u32)>) -> GpuConfig {
         self.procedure_steps = self.procedure_steps.or(Some(workload));
+        self
+    }
+
+    /// This configuration with `workload`'s choice of local queues where the command line
+    /// made none.
+    pub fn or_local_queues(mut self, workload: bool) -> GpuConfig {
+        self.local_queues = self.local_queues.or(Some(workload));
         self
     }
 }
@@ -215,7 +223,7 @@ pub fn compile(
                 direct_enqueue: config.direct_enqueue,
                 turn_anatomy: config.turn_anatomy,
                 subgroups: config.subgroups,
-                local_queues: config.local_queues,
+                local_queues: config.local_queues.unwrap_or(false),
                 local_bytes: config
                     .local_bytes
                     .unwrap_or(MegakernelConfig::default().local_bytes),

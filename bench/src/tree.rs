@@ -19,6 +19,10 @@ impl ScheduledProblem for TreeParams {
         workloads::tree::megakernel_procedure_steps(gpu)
     }
 
+    fn local_queues(&self) -> bool {
+        self.megakernel_local_queues()
+    }
+
     fn reference(&self) -> TreeResult {
         TreeParams::reference(self)
     }

@@ -94,6 +94,11 @@ pub trait ScheduledProblem: Clone {
     fn procedure_steps(_gpu: &Gpu) -> Vec<(String, u32)> {
         Vec::new()
     }
+    /// Whether the megakernel keeps this problem's declared-local emits in the workgroup
+    /// (`GpuConfig::local_queues` when the command line says neither way); default false.
+    fn local_queues(&self) -> bool {
+        false
+    }
 
     /// Points `run` at this problem when its compiled program serves it unchanged (so the
     /// schedulers compiled for it are kept); false (the default) builds a new run.
@@ -128,12 +133,12 @@ pub trait ScheduledProblem: Clone {
 }
 
 /// The GPU run of the program last prepared and the schedulers compiled for it, by strategy
-/// name and initial queue capacity. Workloads whose problems share a program (tree presets of
+/// name, initial queue capacity and local queues. Workloads whose problems share a program (tree presets of
 /// one payload size and fan-out) can share one, so the suite compiles (and the megakernel
 /// probes its workgroup count) once for all of them.
 pub struct RunSlot<P: ScheduledProblem> {
     run: Option<P::Run>,
-    schedulers: Vec<(String, u32, Scheduler)>,
+    schedulers: Vec<(String, u32, bool, Scheduler)>,
 }
 
 /// A [`Workload`] over sizes of a [`ScheduledProblem`]: keeps the GPU run and the schedulers
@@ -247,13 +252,18 @@ impl<P: ScheduledProblem> Workload for ProblemWorkload<P> {
                 // grow its queues in every timed run.
                 let name = strategy.name();
                 let capacity = self.config.capacity.unwrap_or(p.capacity(reference));
-                let have = |s: &&(String, u32, Scheduler)| s.0 == name && s.1 == capacity;
+                let config = (self.config.clone())
+                    .or_procedure_steps(P::procedure_steps(gpu))
+                    .or_local_queues(p.local_queues());
+                let local = config.local_queues == Some(true);
+                let have = |s: &&(String, u32, bool, Scheduler)| {
+                    s.0 == name && s.1 == capacity && s.2 == local
+                };
                 if !schedulers.iter().any(|s| have(&s)) {
-                    let config = (self.config.clone()).or_procedure_steps(P::procedure_steps(gpu));
                     let s = compile(gpu, P::program(run), strategy, &config, capacity)?;
-                    schedulers.push((name.clone(), capacity, s));
+                    schedulers.push((name.clone(), capacity, local, s));
                 }
-                let scheduler = &schedulers.iter().find(have).unwrap().2;
+                let scheduler = &schedulers.iter().find(have).unwrap().3;
                 let start = Instant::now();
                 let (stats, out) = P::run(run, gpu, scheduler)?;
                 let wall = ms_since(start);

@@ -685,8 +685,40 @@ pub fn megakernel_procedure_steps(gpu: &scheduler::Gpu) -> Vec<(String, u32)> {
     vec![("leaf".into(), 4)]
 }
 
+impl TreeParams {
+    /// Whether the megakernel should keep a workgroup's children local
+    /// (`MegakernelConfig::local_queues`; the program declares them local): where every node has
+    /// the same number of children, at least two, a batch's children fill the workgroup's next
+    /// step, so local batches stay full and skip the global queue's round trips. Where the
+    /// fan-out is random (mean at most 1.5 in the presets), a workgroup's lineages thin out and its
+    /// local batches shrink (deep: 39 items a batch against 248), costing more turns than the
+    /// claims they save. H200, median of 10 (docs/results.md, 2026-12-03, "Local queues in the
+    /// slots buffer"): binary 0.160 -> 0.128 ms, heavy work 0.184 -> 0.172, large-payload 0.567
+    /// -> 0.553; deep 1.35 -> 1.69, irregular 0.183 -> 0.19.
+    pub fn megakernel_local_queues(&self) -> bool {
+        matches!(self.fanout, Fanout::Fixed(k) if k >= 2)
+    }
+}
+
 #[cfg(test)]
 mod tests {
+    /// Local queues where every node has the same two or more children, nowhere else.
+    #[test]
+    fn local_queues_only_for_fixed_fanouts_of_two_or_more() {
+        use super::{Fanout, TreeParams, TreePreset};
+        let chosen: Vec<bool> = TreePreset::ALL
+            .iter()
+            .map(|p| p.params().megakernel_local_queues())
+            .collect();
+        // binary, irregular, deep, large-payload, heavy work
+        assert_eq!(chosen, [true, false, false, true, true]);
+        let chain = TreeParams {
+            fanout: Fanout::Fixed(1),
+            ..TreePreset::Binary.params()
+        };
+        assert!(!chain.megakernel_local_queues());
+    }
+
     /// The expected size is the exact count for fixed fanouts, the presets all run, and the
     /// trees of the issue that never ended (or aborted) are refused.
     #[test]
