@@ -54,8 +54,8 @@ impl ScheduledProblem for TreeParams {
     /// Same payload and the same declared fan-out: the compiled program is the same (a larger
     /// declared fan-out would serve too, but reserves more room and so is not the same run).
     fn retarget(&self, run: &mut TreeRun) -> bool {
-        fanout_k(&run.params) == fanout_k(self)
-            && run.params.payload_words == self.payload_words
+        fanout_k(run.params()) == fanout_k(self)
+            && run.params().payload_words == self.payload_words
             && run.set_params(self.clone()).is_ok()
     }
 }
