@@ -790,6 +790,18 @@ fn a_queue_memory_budget_is_kept_or_reported_as_overflow() {
         assert!(stats.queue_bytes <= budget, "{kind:?}: {stats:?}");
         assert_eq!(result, reference, "{kind:?}");
     }
+    // The workgroups' local areas, in the slots buffer past the queues, count in the budget.
+    let config = MegakernelConfig {
+        local_queues: true,
+        initial_capacity: 1 << 12,
+        ..Default::default()
+    };
+    let local = Scheduler::megakernel(&gpu, &run.program, config).unwrap();
+    let budget = 1 << 20;
+    let (stats, result) = run.run_within(&gpu, &local, Some(budget)).unwrap();
+    assert!(stats.local_items > 0, "{stats:?}");
+    assert!(stats.queue_bytes <= budget, "{stats:?}");
+    assert_eq!(result, reference);
 }
 
 /// The device-driven multi-pass records one indirect dispatch per procedure a round and one plan

@@ -188,16 +188,18 @@ pub struct Cli {
     #[arg(long, help_heading = "Scheduler")]
     pub no_local_queues: bool,
 
+    /// With local queues: most bytes of one megakernel workgroup's local area, in global memory,
+    /// once per workgroup (`MegakernelConfig::local_bytes`; default 1 MiB: a full batch per
+    /// buffer of every local target where it fits). A size too small for one item of any local
+    /// target runs without local queues, with a warning.
+    #[arg(long, value_name = "BYTES", help_heading = "Scheduler")]
+    pub local_bytes: Option<u32>,
+
     /// How the device-driven multi-pass dispatches a round (`MultipassConfig::fused_rounds`):
     /// `on`, one indirect dispatch of every procedure's workgroups; `off`, one per procedure;
     /// `auto`, on for GPUs and off for CPU adapters such as lavapipe (docs/scheduler.md 5.1).
     #[arg(long, value_enum, default_value = "auto", help_heading = "Scheduler")]
     pub fused_rounds: FusedRounds,
-
-    /// Most bytes of one megakernel workgroup's local queues (`MegakernelConfig::local_bytes`;
-    /// default 1 MiB: a full batch per buffer of every local target where it fits).
-    #[arg(long, value_name = "BYTES", help_heading = "Scheduler")]
-    pub local_bytes: Option<u32>,
 }
 
 /// `--fused-rounds`: how the device-driven multi-pass dispatches a round.

@@ -123,11 +123,13 @@ impl Procedure {
     }
 
     /// Lets the items this procedure emits to `target` (declared with [`Procedure::emits`]) stay
-    /// on chip: in the megakernel with `MegakernelConfig::local_queues` (off by default: it did
-    /// not pay on the H200 yet, docs/scheduler.md 2.7), a batch's emits to `target` go to a region of the workgroup's
-    /// own memory while it has room, and the workgroup runs them as its next batch, without the
-    /// global queue's tickets, flags and claim (Whippletree's shared-memory queues, Steinberger et
-    /// al. 2014, section 4; the local bound-and-split of Micropolis, Weber et al. 2015). What does
+    /// with the workgroup: in the megakernel with `MegakernelConfig::local_queues` (off by
+    /// default: it pays where a batch's children fill the workgroup's next step, such as trees
+    /// of a fixed fan-out of 2, and costs where they thin out; docs/scheduler.md 2.7), a batch's
+    /// emits to `target` go to the workgroup's own area of the slots buffer while it has room, and
+    /// the workgroup runs them as its next batch, without the global queue's tickets, flags and
+    /// claim (Whippletree's per-block queues, Steinberger et al. 2014, section 4; the local
+    /// bound-and-split of Micropolis, Weber et al. 2015). What does
     /// not fit goes to the global queue as before. While another workgroup of the launch is idle,
     /// a workgroup keeps only one step's worth (`items_per_step` of `target`) and shares the rest.
     /// The multi-pass strategies have no workgroup that outlives a pass and ignore it. Checked by

@@ -158,8 +158,10 @@ pub struct MegakernelConfig {
     /// queues in the slots buffer".
     pub local_queues: bool,
     /// Most bytes of one workgroup's local area, both buffers of every local target (default
-    /// [`LOCAL_MAX_BYTES`]: a full batch per buffer where it fits). Global memory: the slots
-    /// buffer grows by this times the workgroups.
+    /// [`LOCAL_MAX_BYTES`]: a full batch per buffer where it fits; split evenly between the
+    /// targets otherwise). A target whose share holds no item is not kept local, and where no
+    /// target is left the megakernel runs without local queues and warns. Global memory: the
+    /// slots buffer grows by the area in use (at most this) times the workgroups.
     pub local_bytes: u32,
 }
 
@@ -380,6 +382,12 @@ impl Megakernel {
             plan = local::LocalPlan::new(program, &batch, config.local_bytes);
             if plan.active() {
                 source = generate(&plan, direct);
+            } else {
+                log::warn!(
+                    "megakernel: local queues asked for, but {} bytes per workgroup hold no item \
+                     of any local target: running without them",
+                    config.local_bytes
+                );
             }
             log::debug!(
                 "megakernel: local queues of {:?} items per buffer ({} bytes per workgroup)",
@@ -525,6 +533,13 @@ impl Megakernel {
         gpu.max_binding_bytes().saturating_sub(local)
     }
 
+    /// What of a run's queue storage budget the queues may take: the budget less the
+    /// workgroups' local areas.
+    fn queue_budget(&self, max_queue_bytes: Option<u64>, workgroups: u32) -> Option<u64> {
+        let local = workgroups as u64 * self.local_wg_words as u64 * 4;
+        max_queue_bytes.map(|b| b.saturating_sub(local))
+    }
+
     fn params(&self, layout: &QueueLayout) -> Vec<u32> {
         let nq = self.program.queue_count();
         let mut p = vec![0u32; P_QUEUES + nq * 5 + nq * nq];
@@ -624,7 +639,8 @@ impl Megakernel {
     }
 
     /// Runs the program to completion from `seeds`. `user` is bind group 1, if the program has
-    /// one. `max_queue_bytes` bounds the queue storage (slots and flags) of this run. Errors:
+    /// one. `max_queue_bytes` bounds the queue storage (slots, the workgroups' local areas and
+    /// flags) of this run. Errors:
     /// every [`RunError`] but `NoAdapter` (see `docs/scheduler.md`, section 6).
     pub fn run(
         &self,
@@ -646,7 +662,7 @@ impl Megakernel {
             seeds,
             self.queue_binding_bytes(gpu, workgroups),
             self.config.max_capacity,
-            max_queue_bytes,
+            self.queue_budget(max_queue_bytes, workgroups),
             1,
         )?;
         // A queue holds every ticket of a launch, so a run grows its queues (each growth a
@@ -895,9 +911,10 @@ impl Megakernel {
                 *need = (*need).max(stats.executed[t] + promised);
             }
         }
+        // The slots buffer holds the workgroups' local areas too.
         stats.queue_bytes = dq
             .as_ref()
-            .map_or(0, |d| d.layout.total_words * 4 + d.layout.total_slots * 4);
+            .map_or(0, |d| d.slots.size() + d.layout.total_slots * 4);
         stats.gpu_ms = gpu_ms;
         stats.wall_ms = start_time.elapsed().as_secs_f64() * 1e3;
         // Keep the device queues and the read-back buffer for the next run.

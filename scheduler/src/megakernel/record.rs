@@ -50,7 +50,7 @@ impl Megakernel {
                 self.queue_binding_bytes(gpu, workgroups),
                 self.config.max_capacity,
             ),
-            max_queue_bytes,
+            self.queue_budget(max_queue_bytes, workgroups),
             1,
         );
         QueueLayout::check_seeds(&self.program, seeded, &max_cap)?;
@@ -203,7 +203,7 @@ impl RecordedLaunch {
             launches: 1,
             workgroups: self.workgroups,
             workgroup_size: self.workgroup_size,
-            queue_bytes: self.dq.layout.total_words * 4 + self.dq.layout.total_slots * 4,
+            queue_bytes: self.dq.slots.size() + self.dq.layout.total_slots * 4,
             ..Default::default()
         };
         stats.submits = 0;
