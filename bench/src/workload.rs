@@ -133,9 +133,9 @@ pub trait ScheduledProblem: Clone {
 }
 
 /// The GPU run of the program last prepared and the schedulers compiled for it, by strategy
-/// name, initial queue capacity and local queues. Workloads whose problems share a program (tree presets of
-/// one payload size and fan-out) can share one, so the suite compiles (and the megakernel
-/// probes its workgroup count) once for all of them.
+/// name, initial queue capacity and local queues. Workloads whose problems share a program
+/// (tree presets of one payload size and fan-out) can share one, so the suite compiles (and the
+/// megakernel probes its workgroup count) once for all of them.
 pub struct RunSlot<P: ScheduledProblem> {
     run: Option<P::Run>,
     schedulers: Vec<(String, u32, bool, Scheduler)>,
@@ -252,14 +252,14 @@ impl<P: ScheduledProblem> Workload for ProblemWorkload<P> {
                 // grow its queues in every timed run.
                 let name = strategy.name();
                 let capacity = self.config.capacity.unwrap_or(p.capacity(reference));
-                let config = (self.config.clone())
-                    .or_procedure_steps(P::procedure_steps(gpu))
-                    .or_local_queues(p.local_queues());
-                let local = config.local_queues == Some(true);
+                let local = self.config.local_queues.unwrap_or(p.local_queues());
                 let have = |s: &&(String, u32, bool, Scheduler)| {
                     s.0 == name && s.1 == capacity && s.2 == local
                 };
                 if !schedulers.iter().any(|s| have(&s)) {
+                    let config = (self.config.clone())
+                        .or_procedure_steps(P::procedure_steps(gpu))
+                        .or_local_queues(local);
                     let s = compile(gpu, P::program(run), strategy, &config, capacity)?;
                     schedulers.push((name.clone(), capacity, local, s));
                 }

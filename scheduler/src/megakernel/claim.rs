@@ -1,6 +1,7 @@
 //! What a workgroup claims: the order it tries the queues in ([`priority_order`], from
 //! [`QueuePolicy`]) and how many items one batch of each queue holds ([`batch_items`]). Both are
-//! computed once per compiled megakernel and passed to the shader in its params.
+//! computed once per compiled megakernel and passed to the shader in its params; from the
+//! batch sizes, the most one batch may emit to a queue ([`worst_batch_output`]).
 
 use super::layout::MAX_BATCH;
 use super::{MegakernelConfig, QueuePolicy};
@@ -64,6 +65,15 @@ pub(super) fn priority_order(
         }
     }
     Ok(order)
+}
+
+/// The most items one batch of any queue may emit to queue `t` (`batch[q]` items of `q`, each up
+/// to its declared emits to `t`): the room a running batch may hold promised in `t`'s budget.
+pub(super) fn worst_batch_output(program: &Program, batch: &[u32], t: usize) -> u64 {
+    (program.procs.iter().zip(batch))
+        .map(|(p, &b)| b as u64 * p.emits[t] as u64)
+        .max()
+        .unwrap_or(0)
 }
 
 #[cfg(test)]

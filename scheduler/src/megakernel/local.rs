@@ -8,6 +8,7 @@
 //! the regions and writes their WGSL constants; the protocol is in `shaders/megakernel.wgsl`
 //! (`LOCAL`).
 
+use super::claim::worst_batch_output;
 use crate::error::RunError;
 use crate::program::Program;
 
@@ -57,19 +58,13 @@ impl LocalPlan {
         let mut off = 0;
         for &t in &targets {
             let words = program.procs[t].words();
-            let cap = batch[t].min(share / words);
-            plan.cap[t] = cap;
+            plan.cap[t] = batch[t].min(share / words);
             plan.off[t] = off;
-            off += 2 * (cap * words).next_multiple_of(4);
+            off += 2 * plan.buffer_words(program, t);
         }
         plan.wg_words = off;
         plan.credit_max = (0..nq)
-            .map(|t| {
-                (program.procs.iter().zip(batch))
-                    .map(|(p, &b)| b.saturating_mul(p.emits[t]))
-                    .max()
-                    .unwrap_or(0)
-            })
+            .map(|t| worst_batch_output(program, batch, t).min(u32::MAX as u64) as u32)
             .collect();
         plan
     }

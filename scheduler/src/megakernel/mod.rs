@@ -529,15 +529,19 @@ impl Megakernel {
     /// Most bytes the queues' slots may take in the slots binding: the device's limit less the
     /// workgroups' local areas that follow them.
     fn queue_binding_bytes(&self, gpu: &Gpu, workgroups: u32) -> u64 {
-        let local = workgroups as u64 * self.local_wg_words as u64 * 4;
-        gpu.max_binding_bytes().saturating_sub(local)
+        gpu.max_binding_bytes()
+            .saturating_sub(self.local_area_words(workgroups) * 4)
+    }
+
+    /// Words of the local areas of `workgroups` workgroups, past the queues in the slots buffer.
+    fn local_area_words(&self, workgroups: u32) -> u64 {
+        workgroups as u64 * self.local_wg_words as u64
     }
 
     /// What of a run's queue storage budget the queues may take: the budget less the
     /// workgroups' local areas.
     fn queue_budget(&self, max_queue_bytes: Option<u64>, workgroups: u32) -> Option<u64> {
-        let local = workgroups as u64 * self.local_wg_words as u64 * 4;
-        max_queue_bytes.map(|b| b.saturating_sub(local))
+        max_queue_bytes.map(|b| b.saturating_sub(self.local_area_words(workgroups) * 4))
     }
 
     fn params(&self, layout: &QueueLayout) -> Vec<u32> {
@@ -571,8 +575,8 @@ impl Megakernel {
     ) -> Result<DeviceQueues, RunError> {
         let nq = self.program.queue_count();
         let ctrl = gpu.storage_buffer("ctrl", ctrl_words(nq) as u64)?;
-        let local_words = workgroups as u64 * self.local_wg_words as u64;
-        let slots = gpu.storage_buffer("slots", layout.total_words + local_words)?;
+        let slots_words = layout.total_words + self.local_area_words(workgroups);
+        let slots = gpu.storage_buffer("slots", slots_words)?;
         let flags = gpu.storage_buffer("flags", layout.total_slots)?;
         let outbox = match outbox {
             Some(o) => o,

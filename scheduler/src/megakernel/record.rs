@@ -4,6 +4,7 @@
 //! [`Megakernel::write_ctrl`]), kept in two small buffers and copied in each record, so a record
 //! writes nothing from the host.
 
+use super::claim::worst_batch_output;
 use super::layout::*;
 use super::{DeviceQueues, Megakernel};
 use crate::error::RunError;
@@ -59,13 +60,7 @@ impl Megakernel {
         // `wanted` asks for, each queue keeps room for one batch's worst case per workgroup.
         let nq = seeded.len();
         let slack: Vec<u64> = (0..nq)
-            .map(|t| {
-                let worst = (self.program.procs.iter().zip(&self.batch))
-                    .map(|(p, &batch)| batch as u64 * p.emits[t] as u64)
-                    .max()
-                    .unwrap_or(0);
-                workgroups as u64 * worst
-            })
+            .map(|t| workgroups as u64 * worst_batch_output(&self.program, &self.batch, t))
             .collect();
         let capacity: Vec<u32> = (0..nq)
             .map(|q| {
