@@ -82,17 +82,19 @@ const CONSUMED: u32 = 0xffffffffu; // slot flag: processed; any other value: rea
 const CMD_IDLE: u32 = 0u;
 const CMD_RUN: u32 = 1u;
 const CMD_EXIT: u32 = 2u;
-const CMD_LOCAL: u32 = 3u;   // run the items of local queue wg_q held in the workgroup
+const CMD_LOCAL: u32 = 3u;   // run the items of local queue q held in the workgroup; the credit covers their output
+const CMD_LOCAL_RESERVE: u32 = 4u; // the same, once the budget has room for what the credit does not cover
 
 @group(0) @binding(0) var<storage, read_write> ctrl: array<atomic<u32>>;
 @group(0) @binding(2) var<storage, read_write> flags: array<atomic<u32>>;
 @group(0) @binding(3) var<storage, read_write> outbox: array<vec4<u32>>;
 @group(0) @binding(4) var<storage, read> params: array<u32>;
 
-var<workgroup> wg_cmd: u32;
-var<workgroup> wg_q: u32;
-var<workgroup> wg_h: u32;
-var<workgroup> wg_n: u32;
+// The leader's decision for the turn, read by every lane in one workgroupUniformLoad (each is a
+// barrier, a load and a barrier): x the command (CMD_*), y the queue q, z the first ticket h of
+// a claimed batch, w its items n.
+var<workgroup> wg_turn: vec4<u32>;
+var<workgroup> wg_refused: u32;
 var<workgroup> wg_stamp: u32;
 var<workgroup> wg_ready: array<u32, MAX_BATCH>;
 var<workgroup> wg_emit_count: array<atomic<u32>, NQ>;
@@ -119,6 +121,12 @@ var<workgroup> wg_local_lim: array<u32, NQ>;
 var<workgroup> wg_local_held: array<u32, NQ>;
 var<workgroup> wg_idle_now: u32;
 var<workgroup> wg_local_fail: atomic<u32>;
+// Per queue t (LOCAL): room in t's budget this workgroup reserved and has not promised (what its
+// batches left unused), for its next local batches: in a steady run of local batches their
+// promises need no budget atomic, and the leader sees whether the credit covers a batch (no
+// barrier to ask the lanes). At most LOCAL_CREDIT_MAX[t]; given back at a spill. Written by
+// lane t only, read by the leader between the turn's first barrier and its decision's load.
+var<workgroup> wg_credit: array<u32, NQ>;
 
 var<private> sched_proc: u32;
 var<private> sched_active: bool;
@@ -141,10 +149,6 @@ var<private> sched_local_wg: u32;
 var<private> sched_local_par: u32;
 // The leader counts itself in G_IDLE_NOW.
 var<private> sched_idle_reg: bool;
-// Lane t < NQ (LOCAL): room in queue t's budget this workgroup reserved and has not promised
-// (what its batches left unused), for its next local batches: in a steady run of local batches
-// their promises need no budget atomics. At most LOCAL_CREDIT_MAX[t]; given back at a spill.
-var<private> sched_credit: u32;
 var<private> an: array<u32, AN_WORDS>;
 var<workgroup> wg_an_wait: atomic<u32>;
 
@@ -256,9 +260,9 @@ fn try_claim(q: u32, avail: i32) -> bool {
         sched_blocked = true;
         return false;
     }
-    wg_q = q;
-    wg_n = got;
-    wg_h = h;
+    wg_turn.y = q;
+    wg_turn.z = h;
+    wg_turn.w = got;
     return true;
 }
 
@@ -278,16 +282,43 @@ fn fifo_pick() -> u32 {
     return best;
 }
 
+// Leader only (LOCAL): how many items of each target t a batch of q may keep, in wg_local_lim[t],
+// and how many it holds before the batch, in wg_local_held[t]: a full region while every
+// workgroup is busy; one step's worth while some are idle (one step runs them as fast as many
+// workgroups would), the rest shared through the global queue. Set before the turn's decision is
+// read, so a local batch needs no barrier before its bodies emit.
+fn local_limits(q: u32) {
+    for (var t = 0u; t < NQ; t++) {
+        let held = atomicLoad(&wg_local_n[t]);
+        wg_local_held[t] = held;
+        var lim = held;
+        if LOCAL_EDGE[q * NQ + t] != 0u {
+            var want = LOCAL_CAP[t];
+            if wg_idle_now != 0u { want = min(want, WG_SIZE / THREADS[t]); }
+            lim = max(held, want);
+        }
+        wg_local_lim[t] = lim;
+    }
+}
+
 fn leader_decide() -> u32 {
     an_add(AN_TURNS, 1u);
     if wg_stop != 0u { return CMD_EXIT; }
     // Work held in the workgroup runs first, in priority order: no global atomic to claim it.
+    // The items are taken from the filling buffer here (put back if their room cannot be
+    // reserved). Where the credit covers their worst-case output the batch starts at once;
+    // else the lanes reserve the rest of the room first.
     for (var i = 0u; i < NQ && LOCAL; i++) {
-        let m = atomicLoad(&wg_local_n[prio(i)]);
+        let q = prio(i);
+        let m = atomicLoad(&wg_local_n[q]);
         if m > 0u {
-            wg_q = prio(i);
-            wg_n = m;
-            wg_h = 0u;
+            wg_turn.y = q;
+            wg_turn.z = 0u;
+            wg_turn.w = m;
+            atomicStore(&wg_local_n[q], 0u);
+            for (var t = 0u; t < NQ; t++) {
+                if m * EMITS[q * NQ + t] > wg_credit[t] { return CMD_LOCAL_RESERVE; }
+            }
             return CMD_LOCAL;
         }
     }
@@ -327,9 +358,9 @@ fn spill_local(lid: u32) {
         let m = atomicLoad(&wg_local_n[lid]);
         wg_emit_n[lid] = m;
         if m > 0u { wg_emit_base[lid] = atomicAdd(&ctrl[lid * QSTRIDE + Q_RESERVE], m); }
-        if sched_credit > 0u {
-            atomicSub(&ctrl[lid * QSTRIDE + Q_BUDGET], sched_credit);
-            sched_credit = 0u;
+        if wg_credit[lid] > 0u {
+            atomicSub(&ctrl[lid * QSTRIDE + Q_BUDGET], wg_credit[lid]);
+            wg_credit[lid] = 0u;
         }
     }
     if lid == 0u {
@@ -413,7 +444,10 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
     }
     sched_outbox = wid.x * params[P_OUTBOX_STRIDE];
     sched_local_wg = params[P_LOCAL_BASE] + wid.x * LOCAL_WG_WORDS;
-    if LOCAL && lid < NQ { atomicStore(&wg_local_n[lid], 0u); } // ordered by the probe's barrier
+    if LOCAL && lid < NQ { // ordered by the probe's barrier
+        atomicStore(&wg_local_n[lid], 0u);
+        wg_credit[lid] = 0u;
+    }
     var idle = 0u;
     var streak = 0u;
     var iter = 0u;
@@ -430,22 +464,25 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         probed = false;
         workgroupBarrier();
         if lid == 0u {
-            wg_cmd = leader_decide();
+            let decided = leader_decide();
+            wg_turn.x = decided;
             if LOCAL {
                 // Idle right now, for workgroups deciding how much to keep: only changes cost.
-                let idle_now = wg_cmd == CMD_IDLE;
+                let idle_now = decided == CMD_IDLE;
                 if idle_now != sched_idle_reg {
                     if idle_now { atomicAdd(&ctrl[gw(G_IDLE_NOW)], 1u); } else { atomicSub(&ctrl[gw(G_IDLE_NOW)], 1u); }
                     sched_idle_reg = idle_now;
                 }
                 atomicStore(&wg_local_fail, 0u);
+                if decided == CMD_RUN || decided >= CMD_LOCAL { local_limits(wg_turn.y); }
             }
             atomicStore(&wg_abandoned, 0u);
             atomicStore(&wg_emitted, 0u);
             if TURN_ANATOMY { atomicStore(&wg_an_wait, 0u); }
         }
         if lid < NQ { atomicStore(&wg_emit_count[lid], 0u); }
-        let cmd = workgroupUniformLoad(&wg_cmd);
+        let turn = workgroupUniformLoad(&wg_turn);
+        var cmd = turn.x;
         if cmd == CMD_EXIT { break; }
         if cmd == CMD_IDLE {
             idle++;
@@ -458,52 +495,39 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
             continue;
         }
         streak = 0u;
-        let q = workgroupUniformLoad(&wg_q);
-        let h = workgroupUniformLoad(&wg_h);
-        let n = workgroupUniformLoad(&wg_n);
-        let from_local = LOCAL && cmd == CMD_LOCAL;
-        sched_from_local = from_local;
-        if from_local {
-            // 0. A local batch: its worst-case output in every target promised from the
-            //    workgroup's credit, lanes in parallel, the shortfall reserved in the budget;
-            //    without room, spill what the workgroup holds and claim as usual.
-            var need = 0u;
-            if lid < NQ { need = n * EMITS[q * NQ + lid]; }
+        let q = turn.y;
+        let h = turn.z;
+        let n = turn.w;
+        if LOCAL && cmd == CMD_LOCAL_RESERVE {
+            // 0. A local batch whose worst-case output the credit does not cover: lanes in
+            //    parallel reserve the shortfall in each target's budget; without room, spill
+            //    what the workgroup holds and claim as usual.
             var took = 0u;
-            if need > sched_credit {
-                took = need - sched_credit;
+            if lid < NQ && n * EMITS[q * NQ + lid] > wg_credit[lid] {
+                took = n * EMITS[q * NQ + lid] - wg_credit[lid];
                 let old = atomicAdd(&ctrl[lid * QSTRIDE + Q_BUDGET], took);
                 if old + took > q_cap(lid) { atomicStore(&wg_local_fail, 1u); }
             }
             workgroupBarrier();
-            if lid == 0u { wg_cmd = atomicLoad(&wg_local_fail); }
-            if workgroupUniformLoad(&wg_cmd) != 0u {
+            if lid == 0u { wg_refused = atomicLoad(&wg_local_fail); }
+            if workgroupUniformLoad(&wg_refused) != 0u {
                 if took > 0u { atomicSub(&ctrl[lid * QSTRIDE + Q_BUDGET], took); }
+                if lid == 0u { atomicStore(&wg_local_n[q], n); } // put back, for the spill
                 spill_local(lid);
                 continue;
             }
-            sched_credit = sched_credit + took - need;
-            // The batch runs from the buffer it filled (`sched_local_in`), while q's emits fill
-            // the other. Its items were written before the last batch's release barrier, which
-            // every lane passed: visible here.
-            sched_local_par ^= 1u << q;
-            for (var i = lid; i < n; i += WG_SIZE) { wg_ready[i] = 1u; }
-            if lid == 0u { atomicStore(&wg_local_n[q], 0u); }
-            workgroupBarrier();
+            if lid < NQ { wg_credit[lid] += took; }
+            cmd = CMD_LOCAL;
         }
-        if LOCAL && lid < NQ {
-            // How many items of lid this batch may keep: a full region while every workgroup is
-            // busy; one step's worth while some are idle (one step runs them as fast as many
-            // workgroups would), the rest shared through the global queue.
-            let held = atomicLoad(&wg_local_n[lid]);
-            wg_local_held[lid] = held;
-            var lim = held;
-            if LOCAL_EDGE[q * NQ + lid] != 0u {
-                var want = LOCAL_CAP[lid];
-                if wg_idle_now != 0u { want = min(want, WG_SIZE / THREADS[lid]); }
-                lim = max(held, want);
-            }
-            wg_local_lim[lid] = lim;
+        let from_local = LOCAL && cmd == CMD_LOCAL;
+        sched_from_local = from_local;
+        if from_local {
+            // A local batch: its worst-case output in every target promised from the credit
+            // (the leader saw that it covers it). It runs from the buffer it filled
+            // (`sched_local_in`), while q's emits fill the other. Its items were written before
+            // the last batch's release barrier, which every lane passed: visible here.
+            if lid < NQ { wg_credit[lid] -= n * EMITS[q * NQ + lid]; }
+            sched_local_par ^= 1u << q;
         }
 
         // 1. Wait, bounded, for each claimed slot's producer to publish it. A slot whose wait
@@ -520,10 +544,12 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
             if ok == 0u { atomicAdd(&wg_abandoned, 1u); }
         }
         if TURN_ANATOMY && polls > 0u { atomicMax(&wg_an_wait, polls); }
-        storageBarrier(); // acquire: flags seen before the payload is read
-        // wg_ready is workgroup memory, which storageBarrier does not order: lanes other than the
-        // one that waited read it when threads_per_item > 1.
-        workgroupBarrier();
+        if !from_local {
+            storageBarrier(); // acquire: flags seen before the payload is read
+            // wg_ready is workgroup memory, which storageBarrier does not order: lanes other
+            // than the one that waited read it when threads_per_item > 1.
+            workgroupBarrier();
+        }
 
         // 2. Run the batch, items_per_step items at a time.
         let per_step = WG_SIZE / THREADS[q];
@@ -532,7 +558,7 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         sched_batch_n = n;
         for (var first = 0u; first < n; first += per_step) {
             let idx = first + slot;
-            sched_active = idx < n && wg_ready[min(idx, MAX_BATCH - 1u)] != 0u;
+            sched_active = idx < n && (from_local || wg_ready[min(idx, MAX_BATCH - 1u)] != 0u);
             mk_execute(q, h + idx, Invocation(lid % THREADS[q], slot, sched_active, THREADS[q]));
             // The next step may reuse the body's workgroup memory: all threads finish this one first.
             workgroupBarrier();
@@ -581,10 +607,10 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
             if from_local && t == q { refund += n; }
             if LOCAL {
                 // Kept as credit for the next local batches, up to a cap.
-                sched_credit += refund;
-                if sched_credit > LOCAL_CREDIT_MAX[t] {
-                    atomicSub(&ctrl[t * QSTRIDE + Q_BUDGET], sched_credit - LOCAL_CREDIT_MAX[t]);
-                    sched_credit = LOCAL_CREDIT_MAX[t];
+                let credit = wg_credit[t] + refund;
+                wg_credit[t] = min(credit, LOCAL_CREDIT_MAX[t]);
+                if credit > LOCAL_CREDIT_MAX[t] {
+                    atomicSub(&ctrl[t * QSTRIDE + Q_BUDGET], credit - LOCAL_CREDIT_MAX[t]);
                 }
             } else if refund > 0u {
                 atomicSub(&ctrl[t * QSTRIDE + Q_BUDGET], refund);

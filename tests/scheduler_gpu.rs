@@ -790,10 +790,14 @@ fn a_queue_memory_budget_is_kept_or_reported_as_overflow() {
         assert!(stats.queue_bytes <= budget, "{kind:?}: {stats:?}");
         assert_eq!(result, reference, "{kind:?}");
     }
-    // The workgroups' local areas, in the slots buffer past the queues, count in the budget.
+    // The workgroups' local areas, in the slots buffer past the queues, count in the budget:
+    // where those of every workgroup would take more than half of it, fewer workgroups run
+    // (4,096 asked for here, so that this holds on every adapter, as it does for the probed
+    // count of a large GPU).
     let config = MegakernelConfig {
         local_queues: true,
         initial_capacity: 1 << 12,
+        workgroups: Workgroups::Fixed(4096),
         ..Default::default()
     };
     let local = Scheduler::megakernel(&gpu, &run.program, config).unwrap();
@@ -801,6 +805,12 @@ fn a_queue_memory_budget_is_kept_or_reported_as_overflow() {
     let (stats, result) = run.run_within(&gpu, &local, Some(budget)).unwrap();
     assert!(stats.local_items > 0, "{stats:?}");
     assert!(stats.queue_bytes <= budget, "{stats:?}");
+    assert!((1..4096).contains(&stats.workgroups), "{stats:?}");
+    assert_eq!(result, reference);
+    // The same scheduler without a budget launches them all again, in buffers for all of them.
+    let (all, result) = run.run(&gpu, &local).unwrap();
+    assert_eq!(all.workgroups, 4096, "{all:?}");
+    assert!(all.queue_bytes > stats.queue_bytes, "{all:?}");
     assert_eq!(result, reference);
 }
 

@@ -124,8 +124,8 @@ impl Procedure {
 
     /// Lets the items this procedure emits to `target` (declared with [`Procedure::emits`]) stay
     /// with the workgroup: in the megakernel with `MegakernelConfig::local_queues` (off by
-    /// default: it pays where a batch's children fill the workgroup's next step, such as trees
-    /// of a fixed fan-out of 2, and costs where they thin out; docs/scheduler.md 2.7), a batch's
+    /// default: it pays where a batch's children fill the workgroup's next steps, such as trees
+    /// that do not thin out, and costs where lineages die out; docs/scheduler.md 2.7), a batch's
     /// emits to `target` go to the workgroup's own area of the slots buffer while it has room, and
     /// the workgroup runs them as its next batch, without the global queue's tickets, flags and
     /// claim (Whippletree's per-block queues, Steinberger et al. 2014, section 4; the local

@@ -105,7 +105,7 @@ impl LocalPlan {
              const LOCAL_OFF: array<u32, {nq}> = array<u32, {nq}>({});\n\
              const LOCAL_STRIDE: array<u32, {nq}> = array<u32, {nq}>({});\n\
              const LOCAL_WG_WORDS: u32 = {}u;\n\
-             // Most unpromised budget room of queue t a workgroup keeps (`sched_credit`)\n\
+             // Most unpromised budget room of queue t a workgroup keeps (`wg_credit`)\n\
              const LOCAL_CREDIT_MAX: array<u32, {nq}> = array<u32, {nq}>({});\n",
             list(&edge),
             list(&self.cap),

@@ -6,6 +6,8 @@
 pub mod anatomy;
 mod claim;
 mod compact;
+mod config;
+pub use config::*;
 pub(crate) mod layout;
 pub(crate) mod local;
 pub use local::LOCAL_MAX_BYTES;
@@ -28,173 +30,6 @@ use crate::queue_layout::{QueueLayout, RunStart};
 use crate::readback::Readback;
 use crate::stats::RunStats;
 use crate::timing::SpanTimer;
-
-/// How many workgroups a launch has.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Workgroups {
-    /// As many as the probe launch finds running at the same time, at most `max`. The default:
-    /// a persistent workgroup must never wait on one that has not started.
-    Probe {
-        /// Most workgroups the probe launches (and so the most it can report).
-        max: u32,
-    },
-    /// Exactly this many (tests use it to oversubscribe on purpose; waits stay bounded).
-    Fixed(u32),
-}
-
-/// Which queue a workgroup takes its next batch from.
-#[derive(Debug, Clone, PartialEq)]
-pub enum QueuePolicy {
-    /// The first queue with work in this order of procedure names (unnamed ones follow in
-    /// reverse registration order). "Later stages first" keeps queues short.
-    Priority(Vec<String>),
-    /// The queue whose oldest waiting batch was published first.
-    Fifo,
-}
-
-/// Turns of the persistent loop per launch on lavapipe: with bodies' own loops (a Reyes grid
-/// samples its micropolygons in nested loops) this keeps an invocation's total loop
-/// iterations far below lavapipe's cumulative 65,535 cut.
-pub const LAVAPIPE_MAX_ITERATIONS: u32 = 96;
-/// Polls of a flag per wait on lavapipe (the polls count against the same cut).
-pub const LAVAPIPE_SPIN_LIMIT: u32 = 64;
-
-/// Growth factor of the queues after a launch that stopped for want of room: each such launch
-/// costs a relaunch (a host wait and new buffers), so growing fourfold instead of twofold halves
-/// their number, `log4(need / start)`, for at most 4x the needed memory (within the limit).
-pub const ROOM_GROWTH: u64 = 4;
-
-/// Settings of [`Megakernel::new`]; [`Default`] gives the documented defaults.
-#[derive(Debug, Clone)]
-pub struct MegakernelConfig {
-    /// Workgroups per launch (default: probed, at most 4,096).
-    pub workgroups: Workgroups,
-    /// Which queue a workgroup takes its next batch from (default: later procedures first).
-    pub policy: QueuePolicy,
-    /// Threads per workgroup: a multiple of 256 up to 1,024 and the device's
-    /// `max_compute_invocations_per_workgroup` (default 256). Every procedure's items per step
-    /// and `.shared` array scale with it. Larger workgroups bound the registers each thread may
-    /// take (the 65,536 of an NVIDIA SM shared by at least one workgroup: 768 threads get at
-    /// most 80): a way to run more warps per SM where the driver's compiler would otherwise
-    /// give a large kernel 128 registers and two workgroups of 256. Measured on the H200 it
-    /// made no workload's default faster at every size: Reyes frames as fast or slower at 768,
-    /// most trees slower; the large-payload tree faster at 512 at one size of four
-    /// (docs/scheduler.md 4; docs/results.md, 2026-12-03 (fifth session)).
-    pub workgroup_size: u32,
-    /// Workgroup steps per claimed batch (a step runs `workgroup_size / threads_per_item`
-    /// items), for every procedure not named in `procedure_batch_steps`.
-    pub batch_steps: u32,
-    /// Workgroup steps per batch of the procedures named here (`(name, steps)`), overriding
-    /// `batch_steps` for them: a batch's turn costs the same scheduling atomics however many
-    /// items it holds, so a procedure of few items a step (one grid of 256 threads) amortizes
-    /// them over more steps, while one of many small items keeps batches short and its
-    /// children published early. Default empty. A name that is not a procedure of the program
-    /// is an error of [`Megakernel::new`].
-    pub procedure_batch_steps: Vec<(String, u32)>,
-    /// Loop turns per workgroup per launch; far below lavapipe's 65,535-iteration cut. On
-    /// lavapipe that cut counts every loop iteration nested in the persistent loop, bodies'
-    /// loops included, so there it is lowered to [`LAVAPIPE_MAX_ITERATIONS`].
-    pub max_iterations: u32,
-    /// Polls of one slot's flag before it is abandoned to the next launch.
-    pub spin_limit: u32,
-    /// Longest pause of an idle workgroup between two polls for work, in trips of a chain of
-    /// dependent loads (each an L1 hit's latency, during which the warp issues almost nothing)
-    /// run by one warp, lanes 0-31, while the others wait at a barrier (docs/scheduler.md 2.2);
-    /// the pause doubles per idle turn up to this (each pause jittered between half and one and
-    /// a half times its length, so that workgroups idle since the same turn do not poll in
-    /// step) and ends at the first claimed batch. On the H200 32 is the best bound measured or
-    /// within about 2% of it on every tree, better than no pause (deep tree 1.364 against 1.588
-    /// ms), and the load chain beat the earlier multiply-add pause by up to 11% (deep tree;
-    /// docs/results.md, 2026-12-03 (second session), "an idle pause that waits on memory"). 0
-    /// polls without a pause (and is what lavapipe gets: its loop limiter counts the pause's
-    /// trips).
-    pub idle_backoff: u32,
-    /// Slots per queue at the start of a run (at least twice the seeds).
-    pub initial_capacity: u32,
-    /// A queue grows (at least doubling) up to this many slots, and never past its share of
-    /// the largest storage binding; beyond that the run reports [`RunError::QueueOverflow`].
-    pub max_capacity: u32,
-    /// Launches per run before it stops with [`RunError::NoProgress`] (default 10,000).
-    pub max_launches: u32,
-    /// How queues and outboxes hold items; `None` (the default) picks
-    /// [`ItemLayout::for_program`].
-    pub item_layout: Option<ItemLayout>,
-    /// Enqueue straight into the target queue's slots (a ticket per item, the batch's tickets
-    /// listed in workgroup memory for publishing) instead of into a per-workgroup outbox copied
-    /// out after the batch: saves a write and a read of every item, costs an atomic per item
-    /// instead of one per batch. Only where a batch's worst-case emits fit
-    /// [`MAX_DIRECT_EMITS`] (`Some(true)` where they do not: the outbox, with a warning).
-    /// `None` (the default): wherever a batch's tickets fit. Measured on
-    /// the H200: 64-word items 1.17 -> 0.80 ms, Reyes frames 1-4% faster (docs/results.md,
-    /// "Direct enqueue in the megakernel"); 3-word items were 6-25% slower until the turn lost
-    /// its fence after the run, and are now 2-7% faster on four trees of five (irregular 2%
-    /// slower; docs/results.md, 2026-12-02, "A cheaper megakernel turn").
-    pub direct_enqueue: Option<bool>,
-    /// Count what each loop turn spends per phase (claim, wait for flags, execute, enqueue,
-    /// reserve, copy, publish) and report it in [`RunStats::turn_anatomy`]: a few registers and one
-    /// atomic per counter per workgroup at exit. Off by default; when off the counters are
-    /// compiled out.
-    pub turn_anatomy: bool,
-    /// Take enqueue tickets once per subgroup (one atomic for all lanes of a subgroup that emit
-    /// to a queue at once) with wgpu's `SUBGROUP` operations, instead of one atomic per item.
-    /// `Some(false)` (the default): one atomic per item; measured on the H200 the subgroup path
-    /// was slower on the trees (binary 0.254 against 0.233 ms, large-payload 0.748 against
-    /// 0.730; docs/results.md, 2026-12-02), where a batch's lanes rarely emit to one queue at
-    /// once. `None`: where the device has them ([`Gpu::subgroups`]); `Some(true)` on a device
-    /// without them is an error.
-    pub subgroups: Option<bool>,
-    /// Start a run with the room the largest earlier run of this megakernel needed to finish in
-    /// one launch (default `true`): queues that had to grow (each growth a relaunch after a host
-    /// round trip) are not shrunk back to `initial_capacity`. `false` starts every run at
-    /// `initial_capacity` (tests use it to exercise growth run after run).
-    pub size_from_last_run: bool,
-    /// Keep the emits that procedures declare local ([`crate::Procedure::local`]) in the
-    /// workgroup's own area of the slots buffer and run them there next, before claiming from
-    /// the global queues (no ticket, flag or claim for them; docs/scheduler.md 2.7). No effect on
-    /// a program that declares nothing local. Default `false`: it pays where a batch's children
-    /// fill the workgroup's next step (H200: trees of a fixed fan-out of 2, binary 0.160 ->
-    /// 0.128 ms, heavy work 0.184 -> 0.172) and costs where lineages thin out (random
-    /// fan-out: deep 1.35 -> 1.69 ms; Reyes frames 3-5%); docs/results.md, 2026-12-03, "Local
-    /// queues in the slots buffer".
-    pub local_queues: bool,
-    /// Most bytes of one workgroup's local area, both buffers of every local target (default
-    /// [`LOCAL_MAX_BYTES`]: a full batch per buffer where it fits; split evenly between the
-    /// targets otherwise). A target whose share holds no item is not kept local, and where no
-    /// target is left the megakernel runs without local queues and warns. Global memory: the
-    /// slots buffer grows by the area in use (at most this) times the workgroups.
-    pub local_bytes: u32,
-}
-
-/// Most tickets one batch of a 256-thread workgroup may list for direct enqueue
-/// (`MegakernelConfig::direct_enqueue`): 8 KiB of workgroup memory, beside the 4 KiB of
-/// `wg_ready`, within the 16 KiB every Vulkan device offers. Larger workgroups may list this
-/// many per 256 threads, where the whole kernel's workgroup memory fits the device's limit.
-pub const MAX_DIRECT_EMITS: u32 = 2048;
-
-impl Default for MegakernelConfig {
-    fn default() -> Self {
-        MegakernelConfig {
-            workgroups: Workgroups::Probe { max: 4096 },
-            workgroup_size: WORKGROUP_SIZE,
-            policy: QueuePolicy::Priority(Vec::new()),
-            batch_steps: 1,
-            procedure_batch_steps: Vec::new(),
-            max_iterations: 16_384,
-            spin_limit: 4096,
-            idle_backoff: 32,
-            initial_capacity: 1 << 16,
-            max_capacity: 1 << 26,
-            max_launches: 10_000,
-            item_layout: None,
-            direct_enqueue: None,
-            turn_anatomy: false,
-            subgroups: Some(false),
-            size_from_last_run: true,
-            local_queues: false,
-            local_bytes: LOCAL_MAX_BYTES,
-        }
-    }
-}
 
 /// A program compiled for the persistent megakernel: one pipeline, queue buffers kept between
 /// runs, and the workgroup count (probed on the first run). Usually reached through
@@ -228,6 +63,8 @@ pub struct Megakernel {
 /// Buffers of one queue layout.
 struct DeviceQueues {
     layout: QueueLayout,
+    /// The workgroups whose local areas (in `slots`) and outbox parts the buffers hold.
+    workgroups: u32,
     ctrl: wgpu::Buffer,
     slots: wgpu::Buffer,
     flags: wgpu::Buffer,
@@ -538,6 +375,26 @@ impl Megakernel {
         workgroups as u64 * self.local_wg_words as u64
     }
 
+    /// The workgroups a run within `max_queue_bytes` launches: every one, unless their local
+    /// areas would take more than half of the budget; then as many as half of it holds (at
+    /// least one), with a warning. The local areas are a fixed size per workgroup (compiled
+    /// in), so a budget that suits the queues would otherwise fail on a GPU that runs many
+    /// workgroups (H200, 660 workgroups: a small tree's run under 1 MiB overflowed).
+    fn workgroups_within(&self, workgroups: u32, max_queue_bytes: Option<u64>) -> u32 {
+        let area = self.local_wg_words as u64 * 4;
+        let Some(budget) = max_queue_bytes else {
+            return workgroups;
+        };
+        if area * workgroups as u64 <= budget / 2 {
+            return workgroups;
+        }
+        let fit = (budget / 2 / area).clamp(1, workgroups as u64) as u32;
+        log::warn!(
+            "a queue memory budget of {budget} bytes holds the local queue areas ({area} bytes              each) of {fit} of the {workgroups} megakernel workgroups: this run launches {fit}              (raise the budget or lower local_bytes to run them all)"
+        );
+        fit
+    }
+
     /// What of a run's queue storage budget the queues may take: the budget less the
     /// workgroups' local areas.
     fn queue_budget(&self, max_queue_bytes: Option<u64>, workgroups: u32) -> Option<u64> {
@@ -597,6 +454,7 @@ impl Megakernel {
         );
         Ok(DeviceQueues {
             layout,
+            workgroups,
             ctrl,
             slots,
             flags,
@@ -654,7 +512,7 @@ impl Megakernel {
         max_queue_bytes: Option<u64>,
     ) -> Result<RunStats, RunError> {
         self.kernels.check_user_group(user)?;
-        let workgroups = self.workgroups(gpu, user)?;
+        let workgroups = self.workgroups_within(self.workgroups(gpu, user)?, max_queue_bytes);
         let start_time = Instant::now();
         let nq = self.program.queue_count();
         let RunStart {
@@ -718,7 +576,10 @@ impl Megakernel {
         let mut start = Start::Upload(live);
         loop {
             let layout = QueueLayout::new(&self.program, capacity.clone())?;
-            if dq.as_ref().is_none_or(|d| d.layout != layout) {
+            if dq
+                .as_ref()
+                .is_none_or(|d| d.layout != layout || d.workgroups != workgroups)
+            {
                 let outbox = match &start {
                     Start::Compact { old, .. } => Some(old.outbox.clone()),
                     Start::Upload(_) => None,

@@ -696,36 +696,45 @@ pub fn megakernel_procedure_steps(gpu: &scheduler::Gpu) -> Vec<(String, u32)> {
 
 impl TreeParams {
     /// Whether the megakernel should keep a workgroup's children local
-    /// (`MegakernelConfig::local_queues`; the program declares them local): where every node has
-    /// the same number of children, at least two, a batch's children fill the workgroup's next
-    /// step, so local batches stay full and skip the global queue's round trips. Where the
-    /// fan-out is random (mean at most 1.5 in the presets), a workgroup's lineages thin out and its
-    /// local batches shrink (deep: 39 items a batch against 248), costing more turns than the
-    /// claims they save. H200, median of 10 (docs/results.md, 2026-12-03, "Local queues in the
-    /// slots buffer"): binary 0.160 -> 0.128 ms, heavy work 0.184 -> 0.172, large-payload 0.567
-    /// -> 0.553; deep 1.35 -> 1.69, irregular 0.183 -> 0.19.
+    /// (`MegakernelConfig::local_queues`; the program declares them local): where the tree does
+    /// not thin out, a batch's children fill the workgroup's next steps, so its local batches stay
+    /// full and skip the global queue's round trips. That holds where every node has the same
+    /// number of children, one or more, and where a random fan-out of 0..=k has a mean above one
+    /// (k >= 3). Where the mean is one (deep: 0..=2), a workgroup's lineages die out and its
+    /// local batches shrink (39 items a batch against 248), costing more turns than the claims
+    /// they save. H200, median of 10 (docs/results.md, 2026-12-04, "A local batch without
+    /// barriers of its own"): binary 0.160 -> 0.122 ms, heavy work 0.184 -> 0.164, large-payload
+    /// 0.567 -> 0.534, irregular 0.183 -> 0.174, the one-item chain on one workgroup 8.53 ->
+    /// 5.12 ms; deep 1.33 -> 1.48.
     pub fn megakernel_local_queues(&self) -> bool {
-        matches!(self.fanout, Fanout::Fixed(k) if k >= 2)
+        match self.fanout {
+            Fanout::Fixed(k) => k >= 1,
+            Fanout::Uniform(k) => k >= 3,
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
-    /// Local queues where every node has the same two or more children, nowhere else.
+    /// Local queues where the tree does not thin out: a fixed fan-out of one or more, a random
+    /// one whose mean is above one.
     #[test]
-    fn local_queues_only_for_fixed_fanouts_of_two_or_more() {
+    fn local_queues_only_where_the_tree_does_not_thin_out() {
         use super::{Fanout, TreeParams, TreePreset};
         let chosen: Vec<bool> = TreePreset::ALL
             .iter()
             .map(|p| p.params().megakernel_local_queues())
             .collect();
         // binary, irregular, deep, large-payload, heavy work
-        assert_eq!(chosen, [true, false, false, true, true]);
-        let chain = TreeParams {
-            fanout: Fanout::Fixed(1),
+        assert_eq!(chosen, [true, true, false, true, true]);
+        let with = |fanout| TreeParams {
+            fanout,
             ..TreePreset::Binary.params()
         };
-        assert!(!chain.megakernel_local_queues());
+        assert!(with(Fanout::Fixed(1)).megakernel_local_queues());
+        assert!(!with(Fanout::Fixed(0)).megakernel_local_queues());
+        assert!(!with(Fanout::Uniform(2)).megakernel_local_queues());
+        assert!(with(Fanout::Uniform(4)).megakernel_local_queues());
     }
 
     /// The expected size is the exact count for fixed fanouts, the presets all run, and the
