@@ -62,8 +62,15 @@ fn small_suite_verifies_every_run_and_writes_its_report() {
         // The megakernel's records say what it ran with; the multi-passes' do not.
         if s.starts_with("megakernel") {
             assert_eq!(r["workgroup_size"], 256, "{w} {s} {size}");
+            // Local queues where the workload chose them: the trees that do not thin out.
+            let local = matches!(
+                w,
+                "tree-binary" | "tree-irregular" | "tree-large-payload" | "tree-heavy-work"
+            );
+            assert_eq!(r["local_queues"], local, "{w} {s} {size}");
         } else {
             assert!(r.get("workgroup_size").is_none(), "{w} {s} {size}");
+            assert!(r.get("local_queues").is_none(), "{w} {s} {size}");
         }
         if s == "multipass" && w.starts_with("tree") {
             assert!(r["rounds"].as_u64().unwrap() > 0, "{w} {size}: no rounds");

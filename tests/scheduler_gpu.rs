@@ -788,6 +788,7 @@ fn a_queue_memory_budget_is_kept_or_reported_as_overflow() {
         let budget = 1 << 20;
         let (stats, result) = run.run_within(&gpu, &s, Some(budget)).unwrap();
         assert!(stats.queue_bytes <= budget, "{kind:?}: {stats:?}");
+        assert!(!stats.local_queues, "{kind:?}: {stats:?}");
         assert_eq!(result, reference, "{kind:?}");
     }
     // The workgroups' local areas, in the slots buffer past the queues, count in the budget:
@@ -803,7 +804,7 @@ fn a_queue_memory_budget_is_kept_or_reported_as_overflow() {
     let local = Scheduler::megakernel(&gpu, &run.program, config).unwrap();
     let budget = 1 << 20;
     let (stats, result) = run.run_within(&gpu, &local, Some(budget)).unwrap();
-    assert!(stats.local_items > 0, "{stats:?}");
+    assert!(stats.local_items > 0 && stats.local_queues, "{stats:?}");
     assert!(stats.queue_bytes <= budget, "{stats:?}");
     assert!((1..4096).contains(&stats.workgroups), "{stats:?}");
     assert_eq!(result, reference);

@@ -231,6 +231,7 @@ mod tests {
             launches: 0,
             batches: 0,
             local_items: 0,
+            local_queues: None,
             idle_polls: 0,
             abandoned: 0,
             queue_growths: 0,

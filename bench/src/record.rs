@@ -58,6 +58,9 @@ pub struct RunRecord {
     /// Megakernel: items run from workgroups' local queues (`RunStats::local_items`).
     #[serde(default)]
     pub local_items: u64,
+    /// Megakernel: it ran with local queues (`RunStats::local_queues`); absent for the others.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub local_queues: Option<bool>,
     pub idle_polls: u64,
     pub abandoned: u64,
     pub queue_growths: u64,
@@ -115,6 +118,7 @@ impl RunRecord {
             item_layout: (!s.item_layout.is_empty()).then(|| s.item_layout.clone()),
             enqueue: (!s.enqueue.is_empty()).then(|| s.enqueue.clone()),
             workgroup_size: (s.workgroup_size > 0).then_some(s.workgroup_size),
+            local_queues: (s.workgroup_size > 0).then_some(s.local_queues),
             ..Self::failed(k, String::new())
         }
     }
@@ -146,6 +150,7 @@ impl RunRecord {
             launches: 0,
             batches: 0,
             local_items: 0,
+            local_queues: None,
             idle_polls: 0,
             abandoned: 0,
             queue_growths: 0,

@@ -171,9 +171,9 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
             let w = r
                 .workgroup_size
                 .map_or(String::new(), |w| format!(", {w} threads per workgroup"));
-            let local = match r.local_items {
-                0 => "",
-                _ => ", local queues",
+            let local = match r.local_queues {
+                Some(true) => ", local queues",
+                _ => "",
             };
             let line = format!("{}: {l} items{e}{w}{local}", r.strategy);
             if !queues.contains(&line) {

@@ -422,6 +422,7 @@ mod tests {
             launches: if mk { 3 } else { 0 },
             batches: 10,
             local_items: 0,
+            local_queues: None,
             idle_polls: 50,
             abandoned: 0,
             queue_growths: 0,

@@ -20,6 +20,9 @@ pub struct RunStats {
     /// Megakernel: items run from a workgroup's local queue ([`crate::Procedure::local`]),
     /// counted in `executed` too.
     pub local_items: u64,
+    /// Megakernel: it ran with local queues (`MegakernelConfig::local_queues`, and the program
+    /// declares a local emit that fits `local_bytes`), whether or not an item ran locally.
+    pub local_queues: bool,
     /// Megakernel: loop turns that found nothing to claim.
     pub idle_polls: u64,
     /// Kernel launches. Megakernel: persistent launches (a launch ends early at its loop bound or
@@ -79,6 +82,7 @@ impl RunStats {
         self.rounds += o.rounds;
         self.batches += o.batches;
         self.local_items += o.local_items;
+        self.local_queues |= o.local_queues;
         self.idle_polls += o.idle_polls;
         self.launches += o.launches;
         self.submits += o.submits;

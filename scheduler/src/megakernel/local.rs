@@ -53,8 +53,9 @@ impl LocalPlan {
         if targets.is_empty() {
             return plan;
         }
-        // Words of one buffer of each target, at most.
-        let share = bytes / 4 / 2 / targets.len() as u32;
+        // Words of one buffer of each target, at most: a multiple of 4, so that the buffer's
+        // rounding up to 16 bytes (`buffer_words`) stays within `bytes`.
+        let share = (bytes / 4 / 2 / targets.len() as u32) / 4 * 4;
         let mut off = 0;
         for &t in &targets {
             let words = program.procs[t].words();
@@ -170,6 +171,18 @@ mod tests {
                 .contains("LOCAL_EDGE: array<u32, 4> = array<u32, 4>(1u, 0u, 0u, 0u)")
         );
         assert!(!LocalPlan::none(2).active());
+        // Items of 3 words: every size's area stays within its bytes, 16-byte rounding included.
+        let node = ItemType::new("Node", "struct Node { id: u32, depth: u32, pad: u32 }");
+        let split = Procedure::new("split", node, 1)
+            .emits("split", 2)
+            .local("split")
+            .body("fn split_execute(item: Node, inv: Invocation) { enqueue_split(item); }");
+        let odd = Program::new(vec![split], UserBindings::none()).unwrap();
+        for bytes in (0..512).step_by(4) {
+            let plan = LocalPlan::new(&odd, &[256], bytes);
+            assert!(plan.wg_words * 4 <= bytes, "{bytes}: {plan:?}");
+            assert_eq!(plan.active(), bytes >= 32, "{bytes}: {plan:?}");
+        }
     }
 
     #[test]

@@ -214,6 +214,12 @@ impl Megakernel {
              {most_tickets})",
             if direct { "direct" } else { "outbox" }
         );
+        if config.local_queues && !program.has_local() {
+            log::warn!(
+                "megakernel: local queues are on, but no procedure keeps an emit local \
+                 (Procedure::local): running without them"
+            );
+        }
         if config.local_queues && program.has_local() {
             // In the slots buffer, past the queues: no workgroup memory.
             plan = local::LocalPlan::new(program, &batch, config.local_bytes);
@@ -221,8 +227,8 @@ impl Megakernel {
                 source = generate(&plan, direct);
             } else {
                 log::warn!(
-                    "megakernel: local queues asked for, but {} bytes per workgroup hold no item \
-                     of any local target: running without them",
+                    "megakernel: local queues are on, but {} bytes per workgroup (local_bytes) \
+                     hold no item of any local target: running without them",
                     config.local_bytes
                 );
             }
@@ -377,7 +383,7 @@ impl Megakernel {
 
     /// The workgroups a run within `max_queue_bytes` launches: every one, unless their local
     /// areas would take more than half of the budget; then as many as half of it holds (at
-    /// least one), with a warning. The local areas are a fixed size per workgroup (compiled
+    /// least one, which may then overflow), with a warning. The local areas are a fixed size per workgroup (compiled
     /// in), so a budget that suits the queues would otherwise fail on a GPU that runs many
     /// workgroups (H200, 660 workgroups: a small tree's run under 1 MiB overflowed).
     fn workgroups_within(&self, workgroups: u32, max_queue_bytes: Option<u64>) -> u32 {
@@ -388,9 +394,19 @@ impl Megakernel {
         if area * workgroups as u64 <= budget / 2 {
             return workgroups;
         }
-        let fit = (budget / 2 / area).clamp(1, workgroups as u64) as u32;
+        let fit = (budget / 2 / area).min(workgroups as u64) as u32;
+        if fit == 0 {
+            log::warn!(
+                "megakernel: a queue memory budget of {budget} bytes is less than twice one \
+                 workgroup's local queue area ({area} bytes): this run launches 1 workgroup, \
+                 and its queues may not fit (raise the budget or lower local_bytes)"
+            );
+            return 1;
+        }
         log::warn!(
-            "a queue memory budget of {budget} bytes holds the local queue areas ({area} bytes              each) of {fit} of the {workgroups} megakernel workgroups: this run launches {fit}              (raise the budget or lower local_bytes to run them all)"
+            "megakernel: a queue memory budget of {budget} bytes holds the local queue areas \
+             ({area} bytes each) of {fit} of the {workgroups} workgroups in half of it: this \
+             run launches {fit} (raise the budget or lower local_bytes to run them all)"
         );
         fit
     }
@@ -562,6 +578,7 @@ impl Megakernel {
             peak_occupancy: vec![0; nq],
             workgroups,
             workgroup_size: self.config.workgroup_size,
+            local_queues: self.local_wg_words > 0,
             turn_anatomy: self.config.turn_anatomy.then(anatomy::TurnAnatomy::default),
             ..Default::default()
         };

@@ -27,6 +27,7 @@ pub(crate) struct RecordedLaunch {
     item_layout: ItemLayout,
     direct: bool,
     workgroup_size: u32,
+    local_queues: bool,
 }
 
 impl Megakernel {
@@ -87,6 +88,7 @@ impl Megakernel {
             item_layout: self.item_layout(),
             direct: self.direct_enqueue(),
             workgroup_size: self.config.workgroup_size,
+            local_queues: self.local_wg_words > 0,
         };
         Ok((r, capacity))
     }
@@ -198,6 +200,7 @@ impl RecordedLaunch {
             launches: 1,
             workgroups: self.workgroups,
             workgroup_size: self.workgroup_size,
+            local_queues: self.local_queues,
             queue_bytes: self.dq.slots.size() + self.dq.layout.total_slots * 4,
             ..Default::default()
         };
