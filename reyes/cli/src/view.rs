@@ -362,8 +362,13 @@ impl Viewer {
             .expect("a free name")
     }
 
-    /// A key press; `Ok(true)` to quit.
-    fn key(&mut self, key: &Key) -> Result<bool, CliError> {
+    /// A key press; `Ok(true)` to quit. `repeat`: the press is the window system's autorepeat
+    /// of a held key; only [`steps_on_repeat`] keys act on those, so a held (or, on a busy
+    /// machine, a late-released) S saves one screenshot and M or O moves one step.
+    fn key(&mut self, key: &Key, repeat: bool) -> Result<bool, CliError> {
+        if repeat && !steps_on_repeat(key) {
+            return Ok(false);
+        }
         let s = &mut self.settings;
         let before = *s;
         match key {
@@ -434,6 +439,12 @@ impl Viewer {
     }
 }
 
+/// Keys that step a setting up or down (`[`, `]`, `+`, `=`, `-`): holding one keeps stepping,
+/// as held keys do in editors. Every other key acts once per press.
+fn steps_on_repeat(key: &Key) -> bool {
+    matches!(key, Key::Character(c) if matches!(c.as_str(), "[" | "]" | "+" | "=" | "-"))
+}
+
 impl ApplicationHandler for Viewer {
     fn new_events(&mut self, event_loop: &ActiveEventLoop, _cause: StartCause) {
         // A scripted run never hangs: no frame shown for the GPU's timeout is an error.
@@ -478,7 +489,7 @@ impl ApplicationHandler for Viewer {
                 }
             }
             WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
-                match self.key(&event.logical_key) {
+                match self.key(&event.logical_key, event.repeat) {
                     Ok(true) => event_loop.exit(),
                     Ok(false) => {}
                     Err(e) => self.fail(event_loop, e),
@@ -568,7 +579,7 @@ impl ApplicationHandler for Viewer {
 
 #[cfg(test)]
 mod tests {
-    use super::render_size;
+    use super::{Key, NamedKey, render_size, steps_on_repeat};
 
     /// A window that fits is rendered at its size; a larger one at the largest size of its
     /// aspect whose sub-samples fit one binding (and each side the renderer's limit).
@@ -589,5 +600,18 @@ mod tests {
         let (w, _) = render_size((4 * side, 10), (1, 1), u64::MAX);
         assert!(w <= side);
         assert_eq!(render_size((0, 0), (1, 1), 1), (1, 1));
+    }
+
+    /// Held S, M, O, R and Q act once; the stepping keys keep stepping.
+    #[test]
+    fn only_stepping_keys_act_on_autorepeat() {
+        let ch = |c: &str| Key::Character(c.into());
+        for c in ["s", "S", "m", "o", "r", "q", "1"] {
+            assert!(!steps_on_repeat(&ch(c)), "{c}");
+        }
+        for c in ["[", "]", "+", "=", "-"] {
+            assert!(steps_on_repeat(&ch(c)), "{c}");
+        }
+        assert!(!steps_on_repeat(&Key::Named(NamedKey::Escape)));
     }
 }
