@@ -70,8 +70,8 @@ const VIEW_CONTROLS: &str = "Controls: left drag orbits about the scene's centre
 middle drag pans; the wheel zooms (dollies towards the centre); M cycles the strategy \
 (megakernel, multipass, multipass-host); O cycles --occlusion (auto, on, off); [ and ] divide and multiply the micropolygon size \
 by sqrt 2; 1-4 set NxN pixel samples, + and - add or remove one per axis; R resets the camera; \
-S saves a screenshot PNG; Esc or Q quits. A held key acts once, except [ ] + - which keep \
-stepping. The title shows frames per second, wall and GPU \
+S saves a screenshot PNG; Esc or Q quits. A held key acts once, except [ ] + = - which \
+keep stepping. The title shows frames per second, wall and GPU \
 milliseconds, micropolygons, pieces culled by occlusion (or no culling), the strategy, \
 micropolygon size and samples.";
 

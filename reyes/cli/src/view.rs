@@ -248,7 +248,12 @@ impl Viewer {
             self.rebuild = false;
         }
         let r = st.renderer.as_mut().expect("made above");
-        let culling = r.occlusion();
+        // Pipelined frames cull from the previous frame where the renderer chose to; frames
+        // that are not pipelined cull as `reyes render` does, unless occlusion is off.
+        let culling = match r.not_pipelined() {
+            Some(_) => self.settings.occlusion != Occlusion::Off,
+            None => r.occlusion(),
+        };
         let transform = self.camera.transform(r.centre());
         let frame = (r.render_transforms(&st.gpu, &[transform], &NoProgress))?
             .pop()
