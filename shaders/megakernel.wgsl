@@ -84,6 +84,8 @@ const CMD_RUN: u32 = 1u;
 const CMD_EXIT: u32 = 2u;
 const CMD_LOCAL: u32 = 3u;   // run the items of local queue q held in the workgroup; the credit covers their output
 const CMD_LOCAL_RESERVE: u32 = 4u; // the same, once the budget has room for what the credit does not cover
+// After a local batch, the early probe is read only on every LOCAL_PROBE_EVERY-th turn (LOCAL).
+const LOCAL_PROBE_EVERY: u32 = 8u;
 
 @group(0) @binding(0) var<storage, read_write> ctrl: array<atomic<u32>>;
 @group(0) @binding(2) var<storage, read_write> flags: array<atomic<u32>>;
@@ -629,7 +631,18 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         // The next turn's probe, issued now: its round trip overlaps the release fence and the
         // publish instead of opening the next turn. Kept in a register until the count adds
         // are issued, then completed with this batch's own published items.
-        let early = probe_load(lid);
+        // After a local batch the next turn most likely runs held work, which the leader takes
+        // before it reads any count, so the probe is read on one such turn in LOCAL_PROBE_EVERY
+        // only and the others keep the last one's values (H200: the one-item chain 2.44 -> 2.36
+        // us a turn, irregular tree 0.167 -> 0.164 ms; docs/results.md, 2026-12-04 (second
+        // session)). Every stale value is safe: held work runs first; a stale count only makes
+        // the leader try a claim (the overshoot given back) or idle one turn, whose probe is
+        // fresh; a stale pending is never a false 0 (0 is final); a stale stop delays the exit
+        // by at most LOCAL_PROBE_EVERY - 1 batches; a stale idle count only sets how much a
+        // batch keeps (local_limits).
+        let fresh = !from_local || iter % LOCAL_PROBE_EVERY == LOCAL_PROBE_EVERY - 1u;
+        var early = 0u;
+        if fresh { early = probe_load(lid); }
         workgroupBarrier();
         if lid == 0u {
             // Pending: + the children, - this batch, in one atomic. The children are counted
@@ -735,7 +748,7 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         }
         var own = 0u;
         if lid < NQ { own = wg_emit_n[prio(lid)]; }
-        probe_store(lid, early, own);
+        if fresh { probe_store(lid, early, own); }
         probed = true;
     }
     // Items still held locally go to the global queues for the next launch.
