@@ -636,10 +636,11 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         // only and the others keep the last one's values (H200: the one-item chain 2.44 -> 2.36
         // us a turn, irregular tree 0.167 -> 0.164 ms; docs/results.md, 2026-12-04 (second
         // session)). Every stale value is safe: held work runs first; a stale count only makes
-        // the leader try a claim (the overshoot given back) or idle one turn, whose probe is
-        // fresh; a stale pending is never a false 0 (0 is final); a stale stop delays the exit
-        // by at most LOCAL_PROBE_EVERY - 1 batches; a stale idle count only sets how much a
-        // batch keeps (local_limits).
+        // the leader try a claim (the overshoot given back), idle one turn, whose probe is
+        // fresh, or, once a queue refused this workgroup room, end the launch one relaunch
+        // early; a stale pending is never a false 0 (0 is final); a stop is seen within
+        // LOCAL_PROBE_EVERY batches; a stale idle count only sets how much a batch keeps
+        // (local_limits).
         let fresh = !from_local || iter % LOCAL_PROBE_EVERY == LOCAL_PROBE_EVERY - 1u;
         var early = 0u;
         if fresh { early = probe_load(lid); }

@@ -249,8 +249,9 @@ fn a_scripted_view_saves_reyes_render_s_image() {
 ///
 /// The server autorepeats a held key after 20 ms (`-ardelay`, every 20 ms after that), so the
 /// held S sends repeats whenever the server runs while it is down: the first S is held until
-/// its screenshot is written and 300 ms more. (With the default 660 ms, a busy machine that delayed xdotool's
-/// release past it once made the viewer save a repeat's second screenshot before the drag.)
+/// its screenshot is written and 300 ms more. (With the default 660 ms, a busy machine that
+/// delayed xdotool's release past it once made the viewer save a repeat's second screenshot
+/// before the drag.)
 /// On a machine too busy to repeat, the check is weaker, never wrong.
 #[test]
 fn keys_save_screenshots_and_a_drag_orbits() {

@@ -705,10 +705,11 @@ impl TreeParams {
     /// they save. H200, median of 10 (docs/results.md, 2026-12-04, "A local batch without
     /// barriers of its own"): binary 0.160 -> 0.122 ms, heavy work 0.184 -> 0.164, large-payload
     /// 0.567 -> 0.534, irregular 0.183 -> 0.174, the one-item chain on one workgroup 8.53 ->
-    /// 5.12 ms; deep 1.33 -> 1.48. With the probe skipped after local batches (2026-12-04,
-    /// second session) local queues pay for deep trees of up to about 5,000 roots (1,250 roots
-    /// 1.29 -> 1.16 ms) and still cost at the preset's 20,000 (1.34 -> 1.38); the choice stays by
-    /// fan-out, since a rule by roots would need the launch's width, which the tree does not know.
+    /// 5.12 ms; deep 1.33 -> 1.48. Deep trees of few roots gain from them (2026-12-04, second
+    /// session, without against with local queues, same build: 1,250 roots 1.29 / 1.16 ms, 5,000
+    /// roots 1.31 / 1.26; sizes between 5,000 and 20,000 not measured), the preset's 20,000 roots
+    /// lose (1.34 / 1.38); the choice stays by fan-out, since a rule by roots would need the
+    /// launch's width, which the tree does not know.
     pub fn megakernel_local_queues(&self) -> bool {
         match self.fanout {
             Fanout::Fixed(k) => k >= 1,
