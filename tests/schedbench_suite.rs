@@ -177,6 +177,45 @@ fn procedure_steps_name_the_workloads_procedures() {
     }
 }
 
+/// `--priority` names the workload's procedures, once each, and orders the priority policy
+/// only: anything else is a usage error (exit 2) before anything runs. A valid order runs, every
+/// result checked against the CPU reference (exit 0).
+#[test]
+fn priority_orders_the_workloads_procedures() {
+    for (args, expected) in [
+        (&["--priority", "bound"][..], "its procedures: branch, leaf"),
+        (&["--priority", "leaf,leaf"], "given twice"),
+        (
+            &["--priority", "leaf", "--policy", "fifo"],
+            "--policy priority",
+        ),
+    ] {
+        assert_usage_error(args, expected);
+    }
+    let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
+        .args([
+            "--workload",
+            "tree",
+            "--roots",
+            "2",
+            "--depth",
+            "6",
+            "--strategy",
+        ])
+        .args(["megakernel", "--runs", "1", "--priority", "leaf,branch"])
+        .output()
+        .expect("schedbench runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        table
+            .lines()
+            .any(|l| l.starts_with("megakernel") && l.contains(" true ")),
+        "{table}"
+    );
+}
+
 /// `schedbench --strategy cpu ARGS` exits 2 (a usage error) with `expected` in its message.
 fn assert_usage_error(args: &[&str], expected: &str) {
     let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))

@@ -129,6 +129,18 @@ pub struct Cli {
     #[arg(long, value_enum, default_value_t = Policy::Priority, help_heading = "Scheduler")]
     pub policy: Policy,
 
+    /// The megakernel's queue order under --policy priority: procedure names, highest first,
+    /// comma-separated; procedures not named follow, later ones first (`QueuePolicy::Priority`).
+    /// E.g. `bound,splitu,splitv,diceshade,dicesmall` runs Reyes breadth first (docs/results.md,
+    /// 2026-12-04 (second session)) [default: later procedures first, which keeps queues short].
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_name = "NAMES",
+        help_heading = "Scheduler"
+    )]
+    pub priority: Vec<String>,
+
     /// Megakernel workgroup steps per claimed batch [default: the workload's: 2 for Reyes frames
     /// on a GPU, as `reyes render` runs them (`reyes::gpu_render::megakernel_batch_steps`), else 1].
     #[arg(long, value_parser = value_parser!(u32).range(1..=64), help_heading = "Scheduler")]
@@ -350,7 +362,38 @@ impl Cli {
                     .into(),
             );
         }
+        if !self.priority.is_empty()
+            && (self.policy != Policy::Priority || self.suite && self.workload.is_none())
+        {
+            Self::usage_error(
+                ErrorKind::ArgumentConflict,
+                "--priority orders --policy priority's queues, and with --suite needs --workload \
+                 (procedures are a workload's)"
+                    .into(),
+            );
+        }
         let known = workload.procedures();
+        let mut named = Vec::new();
+        for name in &self.priority {
+            if !known.contains(&name.as_str()) {
+                Self::usage_error(
+                    ErrorKind::ValueValidation,
+                    format!(
+                        "--priority: `{name}` is no procedure of --workload {} (its procedures: \
+                         {})",
+                        workload.name(),
+                        known.join(", ")
+                    ),
+                );
+            }
+            if named.contains(name) {
+                Self::usage_error(
+                    ErrorKind::ValueValidation,
+                    format!("--priority: `{name}` given twice"),
+                );
+            }
+            named.push(name.clone());
+        }
         let mut seen = Vec::new();
         for (name, _) in &self.procedure_steps {
             if !known.contains(&name.as_str()) {
@@ -395,6 +438,7 @@ impl Cli {
             procedure_steps: (!self.procedure_steps.is_empty())
                 .then(|| self.procedure_steps.clone()),
             idle_backoff: self.idle_backoff,
+            priority: self.priority.clone(),
             capacity: self.capacity,
             turn_anatomy: self.turn_anatomy,
             subgroups: match self.subgroups {

@@ -25,9 +25,11 @@ impl Policy {
         }
     }
 
-    pub fn queue_policy(self) -> QueuePolicy {
+    /// The scheduler's policy; `order`: the procedures named first under `Priority`
+    /// (`schedbench --priority`), ignored under `Fifo`.
+    pub fn queue_policy(self, order: &[String]) -> QueuePolicy {
         match self {
-            Policy::Priority => QueuePolicy::Priority(Vec::new()),
+            Policy::Priority => QueuePolicy::Priority(order.to_vec()),
             Policy::Fifo => QueuePolicy::Fifo,
         }
     }
@@ -136,6 +138,9 @@ pub struct GpuConfig {
     pub procedure_steps: Option<Vec<(String, u32)>>,
     /// Longest pause of an idle megakernel workgroup (`MegakernelConfig::idle_backoff`).
     pub idle_backoff: u32,
+    /// Procedures named first in the priority policy's order (`QueuePolicy::Priority`); empty:
+    /// the default order.
+    pub priority: Vec<String>,
     /// How the queues hold items (`MegakernelConfig::item_layout`); `None`: `ItemLayout::for_program`.
     pub item_layout: Option<ItemLayout>,
     /// `MegakernelConfig::direct_enqueue`; `None`: direct wherever a batch's tickets fit.
@@ -163,6 +168,7 @@ impl Default for GpuConfig {
             batch_steps: None,
             procedure_steps: None,
             idle_backoff: MegakernelConfig::default().idle_backoff,
+            priority: Vec::new(),
             item_layout: None,
             direct_enqueue: None,
             capacity: None,
@@ -215,7 +221,7 @@ pub fn compile(
                 workgroup_size: config
                     .workgroup_size
                     .unwrap_or(MegakernelConfig::default().workgroup_size),
-                policy: policy.queue_policy(),
+                policy: policy.queue_policy(&config.priority),
                 batch_steps: config.batch_steps.unwrap_or(1),
                 procedure_batch_steps: config.procedure_steps.clone().unwrap_or_default(),
                 idle_backoff: config.idle_backoff,
