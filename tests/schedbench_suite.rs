@@ -177,42 +177,83 @@ fn procedure_steps_name_the_workloads_procedures() {
     }
 }
 
-/// `--priority` names the workload's procedures, once each, and orders the priority policy
-/// only: anything else is a usage error (exit 2) before anything runs. A valid order runs, every
-/// result checked against the CPU reference (exit 0).
+/// `--priority` names the workload's procedures, each once and none empty, and orders the
+/// priority policy's queues: a FIFO megakernel, or a suite without a workload, is a usage error
+/// (exit 2) before anything runs. The order reaches the scheduler: on one workgroup (the run is
+/// then deterministic) the tree's branches first hold more leaves waiting than the default,
+/// leaves first, and each record's `queue_order` is the order asked for, completed.
 #[test]
 fn priority_orders_the_workloads_procedures() {
+    let dir = tempfile::tempdir().unwrap();
+    let suite = dir.path().join("suite");
+    let suite = suite.to_str().unwrap();
     for (args, expected) in [
         (&["--priority", "bound"][..], "its procedures: branch, leaf"),
         (&["--priority", "leaf,leaf"], "given twice"),
+        (&["--priority", "leaf,"], "an empty name"),
+        (&["--priority", "leaf", "--policy", "fifo"], "not FIFO's"),
         (
-            &["--priority", "leaf", "--policy", "fifo"],
-            "--policy priority",
+            &["--priority", "leaf", "--strategy", "megakernel-fifo"],
+            "not FIFO's",
+        ),
+        (
+            &[
+                "--suite",
+                "--size",
+                "small",
+                "--priority",
+                "leaf",
+                "--out",
+                suite,
+            ],
+            "--priority with --suite needs --workload",
         ),
     ] {
-        assert_usage_error(args, expected);
+        let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
+            .args(args)
+            .output()
+            .expect("schedbench runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(expected), "{args:?}: {err}");
     }
-    let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
-        .args([
-            "--workload",
-            "tree",
-            "--roots",
-            "2",
-            "--depth",
-            "6",
-            "--strategy",
-        ])
-        .args(["megakernel", "--runs", "1", "--priority", "leaf,branch"])
-        .output()
-        .expect("schedbench runs");
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(0), "{err}");
-    let table = String::from_utf8_lossy(&out.stdout);
     assert!(
-        table
+        !dir.path().join("suite").exists(),
+        "a refused suite writes nothing"
+    );
+    let run = |order: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
+            .args(["--workload", "tree", "--roots", "2", "--depth", "10"])
+            .args([
+                "--strategy",
+                "megakernel",
+                "--workgroups",
+                "1",
+                "--no-local-queues",
+            ])
+            .args(["--runs", "1", "--json"])
+            .args(order)
+            .output()
+            .expect("schedbench runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "{order:?}: {err}");
+        let line = String::from_utf8_lossy(&out.stdout)
             .lines()
-            .any(|l| l.starts_with("megakernel") && l.contains(" true ")),
-        "{table}"
+            .next()
+            .unwrap()
+            .to_string();
+        let r: serde_json::Value = serde_json::from_str(&line).unwrap();
+        assert_eq!(r["verified"], true, "{line}");
+        let leaves_waiting = r["peak_occupancy"][1].as_u64().unwrap();
+        (r["queue_order"].clone(), leaves_waiting)
+    };
+    let (default_order, default_peak) = run(&[]);
+    let (branch_order, branch_peak) = run(&["--priority", "branch"]);
+    assert_eq!(default_order, serde_json::json!(["leaf", "branch"]));
+    assert_eq!(branch_order, serde_json::json!(["branch", "leaf"]));
+    assert!(
+        branch_peak > default_peak,
+        "{branch_peak} <= {default_peak}"
     );
 }
 

@@ -129,10 +129,12 @@ pub struct Cli {
     #[arg(long, value_enum, default_value_t = Policy::Priority, help_heading = "Scheduler")]
     pub policy: Policy,
 
-    /// The megakernel's queue order under --policy priority: procedure names, highest first,
-    /// comma-separated; procedures not named follow, later ones first (`QueuePolicy::Priority`).
-    /// E.g. `bound,splitu,splitv,diceshade,dicesmall` runs Reyes breadth first (docs/results.md,
-    /// 2026-12-04 (second session)) [default: later procedures first, which keeps queues short].
+    /// The megakernel's queue order under --policy priority (for --strategy megakernel and all):
+    /// procedure names, highest first, comma-separated; those not named follow, later ones first
+    /// (`QueuePolicy::Priority`; the records' `queue_order` gives the order run). Names as for
+    /// --procedure-steps. E.g. `bound,splitu,splitv,diceshade,dicesmall` runs Reyes breadth first
+    /// (docs/results.md, 2026-12-04 (second session)) [default: later procedures first, which
+    /// keeps queues short: tree leaf,branch; reyes dicesmall,diceshade,splitv,splitu,bound].
     #[arg(
         long,
         value_delimiter = ',',
@@ -362,19 +364,29 @@ impl Cli {
                     .into(),
             );
         }
-        if !self.priority.is_empty()
-            && (self.policy != Policy::Priority || self.suite && self.workload.is_none())
-        {
-            Self::usage_error(
-                ErrorKind::ArgumentConflict,
-                "--priority orders --policy priority's queues, and with --suite needs --workload \
-                 (procedures are a workload's)"
-                    .into(),
-            );
+        if !self.priority.is_empty() {
+            if self.policy != Policy::Priority || self.strategy == "megakernel-fifo" {
+                Self::usage_error(
+                    ErrorKind::ArgumentConflict,
+                    "--priority orders the queues of the priority policy, not FIFO's".into(),
+                );
+            }
+            if self.suite && self.workload.is_none() {
+                Self::usage_error(
+                    ErrorKind::ArgumentConflict,
+                    "--priority with --suite needs --workload (procedures are a workload's)".into(),
+                );
+            }
         }
         let known = workload.procedures();
         let mut named = Vec::new();
         for name in &self.priority {
+            if name.trim().is_empty() {
+                Self::usage_error(
+                    ErrorKind::ValueValidation,
+                    "--priority: an empty name (names are separated by commas alone)".into(),
+                );
+            }
             if !known.contains(&name.as_str()) {
                 Self::usage_error(
                     ErrorKind::ValueValidation,

@@ -232,6 +232,7 @@ mod tests {
             batches: 0,
             local_items: 0,
             local_queues: None,
+            queue_order: None,
             idle_polls: 0,
             abandoned: 0,
             queue_growths: 0,

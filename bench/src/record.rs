@@ -61,6 +61,10 @@ pub struct RunRecord {
     /// Megakernel: it ran with local queues (`RunStats::local_queues`); absent for the others.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub local_queues: Option<bool>,
+    /// Megakernel under the priority policy: the order its workgroups try the queues
+    /// (`RunStats::queue_order`, `schedbench --priority`); absent for the others.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub queue_order: Option<Vec<String>>,
     pub idle_polls: u64,
     pub abandoned: u64,
     pub queue_growths: u64,
@@ -119,6 +123,7 @@ impl RunRecord {
             enqueue: (!s.enqueue.is_empty()).then(|| s.enqueue.clone()),
             workgroup_size: (s.workgroup_size > 0).then_some(s.workgroup_size),
             local_queues: (s.workgroup_size > 0).then_some(s.local_queues),
+            queue_order: (!s.queue_order.is_empty()).then(|| s.queue_order.clone()),
             ..Self::failed(k, String::new())
         }
     }
@@ -151,6 +156,7 @@ impl RunRecord {
             batches: 0,
             local_items: 0,
             local_queues: None,
+            queue_order: None,
             idle_polls: 0,
             abandoned: 0,
             queue_growths: 0,

@@ -290,7 +290,8 @@ pub fn markdown(h: &Header, records: &[RunRecord]) -> String {
          baseline's: the fastest verified strategy other than the megakernel (multi-pass, \
          `cpu` = the workload's multi-threaded CPU implementation, or the workload's own \
          baseline) at the same size in this invocation; below 1 is faster. `megakernel` uses \
-         the priority queue policy (the default), `megakernel-fifo` the FIFO one. Reyes' `cpu` \
+         the priority queue policy (the default; each record's `queue_order` gives its order), \
+         `megakernel-fifo` the FIFO one. Reyes' `cpu` \
          is its CPU twin `reyes::cpu_render`, one thread.\n"
     );
     let all = cells(records);

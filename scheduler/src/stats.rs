@@ -23,6 +23,10 @@ pub struct RunStats {
     /// Megakernel: it ran with local queues (`MegakernelConfig::local_queues`, and the program
     /// declares a local emit that fits `local_bytes`), whether or not an item ran locally.
     pub local_queues: bool,
+    /// Megakernel under the priority policy: the procedures in the order its workgroups try
+    /// their queues (`QueuePolicy::Priority`, the default order completed); empty under FIFO
+    /// and for the other strategies.
+    pub queue_order: Vec<String>,
     /// Megakernel: loop turns that found nothing to claim.
     pub idle_polls: u64,
     /// Kernel launches. Megakernel: persistent launches (a launch ends early at its loop bound or
@@ -83,6 +87,9 @@ impl RunStats {
         self.batches += o.batches;
         self.local_items += o.local_items;
         self.local_queues |= o.local_queues;
+        if self.queue_order.is_empty() {
+            self.queue_order = o.queue_order.clone();
+        }
         self.idle_polls += o.idle_polls;
         self.launches += o.launches;
         self.submits += o.submits;

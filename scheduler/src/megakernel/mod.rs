@@ -579,6 +579,12 @@ impl Megakernel {
             workgroups,
             workgroup_size: self.config.workgroup_size,
             local_queues: self.local_wg_words > 0,
+            queue_order: match self.config.policy {
+                QueuePolicy::Priority(_) => (self.priority.iter())
+                    .map(|&q| self.program.procs[q as usize].proc.name.clone())
+                    .collect(),
+                QueuePolicy::Fifo => Vec::new(),
+            },
             turn_anatomy: self.config.turn_anatomy.then(anatomy::TurnAnatomy::default),
             ..Default::default()
         };
