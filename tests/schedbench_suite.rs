@@ -209,13 +209,7 @@ fn priority_orders_the_workloads_procedures() {
             "--priority with --suite needs --workload",
         ),
     ] {
-        let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
-            .args(args)
-            .output()
-            .expect("schedbench runs");
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
-        assert!(err.contains(expected), "{args:?}: {err}");
+        assert_exits_2(args, expected);
     }
     assert!(
         !dir.path().join("suite").exists(),
@@ -259,8 +253,12 @@ fn priority_orders_the_workloads_procedures() {
 
 /// `schedbench --strategy cpu ARGS` exits 2 (a usage error) with `expected` in its message.
 fn assert_usage_error(args: &[&str], expected: &str) {
+    assert_exits_2(&[&["--strategy", "cpu"][..], args].concat(), expected);
+}
+
+/// `schedbench ARGS` exits 2 (a usage error) with `expected` in its message.
+fn assert_exits_2(args: &[&str], expected: &str) {
     let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
-        .args(["--strategy", "cpu"])
         .args(args)
         .output()
         .expect("schedbench runs");
