@@ -356,76 +356,60 @@ impl Cli {
                 );
             }
         }
-        // Procedure names are the workload's: checked here, before anything runs.
-        if self.suite && self.workload.is_none() && !self.procedure_steps.is_empty() {
+        if !self.priority.is_empty()
+            && (self.policy != Policy::Priority || self.strategy == "megakernel-fifo")
+        {
             Self::usage_error(
                 ErrorKind::ArgumentConflict,
-                "--procedure-steps with --suite needs --workload (procedures are a workload's)"
-                    .into(),
+                "--priority orders the queues of the priority policy, not FIFO's".into(),
             );
         }
-        if !self.priority.is_empty() {
-            if self.policy != Policy::Priority || self.strategy == "megakernel-fifo" {
-                Self::usage_error(
-                    ErrorKind::ArgumentConflict,
-                    "--priority orders the queues of the priority policy, not FIFO's".into(),
-                );
-            }
-            if self.suite && self.workload.is_none() {
-                Self::usage_error(
-                    ErrorKind::ArgumentConflict,
-                    "--priority with --suite needs --workload (procedures are a workload's)".into(),
-                );
-            }
+        if self.priority.iter().any(|n| n.trim().is_empty()) {
+            Self::usage_error(
+                ErrorKind::ValueValidation,
+                "--priority: an empty name (names are separated by commas alone)".into(),
+            );
+        }
+        // Procedure names are the workload's: checked here, before anything runs.
+        self.check_procedure_names("--priority", &self.priority, workload);
+        let steps: Vec<String> = self
+            .procedure_steps
+            .iter()
+            .map(|(n, _)| n.clone())
+            .collect();
+        self.check_procedure_names("--procedure-steps", &steps, workload);
+    }
+
+    /// `names`, given to `flag`: each a procedure of `workload`, none twice, and with --suite
+    /// only beside --workload; else a usage error (exit 2) naming the flag and the procedures.
+    fn check_procedure_names(&self, flag: &str, names: &[String], workload: WorkloadName) {
+        if names.is_empty() {
+            return;
+        }
+        if self.suite && self.workload.is_none() {
+            Self::usage_error(
+                ErrorKind::ArgumentConflict,
+                format!("{flag} with --suite needs --workload (procedures are a workload's)"),
+            );
         }
         let known = workload.procedures();
-        let mut named = Vec::new();
-        for name in &self.priority {
-            if name.trim().is_empty() {
-                Self::usage_error(
-                    ErrorKind::ValueValidation,
-                    "--priority: an empty name (names are separated by commas alone)".into(),
-                );
-            }
+        for (i, name) in names.iter().enumerate() {
             if !known.contains(&name.as_str()) {
                 Self::usage_error(
                     ErrorKind::ValueValidation,
                     format!(
-                        "--priority: `{name}` is no procedure of --workload {} (its procedures: \
-                         {})",
+                        "{flag}: `{name}` is no procedure of --workload {} (its procedures: {})",
                         workload.name(),
                         known.join(", ")
                     ),
                 );
             }
-            if named.contains(name) {
+            if names[..i].contains(name) {
                 Self::usage_error(
                     ErrorKind::ValueValidation,
-                    format!("--priority: `{name}` given twice"),
+                    format!("{flag}: `{name}` given twice"),
                 );
             }
-            named.push(name.clone());
-        }
-        let mut seen = Vec::new();
-        for (name, _) in &self.procedure_steps {
-            if !known.contains(&name.as_str()) {
-                Self::usage_error(
-                    ErrorKind::ValueValidation,
-                    format!(
-                        "--procedure-steps: `{name}` is no procedure of --workload {} (its \
-                         procedures: {})",
-                        workload.name(),
-                        known.join(", ")
-                    ),
-                );
-            }
-            if seen.contains(name) {
-                Self::usage_error(
-                    ErrorKind::ValueValidation,
-                    format!("--procedure-steps: `{name}` given twice"),
-                );
-            }
-            seen.push(name.clone());
         }
     }
 
