@@ -134,6 +134,7 @@ var<private> sched_proc: u32;
 var<private> sched_active: bool;
 var<private> sched_batch_n: u32;
 var<private> sched_outbox: u32;
+var<private> sched_workgroups: u32; // of this launch (GUIDED_CLAIMS)
 var<private> sched_blocked: bool; // some queue refused this workgroup room in this launch
 var<private> sched_pause_sink: u32;
 // Statistics of the lane's own queue (lane t < NQ: queue t), added to ctrl once at exit.
@@ -247,7 +248,13 @@ fn sched_direct_slot(t: u32) -> u32 {
 // workgroup claims from q no more in this launch.
 fn try_claim(q: u32, avail: i32) -> bool {
     if avail <= 0 || sched_refused(q) { return false; }
-    let want = min(u32(avail), batch_max(q));
+    var want = min(u32(avail), batch_max(q));
+    if GUIDED_CLAIMS {
+        // Guided self-scheduling: at most this workgroup's share of all that is pending (the
+        // probe's G_PENDING, possibly stale: a heuristic only), one step's worth at least.
+        let share = wg_pending / sched_workgroups + select(0u, 1u, wg_pending % sched_workgroups != 0u);
+        want = min(want, max(share, WG_SIZE / THREADS[q]));
+    }
     an_add(AN_CLAIM, 1u);
     let old = bitcast<i32>(atomicSub(&ctrl[q * QSTRIDE + Q_COUNT], want));
     let got = u32(clamp(old, 0, i32(want)));
@@ -439,11 +446,13 @@ fn probe(lid: u32) {
 }
 
 @compute @workgroup_size(WG_SIZE)
-fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>) {
+fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>,
+              @builtin(num_workgroups) nwg: vec3<u32>) {
     if params[P_PROBE] != 0u {
         probe(lid);
         return;
     }
+    sched_workgroups = nwg.x;
     sched_outbox = wid.x * params[P_OUTBOX_STRIDE];
     sched_local_wg = params[P_LOCAL_BASE] + wid.x * LOCAL_WG_WORDS;
     if LOCAL && lid < NQ { // ordered by the probe's barrier

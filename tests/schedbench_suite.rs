@@ -251,6 +251,43 @@ fn priority_orders_the_workloads_procedures() {
     );
 }
 
+/// `--guided-claims` and `--no-guided-claims` reach the megakernel and its records say which
+/// ran (`guided_claims`); the tree's default is off; both at once are a usage error.
+#[test]
+fn guided_claims_are_asked_for_and_recorded() {
+    assert_exits_2(
+        &[
+            "--workload",
+            "tree",
+            "--guided-claims",
+            "--no-guided-claims",
+        ],
+        "cannot be used with",
+    );
+    let guided = |flag: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
+            .args(["--workload", "tree", "--roots", "2", "--depth", "8"])
+            .args(["--strategy", "megakernel", "--workgroups", "3"])
+            .args(["--runs", "1", "--json"])
+            .args(flag)
+            .output()
+            .expect("schedbench runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "{flag:?}: {err}");
+        let line = String::from_utf8_lossy(&out.stdout)
+            .lines()
+            .next()
+            .unwrap()
+            .to_string();
+        let r: serde_json::Value = serde_json::from_str(&line).unwrap();
+        assert_eq!(r["verified"], true, "{line}");
+        r["guided_claims"].clone()
+    };
+    assert_eq!(guided(&[]), serde_json::json!(false));
+    assert_eq!(guided(&["--guided-claims"]), serde_json::json!(true));
+    assert_eq!(guided(&["--no-guided-claims"]), serde_json::json!(false));
+}
+
 /// `schedbench --strategy cpu ARGS` exits 2 (a usage error) with `expected` in its message.
 fn assert_usage_error(args: &[&str], expected: &str) {
     assert_exits_2(&[&["--strategy", "cpu"][..], args].concat(), expected);

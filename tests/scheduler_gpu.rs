@@ -245,6 +245,21 @@ fn stress_configs() -> Vec<(&'static str, MegakernelConfig)> {
             },
         ),
         (
+            // Claims cut to each workgroup's share of the pending items: more, smaller
+            // batches, the same results.
+            "guided claims, steps per procedure, tiny queues, short launches",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(3),
+                guided_claims: true,
+                procedure_batch_steps: vec![("leaf".into(), 4)],
+                batch_steps: 2,
+                max_iterations: 24,
+                spin_limit: 1,
+                initial_capacity: 16,
+                ..base.clone()
+            },
+        ),
+        (
             "oversubscribed",
             MegakernelConfig {
                 workgroups: Workgroups::Fixed(24),
@@ -962,6 +977,104 @@ fn every_thread_that_calls_enqueue_adds_an_item_on_every_strategy() {
                 "{kind:?}"
             ),
             other => panic!("{kind:?}: expected an emit-limit error, got {other:?}"),
+        }
+    }
+}
+
+/// Guided claims (`MegakernelConfig::guided_claims`) take at most a workgroup's share of the
+/// pending items, ceil(pending / workgroups), one step at least: 64 items of a 64-thread
+/// procedure (4 a step, batches of up to 32 at 8 steps) need at least 64 / ceil(64 / 8) = 8
+/// batches on 8 workgroups, where whole batches could take them in 2; on one workgroup the share
+/// is everything, so guided or not, exactly 2 batches. Every item runs once either way.
+#[test]
+fn guided_claims_take_a_workgroups_share_of_the_pending_items() {
+    let gpu = gpu();
+    let n = 64u32;
+    let item = ItemType::new("Word", "struct Word { v: u32 }");
+    let wide = Procedure::new("wide", item, 64).body(
+        "fn wide_execute(item: Word, inv: Invocation) {\n\
+         if inv.live && inv.thread == 0u { atomicAdd(&seen[item.v], 1u); }\n}",
+    );
+    let user = UserBindings::storage(
+        "@group(1) @binding(0) var<storage, read_write> seen: array<atomic<u32>>;",
+        &[(0, false)],
+    );
+    let program = Program::new(vec![wide], user).unwrap();
+    let seeds = [Seed::new("wide", &(0..n).collect::<Vec<u32>>())];
+    let batches = |workgroups: u32, guided_claims: bool| {
+        let s = Scheduler::megakernel(
+            &gpu,
+            &program,
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(workgroups),
+                batch_steps: 8,
+                guided_claims,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let seen = gpu.storage_buffer("seen", n as u64).unwrap();
+        let bind = program.user.bind_group(&gpu, &[&seen]).unwrap();
+        let stats = s.run(&gpu, &seeds, Some(&bind)).unwrap();
+        eprintln!("{workgroups} workgroups, guided {guided_claims}: {stats:?}");
+        assert_eq!(stats.executed, [n as u64]);
+        let words = gpu.read_words(&seen, 0, n as u64).unwrap();
+        assert!(words.iter().all(|&c| c == 1), "{words:?}");
+        stats.batches
+    };
+    assert_eq!(batches(1, false), 2);
+    assert_eq!(batches(1, true), 2);
+    let guided = batches(8, true);
+    assert!((8..=n as u64 / 4).contains(&guided), "{guided} batches");
+}
+
+/// `Scheduler::run_reading` returns the ranges as the run left them, on every strategy: a
+/// small range and a large one (copied with each launch's or submission's read-back, or read
+/// once after the host-driven multi-pass's last round), and both for a run of no seeds (no
+/// round at all).
+#[test]
+fn a_run_reads_ranges_back_as_it_left_them_on_every_strategy() {
+    let gpu = gpu();
+    let n = 300u32;
+    let item = ItemType::new("Word", "struct Word { v: u32 }");
+    // Each seed v marks seen[v] and sends v + n on once; those mark seen[v + n].
+    let mark = Procedure::new("mark", item, 1)
+        .emits("mark", 1)
+        .body(&format!(
+            "fn mark_execute(item: Word, inv: Invocation) {{\n\
+         if inv.live {{ atomicAdd(&seen[item.v], 1u); }}\n\
+         if inv.live && item.v < {n}u {{ enqueue_mark(Word(item.v + {n}u)); }}\n}}"
+        ));
+    let user = UserBindings::storage(
+        "@group(1) @binding(0) var<storage, read_write> seen: array<atomic<u32>>;",
+        &[(0, false)],
+    );
+    let program = Program::new(vec![mark], user).unwrap();
+    let big_words = (1 << 16) + 5;
+    let pattern: Vec<u32> = (0..big_words as u32)
+        .map(|i| i.wrapping_mul(2_654_435_761))
+        .collect();
+    for kind in StrategyKind::ALL {
+        let s = Scheduler::new(&gpu, &program, kind, 64).unwrap();
+        for seeded in [n, 0] {
+            let seen = gpu.storage_buffer("seen", 2 * n as u64).unwrap();
+            let big = gpu.storage_buffer("big", big_words).unwrap();
+            gpu.queue
+                .write_buffer(&big, 0, bytemuck::cast_slice(&pattern));
+            let bind = program.user.bind_group(&gpu, &[&seen]).unwrap();
+            let seeds = [Seed::new("mark", &(0..seeded).collect::<Vec<u32>>())];
+            let reads = [(&seen, 0, 2 * n as u64), (&big, 3, big_words - 3)];
+            let (stats, words) = s
+                .run_reading(&gpu, &seeds, Some(&bind), None, &reads)
+                .unwrap();
+            assert_eq!(stats.executed, [2 * seeded as u64], "{kind:?}");
+            let marked = if seeded > 0 { 1 } else { 0 };
+            assert_eq!(words.len(), 2, "{kind:?}");
+            assert!(
+                words[0].iter().all(|&w| w == marked),
+                "{kind:?}, {seeded} seeds"
+            );
+            assert_eq!(words[1], pattern[3..], "{kind:?}, {seeded} seeds");
         }
     }
 }

@@ -132,9 +132,11 @@ pub struct Cli {
     /// The megakernel's queue order under --policy priority (for --strategy megakernel and all):
     /// procedure names, highest first, comma-separated; those not named follow, later ones first
     /// (`QueuePolicy::Priority`; the records' `queue_order` gives the order run). Names as for
-    /// --procedure-steps. E.g. `bound,splitu,splitv,diceshade,dicesmall` runs Reyes breadth first
-    /// (docs/results.md, 2026-12-04 (second session)) [default: later procedures first, which
-    /// keeps queues short: tree leaf,branch; reyes dicesmall,diceshade,splitv,splitu,bound].
+    /// --procedure-steps. E.g. `dicesmall,diceshade` runs Reyes later stages first
+    /// [default: the workload's: Reyes frames on a GPU breadth first, as `reyes render` runs
+    /// them, bound,splitu,splitv,diceshade,dicesmall (`reyes::gpu_render::megakernel_priority`);
+    /// else later procedures first, which keeps queues short: tree leaf,branch; reyes on
+    /// lavapipe dicesmall,diceshade,splitv,splitu,bound].
     #[arg(
         long,
         value_delimiter = ',',
@@ -198,6 +200,18 @@ pub struct Cli {
     /// elsewhere (docs/scheduler.md 2.7).
     #[arg(long, help_heading = "Scheduler", conflicts_with = "no_local_queues")]
     pub local_queues: bool,
+
+    /// Megakernel claims take at most the workgroup's share of the pending items,
+    /// ceil(pending / workgroups), one step's worth at least: guided self-scheduling
+    /// (`MegakernelConfig::guided_claims`). Default: the workload's choice, on for Reyes frames
+    /// on a GPU, as `reyes render` runs them (`reyes::gpu_render::megakernel_guided_claims`),
+    /// off elsewhere.
+    #[arg(long, help_heading = "Scheduler", conflicts_with = "no_guided_claims")]
+    pub guided_claims: bool,
+
+    /// Megakernel claims take whole batches, whatever the workload would choose.
+    #[arg(long, help_heading = "Scheduler")]
+    pub no_guided_claims: bool,
 
     /// The megakernel runs without local queues, whatever the workload would choose.
     #[arg(long, help_heading = "Scheduler")]
@@ -435,6 +449,11 @@ impl Cli {
                 .then(|| self.procedure_steps.clone()),
             idle_backoff: self.idle_backoff,
             priority: self.priority.clone(),
+            guided_claims: match (self.guided_claims, self.no_guided_claims) {
+                (true, _) => Some(true),
+                (_, true) => Some(false),
+                _ => None,
+            },
             capacity: self.capacity,
             turn_anatomy: self.turn_anatomy,
             subgroups: match self.subgroups {

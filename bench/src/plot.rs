@@ -232,6 +232,7 @@ mod tests {
             batches: 0,
             local_items: 0,
             local_queues: None,
+            guided_claims: None,
             queue_order: None,
             idle_polls: 0,
             abandoned: 0,

@@ -61,6 +61,9 @@ pub struct RunRecord {
     /// Megakernel: it ran with local queues (`RunStats::local_queues`); absent for the others.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub local_queues: Option<bool>,
+    /// Megakernel: its claims were guided (`RunStats::guided_claims`); absent for the others.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub guided_claims: Option<bool>,
     /// Megakernel under the priority policy: the order its workgroups try the queues
     /// (`RunStats::queue_order`, `schedbench --priority`); absent for the others.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -123,6 +126,7 @@ impl RunRecord {
             enqueue: (!s.enqueue.is_empty()).then(|| s.enqueue.clone()),
             workgroup_size: (s.workgroup_size > 0).then_some(s.workgroup_size),
             local_queues: (s.workgroup_size > 0).then_some(s.local_queues),
+            guided_claims: (s.workgroup_size > 0).then_some(s.guided_claims),
             queue_order: (!s.queue_order.is_empty()).then(|| s.queue_order.clone()),
             ..Self::failed(k, String::new())
         }
@@ -156,6 +160,7 @@ impl RunRecord {
             batches: 0,
             local_items: 0,
             local_queues: None,
+            guided_claims: None,
             queue_order: None,
             idle_polls: 0,
             abandoned: 0,

@@ -217,7 +217,9 @@ impl Workload for ReyesWorkload {
                         .batch_steps
                         .or(Some(reyes::gpu_render::megakernel_batch_steps(gpu)));
                     let config = config
-                        .or_procedure_steps(reyes::gpu_render::megakernel_procedure_steps(gpu));
+                        .or_procedure_steps(reyes::gpu_render::megakernel_procedure_steps(gpu))
+                        .or_priority(reyes::gpu_render::megakernel_priority(gpu))
+                        .or_guided_claims(reyes::gpu_render::megakernel_guided_claims(gpu));
                     let scheduler = compile(gpu, &program, strategy, &config, capacity)?;
                     let config = RendererConfig::new(scheduler.kind())
                         .features(features)

@@ -175,7 +175,15 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
                 Some(true) => ", local queues",
                 _ => "",
             };
-            let line = format!("{}: {l} items{e}{w}{local}", r.strategy);
+            let guided = match r.guided_claims {
+                Some(true) => ", guided claims",
+                _ => "",
+            };
+            let order = r
+                .queue_order
+                .as_ref()
+                .map_or(String::new(), |o| format!(", queue order {}", o.join(",")));
+            let line = format!("{}: {l} items{e}{w}{local}{guided}{order}", r.strategy);
             if !queues.contains(&line) {
                 queues.push(line);
             }

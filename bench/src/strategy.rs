@@ -141,6 +141,9 @@ pub struct GpuConfig {
     /// Procedures named first in the priority policy's order (`QueuePolicy::Priority`); empty:
     /// the default order.
     pub priority: Vec<String>,
+    /// `MegakernelConfig::guided_claims`; `None`: the workload's choice
+    /// ([`GpuConfig::or_guided_claims`]; on for Reyes frames on GPUs, off elsewhere).
+    pub guided_claims: Option<bool>,
     /// How the queues hold items (`MegakernelConfig::item_layout`); `None`: `ItemLayout::for_program`.
     pub item_layout: Option<ItemLayout>,
     /// `MegakernelConfig::direct_enqueue`; `None`: direct wherever a batch's tickets fit.
@@ -169,6 +172,7 @@ impl Default for GpuConfig {
             procedure_steps: None,
             idle_backoff: MegakernelConfig::default().idle_backoff,
             priority: Vec::new(),
+            guided_claims: None,
             item_layout: None,
             direct_enqueue: None,
             capacity: None,
@@ -186,6 +190,21 @@ impl GpuConfig {
     /// named none.
     pub fn or_procedure_steps(mut self, workload: Vec<(String, u32)>) -> GpuConfig {
         self.procedure_steps = self.procedure_steps.or(Some(workload));
+        self
+    }
+
+    /// This configuration with `workload`'s queue order where the command line named none.
+    pub fn or_priority(mut self, workload: Vec<String>) -> GpuConfig {
+        if self.priority.is_empty() {
+            self.priority = workload;
+        }
+        self
+    }
+
+    /// This configuration with `workload`'s choice of guided claims where the command line
+    /// made none.
+    pub fn or_guided_claims(mut self, workload: bool) -> GpuConfig {
+        self.guided_claims = self.guided_claims.or(Some(workload));
         self
     }
 
@@ -224,6 +243,7 @@ pub fn compile(
                 policy: policy.queue_policy(&config.priority),
                 batch_steps: config.batch_steps.unwrap_or(1),
                 procedure_batch_steps: config.procedure_steps.clone().unwrap_or_default(),
+                guided_claims: config.guided_claims.unwrap_or(false),
                 idle_backoff: config.idle_backoff,
                 item_layout: config.item_layout,
                 direct_enqueue: config.direct_enqueue,

@@ -424,6 +424,7 @@ mod tests {
             batches: 10,
             local_items: 0,
             local_queues: None,
+            guided_claims: None,
             queue_order: None,
             idle_polls: 50,
             abandoned: 0,

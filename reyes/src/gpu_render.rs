@@ -43,6 +43,32 @@ pub fn megakernel_procedure_steps(gpu: &Gpu) -> Vec<(String, u32)> {
     vec![("diceshade".into(), 8), ("dicesmall".into(), 8)]
 }
 
+/// The Reyes megakernel's queue order on `gpu` (`QueuePolicy::Priority`): on GPUs breadth
+/// first, Bound, SplitU, SplitV, then DiceShade and DiceSmall, so that every patch is bounded
+/// and split while the dicing queues fill, and the frame's last splits are not left waiting
+/// behind grids; with [`megakernel_guided_claims`] the H200 renders Killeroo at 1920x1080 in
+/// 0.796 ms against 0.815 in the scheduler's default order (later stages first), the teapot
+/// in 0.535 against 0.566 (docs/results.md, 2026-12-04 (second session)). It costs memory: the
+/// dicing queue holds up to 3.5x the grids at once (Killeroo: 10,600 against 3,000), which
+/// a memory budget pays in more bucket recuts. Empty (the default order) on lavapipe, whose
+/// one workgroup gains nothing from the order.
+pub fn megakernel_priority(gpu: &Gpu) -> Vec<String> {
+    if gpu.is_lavapipe() {
+        return Vec::new();
+    }
+    ["bound", "splitu", "splitv", "diceshade", "dicesmall"]
+        .map(String::from)
+        .to_vec()
+}
+
+/// Whether the Reyes megakernel's claims are guided (`MegakernelConfig::guided_claims`): on
+/// GPUs, with [`megakernel_priority`]. A frame runs short of claimable work in its last
+/// phase, and full batches of 8 grids then leave most workgroups idle while a few dice.
+/// Off on lavapipe (one workgroup: its share is everything).
+pub fn megakernel_guided_claims(gpu: &Gpu) -> bool {
+    !gpu.is_lavapipe()
+}
+
 /// Device features the pipeline needs: 64-bit atomicMax for the depth-and-colour samples.
 pub fn required_features() -> wgpu::Features {
     wgpu::Features::SHADER_INT64 | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX
@@ -347,6 +373,8 @@ impl GpuRenderer {
                     initial_capacity: INITIAL_CAPACITY,
                     batch_steps: megakernel_batch_steps(gpu),
                     procedure_batch_steps: megakernel_procedure_steps(gpu),
+                    policy: scheduler::QueuePolicy::Priority(megakernel_priority(gpu)),
+                    guided_claims: megakernel_guided_claims(gpu),
                     ..Default::default()
                 },
             )?,
@@ -585,10 +613,15 @@ impl GpuRenderer {
                 }
                 gpu.queue.submit([enc.finish()]);
                 let seeds = [Seed::new::<PatchItem>("bound", &items[batch.clone()])];
-                let run = match self
-                    .scheduler
-                    .run_within(gpu, &seeds, Some(bind), queue_budget)
-                {
+                // The counters come back with the run's last read-back.
+                let reads = [(counters, 0, COUNTERS as u64)];
+                let (run, mut counted) = match self.scheduler.run_reading(
+                    gpu,
+                    &seeds,
+                    Some(bind),
+                    queue_budget,
+                    &reads,
+                ) {
                     Err(RunError::QueueOverflow { .. }) if batch.len() > 1 => {
                         let mid = batch.start + batch.len() / 2;
                         batches.push(mid..batch.end);
@@ -622,11 +655,8 @@ impl GpuRenderer {
                     }
                     r => r?,
                 };
-                for (k, v) in gpu
-                    .read_words(counters, 0, COUNTERS as u64)?
-                    .into_iter()
-                    .enumerate()
-                {
+                let counted = counted.pop().expect("the counters' range");
+                for (k, v) in counted.into_iter().enumerate() {
                     if k == C_MAX_DEPTH {
                         out.counters[k] = out.counters[k].max(v as u64);
                     } else {

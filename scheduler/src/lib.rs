@@ -51,6 +51,7 @@ pub use multipass::host::{HostMultipass, HostMultipassConfig};
 pub use multipass::{Multipass, MultipassConfig};
 pub use procedure::{ItemType, Procedure};
 pub use program::{Program, Seed};
+pub use readback::ReadRange;
 pub use recorded_run::{DeviceSeeds, RecordedRun, RecordedSize};
 pub use stats::{Outcome, RunStats};
 pub use strategy::{Scheduler, StrategyKind};

@@ -15,6 +15,11 @@ pub struct Readback {
 }
 
 impl Readback {
+    /// The words it holds (at least those asked for at [`Readback::new`]).
+    pub fn words(&self) -> u64 {
+        self.words
+    }
+
     pub fn new(gpu: &Gpu, label: &str, words: u64) -> Readback {
         // Even, so that any prefix rounded up to 8 bytes stays inside.
         let words = words.max(2).next_multiple_of(2);
@@ -91,33 +96,48 @@ impl Readback {
     }
 }
 
-/// Reads every `(buffer, first word, words)` range in one submission and one bounded wait.
-pub fn read_ranges(
-    gpu: &Gpu,
-    ranges: &[(&wgpu::Buffer, u64, u64)],
-) -> Result<Vec<Vec<u32>>, RunError> {
-    let total: u64 = ranges.iter().map(|r| r.2).sum();
+/// A range of a buffer to read back: `(buffer, first word, words)`. The buffer needs
+/// `COPY_SRC` usage (every [`Gpu::storage_buffer`] has it).
+pub type ReadRange<'a> = (&'a wgpu::Buffer, u64, u64);
+
+/// Words of all `ranges` together.
+pub fn ranges_words(ranges: &[ReadRange]) -> u64 {
+    ranges.iter().map(|r| r.2).sum()
+}
+
+/// Records copies of `ranges` into `rb`, one after another from word `at`.
+pub fn copy_ranges(rb: &Readback, enc: &mut wgpu::CommandEncoder, ranges: &[ReadRange], at: u64) {
+    let mut at = at;
+    for &(buf, first, words) in ranges {
+        if words > 0 {
+            rb.copy(enc, buf, first, at, words);
+        }
+        at += words;
+    }
+}
+
+/// `words` (read back from where [`copy_ranges`] put `ranges`) cut into one vector per range.
+pub fn split_ranges(words: &[u32], ranges: &[ReadRange]) -> Vec<Vec<u32>> {
+    let mut at = 0;
+    ranges
+        .iter()
+        .map(|r| {
+            let v = words[at..at + r.2 as usize].to_vec();
+            at += r.2 as usize;
+            v
+        })
+        .collect()
+}
+
+/// Reads every range in one submission and one bounded wait.
+pub fn read_ranges(gpu: &Gpu, ranges: &[ReadRange]) -> Result<Vec<Vec<u32>>, RunError> {
+    let total = ranges_words(ranges);
     if total == 0 {
         return Ok(vec![Vec::new(); ranges.len()]);
     }
     let rb = Readback::new(gpu, "read ranges", total);
     let mut enc = gpu.device.create_command_encoder(&Default::default());
-    let mut at = 0;
-    for &(buf, first, words) in ranges {
-        if words > 0 {
-            rb.copy(&mut enc, buf, first, at, words);
-        }
-        at += words;
-    }
+    copy_ranges(&rb, &mut enc, ranges, 0);
     gpu.queue.submit([enc.finish()]);
-    let all = rb.read(gpu, total)?;
-    let mut at = 0;
-    Ok(ranges
-        .iter()
-        .map(|r| {
-            let v = all[at..at + r.2 as usize].to_vec();
-            at += r.2 as usize;
-            v
-        })
-        .collect())
+    Ok(split_ranges(&rb.read(gpu, total)?, ranges))
 }

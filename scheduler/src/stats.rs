@@ -23,6 +23,8 @@ pub struct RunStats {
     /// Megakernel: it ran with local queues (`MegakernelConfig::local_queues`, and the program
     /// declares a local emit that fits `local_bytes`), whether or not an item ran locally.
     pub local_queues: bool,
+    /// Megakernel: its claims were guided by the pending items (`MegakernelConfig::guided_claims`).
+    pub guided_claims: bool,
     /// Megakernel under the priority policy: the procedures in the order its workgroups try
     /// their queues (`QueuePolicy::Priority`, the default order completed); empty under FIFO
     /// and for the other strategies.
@@ -87,6 +89,7 @@ impl RunStats {
         self.batches += o.batches;
         self.local_items += o.local_items;
         self.local_queues |= o.local_queues;
+        self.guided_claims |= o.guided_claims;
         if self.queue_order.is_empty() {
             self.queue_order = o.queue_order.clone();
         }

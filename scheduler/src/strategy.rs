@@ -7,6 +7,7 @@ use crate::megakernel::{Megakernel, MegakernelConfig};
 use crate::multipass::host::{HostMultipass, HostMultipassConfig};
 use crate::multipass::{Multipass, MultipassConfig};
 use crate::program::{Program, Seed};
+use crate::readback::ReadRange;
 use crate::stats::RunStats;
 
 /// The scheduling strategies, by the names the command lines and reports use.
@@ -190,10 +191,26 @@ impl Scheduler {
         user: Option<&wgpu::BindGroup>,
         max_queue_bytes: Option<u64>,
     ) -> Result<RunStats, RunError> {
+        Ok(self.run_reading(gpu, seeds, user, max_queue_bytes, &[])?.0)
+    }
+
+    /// [`Scheduler::run_within`] that also reads `reads` back (one vector of words per range,
+    /// as the run left them) with the run's own last read-back, instead of a host round trip of
+    /// their own after it: on the H200 a round trip costs about 0.09 ms, as much as a small
+    /// run's GPU time (docs/results.md, 2026-12-04 (third session)). The buffers need
+    /// `COPY_SRC` ([`Gpu::storage_buffer`]'s have it).
+    pub fn run_reading(
+        &self,
+        gpu: &Gpu,
+        seeds: &[Seed],
+        user: Option<&wgpu::BindGroup>,
+        max_queue_bytes: Option<u64>,
+        reads: &[ReadRange],
+    ) -> Result<(RunStats, Vec<Vec<u32>>), RunError> {
         match self {
-            Scheduler::Megakernel(m) => m.run(gpu, seeds, user, max_queue_bytes),
-            Scheduler::Multipass(m) => m.run(gpu, seeds, user, max_queue_bytes),
-            Scheduler::MultipassHost(m) => m.run(gpu, seeds, user, max_queue_bytes),
+            Scheduler::Megakernel(m) => m.run(gpu, seeds, user, max_queue_bytes, reads),
+            Scheduler::Multipass(m) => m.run(gpu, seeds, user, max_queue_bytes, reads),
+            Scheduler::MultipassHost(m) => m.run(gpu, seeds, user, max_queue_bytes, reads),
         }
     }
 }

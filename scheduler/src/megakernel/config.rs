@@ -67,6 +67,17 @@ pub struct MegakernelConfig {
     /// children published early. Default empty. A name that is not a procedure of the program
     /// is an error of [`Megakernel::new`](crate::Megakernel::new).
     pub procedure_batch_steps: Vec<(String, u32)>,
+    /// Guided self-scheduling (Polychronopoulos and Kuck, IEEE Trans. Computers 1987): a claim
+    /// takes at most the workgroup's share of every item still pending in the launch,
+    /// ceil(`G_PENDING` / workgroups), one step's worth at least, so that the last items of a
+    /// workload that is running short are spread over the workgroups instead of held by a few
+    /// full batches, while batches stay full as long as the pending work would fill every
+    /// workgroup (docs/scheduler.md 2.2). Default `false`. Measured on the H200 at 1920x1080,
+    /// with Bound first (`reyes::gpu_render::megakernel_priority`, which turns it on), against
+    /// neither: teapot 0.568 -> 0.529 ms, Killeroo 0.807 -> 0.792 (docs/results.md, 2026-12-04
+    /// (third session)); on the trees, whose queues run short only at the end, up to 2.4%
+    /// slower (2026-12-04 (second session)).
+    pub guided_claims: bool,
     /// Loop turns per workgroup per launch; far below lavapipe's 65,535-iteration cut. On
     /// lavapipe that cut counts every loop iteration nested in the persistent loop, bodies'
     /// loops included, so there it is lowered to [`LAVAPIPE_MAX_ITERATIONS`].
@@ -155,6 +166,7 @@ impl Default for MegakernelConfig {
             policy: QueuePolicy::Priority(Vec::new()),
             batch_steps: 1,
             procedure_batch_steps: Vec::new(),
+            guided_claims: false,
             max_iterations: 16_384,
             spin_limit: 4096,
             idle_backoff: 32,

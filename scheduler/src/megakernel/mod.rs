@@ -27,7 +27,7 @@ use crate::item_layout::ItemLayout;
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed, WORKGROUP_SIZE};
 use crate::queue_layout::{QueueLayout, RunStart};
-use crate::readback::Readback;
+use crate::readback::{ReadRange, Readback, copy_ranges, ranges_words, split_ranges};
 use crate::stats::RunStats;
 use crate::timing::SpanTimer;
 
@@ -185,8 +185,11 @@ impl Megakernel {
                 gpu.coherent,
                 items,
                 direct.then_some((emit_slots, es_off.as_slice())),
-                config.turn_anatomy,
-                subgroups,
+                wgsl::Switches {
+                    anatomy: config.turn_anatomy,
+                    subgroups,
+                    guided_claims: config.guided_claims,
+                },
                 plan,
             )
         };
@@ -518,7 +521,9 @@ impl Megakernel {
 
     /// Runs the program to completion from `seeds`. `user` is bind group 1, if the program has
     /// one. `max_queue_bytes` bounds the queue storage (slots, the workgroups' local areas and
-    /// flags) of this run. Errors:
+    /// flags) of this run. `reads`: buffer ranges copied after every launch into its counters'
+    /// read-back, returned (one vector per range) as the last launch left them: results come
+    /// back with the run's own last host wait. Errors:
     /// every [`RunError`] but `NoAdapter` (see `docs/scheduler.md`, section 6).
     pub fn run(
         &self,
@@ -526,7 +531,8 @@ impl Megakernel {
         seeds: &[Seed],
         user: Option<&wgpu::BindGroup>,
         max_queue_bytes: Option<u64>,
-    ) -> Result<RunStats, RunError> {
+        reads: &[ReadRange],
+    ) -> Result<(RunStats, Vec<Vec<u32>>), RunError> {
         self.kernels.check_user_group(user)?;
         let workgroups = self.workgroups_within(self.workgroups(gpu, user)?, max_queue_bytes);
         let start_time = Instant::now();
@@ -579,6 +585,7 @@ impl Megakernel {
             workgroups,
             workgroup_size: self.config.workgroup_size,
             local_queues: self.local_wg_words > 0,
+            guided_claims: self.config.guided_claims,
             queue_order: match self.config.policy {
                 QueuePolicy::Priority(_) => (self.priority.iter())
                     .map(|&q| self.program.procs[q as usize].proc.name.clone())
@@ -589,13 +596,19 @@ impl Megakernel {
             ..Default::default()
         };
         // Each launch's GPU time comes back with its counters (one read-back, no extra wait).
+        // The caller's ranges follow them.
         let tw = ctrl_words(nq) as u64;
+        let user_at = tw + SpanTimer::WORDS;
+        let read_words = user_at + ranges_words(reads);
         let mut gpu_ms = gpu.timestamps.then_some(0.0);
         let kept = self.readback.lock().unwrap().take();
-        let (rb, timer) = *kept.unwrap_or_else(|| {
-            let rb = Readback::new(gpu, "ctrl read-back", tw + SpanTimer::WORDS);
-            Box::new((rb, SpanTimer::new(gpu, 1)))
-        });
+        let (rb, timer) = *kept
+            .filter(|k| k.0.words() >= read_words)
+            .unwrap_or_else(|| {
+                let rb = Readback::new(gpu, "ctrl read-back", read_words);
+                Box::new((rb, SpanTimer::new(gpu, 1)))
+            });
+        let results;
         let mut start = Start::Upload(live);
         loop {
             let layout = QueueLayout::new(&self.program, capacity.clone())?;
@@ -657,8 +670,9 @@ impl Megakernel {
             }
             rb.copy(&mut enc, &d.ctrl, 0, 0, tw);
             rb.copy_span(&mut enc, &timer, 0, tw);
+            copy_ranges(&rb, &mut enc, reads, user_at);
             gpu.queue.submit([enc.finish()]);
-            let ctrl = rb.read(gpu, tw + SpanTimer::WORDS)?;
+            let ctrl = rb.read(gpu, read_words)?;
             if let (Some(total), Some(ms)) = (gpu_ms.as_mut(), timer.ms(&ctrl[tw as usize..])) {
                 *total += ms;
             }
@@ -691,6 +705,7 @@ impl Megakernel {
             }
             stats.abandoned += ctrl[g(nq, G_ABANDONED)] as u64;
             if ctrl[g(nq, G_PENDING)] == 0 && ctrl[g(nq, G_ABANDONED)] == 0 {
+                results = split_ranges(&ctrl[user_at as usize..], reads);
                 break;
             }
             // Work is left. Live items per queue: every ticket reserved in this launch (seeds
@@ -808,6 +823,6 @@ impl Megakernel {
         // Keep the device queues and the read-back buffer for the next run.
         *self.cache.lock().unwrap() = dq;
         *self.readback.lock().unwrap() = Some(Box::new((rb, timer)));
-        Ok(stats)
+        Ok((stats, results))
     }
 }

@@ -9,27 +9,44 @@ use crate::program::Program;
 
 pub const TEMPLATE: &str = include_str!("../../../shaders/megakernel.wgsl");
 
+/// Options compiled into the megakernel as constants (each a `MegakernelConfig` field).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Switches {
+    /// Count each turn's phases (`MegakernelConfig::turn_anatomy`).
+    pub anatomy: bool,
+    /// Take enqueue tickets once per subgroup (`MegakernelConfig::subgroups`; the device must
+    /// have wgpu's `SUBGROUP`).
+    pub subgroups: bool,
+    /// Cap each claim at the workgroup's share of the pending items
+    /// (`MegakernelConfig::guided_claims`).
+    pub guided_claims: bool,
+}
+
 /// The megakernel's WGSL for `program` (workgroups of [`Program::workgroup_size`] threads),
 /// with `slots` read through `@coherent` loads where the device has them, and queues and
 /// outboxes holding items as `items` says. `direct`: enqueue
 /// straight into the slots, with the longest ticket list of a batch and each (source, target)
-/// part's offset in it (`MegakernelConfig::direct_enqueue`). `anatomy`: count each turn's
-/// phases (`MegakernelConfig::turn_anatomy`). `subgroups`: take enqueue tickets once per
-/// subgroup (`MegakernelConfig::subgroups`; the device must have wgpu's `SUBGROUP`). `local`:
-/// the workgroup's local regions (`MegakernelConfig::local_queues`; [`LocalPlan::none`] for none).
+/// part's offset in it (`MegakernelConfig::direct_enqueue`). `switches`: the compiled-in
+/// options ([`Switches`]). `local`: the workgroup's local regions
+/// (`MegakernelConfig::local_queues`; [`LocalPlan::none`] for none).
 pub fn source(
     program: &Program,
     coherent: bool,
     items: ItemLayout,
     direct: Option<(u32, &[u32])>,
-    anatomy: bool,
-    subgroups: bool,
+    switches: Switches,
     local: &LocalPlan,
 ) -> String {
+    let Switches {
+        anatomy,
+        subgroups,
+        guided_claims,
+    } = switches;
     let planar = items == ItemLayout::Planar;
     let mut s = program.tables_wgsl();
     s += &format!("const ITEMS_PLANAR: bool = {planar};\n");
     s += &format!("const TURN_ANATOMY: bool = {anatomy};\n");
+    s += &format!("const GUIDED_CLAIMS: bool = {guided_claims};\n");
     s += &format!("const WG_SIZE: u32 = {}u;\n", program.workgroup_size());
     let (slots, offsets) = direct.unwrap_or((1, &[]));
     let nq = program.queue_count();
@@ -233,7 +250,14 @@ mod tests {
     /// local queues.
     fn plain_source(p: &Program) -> String {
         let plan = super::LocalPlan::none(p.queue_count());
-        super::source(p, false, ItemLayout::Interleaved, None, false, false, &plan)
+        super::source(
+            p,
+            false,
+            ItemLayout::Interleaved,
+            None,
+            Default::default(),
+            &plan,
+        )
     }
 
     #[test]
@@ -248,6 +272,34 @@ mod tests {
         let src = plain_source(&p);
         assert_eq!(src.matches("one_execute(it, inv)").count(), 1, "{src}");
         assert!(src.contains("case 0u, 2u:"), "{src}");
+    }
+
+    #[test]
+    fn switches_are_compiled_in_as_constants() {
+        let word = ItemType::new("Word", "struct Word { v: u32 }");
+        let leaf =
+            Procedure::new("leaf", word, 1).body("fn leaf_execute(item: Word, inv: Invocation) {}");
+        let p = Program::new(vec![leaf], UserBindings::none()).unwrap();
+        let plain = plain_source(&p);
+        assert!(
+            plain.contains("const GUIDED_CLAIMS: bool = false;"),
+            "{plain}"
+        );
+        let plan = super::LocalPlan::none(p.queue_count());
+        let switches = super::Switches {
+            guided_claims: true,
+            ..Default::default()
+        };
+        let guided = super::source(&p, false, ItemLayout::Interleaved, None, switches, &plan);
+        assert!(
+            guided.contains("const GUIDED_CLAIMS: bool = true;"),
+            "{guided}"
+        );
+        assert!(
+            guided.contains("const TURN_ANATOMY: bool = false;"),
+            "{guided}"
+        );
+        naga::front::wgsl::parse_str(&guided).unwrap();
     }
 
     #[test]

@@ -16,7 +16,7 @@ use crate::multipass::partial::{at_limit, needs_partial, partial_round};
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
 use crate::queue_layout::{QueueLayout, RunStart};
-use crate::readback::Readback;
+use crate::readback::{ReadRange, Readback, copy_ranges, ranges_words, split_ranges};
 use crate::stats::RunStats;
 use crate::timing::RunTimer;
 
@@ -207,14 +207,19 @@ impl HostMultipass {
 
     /// Runs the program to completion from `seeds`; `user` is bind group 1, if the program has
     /// one; `max_queue_bytes` bounds the item storage of this run (two copies of every queue).
-    /// Errors: every [`RunError`] but `NoAdapter` (see `docs/scheduler.md`, section 6).
+    /// `reads`: buffer ranges read back once after the last round into the kept read-back
+    /// buffer, one vector per range (a copy every round, to save that one wait, cost more: H200,
+    /// the deep tree's 201 rounds 19.9 -> 21.9 ms of wall time; docs/results.md, 2026-12-04
+    /// (third session)). Errors: every [`RunError`] but `NoAdapter` (see
+    /// `docs/scheduler.md`, section 6).
     pub fn run(
         &self,
         gpu: &Gpu,
         seeds: &[Seed],
         user: Option<&wgpu::BindGroup>,
         max_queue_bytes: Option<u64>,
-    ) -> Result<RunStats, RunError> {
+        reads: &[ReadRange],
+    ) -> Result<(RunStats, Vec<Vec<u32>>), RunError> {
         self.kernels.check_user_group(user)?;
         let start = Instant::now();
         let nq = self.program.queue_count();
@@ -248,9 +253,15 @@ impl HostMultipass {
             peak_occupancy: vec![0; nq],
             ..Default::default()
         };
+        // The caller's ranges follow the counts.
         let count_words = (nq + EXTRA_WORDS) as u64;
         let rb = self.readback.lock().unwrap().take();
-        let rb = rb.unwrap_or_else(|| Readback::new(gpu, "round counts read-back", count_words));
+        let rb = rb
+            .filter(|rb| rb.words() >= count_words + ranges_words(reads))
+            .unwrap_or_else(|| {
+                let words = count_words + ranges_words(reads);
+                Readback::new(gpu, "round counts read-back", words)
+            });
         let mut timer = RunTimer::new(gpu, 64);
         let cached = self.cache.lock().unwrap().take();
         let kept = cached.as_ref().map(|d| d.layout.capacity.as_slice());
@@ -406,10 +417,19 @@ impl HostMultipass {
             par = 1 - par;
         }
         stats.queue_bytes = d.layout.total_words * 4 * 2;
+        // The caller's ranges: one submission and wait, into the kept read-back.
+        let mut results = vec![Vec::new(); reads.len()];
+        if !reads.is_empty() {
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            copy_ranges(&rb, &mut enc, reads, count_words);
+            gpu.queue.submit([enc.finish()]);
+            let words = rb.read(gpu, count_words + ranges_words(reads))?;
+            results = split_ranges(&words[count_words as usize..], reads);
+        }
         stats.gpu_ms = timer.finish(gpu)?;
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
         *self.cache.lock().unwrap() = Some(d);
         *self.readback.lock().unwrap() = Some(rb);
-        Ok(stats)
+        Ok((stats, results))
     }
 }

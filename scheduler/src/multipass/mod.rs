@@ -24,6 +24,7 @@ use crate::item_layout::ItemLayout;
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
 use crate::queue_layout::{QueueLayout, RunStart};
+use crate::readback::{ReadRange, Readback, copy_ranges, ranges_words, split_ranges};
 use crate::stats::RunStats;
 use crate::timing::{PassTimer, StageTimer};
 
@@ -99,6 +100,8 @@ pub struct Multipass {
     /// Rounds the last finished run executed (0 before the first): the next run's first
     /// submission encodes that many.
     learned_rounds: std::sync::atomic::AtomicU32,
+    /// The counters' read-back (and the caller's ranges after them), kept between runs.
+    readback: std::sync::Mutex<Option<Readback>>,
 }
 
 struct DeviceRounds {
@@ -157,6 +160,7 @@ impl Multipass {
             kernels,
             cache: Default::default(),
             learned_rounds: Default::default(),
+            readback: Default::default(),
         })
     }
 
@@ -382,15 +386,18 @@ impl Multipass {
     }
 
     /// Runs the program to completion from `seeds`; `user` is bind group 1, if the program has
-    /// one; `max_queue_bytes` bounds the item, emit and flag storage of this run. Errors: every
-    /// [`RunError`] but `NoAdapter` (see `docs/scheduler.md`, section 6).
+    /// one; `max_queue_bytes` bounds the item, emit and flag storage of this run. `reads`:
+    /// buffer ranges copied into the counters' read-back at the end of every submission,
+    /// returned (one vector per range) as the last one left them. Errors: every [`RunError`] but `NoAdapter` (see
+    /// `docs/scheduler.md`, section 6).
     pub fn run(
         &self,
         gpu: &Gpu,
         seeds: &[Seed],
         user: Option<&wgpu::BindGroup>,
         max_queue_bytes: Option<u64>,
-    ) -> Result<RunStats, RunError> {
+        reads: &[ReadRange],
+    ) -> Result<(RunStats, Vec<Vec<u32>>), RunError> {
         self.kernels.check_user_group(user)?;
         let start = Instant::now();
         let nq = self.program.queue_count();
@@ -451,6 +458,15 @@ impl Multipass {
             .stage_timing
             .then(|| StageTimer::new(gpu, nq + 1, rounds.max(rounds_per_submit) * nq as u32 + 1));
         let mut encoded = 0u64;
+        // Each submission's counters come back in its own read-back, the caller's ranges
+        // after them.
+        let cw = ctrl_words(nq) as u64;
+        let read_words = cw + ranges_words(reads);
+        let rb = self.readback.lock().unwrap().take();
+        let rb = rb
+            .filter(|rb| rb.words() >= read_words)
+            .unwrap_or_else(|| Readback::new(gpu, "multi-pass read-back", read_words));
+        let mut results;
         // Rounds encoded since the last upload: round r reads items[r % 2].
         let mut since_upload = 0u64;
         let cached = self.cache.lock().unwrap().take();
@@ -480,6 +496,8 @@ impl Multipass {
                 stage_timer.as_ref(),
                 user,
             );
+            rb.copy(&mut enc, &d.ctrl, 0, 0, cw);
+            copy_ranges(&rb, &mut enc, reads, cw);
             timer.resolve(&mut enc);
             if let Some(st) = &stage_timer {
                 st.resolve(&mut enc);
@@ -489,7 +507,9 @@ impl Multipass {
             stats.launches += 1 + rounds as u64 * self.dispatches_per_round();
             encoded += rounds as u64;
             since_upload += rounds as u64;
-            let ctrl = gpu.read_words(&d.ctrl, 0, ctrl_words(nq) as u64)?;
+            let mut ctrl = rb.read(gpu, read_words)?;
+            results = split_ranges(&ctrl[cw as usize..], reads);
+            ctrl.truncate(cw as usize);
             if let Some(st) = &mut stage_timer {
                 st.collect(gpu)?;
             } else {
@@ -583,7 +603,8 @@ impl Multipass {
         }
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
         *self.cache.lock().unwrap() = Some(d);
-        Ok(stats)
+        *self.readback.lock().unwrap() = Some(rb);
+        Ok((stats, results))
     }
 
     fn accumulate(&self, stats: &mut RunStats, ctrl: &[u32]) {

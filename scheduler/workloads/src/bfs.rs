@@ -381,9 +381,11 @@ impl BfsRun {
             )));
         }
         write_words(gpu, &self.level, &initial_levels(&self.params));
-        let stats = scheduler.run(gpu, &self.params.seeds(), Some(&self.bind))?;
-        let levels = gpu.read_words(&self.level, 0, self.params.graph().vertices() as u64)?;
-        Ok((stats, levels))
+        // The levels come back with the run's last read-back.
+        let levels = [(&self.level, 0, self.params.graph().vertices() as u64)];
+        let (stats, mut words) =
+            scheduler.run_reading(gpu, &self.params.seeds(), Some(&self.bind), None, &levels)?;
+        Ok((stats, words.pop().expect("the levels' range")))
     }
 }
 

@@ -557,9 +557,15 @@ impl MandelRun {
         gpu.queue.submit([enc.finish()]);
         gpu.queue
             .write_buffer(&self.cfg, 0, bytemuck::bytes_of(&p.cfg()));
-        let stats = scheduler.run(gpu, &p.seeds(), Some(&self.bind))?;
-        let dwell = gpu.read_words(&self.out, 0, p.width as u64 * p.height as u64)?;
-        let count = gpu.read_words(&self.count, 0, 2)?;
+        // The image and the counts come back with the run's last read-back.
+        let reads = [
+            (&self.out, 0, p.width as u64 * p.height as u64),
+            (&self.count, 0, 2),
+        ];
+        let (stats, mut words) =
+            scheduler.run_reading(gpu, &p.seeds(), Some(&self.bind), None, &reads)?;
+        let count = words.pop().expect("the counts' range");
+        let dwell = words.pop().expect("the image's range");
         let work = MsWork {
             rects: stats.executed[0],
             fills: stats.executed[1],

@@ -663,8 +663,11 @@ impl TreeRun {
         ];
         gpu.queue
             .write_buffer(&self.cfg, 0, bytemuck::cast_slice(&cfg));
-        let stats = scheduler.run_within(gpu, &self.seeds, Some(&self.bind), max_queue_bytes)?;
-        let words = gpu.read_words(&self.out, 0, (BUCKETS * 4) as u64)?;
+        // The folds come back with the run's last read-back: no round trip of their own.
+        let out = [(&self.out, 0, (BUCKETS * 4) as u64)];
+        let (stats, mut words) =
+            scheduler.run_reading(gpu, &self.seeds, Some(&self.bind), max_queue_bytes, &out)?;
+        let words = words.pop().expect("the folds' range");
         let mut r = TreeResult {
             branches: stats.executed[0],
             leaves: stats.executed[1],
