@@ -1031,7 +1031,7 @@ fn guided_claims_take_a_workgroups_share_of_the_pending_items() {
 /// `Scheduler::run_reading` returns the ranges as the run left them, on every strategy: a
 /// small range and a large one (copied with each launch's or submission's read-back, or read
 /// once after the host-driven multi-pass's last round), and both for a run of no seeds (no
-/// round at all).
+/// round at all). A range that cannot be read is an error naming it, before the run.
 #[test]
 fn a_run_reads_ranges_back_as_it_left_them_on_every_strategy() {
     let gpu = gpu();
@@ -1076,6 +1076,34 @@ fn a_run_reads_ranges_back_as_it_left_them_on_every_strategy() {
             );
             assert_eq!(words[1], pattern[3..], "{kind:?}, {seeded} seeds");
         }
+        // A range past its buffer, or a buffer that cannot be copied from, is refused by name
+        // before the run.
+        let seen = gpu.storage_buffer("seen", 2 * n as u64).unwrap();
+        let bind = program.user.bind_group(&gpu, &[&seen]).unwrap();
+        let no_copy = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("no copy"),
+            size: 16,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let seeds = [Seed::new("mark", &[0u32])];
+        for (reads, expected) in [
+            (
+                vec![(&seen, 0, 2 * n as u64 + 1)],
+                "read range 0 (words 0..601): past the end",
+            ),
+            (
+                vec![(&seen, 0, 1), (&no_copy, 0, 4)],
+                "read range 1 (words 0..4): its buffer lacks COPY_SRC",
+            ),
+        ] {
+            match s.run_reading(&gpu, &seeds, Some(&bind), None, &reads) {
+                Err(RunError::Program(m)) => assert!(m.contains(expected), "{kind:?}: {m}"),
+                other => panic!("{kind:?}: expected a program error, got {other:?}"),
+            }
+        }
+        let (stats, _) = s.run_reading(&gpu, &seeds, Some(&bind), None, &[]).unwrap();
+        assert_eq!(stats.executed, [2], "{kind:?}: runs after a refused range");
     }
 }
 

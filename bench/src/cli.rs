@@ -201,6 +201,10 @@ pub struct Cli {
     #[arg(long, help_heading = "Scheduler", conflicts_with = "no_local_queues")]
     pub local_queues: bool,
 
+    /// The megakernel runs without local queues, whatever the workload would choose.
+    #[arg(long, help_heading = "Scheduler")]
+    pub no_local_queues: bool,
+
     /// Megakernel claims take at most the workgroup's share of the pending items,
     /// ceil(pending / workgroups), one step's worth at least: guided self-scheduling
     /// (`MegakernelConfig::guided_claims`). Default: the workload's choice, on for Reyes frames
@@ -212,10 +216,6 @@ pub struct Cli {
     /// Megakernel claims take whole batches, whatever the workload would choose.
     #[arg(long, help_heading = "Scheduler")]
     pub no_guided_claims: bool,
-
-    /// The megakernel runs without local queues, whatever the workload would choose.
-    #[arg(long, help_heading = "Scheduler")]
-    pub no_local_queues: bool,
 
     /// With local queues: most bytes of one megakernel workgroup's local area, in global memory,
     /// once per workgroup (`MegakernelConfig::local_bytes`; default 1 MiB: a full batch per

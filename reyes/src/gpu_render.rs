@@ -47,11 +47,12 @@ pub fn megakernel_procedure_steps(gpu: &Gpu) -> Vec<(String, u32)> {
 /// first, Bound, SplitU, SplitV, then DiceShade and DiceSmall, so that every patch is bounded
 /// and split while the dicing queues fill, and the frame's last splits are not left waiting
 /// behind grids; with [`megakernel_guided_claims`] the H200 renders Killeroo at 1920x1080 in
-/// 0.796 ms against 0.815 in the scheduler's default order (later stages first), the teapot
-/// in 0.535 against 0.566 (docs/results.md, 2026-12-04 (second session)). It costs memory: the
-/// dicing queue holds up to 3.5x the grids at once (Killeroo: 10,600 against 3,000), which
-/// a memory budget pays in more bucket recuts. Empty (the default order) on lavapipe, whose
-/// one workgroup gains nothing from the order.
+/// 0.792 ms against 0.807 in the scheduler's default order (later stages first) without them,
+/// the teapot in 0.529 against 0.568 (docs/results.md, 2026-12-04 (third session)). It costs
+/// memory: the dicing queue holds up to 3.5x the grids at once (Killeroo: 10,600 against
+/// 3,000), which could cost bucket recuts under a tight memory budget (none for Killeroo at
+/// 1080p under 80 MiB). Empty (the default order) on lavapipe, whose one workgroup gains
+/// nothing from the order.
 pub fn megakernel_priority(gpu: &Gpu) -> Vec<String> {
     if gpu.is_lavapipe() {
         return Vec::new();

@@ -193,7 +193,8 @@ fn run(print: bool) -> Result<(), FanoutError> {
         let bind = program.user.bind_group(&gpu, &[&out, &cfg])?;
         let strategy = |e| FanoutError::Strategy(kind, e);
         let scheduler = Scheduler::new(&gpu, &program, kind, 1024).map_err(strategy)?;
-        // The counters come back with the run's own last read-back (no extra host wait).
+        // The counters come back with the run: in the megakernel's and the device-driven
+        // multi-pass's own last read-back, after the host-driven one's last round.
         let (stats, mut words) = scheduler
             .run_reading(&gpu, &seeds, Some(&bind), None, &[(&out, 0, 2)])
             .map_err(strategy)?;

@@ -194,11 +194,16 @@ impl Scheduler {
         Ok(self.run_reading(gpu, seeds, user, max_queue_bytes, &[])?.0)
     }
 
-    /// [`Scheduler::run_within`] that also reads `reads` back (one vector of words per range,
-    /// as the run left them) with the run's own last read-back, instead of a host round trip of
-    /// their own after it: on the H200 a round trip costs about 0.09 ms, as much as a small
-    /// run's GPU time (docs/results.md, 2026-12-04 (third session)). The buffers need
-    /// `COPY_SRC` ([`Gpu::storage_buffer`]'s have it).
+    /// [`Scheduler::run_within`] that also reads `reads` back: `(buffer, first word, words)`
+    /// ranges, returned as one vector of words per range, as the run left them (a run of no
+    /// seeds: as they were). The megakernel copies them into each launch's read-back and the
+    /// device-driven multi-pass into each submission's, so they cost no host round trip of
+    /// their own (on the H200 about 0.09 ms, as much as a small run's GPU time; docs/results.md,
+    /// 2026-12-04 (third session)), but a copy per launch or submission (usually one); the
+    /// host-driven multi-pass reads them once after its last round, a wait of their own. The
+    /// read-back buffer grows to the largest request and is kept with the scheduler. Errors: as
+    /// [`Scheduler::run_within`], and [`RunError::Program`] before anything runs for a range
+    /// past its buffer's end or a buffer without `COPY_SRC` ([`Gpu::storage_buffer`]'s have it).
     pub fn run_reading(
         &self,
         gpu: &Gpu,
@@ -207,6 +212,20 @@ impl Scheduler {
         max_queue_bytes: Option<u64>,
         reads: &[ReadRange],
     ) -> Result<(RunStats, Vec<Vec<u32>>), RunError> {
+        for (i, &(buf, first, words)) in reads.iter().enumerate() {
+            let label = format!("read range {i} (words {first}..{})", first + words);
+            if !buf.usage().contains(wgpu::BufferUsages::COPY_SRC) {
+                return Err(RunError::Program(format!(
+                    "{label}: its buffer lacks COPY_SRC usage"
+                )));
+            }
+            if (first + words) * 4 > buf.size() {
+                return Err(RunError::Program(format!(
+                    "{label}: past the end of its buffer of {} words",
+                    buf.size() / 4
+                )));
+            }
+        }
         match self {
             Scheduler::Megakernel(m) => m.run(gpu, seeds, user, max_queue_bytes, reads),
             Scheduler::Multipass(m) => m.run(gpu, seeds, user, max_queue_bytes, reads),

@@ -43,7 +43,7 @@ pub struct Megakernel {
     outbox_stride: u32,
     ob_off: Vec<u32>,
     priority: Vec<u32>,
-    /// Most items a batch of each queue holds ([`batch_items`]).
+    /// Most items a batch of each queue holds ([`claim::batch_items`]).
     batch: Vec<u32>,
     /// Words of each workgroup's local area, past the queues in the slots buffer (0 without
     /// local queues; `local::LocalPlan`).
