@@ -216,28 +216,8 @@ fn priority_orders_the_workloads_procedures() {
         "a refused suite writes nothing"
     );
     let run = |order: &[&str]| {
-        let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
-            .args(["--workload", "tree", "--roots", "2", "--depth", "10"])
-            .args([
-                "--strategy",
-                "megakernel",
-                "--workgroups",
-                "1",
-                "--no-local-queues",
-            ])
-            .args(["--runs", "1", "--json"])
-            .args(order)
-            .output()
-            .expect("schedbench runs");
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(0), "{order:?}: {err}");
-        let line = String::from_utf8_lossy(&out.stdout)
-            .lines()
-            .next()
-            .unwrap()
-            .to_string();
-        let r: serde_json::Value = serde_json::from_str(&line).unwrap();
-        assert_eq!(r["verified"], true, "{line}");
+        let tree = ["--roots", "2", "--depth", "10", "--workgroups", "1"];
+        let r = first_json_record(&[&tree[..], &["--no-local-queues"], order].concat());
         let leaves_waiting = r["peak_occupancy"][1].as_u64().unwrap();
         (r["queue_order"].clone(), leaves_waiting)
     };
@@ -265,27 +245,30 @@ fn guided_claims_are_asked_for_and_recorded() {
         "cannot be used with",
     );
     let guided = |flag: &[&str]| {
-        let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
-            .args(["--workload", "tree", "--roots", "2", "--depth", "8"])
-            .args(["--strategy", "megakernel", "--workgroups", "3"])
-            .args(["--runs", "1", "--json"])
-            .args(flag)
-            .output()
-            .expect("schedbench runs");
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(0), "{flag:?}: {err}");
-        let line = String::from_utf8_lossy(&out.stdout)
-            .lines()
-            .next()
-            .unwrap()
-            .to_string();
-        let r: serde_json::Value = serde_json::from_str(&line).unwrap();
-        assert_eq!(r["verified"], true, "{line}");
-        r["guided_claims"].clone()
+        let tree = ["--roots", "2", "--depth", "8", "--workgroups", "3"];
+        first_json_record(&[&tree[..], flag].concat())["guided_claims"].clone()
     };
     assert_eq!(guided(&[]), serde_json::json!(false));
     assert_eq!(guided(&["--guided-claims"]), serde_json::json!(true));
     assert_eq!(guided(&["--no-guided-claims"]), serde_json::json!(false));
+}
+
+/// The first JSON record of `schedbench --workload tree --strategy megakernel --runs 1 --json
+/// ARGS`, which must exit 0 with a verified run.
+fn first_json_record(args: &[&str]) -> serde_json::Value {
+    let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
+        .args(["--workload", "tree", "--strategy", "megakernel"])
+        .args(["--runs", "1", "--json"])
+        .args(args)
+        .output()
+        .expect("schedbench runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{args:?}: {err}");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let line = stdout.lines().next().unwrap();
+    let r: serde_json::Value = serde_json::from_str(line).unwrap();
+    assert_eq!(r["verified"], true, "{line}");
+    r
 }
 
 /// `schedbench --strategy cpu ARGS` exits 2 (a usage error) with `expected` in its message.

@@ -15,11 +15,6 @@ pub struct Readback {
 }
 
 impl Readback {
-    /// The words it holds (at least those asked for at [`Readback::new`]).
-    pub fn words(&self) -> u64 {
-        self.words
-    }
-
     pub fn new(gpu: &Gpu, label: &str, words: u64) -> Readback {
         // Even, so that any prefix rounded up to 8 bytes stays inside.
         let words = words.max(2).next_multiple_of(2);
@@ -32,6 +27,28 @@ impl Readback {
             }),
             words,
         }
+    }
+
+    /// `kept` where it holds at least `words` words, else a new one of `words`: a scheduler's
+    /// read-back, reused run after run and grown when a run reads more.
+    pub fn reuse(kept: Option<Readback>, gpu: &Gpu, label: &str, words: u64) -> Readback {
+        kept.filter(|rb| rb.words >= words)
+            .unwrap_or_else(|| Readback::new(gpu, label, words))
+    }
+
+    /// Copies `ranges` here, one after another from word `at`, in a submission of their own and
+    /// reads them back (one bounded wait), one vector per range.
+    pub fn read_ranges(
+        &self,
+        gpu: &Gpu,
+        ranges: &[ReadRange],
+        at: u64,
+    ) -> Result<Vec<Vec<u32>>, RunError> {
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        copy_ranges(self, &mut enc, ranges, at);
+        gpu.queue.submit([enc.finish()]);
+        let words = self.read(gpu, at + ranges_words(ranges))?;
+        Ok(split_ranges(&words[at as usize..], ranges))
     }
 
     /// Records the resolve of `timer`'s span `slot` and its copy here at word `dst_word`, after
@@ -135,9 +152,5 @@ pub fn read_ranges(gpu: &Gpu, ranges: &[ReadRange]) -> Result<Vec<Vec<u32>>, Run
     if total == 0 {
         return Ok(vec![Vec::new(); ranges.len()]);
     }
-    let rb = Readback::new(gpu, "read ranges", total);
-    let mut enc = gpu.device.create_command_encoder(&Default::default());
-    copy_ranges(&rb, &mut enc, ranges, 0);
-    gpu.queue.submit([enc.finish()]);
-    Ok(split_ranges(&rb.read(gpu, total)?, ranges))
+    Readback::new(gpu, "read ranges", total).read_ranges(gpu, ranges, 0)
 }

@@ -601,13 +601,10 @@ impl Megakernel {
         let user_at = tw + SpanTimer::WORDS;
         let read_words = user_at + ranges_words(reads);
         let mut gpu_ms = gpu.timestamps.then_some(0.0);
-        let kept = self.readback.lock().unwrap().take();
-        let (rb, timer) = *kept
-            .filter(|k| k.0.words() >= read_words)
-            .unwrap_or_else(|| {
-                let rb = Readback::new(gpu, "ctrl read-back", read_words);
-                Box::new((rb, SpanTimer::new(gpu, 1)))
-            });
+        let kept = self.readback.lock().unwrap().take().map(|k| *k);
+        let (rb, timer) = kept.map_or((None, None), |(rb, timer)| (Some(rb), Some(timer)));
+        let rb = Readback::reuse(rb, gpu, "ctrl read-back", read_words);
+        let timer = timer.unwrap_or_else(|| SpanTimer::new(gpu, 1));
         let results;
         let mut start = Start::Upload(live);
         loop {

@@ -16,7 +16,7 @@ use crate::multipass::partial::{at_limit, needs_partial, partial_round};
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
 use crate::queue_layout::{QueueLayout, RunStart};
-use crate::readback::{ReadRange, Readback, copy_ranges, ranges_words, split_ranges};
+use crate::readback::{ReadRange, Readback, ranges_words};
 use crate::stats::RunStats;
 use crate::timing::RunTimer;
 
@@ -255,13 +255,9 @@ impl HostMultipass {
         };
         // The caller's ranges follow the counts.
         let count_words = (nq + EXTRA_WORDS) as u64;
-        let rb = self.readback.lock().unwrap().take();
-        let rb = rb
-            .filter(|rb| rb.words() >= count_words + ranges_words(reads))
-            .unwrap_or_else(|| {
-                let words = count_words + ranges_words(reads);
-                Readback::new(gpu, "round counts read-back", words)
-            });
+        let kept = self.readback.lock().unwrap().take();
+        let words = count_words + ranges_words(reads);
+        let rb = Readback::reuse(kept, gpu, "round counts read-back", words);
         let mut timer = RunTimer::new(gpu, 64);
         let cached = self.cache.lock().unwrap().take();
         let kept = cached.as_ref().map(|d| d.layout.capacity.as_slice());
@@ -418,14 +414,10 @@ impl HostMultipass {
         }
         stats.queue_bytes = d.layout.total_words * 4 * 2;
         // The caller's ranges: one submission and wait, into the kept read-back.
-        let mut results = vec![Vec::new(); reads.len()];
-        if !reads.is_empty() {
-            let mut enc = gpu.device.create_command_encoder(&Default::default());
-            copy_ranges(&rb, &mut enc, reads, count_words);
-            gpu.queue.submit([enc.finish()]);
-            let words = rb.read(gpu, count_words + ranges_words(reads))?;
-            results = split_ranges(&words[count_words as usize..], reads);
-        }
+        let results = match reads.is_empty() {
+            true => Vec::new(),
+            false => rb.read_ranges(gpu, reads, count_words)?,
+        };
         stats.gpu_ms = timer.finish(gpu)?;
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
         *self.cache.lock().unwrap() = Some(d);

@@ -462,10 +462,8 @@ impl Multipass {
         // after them.
         let cw = ctrl_words(nq) as u64;
         let read_words = cw + ranges_words(reads);
-        let rb = self.readback.lock().unwrap().take();
-        let rb = rb
-            .filter(|rb| rb.words() >= read_words)
-            .unwrap_or_else(|| Readback::new(gpu, "multi-pass read-back", read_words));
+        let kept = self.readback.lock().unwrap().take();
+        let rb = Readback::reuse(kept, gpu, "multi-pass read-back", read_words);
         let mut results;
         // Rounds encoded since the last upload: round r reads items[r % 2].
         let mut since_upload = 0u64;
