@@ -316,20 +316,31 @@ fn leader_decide() -> u32 {
     // Work held in the workgroup runs first, in priority order: no global atomic to claim it.
     // The items are taken from the filling buffer here (put back if their room cannot be
     // reserved). Where the credit covers their worst-case output the batch starts at once;
-    // else the lanes reserve the rest of the room first.
+    // else the lanes reserve the rest of the room first. A queue that emits nothing
+    // (LOCAL_DEFER) waits while it holds less than a step and other held work can run: its
+    // items lengthen no chain, and a later turn runs more of them at the same cost (the deep
+    // tree's leaves took every other local turn).
+    var pick = NQ;
     for (var i = 0u; i < NQ && LOCAL; i++) {
         let q = prio(i);
         let m = atomicLoad(&wg_local_n[q]);
-        if m > 0u {
-            wg_turn.y = q;
-            wg_turn.z = 0u;
-            wg_turn.w = m;
-            atomicStore(&wg_local_n[q], 0u);
-            for (var t = 0u; t < NQ; t++) {
-                if m * EMITS[q * NQ + t] > wg_credit[t] { return CMD_LOCAL_RESERVE; }
-            }
-            return CMD_LOCAL;
+        if m == 0u { continue; }
+        if pick == NQ { pick = q; }
+        if LOCAL_DEFER[q] == 0u || m >= min(WG_SIZE / THREADS[q], LOCAL_CAP[q]) {
+            pick = q;
+            break;
         }
+    }
+    if LOCAL && pick < NQ {
+        let m = atomicLoad(&wg_local_n[pick]);
+        wg_turn.y = pick;
+        wg_turn.z = 0u;
+        wg_turn.w = m;
+        atomicStore(&wg_local_n[pick], 0u);
+        for (var t = 0u; t < NQ; t++) {
+            if m * EMITS[pick * NQ + t] > wg_credit[t] { return CMD_LOCAL_RESERVE; }
+        }
+        return CMD_LOCAL;
     }
     if params[P_POLICY] == 1u {
         let q = fifo_pick();

@@ -28,7 +28,7 @@ mod pipeline;
 pub mod procedure;
 pub mod program;
 mod queue_layout;
-mod readback;
+pub mod readback;
 pub mod recorded_run;
 pub mod stats;
 pub mod strategy;

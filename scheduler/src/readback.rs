@@ -15,6 +15,7 @@ pub struct Readback {
 }
 
 impl Readback {
+    /// A read-back of at least `words` words (rounded up to an even count).
     pub fn new(gpu: &Gpu, label: &str, words: u64) -> Readback {
         // Even, so that any prefix rounded up to 8 bytes stays inside.
         let words = words.max(2).next_multiple_of(2);

@@ -96,6 +96,12 @@ impl LocalPlan {
             .flat_map(|p| (0..nq).map(|t| (on && p.local[t] && self.cap[t] > 0) as u32))
             .collect();
         let stride: Vec<u32> = (0..nq).map(|t| self.buffer_words(program, t)).collect();
+        // A held target that emits nothing runs after other held work until it fills a step.
+        let defer: Vec<u32> = (0..nq)
+            .map(|t| {
+                (on && self.cap[t] > 0 && program.procs[t].emits.iter().all(|&e| e == 0)) as u32
+            })
+            .collect();
         format!(
             "const LOCAL: bool = {on};\n\
              // LOCAL_EDGE[q * NQ + t]: 1 when q's emits to t may stay in the workgroup\n\
@@ -106,6 +112,9 @@ impl LocalPlan {
              const LOCAL_OFF: array<u32, {nq}> = array<u32, {nq}>({});\n\
              const LOCAL_STRIDE: array<u32, {nq}> = array<u32, {nq}>({});\n\
              const LOCAL_WG_WORDS: u32 = {}u;\n\
+             // 1 where queue t emits nothing: its held items wait for other held work until\n\
+             // they fill a step\n\
+             const LOCAL_DEFER: array<u32, {nq}> = array<u32, {nq}>({});\n\
              // Most unpromised budget room of queue t a workgroup keeps (`wg_credit`)\n\
              const LOCAL_CREDIT_MAX: array<u32, {nq}> = array<u32, {nq}>({});\n",
             list(&edge),
@@ -113,6 +122,7 @@ impl LocalPlan {
             list(&self.off),
             list(&stride),
             self.wg_words,
+            list(&defer),
             list(&self.credit_max),
             n2 = nq * nq,
         )
@@ -183,6 +193,34 @@ mod tests {
             assert!(plan.wg_words * 4 <= bytes, "{bytes}: {plan:?}");
             assert_eq!(plan.active(), bytes >= 32, "{bytes}: {plan:?}");
         }
+    }
+
+    /// Only a local target that emits nothing is deferred: `leaf` once it is kept local, never
+    /// `split`, which emits.
+    #[test]
+    fn only_local_sinks_are_deferred() {
+        let p = program();
+        let plan = LocalPlan::new(&p, &[256, 1024], 1 << 20);
+        assert!(
+            plan.wgsl(&p)
+                .contains("LOCAL_DEFER: array<u32, 2> = array<u32, 2>(0u, 0u)")
+        );
+        let node = ItemType::new("Node", "struct Node { id: u32 }");
+        let split = Procedure::new("split", node.clone(), 1)
+            .emits("split", 2)
+            .emits("leaf", 2)
+            .local("split")
+            .local("leaf")
+            .body("fn split_execute(item: Node, inv: Invocation) { enqueue_split(item); enqueue_leaf(item); }");
+        let leaf =
+            Procedure::new("leaf", node, 1).body("fn leaf_execute(item: Node, inv: Invocation) {}");
+        let both = Program::new(vec![split, leaf], UserBindings::none()).unwrap();
+        let plan = LocalPlan::new(&both, &[256, 1024], 1 << 20);
+        assert!(
+            plan.wgsl(&both)
+                .contains("LOCAL_DEFER: array<u32, 2> = array<u32, 2>(0u, 1u)")
+        );
+        assert!(!LocalPlan::none(2).wgsl(&both).contains("(0u, 1u)"));
     }
 
     #[test]

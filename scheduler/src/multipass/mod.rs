@@ -26,7 +26,7 @@ use crate::program::{Program, Seed};
 use crate::queue_layout::{QueueLayout, RunStart};
 use crate::readback::{ReadRange, Readback, copy_ranges, ranges_words, split_ranges};
 use crate::stats::RunStats;
-use crate::timing::{PassTimer, StageTimer};
+use crate::timing::{SpanTimer, StageTimer};
 
 /// Settings of [`Multipass::new`]; [`Default`] gives the documented defaults.
 #[derive(Debug, Clone)]
@@ -101,7 +101,7 @@ pub struct Multipass {
     /// submission encodes that many.
     learned_rounds: std::sync::atomic::AtomicU32,
     /// The counters' read-back (and the caller's ranges after them), kept between runs.
-    readback: std::sync::Mutex<Option<Readback>>,
+    readback: std::sync::Mutex<Option<(Readback, SpanTimer)>>,
 }
 
 struct DeviceRounds {
@@ -312,7 +312,7 @@ impl Multipass {
         d: &DeviceRounds,
         rounds: u32,
         first_round: u64,
-        timer: Option<&PassTimer>,
+        timer: Option<&SpanTimer>,
         stages: Option<&StageTimer>,
         user: Option<&wgpu::BindGroup>,
     ) {
@@ -325,7 +325,7 @@ impl Multipass {
         let begin = |enc: &mut wgpu::CommandEncoder, stage: usize| {
             let writes = match stages {
                 Some(st) => st.writes(stage),
-                None => timer.and_then(|t| t.writes()),
+                None => timer.and_then(|t| t.whole(0)),
             };
             let mut pass = enc
                 .begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -452,18 +452,21 @@ impl Multipass {
             peak_occupancy: vec![0; nq],
             ..Default::default()
         };
-        let mut timer = PassTimer::new(gpu);
         let mut stage_timer = self
             .config
             .stage_timing
             .then(|| StageTimer::new(gpu, nq + 1, rounds.max(rounds_per_submit) * nq as u32 + 1));
         let mut encoded = 0u64;
-        // Each submission's counters come back in its own read-back, the caller's ranges
-        // after them.
+        // Each submission's counters come back in its own read-back, with its GPU time (no
+        // wait of its own) and the caller's ranges after them.
         let cw = ctrl_words(nq) as u64;
-        let read_words = cw + ranges_words(reads);
+        let user_at = cw + SpanTimer::WORDS;
+        let read_words = user_at + ranges_words(reads);
         let kept = self.readback.lock().unwrap().take();
-        let rb = Readback::reuse(kept, gpu, "multi-pass read-back", read_words);
+        let (rb, timer) = kept.map_or((None, None), |(rb, timer)| (Some(rb), Some(timer)));
+        let rb = Readback::reuse(rb, gpu, "multi-pass read-back", read_words);
+        let timer = timer.unwrap_or_else(|| SpanTimer::new(gpu, 1));
+        let mut gpu_ms = gpu.timestamps.then_some(0.0);
         let mut results;
         // Rounds encoded since the last upload: round r reads items[r % 2].
         let mut since_upload = 0u64;
@@ -495,8 +498,10 @@ impl Multipass {
                 user,
             );
             rb.copy(&mut enc, &d.ctrl, 0, 0, cw);
-            copy_ranges(&rb, &mut enc, reads, cw);
-            timer.resolve(&mut enc);
+            if stage_timer.is_none() {
+                rb.copy_span(&mut enc, &timer, 0, cw);
+            }
+            copy_ranges(&rb, &mut enc, reads, user_at);
             if let Some(st) = &stage_timer {
                 st.resolve(&mut enc);
             }
@@ -506,13 +511,15 @@ impl Multipass {
             encoded += rounds as u64;
             since_upload += rounds as u64;
             let mut ctrl = rb.read(gpu, read_words)?;
-            results = split_ranges(&ctrl[cw as usize..], reads);
-            ctrl.truncate(cw as usize);
+            results = split_ranges(&ctrl[user_at as usize..], reads);
             if let Some(st) = &mut stage_timer {
                 st.collect(gpu)?;
-            } else {
-                timer.collect(gpu)?;
+            } else if let (Some(total), Some(ms)) =
+                (gpu_ms.as_mut(), timer.ms(&ctrl[cw as usize..]))
+            {
+                *total += ms;
             }
+            ctrl.truncate(cw as usize);
             let error = ctrl[g(nq, G_ERROR)];
             let (a, b) = (ctrl[g(nq, G_ERR_A)] as usize, ctrl[g(nq, G_ERR_B)]);
             if error == ERR_EMIT {
@@ -594,14 +601,14 @@ impl Multipass {
             stats.rounds.clamp(1, MAX_LEARNED_ROUNDS as u64) as u32,
             std::sync::atomic::Ordering::Relaxed,
         );
-        stats.gpu_ms = timer.total_ms();
+        stats.gpu_ms = gpu_ms;
         if let Some(ms) = stage_timer.and_then(|st| st.stage_ms()) {
             stats.gpu_ms = Some(ms.iter().sum());
             stats.stage_gpu_ms = ms;
         }
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
         *self.cache.lock().unwrap() = Some(d);
-        *self.readback.lock().unwrap() = Some(rb);
+        *self.readback.lock().unwrap() = Some((rb, timer));
         Ok((stats, results))
     }
 

@@ -20,7 +20,8 @@ use std::time::Instant;
 use crate::bfs::{BfsParams, initial_levels, upload_graph, write_words};
 use scheduler::error::RunError;
 use scheduler::gpu::Gpu;
-use scheduler::timing::PassTimer;
+use scheduler::readback::Readback;
+use scheduler::timing::SpanTimer;
 
 /// What a frontier BFS run did.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -150,6 +151,9 @@ pub struct FrontierBfs {
     /// `expand` reading `front[p]` and appending to `front[1 - p]`.
     expand_bind: [wgpu::BindGroup; 2],
     plan_bind: wgpu::BindGroup,
+    /// Each submission's `ctrl` and GPU time, read back in one wait.
+    readback: Readback,
+    timer: SpanTimer,
 }
 
 impl FrontierBfs {
@@ -212,6 +216,8 @@ impl FrontierBfs {
             front,
             expand_bind,
             plan_bind,
+            readback: Readback::new(gpu, "frontier bfs read-back", 4 + SpanTimer::WORDS),
+            timer: SpanTimer::new(gpu, 1),
         })
     }
 
@@ -230,7 +236,7 @@ impl FrontierBfs {
         write_words(gpu, &self.ctrl, &[1, 0, 0, 1]);
         write_words(gpu, &self.args, &[1, 1, 1]);
         let start = Instant::now();
-        let mut timer = PassTimer::new(gpu);
+        let mut gpu_ms = gpu.timestamps.then_some(0.0);
         let mut stats = FrontierStats::default();
         let mut encoded = 0u64;
         let mut per_submit = 8u64;
@@ -239,7 +245,7 @@ impl FrontierBfs {
             {
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("frontier bfs levels"),
-                    timestamp_writes: timer.writes(),
+                    timestamp_writes: self.timer.whole(0),
                 });
                 for _ in 0..per_submit {
                     pass.set_pipeline(&self.expand);
@@ -251,10 +257,15 @@ impl FrontierBfs {
                     encoded += 1;
                 }
             }
-            timer.resolve(&mut enc);
+            // The counters and the GPU time come back in one wait.
+            self.readback.copy(&mut enc, &self.ctrl, 0, 0, 4);
+            self.readback.copy_span(&mut enc, &self.timer, 0, 4);
             gpu.queue.submit([enc.finish()]);
-            let ctrl = gpu.read_words(&self.ctrl, 0, 4)?;
-            timer.collect(gpu)?;
+            let mut ctrl = self.readback.read(gpu, 4 + SpanTimer::WORDS)?;
+            if let (Some(total), Some(ms)) = (gpu_ms.as_mut(), self.timer.ms(&ctrl[4..])) {
+                *total += ms;
+            }
+            ctrl.truncate(4);
             stats.submits += 1;
             if ctrl[C_N] == 0 {
                 break ctrl;
@@ -268,7 +279,7 @@ impl FrontierBfs {
             per_submit = (per_submit * 2).min(64);
         };
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
-        stats.gpu_ms = timer.total_ms();
+        stats.gpu_ms = gpu_ms;
         stats.levels = ctrl[C_LEVEL] + 1;
         stats.reached = ctrl[C_REACHED] as u64;
         let levels = gpu.read_words(&self.level, 0, n as u64)?;

@@ -699,48 +699,48 @@ pub fn megakernel_procedure_steps(gpu: &scheduler::Gpu) -> Vec<(String, u32)> {
 
 impl TreeParams {
     /// Whether the megakernel should keep a workgroup's children local
-    /// (`MegakernelConfig::local_queues`; the program declares them local): where the tree does
-    /// not thin out, a batch's children fill the workgroup's next steps, so its local batches stay
-    /// full and skip the global queue's round trips. That holds where every node has the same
-    /// number of children, one or more, and where a random fan-out of 0..=k has a mean above one
-    /// (k >= 3). Where the mean is one (deep: 0..=2), a workgroup's lineages die out and its
-    /// local batches shrink (39 items a batch against 248), costing more turns than the claims
-    /// they save. H200, median of 10 (docs/results.md, 2026-12-04, "A local batch without
-    /// barriers of its own"): binary 0.160 -> 0.122 ms, heavy work 0.184 -> 0.164, large-payload
-    /// 0.567 -> 0.534, irregular 0.183 -> 0.174, the one-item chain on one workgroup 8.53 ->
-    /// 5.12 ms; deep 1.33 -> 1.48. Deep trees of few roots gain from them (2026-12-04, second
-    /// session, without against with local queues, same build: 1,250 roots 1.29 / 1.16 ms, 5,000
-    /// roots 1.31 / 1.26; sizes between 5,000 and 20,000 not measured), the preset's 20,000 roots
-    /// lose (1.34 / 1.38); the choice stays by fan-out, since a rule by roots would need the
-    /// launch's width, which the tree does not know.
+    /// (`MegakernelConfig::local_queues`; the program declares them local): wherever the tree
+    /// does not die out, a fixed fan-out of one or more or a random one of mean one or more
+    /// (0..=k children, k >= 2). A batch's children fill the workgroup's next steps and skip the
+    /// global queue's round trips. Where the mean is one (deep: 0..=2) a workgroup's lineages
+    /// thin out, and its leaves, a few a level, took every other local turn until held leaves
+    /// waited for held branches (`LOCAL_DEFER`, docs/scheduler.md 2.7); since then local queues
+    /// pay there too. H200, GPU ms median of 10, without / with local queues (docs/results.md,
+    /// 2026-12-04 (fourth session)): deep 20,000 roots 1.344 / 1.11-1.16, 5,000 roots 1.304 /
+    /// 1.08-1.12, 1,250 roots 1.29 / 1.00-1.02. Earlier, for the other presets (2026-12-04, "A
+    /// local batch without barriers of its own"): binary 0.160 -> 0.122 ms, heavy work 0.184 ->
+    /// 0.164, large-payload 0.567 -> 0.534, irregular 0.183 -> 0.174, the one-item chain on one
+    /// workgroup 8.53 -> 5.12 ms. A tree of mean fan-out below one (0..=1) is left without:
+    /// not measured.
     pub fn megakernel_local_queues(&self) -> bool {
         match self.fanout {
             Fanout::Fixed(k) => k >= 1,
-            Fanout::Uniform(k) => k >= 3,
+            Fanout::Uniform(k) => k >= 2,
         }
     }
 }
 
 #[cfg(test)]
 mod tests {
-    /// Local queues where the tree does not thin out: a fixed fan-out of one or more, a random
-    /// one whose mean is above one.
+    /// Local queues where the tree does not die out: a fixed fan-out of one or more, a random
+    /// one whose mean is one or more.
     #[test]
-    fn local_queues_only_where_the_tree_does_not_thin_out() {
+    fn local_queues_only_where_the_tree_does_not_die_out() {
         use super::{Fanout, TreeParams, TreePreset};
         let chosen: Vec<bool> = TreePreset::ALL
             .iter()
             .map(|p| p.params().megakernel_local_queues())
             .collect();
         // binary, irregular, deep, large-payload, heavy work
-        assert_eq!(chosen, [true, true, false, true, true]);
+        assert_eq!(chosen, [true; 5]);
         let with = |fanout| TreeParams {
             fanout,
             ..TreePreset::Binary.params()
         };
         assert!(with(Fanout::Fixed(1)).megakernel_local_queues());
         assert!(!with(Fanout::Fixed(0)).megakernel_local_queues());
-        assert!(!with(Fanout::Uniform(2)).megakernel_local_queues());
+        assert!(with(Fanout::Uniform(2)).megakernel_local_queues());
+        assert!(!with(Fanout::Uniform(1)).megakernel_local_queues());
         assert!(with(Fanout::Uniform(4)).megakernel_local_queues());
     }
 
