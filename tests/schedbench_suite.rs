@@ -62,10 +62,14 @@ fn small_suite_verifies_every_run_and_writes_its_report() {
         // The megakernel's records say what it ran with; the multi-passes' do not.
         if s.starts_with("megakernel") {
             assert_eq!(r["workgroup_size"], 256, "{w} {s} {size}");
-            // Local queues where the workload chose them: the trees that do not thin out.
+            // Local queues where the workload chose them: the trees that do not die out.
             let local = matches!(
                 w,
-                "tree-binary" | "tree-irregular" | "tree-large-payload" | "tree-heavy-work"
+                "tree-binary"
+                    | "tree-irregular"
+                    | "tree-deep"
+                    | "tree-large-payload"
+                    | "tree-heavy-work"
             );
             assert_eq!(r["local_queues"], local, "{w} {s} {size}");
         } else {

@@ -196,7 +196,7 @@ pub struct Cli {
     /// The megakernel keeps the emits a workload declares local (the tree's children, Reyes'
     /// Bound and Split pieces) in its workgroup's area of the queue buffer and runs them next on
     /// the same workgroup (`MegakernelConfig::local_queues`). Default: the workload's choice, on
-    /// for trees that do not thin out (a fixed fan-out, or a random one of mean above 1), off
+    /// for trees that do not die out (a fixed fan-out, or a random one of mean 1 or more), off
     /// elsewhere (docs/scheduler.md 2.7).
     #[arg(long, help_heading = "Scheduler", conflicts_with = "no_local_queues")]
     pub local_queues: bool,

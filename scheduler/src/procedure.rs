@@ -125,7 +125,8 @@ impl Procedure {
     /// Lets the items this procedure emits to `target` (declared with [`Procedure::emits`]) stay
     /// with the workgroup: in the megakernel with `MegakernelConfig::local_queues` (off by
     /// default: it pays where a batch's children fill the workgroup's next steps, such as trees
-    /// that do not thin out, and costs where lineages die out; docs/scheduler.md 2.7), a batch's
+    /// that do not die out, and costs where a few pieces are left before other work, as on Reyes'
+    /// patches; docs/scheduler.md 2.7), a batch's
     /// emits to `target` go to the workgroup's own area of the slots buffer while it has room, and
     /// the workgroup runs them as its next batch, without the global queue's tickets, flags and
     /// claim (Whippletree's per-block queues, Steinberger et al. 2014, section 4; the local
