@@ -317,9 +317,9 @@ fn leader_decide() -> u32 {
     // The items are taken from the filling buffer here (put back if their room cannot be
     // reserved). Where the credit covers their worst-case output the batch starts at once;
     // else the lanes reserve the rest of the room first. A queue that emits nothing
-    // (LOCAL_DEFER) waits while it holds less than a step and other held work can run: its
-    // items lengthen no chain, and a later turn runs more of them at the same cost (the deep
-    // tree's leaves took every other local turn).
+    // (LOCAL_DEFER) waits while it holds less than a step (and than its buffer holds) and
+    // other held work can run: its items lengthen no chain, and a later turn runs more of them
+    // at the same cost (the deep tree's leaves took every other local turn).
     var pick = NQ;
     for (var i = 0u; i < NQ && LOCAL; i++) {
         let q = prio(i);

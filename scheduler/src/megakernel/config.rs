@@ -22,7 +22,10 @@ pub enum Workgroups {
 #[derive(Debug, Clone, PartialEq)]
 pub enum QueuePolicy {
     /// The first queue with work in this order of procedure names (unnamed ones follow in
-    /// reverse registration order). "Later stages first" keeps queues short.
+    /// reverse registration order). "Later stages first" keeps queues short. Items a workgroup
+    /// holds in its local queues run before any claim, in this order too, except that a
+    /// procedure that emits nothing waits behind other held work until it fills a step
+    /// (docs/scheduler.md 2.7).
     Priority(Vec<String>),
     /// The queue whose oldest waiting batch was published first.
     Fifo,
@@ -140,9 +143,10 @@ pub struct MegakernelConfig {
     /// the global queues (no ticket, flag or claim for them; docs/scheduler.md 2.7). No effect on
     /// a program that declares nothing local. Default `false`: it pays where a batch's children
     /// fill the workgroup's next steps (H200: binary tree 0.160 -> 0.122 ms, irregular 0.183 ->
-    /// 0.167, the one-item chain 4.2 -> 2.4 us a turn) and costs where lineages die out (deep
-    /// tree 1.33 -> 1.48 ms; Reyes frames 3-5%); docs/results.md, 2026-12-04, "A local batch
-    /// without barriers of its own".
+    /// 0.167, the one-item chain 4.2 -> 2.4 us a turn; docs/results.md, 2026-12-04, "A local
+    /// batch without barriers of its own"), on the deep tree too since held leaves wait for held
+    /// branches (1.34 -> 1.15 ms; 2026-12-04 (fourth session)), and costs where work splits into
+    /// few pieces before other work (Reyes frames 3-5%).
     pub local_queues: bool,
     /// Most bytes of one workgroup's local area, both buffers of every local target (default
     /// [`LOCAL_MAX_BYTES`]: a full batch per buffer where it fits; split evenly between the

@@ -100,7 +100,8 @@ pub struct Multipass {
     /// Rounds the last finished run executed (0 before the first): the next run's first
     /// submission encodes that many.
     learned_rounds: std::sync::atomic::AtomicU32,
-    /// The counters' read-back (and the caller's ranges after them), kept between runs.
+    /// The counters' read-back (then the submission's two timestamps, then the caller's
+    /// ranges), and the timer whose span it copies, kept between runs.
     readback: std::sync::Mutex<Option<(Readback, SpanTimer)>>,
 }
 
