@@ -5,6 +5,7 @@ use std::time::Duration;
 
 use crate::error::RunError;
 use crate::gpu::Gpu;
+use crate::timing::SpanTimer;
 
 /// A `MAP_READ` buffer of `words` u32 words, kept for a scheduler's lifetime, that the caller fills
 /// with [`Readback::copy`] in the same command encoder as the work it reads (so no extra
@@ -58,12 +59,12 @@ impl Readback {
     pub fn copy_span(
         &self,
         enc: &mut wgpu::CommandEncoder,
-        timer: &crate::timing::SpanTimer,
+        timer: &SpanTimer,
         slot: u32,
         dst_word: u64,
     ) {
         assert!(
-            dst_word + crate::timing::SpanTimer::WORDS <= self.words,
+            dst_word + SpanTimer::WORDS <= self.words,
             "Readback: span copy past its end"
         );
         timer.copy(enc, slot, &self.buf, dst_word);
@@ -111,6 +112,95 @@ impl Readback {
         };
         self.buf.unmap();
         Ok(out)
+    }
+}
+
+/// What a run waits for once per submission: a [`Readback`] of `counters` words of the run's
+/// counters, then the two timestamps of the submission's timed pass ([`SpanTimer::WORDS`]),
+/// then the caller's ranges ([`ReadRange`]), with the [`SpanTimer`] whose span it copies. So a
+/// submission's GPU time and results come back in the wait for its counters, with no submission
+/// or wait of their own. Kept between runs by the megakernel, the device-driven multi-pass and
+/// a workload's own baseline (the frontier BFS), and grown when a run reads more.
+pub struct TimedReadback {
+    rb: Readback,
+    timer: SpanTimer,
+    counters: u64,
+}
+
+impl TimedReadback {
+    /// `kept` (its buffer grown where `ranges` need more words), else a new one, for
+    /// `counters` counter words and `ranges` after the timestamps.
+    pub fn reuse(
+        kept: Option<TimedReadback>,
+        gpu: &Gpu,
+        label: &str,
+        counters: u64,
+        ranges: &[ReadRange],
+    ) -> TimedReadback {
+        let words = counters + SpanTimer::WORDS + ranges_words(ranges);
+        let (rb, timer) = match kept {
+            Some(k) if k.counters == counters => (Some(k.rb), k.timer),
+            _ => (None, SpanTimer::new(gpu, 1)),
+        };
+        TimedReadback {
+            rb: Readback::reuse(rb, gpu, label, words),
+            timer,
+            counters,
+        }
+    }
+
+    /// The timestamp writes of the submission's timed pass (its beginning and end); `None`
+    /// without timestamp queries.
+    pub fn pass_writes(&self) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        self.timer.whole(0)
+    }
+
+    /// Records, after the submission's last pass: the counters (the first `counters` words of
+    /// `src`), the timed pass's timestamps where `timed` (a pass took [`Self::pass_writes`]),
+    /// and `ranges`.
+    pub fn copy(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        src: &wgpu::Buffer,
+        timed: bool,
+        ranges: &[ReadRange],
+    ) {
+        self.rb.copy(enc, src, 0, 0, self.counters);
+        if timed {
+            self.rb.copy_span(enc, &self.timer, 0, self.counters);
+        }
+        copy_ranges(&self.rb, enc, ranges, self.counters + SpanTimer::WORDS);
+    }
+
+    /// The submission's words after it finished (one bounded wait): counters, timestamps,
+    /// `ranges`. Errors: [`RunError::Timeout`], [`RunError::Device`].
+    pub fn read(&self, gpu: &Gpu, ranges: &[ReadRange]) -> Result<Vec<u32>, RunError> {
+        self.rb
+            .read(gpu, self.counters + SpanTimer::WORDS + ranges_words(ranges))
+    }
+
+    /// The counters of `words` (what [`Self::read`] returned).
+    pub fn counters<'a>(&self, words: &'a [u32]) -> &'a [u32] {
+        &words[..self.counters as usize]
+    }
+
+    /// Adds the timed pass's GPU milliseconds in `words` to `total` (left `None` without
+    /// timestamp queries).
+    pub fn add_ms(&self, words: &[u32], total: &mut Option<f64>) {
+        if let (Some(t), Some(ms)) = (
+            total.as_mut(),
+            self.timer.ms(&words[self.counters as usize..]),
+        ) {
+            *t += ms;
+        }
+    }
+
+    /// `ranges` as `words` holds them, one vector per range.
+    pub fn ranges(&self, words: &[u32], ranges: &[ReadRange]) -> Vec<Vec<u32>> {
+        split_ranges(
+            &words[(self.counters + SpanTimer::WORDS) as usize..],
+            ranges,
+        )
     }
 }
 

@@ -27,9 +27,8 @@ use crate::item_layout::ItemLayout;
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed, WORKGROUP_SIZE};
 use crate::queue_layout::{QueueLayout, RunStart};
-use crate::readback::{ReadRange, Readback, copy_ranges, ranges_words, split_ranges};
+use crate::readback::{ReadRange, TimedReadback};
 use crate::stats::RunStats;
-use crate::timing::SpanTimer;
 
 /// A program compiled for the persistent megakernel: one pipeline, queue buffers kept between
 /// runs, and the workgroup count (probed on the first run). Usually reached through
@@ -53,7 +52,7 @@ pub struct Megakernel {
     /// The mapped buffer ctrl is read back through after each launch, and the timer whose
     /// timestamps come back with it, kept between runs (boxed: `Scheduler`'s variants stay
     /// near one size).
-    readback: std::sync::Mutex<Option<Box<(Readback, SpanTimer)>>>,
+    readback: std::sync::Mutex<Option<Box<TimedReadback>>>,
     compaction: DeviceCompaction,
     /// Slots per queue that the largest run so far needed to finish in one launch (see
     /// [`Megakernel::run`]); the next run starts with at least this much, within its limits.
@@ -595,16 +594,11 @@ impl Megakernel {
             turn_anatomy: self.config.turn_anatomy.then(anatomy::TurnAnatomy::default),
             ..Default::default()
         };
-        // Each launch's GPU time comes back with its counters (one read-back, no extra wait).
-        // The caller's ranges follow them.
-        let tw = ctrl_words(nq) as u64;
-        let user_at = tw + SpanTimer::WORDS;
-        let read_words = user_at + ranges_words(reads);
+        // Each launch's GPU time and the caller's ranges come back with its counters (one
+        // read-back, no extra wait).
         let mut gpu_ms = gpu.timestamps.then_some(0.0);
         let kept = self.readback.lock().unwrap().take().map(|k| *k);
-        let (rb, timer) = kept.map_or((None, None), |(rb, timer)| (Some(rb), Some(timer)));
-        let rb = Readback::reuse(rb, gpu, "ctrl read-back", read_words);
-        let timer = timer.unwrap_or_else(|| SpanTimer::new(gpu, 1));
+        let rb = TimedReadback::reuse(kept, gpu, "ctrl read-back", ctrl_words(nq) as u64, reads);
         let results;
         let mut start = Start::Upload(live);
         loop {
@@ -653,7 +647,7 @@ impl Megakernel {
             {
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("megakernel"),
-                    timestamp_writes: timer.whole(0),
+                    timestamp_writes: rb.pass_writes(),
                 });
                 if let Some(c) = &compaction {
                     self.compaction.record(&mut pass, c);
@@ -665,18 +659,15 @@ impl Megakernel {
                 }
                 pass.dispatch_workgroups(workgroups, 1, 1);
             }
-            rb.copy(&mut enc, &d.ctrl, 0, 0, tw);
-            rb.copy_span(&mut enc, &timer, 0, tw);
-            copy_ranges(&rb, &mut enc, reads, user_at);
+            rb.copy(&mut enc, &d.ctrl, true, reads);
             gpu.queue.submit([enc.finish()]);
-            let ctrl = rb.read(gpu, read_words)?;
-            if let (Some(total), Some(ms)) = (gpu_ms.as_mut(), timer.ms(&ctrl[tw as usize..])) {
-                *total += ms;
-            }
+            let words = rb.read(gpu, reads)?;
+            rb.add_ms(&words, &mut gpu_ms);
+            let ctrl = rb.counters(&words);
             stats.launches += 1;
             stats.submits += 1;
             if let Start::Compact { live, .. } = &start {
-                compact::check(&self.program, &ctrl, live)?;
+                compact::check(&self.program, ctrl, live)?;
             }
             if ctrl[g(nq, G_ERROR)] == ERR_EMIT {
                 let (p, t) = (ctrl[g(nq, G_ERR_A)] as usize, ctrl[g(nq, G_ERR_B)] as usize);
@@ -702,7 +693,7 @@ impl Megakernel {
             }
             stats.abandoned += ctrl[g(nq, G_ABANDONED)] as u64;
             if ctrl[g(nq, G_PENDING)] == 0 && ctrl[g(nq, G_ABANDONED)] == 0 {
-                results = split_ranges(&ctrl[user_at as usize..], reads);
+                results = rb.ranges(&words, reads);
                 break;
             }
             // Work is left. Live items per queue: every ticket reserved in this launch (seeds
@@ -792,7 +783,7 @@ impl Megakernel {
                     gpu,
                     &self.program,
                     d,
-                    &ctrl,
+                    ctrl,
                     self.item_layout(),
                 )?)
             };
@@ -819,7 +810,7 @@ impl Megakernel {
         stats.wall_ms = start_time.elapsed().as_secs_f64() * 1e3;
         // Keep the device queues and the read-back buffer for the next run.
         *self.cache.lock().unwrap() = dq;
-        *self.readback.lock().unwrap() = Some(Box::new((rb, timer)));
+        *self.readback.lock().unwrap() = Some(Box::new(rb));
         Ok((stats, results))
     }
 }

@@ -24,9 +24,9 @@ use crate::item_layout::ItemLayout;
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
 use crate::queue_layout::{QueueLayout, RunStart};
-use crate::readback::{ReadRange, Readback, copy_ranges, ranges_words, split_ranges};
+use crate::readback::{ReadRange, TimedReadback};
 use crate::stats::RunStats;
-use crate::timing::{SpanTimer, StageTimer};
+use crate::timing::StageTimer;
 
 /// Settings of [`Multipass::new`]; [`Default`] gives the documented defaults.
 #[derive(Debug, Clone)]
@@ -100,9 +100,8 @@ pub struct Multipass {
     /// Rounds the last finished run executed (0 before the first): the next run's first
     /// submission encodes that many.
     learned_rounds: std::sync::atomic::AtomicU32,
-    /// The counters' read-back (then the submission's two timestamps, then the caller's
-    /// ranges), and the timer whose span it copies, kept between runs.
-    readback: std::sync::Mutex<Option<(Readback, SpanTimer)>>,
+    /// Each submission's counters, GPU time and the caller's ranges, kept between runs.
+    readback: std::sync::Mutex<Option<TimedReadback>>,
 }
 
 struct DeviceRounds {
@@ -313,7 +312,7 @@ impl Multipass {
         d: &DeviceRounds,
         rounds: u32,
         first_round: u64,
-        timer: Option<&SpanTimer>,
+        timer: Option<&TimedReadback>,
         stages: Option<&StageTimer>,
         user: Option<&wgpu::BindGroup>,
     ) {
@@ -326,7 +325,7 @@ impl Multipass {
         let begin = |enc: &mut wgpu::CommandEncoder, stage: usize| {
             let writes = match stages {
                 Some(st) => st.writes(stage),
-                None => timer.and_then(|t| t.whole(0)),
+                None => timer.and_then(|t| t.pass_writes()),
             };
             let mut pass = enc
                 .begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -460,15 +459,16 @@ impl Multipass {
         let mut encoded = 0u64;
         // Each submission's counters come back in its own read-back, with its GPU time (no
         // wait of its own) and the caller's ranges after them.
-        let cw = ctrl_words(nq) as u64;
-        let user_at = cw + SpanTimer::WORDS;
-        let read_words = user_at + ranges_words(reads);
         let kept = self.readback.lock().unwrap().take();
-        let (rb, timer) = kept.map_or((None, None), |(rb, timer)| (Some(rb), Some(timer)));
-        let rb = Readback::reuse(rb, gpu, "multi-pass read-back", read_words);
-        let timer = timer.unwrap_or_else(|| SpanTimer::new(gpu, 1));
+        let rb = TimedReadback::reuse(
+            kept,
+            gpu,
+            "multi-pass read-back",
+            ctrl_words(nq) as u64,
+            reads,
+        );
         let mut gpu_ms = gpu.timestamps.then_some(0.0);
-        let mut results;
+        let results;
         // Rounds encoded since the last upload: round r reads items[r % 2].
         let mut since_upload = 0u64;
         let cached = self.cache.lock().unwrap().take();
@@ -494,15 +494,11 @@ impl Multipass {
                 &d,
                 rounds,
                 since_upload,
-                Some(&timer),
+                Some(&rb),
                 stage_timer.as_ref(),
                 user,
             );
-            rb.copy(&mut enc, &d.ctrl, 0, 0, cw);
-            if stage_timer.is_none() {
-                rb.copy_span(&mut enc, &timer, 0, cw);
-            }
-            copy_ranges(&rb, &mut enc, reads, user_at);
+            rb.copy(&mut enc, &d.ctrl, stage_timer.is_none(), reads);
             if let Some(st) = &stage_timer {
                 st.resolve(&mut enc);
             }
@@ -511,16 +507,13 @@ impl Multipass {
             stats.launches += 1 + rounds as u64 * self.dispatches_per_round();
             encoded += rounds as u64;
             since_upload += rounds as u64;
-            let mut ctrl = rb.read(gpu, read_words)?;
-            results = split_ranges(&ctrl[user_at as usize..], reads);
+            let words = rb.read(gpu, reads)?;
+            let ctrl = rb.counters(&words);
             if let Some(st) = &mut stage_timer {
                 st.collect(gpu)?;
-            } else if let (Some(total), Some(ms)) =
-                (gpu_ms.as_mut(), timer.ms(&ctrl[cw as usize..]))
-            {
-                *total += ms;
+            } else {
+                rb.add_ms(&words, &mut gpu_ms);
             }
-            ctrl.truncate(cw as usize);
             let error = ctrl[g(nq, G_ERROR)];
             let (a, b) = (ctrl[g(nq, G_ERR_A)] as usize, ctrl[g(nq, G_ERR_B)]);
             if error == ERR_EMIT {
@@ -539,7 +532,8 @@ impl Multipass {
             let halted = error == ERR_OVERFLOW;
             let next: Vec<u32> = (0..nq).map(|q| ctrl[c(q, C_NEXT)]).collect();
             if !halted && next.iter().all(|&n| n == 0) {
-                self.accumulate(&mut stats, &ctrl);
+                self.accumulate(&mut stats, ctrl);
+                results = rb.ranges(&words, reads);
                 break;
             }
             if !halted {
@@ -550,7 +544,7 @@ impl Multipass {
                 // device. A refusal costs a submission, so the growth leaves room for the rounds
                 // after as well ([`Anticipation`]): at least doubling, at least 2 m, and m times
                 // the work's measured growth over a horizon that doubles with each refusal.
-                self.accumulate(&mut stats, &ctrl);
+                self.accumulate(&mut stats, ctrl);
                 let m: Vec<u64> = (0..nq).map(|t| ctrl[c(t, C_EMITS)] as u64).collect();
                 let factor = anticipation.refused(stats.rounds, m.iter().sum());
                 // A target at its limit runs in part instead of halting: a refusal with nothing
@@ -609,7 +603,7 @@ impl Multipass {
         }
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
         *self.cache.lock().unwrap() = Some(d);
-        *self.readback.lock().unwrap() = Some((rb, timer));
+        *self.readback.lock().unwrap() = Some(rb);
         Ok((stats, results))
     }
 

@@ -20,8 +20,7 @@ use std::time::Instant;
 use crate::bfs::{BfsParams, initial_levels, upload_graph, write_words};
 use scheduler::error::RunError;
 use scheduler::gpu::Gpu;
-use scheduler::readback::Readback;
-use scheduler::timing::SpanTimer;
+use scheduler::readback::TimedReadback;
 
 /// What a frontier BFS run did.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -152,8 +151,7 @@ pub struct FrontierBfs {
     expand_bind: [wgpu::BindGroup; 2],
     plan_bind: wgpu::BindGroup,
     /// Each submission's `ctrl` and GPU time, read back in one wait.
-    readback: Readback,
-    timer: SpanTimer,
+    readback: TimedReadback,
 }
 
 impl FrontierBfs {
@@ -216,8 +214,7 @@ impl FrontierBfs {
             front,
             expand_bind,
             plan_bind,
-            readback: Readback::new(gpu, "frontier bfs read-back", 4 + SpanTimer::WORDS),
-            timer: SpanTimer::new(gpu, 1),
+            readback: TimedReadback::reuse(None, gpu, "frontier bfs read-back", 4, &[]),
         })
     }
 
@@ -245,7 +242,7 @@ impl FrontierBfs {
             {
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("frontier bfs levels"),
-                    timestamp_writes: self.timer.whole(0),
+                    timestamp_writes: self.readback.pass_writes(),
                 });
                 for _ in 0..per_submit {
                     pass.set_pipeline(&self.expand);
@@ -258,14 +255,11 @@ impl FrontierBfs {
                 }
             }
             // The counters and the GPU time come back in one wait.
-            self.readback.copy(&mut enc, &self.ctrl, 0, 0, 4);
-            self.readback.copy_span(&mut enc, &self.timer, 0, 4);
+            self.readback.copy(&mut enc, &self.ctrl, true, &[]);
             gpu.queue.submit([enc.finish()]);
-            let mut ctrl = self.readback.read(gpu, 4 + SpanTimer::WORDS)?;
-            if let (Some(total), Some(ms)) = (gpu_ms.as_mut(), self.timer.ms(&ctrl[4..])) {
-                *total += ms;
-            }
-            ctrl.truncate(4);
+            let words = self.readback.read(gpu, &[])?;
+            self.readback.add_ms(&words, &mut gpu_ms);
+            let ctrl = self.readback.counters(&words).to_vec();
             stats.submits += 1;
             if ctrl[C_N] == 0 {
                 break ctrl;
