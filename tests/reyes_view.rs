@@ -181,7 +181,7 @@ fn the_draw_equals_its_twin() {
                 depth_or_array_layers: 1,
             },
         );
-        gpu.queue.submit([enc.finish()]);
+        gpu.submit(enc);
         let got = gpu.read_buffer(&out, 0, (row * th) as u64).unwrap();
         let p = PresentParams::new((iw, ih), (tw, th), format);
         for y in 0..th {

@@ -10,7 +10,7 @@ use crate::progress::Progress;
 use crate::shaders;
 use crate::stages::hiz::{OCCLUSION_OFF, OCCLUSION_TEST, passes};
 use crate::stages::{C_MAX_DEPTH, COUNTERS};
-use scheduler::timing::PassTimer;
+use scheduler::readback::{ReadRange, TimedReadback};
 use scheduler::{
     Gpu, ItemType, MultipassConfig, Procedure, Program, RunError, RunStats, Scheduler, Seed,
     StrategyKind, UserBindings,
@@ -263,6 +263,9 @@ pub struct GpuRenderer {
     /// changed, a frame of the same size allocates nothing large (a 1080p frame's samples are
     /// 66 MB).
     resources: std::sync::Mutex<Option<(SceneBuffers, Option<FrameTarget>)>>,
+    /// The mapped buffer a bucket's resolve time (and, after the last bucket, the image) comes
+    /// back through: one submission and one wait, kept between frames.
+    resolve_readback: std::sync::Mutex<Option<TimedReadback>>,
     /// [`RendererConfig::lavapipe_tuning`], on lavapipe only.
     lavapipe_tuning: bool,
 }
@@ -312,6 +315,7 @@ impl GpuRenderer {
             scheduler,
             pipelines,
             resources: Default::default(),
+            resolve_readback: Default::default(),
             lavapipe_tuning,
         })
     }
@@ -541,7 +545,25 @@ impl GpuRenderer {
             peak_working_bytes: 0,
             wall_ms: 0.0,
         };
+        // The whole image comes back with the last bucket's resolve: one submission, one wait.
+        let image: [ReadRange; 2] = [(rgba, 0, pixels * 4), (depth, 0, pixels)];
+        let image = match tiles_only {
+            true => &image[..0],
+            false => &image[..],
+        };
+        let kept = self.resolve_readback.lock().unwrap().take();
+        let rb = TimedReadback::reuse(kept, gpu, "resolve read-back", 0, image);
+        // The last bucket's resolve, recorded, submitted before anything else touches the
+        // samples (the next bucket's clear) or after the last bucket with the image's copy.
+        let mut resolving: Option<wgpu::CommandEncoder> = None;
+        let add_resolve = |ms: Option<f64>, out: &mut GpuFrame| {
+            out.resolve_gpu_ms = out.resolve_gpu_ms.zip(ms).map(|(a, b)| a + b);
+        };
         while let Some(tile) = todo.pop().or_else(&mut *next) {
+            if let Some(enc) = resolving.take() {
+                let (ms, _) = self.finish_resolve(gpu, (enc, rgba), &rb, &[])?;
+                add_resolve(ms, &mut out);
+            }
             let tile_frame = f.with_tile(tile);
             // A bucket smaller than the image (under a budget, or one of several devices'
             // buckets) renders only the patches that may reach it.
@@ -573,7 +595,7 @@ impl GpuRenderer {
             scene.write_frame(gpu, &tile_frame);
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             enc.clear_buffer(samples, 0, Some(tile_sample_bytes));
-            gpu.queue.submit([enc.finish()]);
+            gpu.submit(enc);
             // Each pass's patches go in as one batch; a batch whose work does not fit the
             // queues is halved and each half run on its own. Samples keep the nearest key
             // (atomicMax), so batches, in any order and even a refused batch's partial work run
@@ -612,7 +634,7 @@ impl GpuRenderer {
                         scene.write_frame(gpu, &test);
                     }
                 }
-                gpu.queue.submit([enc.finish()]);
+                gpu.submit(enc);
                 let seeds = [Seed::new::<PatchItem>("bound", &items[batch.clone()])];
                 // The counters come back with the run's last read-back.
                 let reads = [(counters, 0, COUNTERS as u64)];
@@ -677,12 +699,25 @@ impl GpuRenderer {
             if recut {
                 continue;
             }
-            let resolve_ms =
-                self.resolve(gpu, (&tile_frame, data.background), samples, rgba, depth)?;
-            out.resolve_gpu_ms = out.resolve_gpu_ms.zip(resolve_ms).map(|(a, b)| a + b);
+            resolving = Some(self.record_resolve(
+                gpu,
+                (&tile_frame, data.background),
+                (samples, rgba, depth),
+                &rb,
+            )?);
             out.buckets += 1;
             done.push(tile);
         }
+        let mut read = match resolving {
+            Some(enc) => {
+                let (ms, read) = self.finish_resolve(gpu, (enc, rgba), &rb, image)?;
+                add_resolve(ms, &mut out);
+                read
+            }
+            // No bucket: the image as it stands.
+            None => scheduler::readback::read_ranges(gpu, image)?,
+        };
+        *self.resolve_readback.lock().unwrap() = Some(rb);
         if tiles_only {
             let tiles = (done.into_iter())
                 .map(|t| TilePixels::read(gpu, f.width, t, rgba, depth))
@@ -690,8 +725,8 @@ impl GpuRenderer {
             out.wall_ms = start.elapsed().as_secs_f64() * 1e3;
             return Ok((out, tiles));
         }
-        let words = gpu.read_words(rgba, 0, pixels * 4)?;
-        let z = gpu.read_words(depth, 0, pixels)?;
+        let z = read.pop().expect("the depth range");
+        let words = read.pop().expect("the colour range");
         let floats: &[f32] = bytemuck::cast_slice(&words);
         out.image = FrameImage {
             width: f.width,
@@ -731,14 +766,15 @@ impl GpuRenderer {
     }
 
     /// Resolves one bucket's samples into the image buffers; its GPU ms when timed.
-    fn resolve(
+    /// Records the resolve of bucket `f` (`samples` into its pixels of `rgba` and `depth`) in an
+    /// encoder of its own, its pass timed by `rb`; [`GpuRenderer::finish_resolve`] submits it.
+    fn record_resolve(
         &self,
         gpu: &Gpu,
         (f, background): (&FrameUniforms, Option<[f32; 3]>),
-        samples: &wgpu::Buffer,
-        rgba: &wgpu::Buffer,
-        depth: &wgpu::Buffer,
-    ) -> Result<Option<f64>, RunError> {
+        (samples, rgba, depth): (&wgpu::Buffer, &wgpu::Buffer, &wgpu::Buffer),
+        rb: &TimedReadback,
+    ) -> Result<wgpu::CommandEncoder, RunError> {
         let (params, (gx, gy)) = resolve_params(f, background);
         let params_buf = gpu.storage_buffer("resolve params", params.len() as u64)?;
         gpu.queue
@@ -746,21 +782,36 @@ impl GpuRenderer {
         let resolve = self.pipelines.resolve(gpu)?;
         let layout = resolve.get_bind_group_layout(0);
         let bind = gpu.bind_buffers("resolve", &layout, &[&params_buf, samples, rgba, depth]);
-        let mut timer = PassTimer::new(gpu);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("resolve"),
-                timestamp_writes: timer.writes(),
+                timestamp_writes: rb.pass_writes(),
             });
             pass.set_pipeline(resolve);
             pass.set_bind_group(0, &bind, &[]);
             pass.dispatch_workgroups(gx, gy, 1);
         }
-        timer.resolve(&mut enc);
-        gpu.queue.submit([enc.finish()]);
-        timer.collect(gpu)?;
-        Ok(timer.total_ms())
+        Ok(enc)
+    }
+
+    /// Submits a resolve [`GpuRenderer::record_resolve`] recorded into `rgba`, with `ranges`
+    /// copied after it, and waits once: the resolve's GPU ms (`None` without timestamps) and
+    /// the ranges.
+    fn finish_resolve(
+        &self,
+        gpu: &Gpu,
+        (mut enc, rgba): (wgpu::CommandEncoder, &wgpu::Buffer),
+        rb: &TimedReadback,
+        ranges: &[ReadRange],
+    ) -> Result<(Option<f64>, Vec<Vec<u32>>), RunError> {
+        // No counters: `rgba` only stands for their (empty) source.
+        rb.copy(&mut enc, rgba, true, ranges);
+        gpu.submit(enc);
+        let words = rb.read(gpu, ranges)?;
+        let mut ms = gpu.timestamps.then_some(0.0);
+        rb.add_ms(&words, &mut ms);
+        Ok((ms, rb.ranges(&words, ranges)))
     }
 }
 

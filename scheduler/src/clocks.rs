@@ -39,7 +39,7 @@ pub fn raise_clocks(gpu: &Gpu, duration: Duration) -> Result<(), RunError> {
             pass.set_bind_group(0, &bind, &[]);
             pass.dispatch_workgroups(4096, 1, 1);
         }
-        gpu.queue.submit([enc.finish()]);
+        gpu.submit(enc);
         gpu.wait("raising the GPU clocks")?;
     }
     Ok(())

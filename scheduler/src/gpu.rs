@@ -4,14 +4,31 @@
 //! Environment: `WGPU_ADAPTER_NAME` (substring of the adapter name), `WGPU_BACKEND`
 //! (e.g. `vulkan`), `WGPU_POWER_PREF`. No adapter is a loud error, never a silent skip.
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use crate::error::RunError;
 
 /// How long any single wait for the GPU may last before the run is abandoned with an error.
 /// Generous, because lavapipe on two cores is slow; a real GPU finishes in milliseconds.
 pub const DEFAULT_GPU_TIMEOUT: Duration = Duration::from_secs(120);
+
+/// Microseconds a wait polls before it blocks ([`Gpu::spin_wait`]); unset or 0: none.
+pub const SPIN_WAIT_ENV: &str = "SCHED_SPIN_WAIT_US";
+
+fn spin_wait_from_env() -> Duration {
+    let Ok(v) = std::env::var(SPIN_WAIT_ENV) else {
+        return Duration::ZERO;
+    };
+    match v.trim().parse() {
+        Ok(us) => Duration::from_micros(us),
+        Err(_) => {
+            log::warn!("{SPIN_WAIT_ENV}={v:?} is not a count of microseconds: waits block at once");
+            Duration::ZERO
+        }
+    }
+}
 
 /// An adapter, its device and queue, and what they can do.
 pub struct Gpu {
@@ -34,12 +51,19 @@ pub struct Gpu {
     /// Bound of every wait for the GPU ([`DEFAULT_GPU_TIMEOUT`] unless changed): a wait that
     /// runs out is a [`RunError::Timeout`].
     pub timeout: Duration,
+    /// How long a wait polls the device before it blocks ([`SPIN_WAIT_ENV`], else zero: it
+    /// blocks at once). Polling costs a CPU core for that long but sees the work finish
+    /// without the wake-up of a blocked thread, which matters for runs of well under a
+    /// millisecond; on a CPU adapter it takes a core from the work it waits for.
+    pub spin_wait: Duration,
     /// wgpu errors not captured by an error scope (validation, out of memory), in order. wgpu's
     /// default handler panics; this device records them instead and [`Gpu::wait`] reports the
     /// first as [`RunError::Device`], so a bad dispatch is an error of the run, never a panic.
     uncaptured: Arc<Mutex<Vec<String>>>,
     /// Every loop of every module compiled on this device ends by itself ([`Gpu::trust_loops`]).
     loops_trusted: bool,
+    /// Submissions made through [`Gpu::submit`] ([`Gpu::submissions`]).
+    submitted: AtomicU64,
 }
 
 impl Gpu {
@@ -162,8 +186,24 @@ impl Gpu {
             queue,
             info,
             timeout: DEFAULT_GPU_TIMEOUT,
+            spin_wait: spin_wait_from_env(),
             loops_trusted: false,
+            submitted: AtomicU64::new(0),
         })
+    }
+
+    /// Finishes `enc` and submits it to the queue, counted in [`Gpu::submissions`]. Every
+    /// submission of the scheduler, its workloads and the renderer goes through here, so that
+    /// a test can hold a run to the submissions it should cost (each costs host time and a gap
+    /// on the device).
+    pub fn submit(&self, enc: wgpu::CommandEncoder) -> wgpu::SubmissionIndex {
+        self.submitted.fetch_add(1, Ordering::Relaxed);
+        self.queue.submit([enc.finish()])
+    }
+
+    /// Submissions made through [`Gpu::submit`] since the device was opened.
+    pub fn submissions(&self) -> u64 {
+        self.submitted.load(Ordering::Relaxed)
     }
 
     /// A one-line description: name and backend.
@@ -184,10 +224,26 @@ impl Gpu {
         submission: Option<wgpu::SubmissionIndex>,
         what: &str,
     ) -> Result<(), RunError> {
-        let polled = self.device.poll(wgpu::PollType::Wait {
-            submission_index: submission,
-            timeout: Some(self.timeout),
-        });
+        let begin = Instant::now();
+        let mut polled = Err(wgpu::PollError::Timeout);
+        // Poll (a wait of no time) while the spin lasts, then block for the rest.
+        while !self.spin_wait.is_zero() {
+            polled = self.device.poll(wgpu::PollType::Wait {
+                submission_index: submission.clone(),
+                timeout: Some(Duration::ZERO),
+            });
+            if !matches!(polled, Err(wgpu::PollError::Timeout)) || begin.elapsed() >= self.spin_wait
+            {
+                break;
+            }
+            std::hint::spin_loop();
+        }
+        if matches!(polled, Err(wgpu::PollError::Timeout)) {
+            polled = self.device.poll(wgpu::PollType::Wait {
+                submission_index: submission,
+                timeout: Some(self.timeout.saturating_sub(begin.elapsed())),
+            });
+        }
         if let Some(e) = self.take_error() {
             return Err(RunError::Device(format!("{what}: {e}")));
         }
@@ -229,7 +285,7 @@ impl Gpu {
         });
         let mut enc = self.device.create_command_encoder(&Default::default());
         enc.copy_buffer_to_buffer(src, offset, &staging, 0, size);
-        self.queue.submit([enc.finish()]);
+        self.submit(enc);
         let slice = staging.slice(..);
         let (tx, rx) = std::sync::mpsc::channel();
         slice.map_async(wgpu::MapMode::Read, move |r| {

@@ -1,6 +1,8 @@
 //! Where each procedure's queue lives in the shared item storage: one region per queue,
 //! `capacity` slots of the item's words. Both strategies use it; growing a queue means a new layout.
 
+use std::borrow::Cow;
+
 use crate::error::RunError;
 use crate::program::{Program, Seed};
 
@@ -104,14 +106,14 @@ impl QueueLayout {
     /// queue's most slots ([`QueueLayout::capacity_limits`] under `configured`, then
     /// [`QueueLayout::within_budget`] with `words_copies`). Errors: a malformed seed, and
     /// [`RunError::QueueOverflow`] naming the first queue whose seeds alone exceed its limit.
-    pub(crate) fn run_start(
+    pub(crate) fn run_start<'a>(
         program: &Program,
-        seeds: &[Seed],
+        seeds: &'a [Seed],
         max_binding_bytes: u64,
         configured: u32,
         budget: Option<u64>,
         words_copies: u64,
-    ) -> Result<RunStart, RunError> {
+    ) -> Result<RunStart<'a>, RunError> {
         let live = Self::seed_items(program, seeds)?;
         let max_cap = Self::within_budget(
             program,
@@ -148,9 +150,14 @@ impl QueueLayout {
         Ok(())
     }
 
-    /// Per-queue seed items (words back to back), validated against the program.
-    pub fn seed_items(program: &Program, seeds: &[Seed]) -> Result<Vec<Vec<u32>>, RunError> {
-        let mut per_queue = vec![Vec::new(); program.queue_count()];
+    /// Per-queue seed items (words back to back), validated against the program: borrowed
+    /// from `seeds` where a queue has one seed (a frame's thousands of patches are not copied
+    /// again on their way to the device), else joined.
+    pub fn seed_items<'a>(
+        program: &Program,
+        seeds: &'a [Seed],
+    ) -> Result<Vec<Cow<'a, [u32]>>, RunError> {
+        let mut per_queue: Vec<Cow<'a, [u32]>> = vec![Cow::Borrowed(&[]); program.queue_count()];
         for s in seeds {
             let q = program.index_of(&s.procedure).ok_or_else(|| {
                 RunError::Program(format!("seed for unknown procedure `{}`", s.procedure))
@@ -163,16 +170,19 @@ impl QueueLayout {
                     s.words.len()
                 )));
             }
-            per_queue[q].extend_from_slice(&s.words);
+            match per_queue[q].is_empty() {
+                true => per_queue[q] = Cow::Borrowed(&s.words),
+                false => per_queue[q].to_mut().extend_from_slice(&s.words),
+            }
         }
         Ok(per_queue)
     }
 }
 
 /// See [`QueueLayout::run_start`].
-pub(crate) struct RunStart {
-    /// Seed items per queue, words back to back.
-    pub live: Vec<Vec<u32>>,
+pub(crate) struct RunStart<'a> {
+    /// Seed items per queue, words back to back (see [`QueueLayout::seed_items`]).
+    pub live: Vec<Cow<'a, [u32]>>,
     /// Seed items per queue.
     pub seeded: Vec<u32>,
     /// The most slots each queue may grow to in this run.

@@ -48,7 +48,7 @@ impl Readback {
     ) -> Result<Vec<Vec<u32>>, RunError> {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         copy_ranges(self, &mut enc, ranges, at);
-        gpu.queue.submit([enc.finish()]);
+        gpu.submit(enc);
         let words = self.read(gpu, at + ranges_words(ranges))?;
         Ok(split_ranges(&words[at as usize..], ranges))
     }
@@ -83,6 +83,9 @@ impl Readback {
             dst_word + words <= self.words,
             "Readback: copy past its end"
         );
+        if words == 0 {
+            return;
+        }
         enc.copy_buffer_to_buffer(src, src_word * 4, &self.buf, dst_word * 4, words * 4);
     }
 
@@ -217,9 +220,7 @@ pub fn ranges_words(ranges: &[ReadRange]) -> u64 {
 pub fn copy_ranges(rb: &Readback, enc: &mut wgpu::CommandEncoder, ranges: &[ReadRange], at: u64) {
     let mut at = at;
     for &(buf, first, words) in ranges {
-        if words > 0 {
-            rb.copy(enc, buf, first, at, words);
-        }
+        rb.copy(enc, buf, first, at, words);
         at += words;
     }
 }

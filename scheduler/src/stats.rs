@@ -37,9 +37,16 @@ pub struct RunStats {
     /// empty indirect dispatches included, wgpu's own indirect-validation dispatches not.
     pub launches: u64,
     /// Host round trips: submissions the host waited on. Megakernel: one per launch plus one per
-    /// host compaction; device-driven multi-pass: one per chunk of rounds; host-driven
-    /// multi-pass: one per round.
+    /// host compaction (and the co-residency probe, on a scheduler's first run); device-driven
+    /// multi-pass: one per chunk of rounds; host-driven multi-pass: one per round. Uploads,
+    /// clears and growth's copies ride with these, so they are all of a run's submissions but
+    /// the host-driven multi-pass's final read of the caller's ranges and of its timestamps
+    /// ([`Gpu::submissions`](crate::Gpu::submissions) counts them all).
     pub submits: u64,
+    /// Megakernel: relaunches whose live items went through the host (read back and written
+    /// again): after a launch that ended with work left and grew no queue (one that grew moves
+    /// them on the device). Each is one of `submits`.
+    pub host_compactions: u64,
     /// Megakernel: slots whose bounded wait ran out and were handed to the next launch.
     pub abandoned: u64,
     /// Queues grown because live work did not fit.
@@ -96,6 +103,7 @@ impl RunStats {
         self.idle_polls += o.idle_polls;
         self.launches += o.launches;
         self.submits += o.submits;
+        self.host_compactions += o.host_compactions;
         self.abandoned += o.abandoned;
         self.queue_growths += o.queue_growths;
         self.partial_rounds += o.partial_rounds;

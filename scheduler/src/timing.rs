@@ -176,7 +176,7 @@ impl RunTimer {
         if self.used > 0 && gpu.timestamps {
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             self.inner.resolve(&mut enc);
-            gpu.queue.submit([enc.finish()]);
+            gpu.submit(enc);
             self.inner.collect(gpu)?;
         }
         Ok(self.inner.stage_ms().map(|ms| ms[0]))

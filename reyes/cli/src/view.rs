@@ -289,7 +289,7 @@ impl Viewer {
             &view,
             window,
         );
-        st.gpu.queue.submit([enc.finish()]);
+        st.gpu.submit(enc);
         st.window.pre_present_notify();
         st.gpu.queue.present(texture);
         if let Some(e) = st.gpu.take_error() {

@@ -577,7 +577,7 @@ impl RasterPeer {
             enc.copy_buffer_to_buffer(src, 0, dst, 0, src.size());
             maps.push(dst.clone());
         }
-        let submission = gpu.queue.submit([enc.finish()]);
+        let submission = gpu.submit(enc);
         let mapped = crate::realtime::map_for_read(&maps);
         Ok(InFlight {
             angle,

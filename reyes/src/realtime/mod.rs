@@ -635,7 +635,7 @@ impl RealtimeRenderer {
                 maps.push(dst.clone());
             }
         }
-        let submission = gpu.queue.submit([enc.finish()]);
+        let submission = gpu.submit(enc);
         let mapped = map_for_read(&maps);
         Ok(InFlight {
             transform,

@@ -14,6 +14,7 @@ pub use local::LOCAL_MAX_BYTES;
 pub(crate) mod record;
 pub(crate) mod wgsl;
 
+use std::borrow::Cow;
 use std::time::Instant;
 
 use layout::*;
@@ -27,7 +28,7 @@ use crate::item_layout::ItemLayout;
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed, WORKGROUP_SIZE};
 use crate::queue_layout::{QueueLayout, RunStart};
-use crate::readback::{ReadRange, TimedReadback};
+use crate::readback::{ReadRange, Readback, TimedReadback};
 use crate::stats::RunStats;
 
 /// A program compiled for the persistent megakernel: one pipeline, queue buffers kept between
@@ -73,9 +74,9 @@ struct DeviceQueues {
 }
 
 /// How the next launch gets its live items.
-enum Start {
+enum Start<'a> {
     /// Written by the host (seeds, or what [`compact::host_compact`] kept).
-    Upload(Vec<Vec<u32>>),
+    Upload(Vec<Cow<'a, [u32]>>),
     /// Copied on the device from the previous launch's buffers, whose first `reserved[q]`
     /// tickets hold `live[q]` published, unconsumed items per queue.
     Compact {
@@ -366,8 +367,11 @@ impl Megakernel {
             }
             pass.dispatch_workgroups(max, 1, 1);
         }
-        gpu.queue.submit([enc.finish()]);
-        let ctrl = gpu.read_words(&dq.ctrl, 0, ctrl_words(nq) as u64)?;
+        let words = ctrl_words(nq) as u64;
+        let rb = Readback::new(gpu, "probe read-back", words);
+        rb.copy(&mut enc, &dq.ctrl, 0, 0, words);
+        gpu.submit(enc);
+        let ctrl = rb.read(gpu, words)?;
         Ok(ctrl[g(nq, G_PROBE_RESIDENT)].clamp(1, max))
     }
 
@@ -496,23 +500,31 @@ impl Megakernel {
             .write_buffer(ctrl_buf, 0, bytemuck::cast_slice(&ctrl));
     }
 
-    /// Writes live items (per queue, words back to back) as the whole queue state of a launch.
-    fn upload(&self, gpu: &Gpu, dq: &DeviceQueues, live: &[Vec<u32>]) {
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        enc.clear_buffer(&dq.flags, 0, None);
-        gpu.queue.submit([enc.finish()]);
+    /// Writes live items (per queue, words back to back) as the whole queue state of a launch,
+    /// with no submission of its own: items, their flags' stamps and ctrl by queue writes (which
+    /// land before the launch's submission), and the clearing of every other flag recorded in
+    /// `enc`, the launch's encoder, on ranges disjoint from the stamps (so the two orders agree).
+    fn upload(
+        &self,
+        gpu: &Gpu,
+        dq: &DeviceQueues,
+        live: &[Cow<[u32]>],
+        enc: &mut wgpu::CommandEncoder,
+    ) {
         let mut counts = Vec::new();
         for (q, items) in live.iter().enumerate() {
             let n = (items.len() / dq.layout.words[q] as usize) as u32;
             counts.push(n);
+            let base = dq.layout.flag_base[q] as u64;
             if n > 0 {
                 (self.item_layout()).write_items(&gpu.queue, &dq.slots, &dq.layout, q, items);
                 let f = vec![SEED_STAMP; n as usize];
-                gpu.queue.write_buffer(
-                    &dq.flags,
-                    dq.layout.flag_base[q] as u64 * 4,
-                    bytemuck::cast_slice(&f),
-                );
+                gpu.queue
+                    .write_buffer(&dq.flags, base * 4, bytemuck::cast_slice(&f));
+            }
+            let rest = dq.layout.capacity[q] as u64 - n as u64;
+            if rest > 0 {
+                enc.clear_buffer(&dq.flags, (base + n as u64) * 4, Some(rest * 4));
             }
         }
         self.write_ctrl(gpu, &dq.ctrl, &counts);
@@ -533,6 +545,8 @@ impl Megakernel {
         reads: &[ReadRange],
     ) -> Result<(RunStats, Vec<Vec<u32>>), RunError> {
         self.kernels.check_user_group(user)?;
+        // A first run probes the workgroup count: one submission and wait more.
+        let probed = self.workgroups.load(std::sync::atomic::Ordering::Relaxed) == 0;
         let workgroups = self.workgroups_within(self.workgroups(gpu, user)?, max_queue_bytes);
         let start_time = Instant::now();
         let nq = self.program.queue_count();
@@ -592,6 +606,7 @@ impl Megakernel {
                 QueuePolicy::Fifo => Vec::new(),
             },
             turn_anatomy: self.config.turn_anatomy.then(anatomy::TurnAnatomy::default),
+            submits: probed as u64,
             ..Default::default()
         };
         // Each launch's GPU time and the caller's ranges come back with its counters (one
@@ -626,9 +641,10 @@ impl Megakernel {
                     stats.launches
                 )));
             }
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
             let compaction: Option<CompactionPass> = match &start {
                 Start::Upload(live) => {
-                    self.upload(gpu, d, live);
+                    self.upload(gpu, d, live, &mut enc);
                     None
                 }
                 Start::Compact {
@@ -643,7 +659,6 @@ impl Megakernel {
                     )
                 }
             };
-            let mut enc = gpu.device.create_command_encoder(&Default::default());
             {
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("megakernel"),
@@ -660,7 +675,7 @@ impl Megakernel {
                 pass.dispatch_workgroups(workgroups, 1, 1);
             }
             rb.copy(&mut enc, &d.ctrl, true, reads);
-            gpu.queue.submit([enc.finish()]);
+            gpu.submit(enc);
             let words = rb.read(gpu, reads)?;
             rb.add_ms(&words, &mut gpu_ms);
             let ctrl = rb.counters(&words);
@@ -779,13 +794,13 @@ impl Megakernel {
                 }
             } else {
                 stats.submits += 1;
-                Start::Upload(compact::host_compact(
-                    gpu,
-                    &self.program,
-                    d,
-                    ctrl,
-                    self.item_layout(),
-                )?)
+                stats.host_compactions += 1;
+                Start::Upload(
+                    compact::host_compact(gpu, &self.program, d, ctrl, self.item_layout())?
+                        .into_iter()
+                        .map(Cow::Owned)
+                        .collect(),
+                )
             };
         }
         // Room for one launch of this run: every item it appended to a queue (the executed ones:

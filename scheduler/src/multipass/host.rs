@@ -378,7 +378,7 @@ impl HostMultipass {
             }
             rb.copy(&mut enc, &d.counts[1 - par], 0, 0, count_words);
             timer.end_submission(&mut enc);
-            gpu.queue.submit([enc.finish()]);
+            gpu.submit(enc);
             let out = rb.read(gpu, count_words)?;
             timer.after_wait(gpu)?;
             stats.submits += 1;

@@ -244,7 +244,7 @@ impl Multipass {
     }
 
     /// Makes `live` (per queue, words back to back) the inputs of the next round, at parity 0.
-    fn upload(&self, gpu: &Gpu, d: &DeviceRounds, live: &[Vec<u32>]) {
+    fn upload(&self, gpu: &Gpu, d: &DeviceRounds, live: &[std::borrow::Cow<[u32]>]) {
         let nq = self.program.queue_count();
         let mut ctrl = vec![0u32; ctrl_words(nq)];
         for (q, items) in live.iter().enumerate() {
@@ -257,7 +257,9 @@ impl Multipass {
     }
 
     /// Makes the `counts[q]` inputs in `from.items[parity]` the inputs of the next round in `to`
-    /// (parity 0), copied on the device: growth moves no item through the host.
+    /// (parity 0), copied on the device: growth moves no item through the host. The copies go
+    /// into `enc`, the next chunk's encoder (no submission of their own); `to`'s ctrl is a
+    /// queue write, which lands before that submission.
     fn move_inputs(
         &self,
         gpu: &Gpu,
@@ -265,14 +267,14 @@ impl Multipass {
         parity: usize,
         to: &DeviceRounds,
         counts: &[u32],
+        enc: &mut wgpu::CommandEncoder,
     ) {
         let nq = self.program.queue_count();
         let mut ctrl = vec![0u32; ctrl_words(nq)];
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
         for (q, &n) in counts.iter().enumerate() {
             ctrl[c(q, C_NEXT)] = n;
             self.item_layout().encode_copy(
-                &mut enc,
+                enc,
                 (&from.items[parity], &from.layout),
                 (&to.items[0], &to.layout),
                 q,
@@ -281,7 +283,6 @@ impl Multipass {
         }
         gpu.queue
             .write_buffer(&to.ctrl, 0, bytemuck::cast_slice(&ctrl));
-        gpu.queue.submit([enc.finish()]);
     }
 
     /// Whether rounds are fused (`new` settled `config.fused_rounds` from the adapter).
@@ -481,13 +482,17 @@ impl Multipass {
             _ => self.device_rounds(gpu, layout, at_limit, MAX_CHUNK)?,
         };
         self.upload(gpu, &d, &live);
+        // The encoder of the next chunk, when a growth already recorded its inputs' move.
+        let mut moved: Option<wgpu::CommandEncoder> = None;
         loop {
             if encoded >= self.config.max_rounds as u64 {
                 return Err(RunError::NoProgress(format!(
                     "work left after {encoded} multi-pass rounds"
                 )));
             }
-            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            let mut enc = moved
+                .take()
+                .unwrap_or_else(|| gpu.device.create_command_encoder(&Default::default()));
             self.set_chunk(gpu, &d, rounds);
             self.encode_rounds(
                 &mut enc,
@@ -502,7 +507,7 @@ impl Multipass {
             if let Some(st) = &stage_timer {
                 st.resolve(&mut enc);
             }
-            gpu.queue.submit([enc.finish()]);
+            gpu.submit(enc);
             stats.submits += 1;
             stats.launches += 1 + rounds as u64 * self.dispatches_per_round();
             encoded += rounds as u64;
@@ -586,7 +591,9 @@ impl Multipass {
                     partial::at_limit(&capacity, &max_cap),
                     MAX_CHUNK,
                 )?;
-                self.move_inputs(gpu, &d, parity, &new, &next);
+                let mut enc = gpu.device.create_command_encoder(&Default::default());
+                self.move_inputs(gpu, &d, parity, &new, &next, &mut enc);
+                moved = Some(enc);
                 d = new;
                 since_upload = 0;
             }

@@ -256,7 +256,7 @@ impl FrontierBfs {
             }
             // The counters and the GPU time come back in one wait.
             self.readback.copy(&mut enc, &self.ctrl, true, &[]);
-            gpu.queue.submit([enc.finish()]);
+            gpu.submit(enc);
             let words = self.readback.read(gpu, &[])?;
             self.readback.add_ms(&words, &mut gpu_ms);
             let ctrl = self.readback.counters(&words).to_vec();

@@ -222,7 +222,7 @@ pub fn fma_is_fused(gpu: &Gpu) -> Result<bool, RunError> {
         pass.set_bind_group(0, &bind, &[]);
         pass.dispatch_workgroups(1, 1, 1);
     }
-    gpu.queue.submit([enc.finish()]);
+    gpu.submit(enc);
     let got = f32::from_bits(gpu.read_words(&io, 3, 1)?[0]);
     if got == fused {
         Ok(true)
@@ -554,7 +554,7 @@ impl MandelRun {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&self.out, 0, None);
         enc.clear_buffer(&self.count, 0, None);
-        gpu.queue.submit([enc.finish()]);
+        gpu.submit(enc);
         gpu.queue
             .write_buffer(&self.cfg, 0, bytemuck::bytes_of(&p.cfg()));
         // The image and the counts come back with the run's last read-back.

@@ -650,9 +650,11 @@ impl TreeRun {
         scheduler: &Scheduler,
         max_queue_bytes: Option<u64>,
     ) -> Result<(RunStats, TreeResult), RunError> {
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        enc.clear_buffer(&self.out, 0, None);
-        gpu.queue.submit([enc.finish()]);
+        // Zeroed by a queue write (4 KiB), which lands with the run's first submission: no
+        // submission of its own.
+        let zeros = [0u32; (BUCKETS * 4) as usize];
+        gpu.queue
+            .write_buffer(&self.out, 0, bytemuck::cast_slice(&zeros));
         let p = &self.params;
         let cfg = [
             p.max_depth,
