@@ -200,7 +200,8 @@ impl Scheduler {
     /// device-driven multi-pass into each submission's, so they cost no host round trip of
     /// their own (on the H200 about 0.09 ms, as much as a small run's GPU time; docs/results.md,
     /// 2026-12-04 (third session)), but a copy per launch or submission (usually one); the
-    /// host-driven multi-pass reads them once after its last round, a wait of their own. The
+    /// host-driven multi-pass reads them once after its last round, with the timestamps it
+    /// has not read yet, in one wait of their own. The
     /// read-back buffer grows to the largest request and is kept with the scheduler. Errors: as
     /// [`Scheduler::run_within`], and [`RunError::Program`] before anything runs for a range
     /// past its buffer's end or a buffer without `COPY_SRC` ([`Gpu::storage_buffer`]'s have it).

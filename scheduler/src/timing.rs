@@ -105,15 +105,46 @@ impl StageTimer {
 
     /// Reads the passes since the last collect back into their stages.
     pub fn collect(&mut self, gpu: &Gpu) -> Result<(), RunError> {
-        let stages = std::mem::take(&mut *self.pending.borrow_mut());
-        if self.set.is_some() && !stages.is_empty() {
-            let bytes = gpu.read_buffer(&self.resolved, 0, 16 * stages.len() as u64)?;
-            let t: &[u64] = bytemuck::cast_slice(&bytes);
-            for (k, s) in stages.into_iter().enumerate() {
-                self.stage_ns[s] += t[2 * k + 1].saturating_sub(t[2 * k]) as f64 * self.period_ns;
-            }
+        let n = self.pending.borrow().len() as u64;
+        if self.set.is_some() && n > 0 {
+            let bytes = gpu.read_buffer(&self.resolved, 0, 16 * n)?;
+            self.collect_words(&bytemuck::pod_collect_to_vec::<u8, u32>(&bytes));
         }
+        self.pending.borrow_mut().clear();
         Ok(())
+    }
+
+    /// Records the resolve of the passes since the last collect and the copy of their
+    /// timestamps (4 words a pass) into `rb` from word `dst_word`, so that they come back with
+    /// the caller's wait; [`StageTimer::collect_words`] then adds them up. Returns the words
+    /// copied (0 without timestamp queries or passes).
+    pub fn copy_pending(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        rb: &crate::readback::Readback,
+        dst_word: u64,
+    ) -> u64 {
+        let n = self.pending.borrow().len() as u64;
+        if self.set.is_none() || n == 0 {
+            return 0;
+        }
+        self.resolve(enc);
+        rb.copy(enc, &self.resolved, 0, dst_word, 4 * n);
+        4 * n
+    }
+
+    /// Adds the passes since the last collect from `words` (their timestamps as
+    /// [`StageTimer::copy_pending`] put them) and starts a new set.
+    pub fn collect_words(&mut self, words: &[u32]) {
+        let stages = std::mem::take(&mut *self.pending.borrow_mut());
+        if self.set.is_none() {
+            return;
+        }
+        // Little-endian u64 timestamps, read as word pairs (a word slice need not be 8-aligned).
+        let t = |i: usize| words[2 * i] as u64 | (words[2 * i + 1] as u64) << 32;
+        for (k, s) in stages.into_iter().enumerate() {
+            self.stage_ns[s] += t(2 * k + 1).saturating_sub(t(2 * k)) as f64 * self.period_ns;
+        }
     }
 
     pub fn stage_ms(&self) -> Option<Vec<f64>> {
@@ -170,16 +201,28 @@ impl RunTimer {
         Ok(())
     }
 
-    /// Reads the remaining timestamps (one submission and wait, only with timestamp queries)
-    /// and returns the GPU time of every timed pass.
-    pub fn finish(mut self, gpu: &Gpu) -> Result<Option<f64>, RunError> {
-        if self.used > 0 && gpu.timestamps {
-            let mut enc = gpu.device.create_command_encoder(&Default::default());
-            self.inner.resolve(&mut enc);
-            gpu.submit(enc);
-            self.inner.collect(gpu)?;
-        }
-        Ok(self.inner.stage_ms().map(|ms| ms[0]))
+    /// Most words [`RunTimer::copy_rest`] copies.
+    pub fn words(&self) -> u64 {
+        4 * self.passes as u64
+    }
+
+    /// Records, in the run's last encoder, the resolve of the timestamps not yet read and their
+    /// copy into `rb` from word `dst_word` (no submission or wait of their own); returns the
+    /// words copied (0 when none are left or without timestamp queries).
+    pub fn copy_rest(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        rb: &crate::readback::Readback,
+        dst_word: u64,
+    ) -> u64 {
+        self.inner.copy_pending(enc, rb, dst_word)
+    }
+
+    /// The GPU time of every timed pass, the rest read from `words` (what
+    /// [`RunTimer::copy_rest`] copied, after the wait).
+    pub fn finish(mut self, words: &[u32]) -> Option<f64> {
+        self.inner.collect_words(words);
+        self.inner.stage_ms().map(|ms| ms[0])
     }
 }
 

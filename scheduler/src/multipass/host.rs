@@ -16,7 +16,7 @@ use crate::multipass::partial::{at_limit, needs_partial, partial_round};
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
 use crate::queue_layout::{QueueLayout, RunStart};
-use crate::readback::{ReadRange, Readback, ranges_words};
+use crate::readback::{ReadRange, Readback, copy_ranges, ranges_words, split_ranges};
 use crate::stats::RunStats;
 use crate::timing::RunTimer;
 
@@ -208,7 +208,7 @@ impl HostMultipass {
     /// Runs the program to completion from `seeds`; `user` is bind group 1, if the program has
     /// one; `max_queue_bytes` bounds the item storage of this run (two copies of every queue).
     /// `reads`: buffer ranges read back once after the last round into the kept read-back
-    /// buffer, one vector per range (a copy every round, to save that one wait, cost more: H200,
+    /// buffer, with the timestamps not yet read (one submission and wait), one vector per range (a copy every round, to save that one wait, cost more: H200,
     /// the deep tree's 201 rounds 19.9 -> 21.9 ms of wall time; docs/results.md, 2026-12-04
     /// (third session)). Errors: every [`RunError`] but `NoAdapter` (see
     /// `docs/scheduler.md`, section 6).
@@ -256,9 +256,9 @@ impl HostMultipass {
         // The caller's ranges follow the counts.
         let count_words = (nq + EXTRA_WORDS) as u64;
         let kept = self.readback.lock().unwrap().take();
-        let words = count_words + ranges_words(reads);
-        let rb = Readback::reuse(kept, gpu, "round counts read-back", words);
         let mut timer = RunTimer::new(gpu, 64);
+        let words = count_words + ranges_words(reads) + timer.words();
+        let rb = Readback::reuse(kept, gpu, "round counts read-back", words);
         let cached = self.cache.lock().unwrap().take();
         let kept = cached.as_ref().map(|d| d.layout.capacity.as_slice());
         capacity = start_capacity(self.config.size_from_last_run, kept, capacity, &max_cap);
@@ -413,12 +413,24 @@ impl HostMultipass {
             par = 1 - par;
         }
         stats.queue_bytes = d.layout.total_words * 4 * 2;
-        // The caller's ranges: one submission and wait, into the kept read-back.
+        // The caller's ranges and the timestamps not yet read: one submission and one wait,
+        // into the kept read-back (none when there is neither).
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        copy_ranges(&rb, &mut enc, reads, count_words);
+        let at = count_words + ranges_words(reads);
+        let stamps = timer.copy_rest(&mut enc, &rb, at);
+        let words = match reads.is_empty() && stamps == 0 {
+            true => Vec::new(),
+            false => {
+                gpu.submit(enc);
+                rb.read(gpu, at + stamps)?
+            }
+        };
         let results = match reads.is_empty() {
             true => Vec::new(),
-            false => rb.read_ranges(gpu, reads, count_words)?,
+            false => split_ranges(&words[count_words as usize..], reads),
         };
-        stats.gpu_ms = timer.finish(gpu)?;
+        stats.gpu_ms = timer.finish(words.get(at as usize..).unwrap_or(&[]));
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
         *self.cache.lock().unwrap() = Some(d);
         *self.readback.lock().unwrap() = Some(rb);
