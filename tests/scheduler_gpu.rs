@@ -37,6 +37,34 @@ fn tree_matches_cpu_reference_on_every_strategy() {
     }
 }
 
+/// A host-driven run of more rounds than its timer's query set holds (64 passes) reads the
+/// full sets' timestamps with the rounds' counts: its submissions are its rounds plus the one
+/// after the last round, and it still reports its GPU time.
+#[test]
+fn host_driven_timestamps_come_back_with_the_rounds() {
+    let gpu = gpu();
+    let params = TreeParams {
+        roots: 3,
+        max_depth: 150,
+        fanout: Fanout::Fixed(1),
+        work: 1,
+        payload_words: 1,
+        seed: 5,
+    };
+    let reference = params.reference();
+    let run = TreeRun::new(&gpu, params).unwrap();
+    let s = Scheduler::new(&gpu, &run.program, StrategyKind::MultipassHost, 1 << 10).unwrap();
+    let before = gpu.submissions();
+    let (stats, result) = run.run(&gpu, &s).unwrap();
+    assert_eq!(result, reference);
+    assert!(stats.rounds > 128, "{stats:?}");
+    assert_eq!(gpu.submissions() - before, stats.submits + 1, "{stats:?}");
+    assert_eq!(stats.submits, stats.rounds, "{stats:?}");
+    if gpu.timestamps {
+        assert!(stats.gpu_ms.is_some_and(|ms| ms > 0.0), "{stats:?}");
+    }
+}
+
 /// Waits that poll before they block (`Gpu::spin_wait`) see the same runs finish: exact
 /// results on every strategy, whether the spin outlasts the work (a long spin) or runs out
 /// first and the wait blocks (a spin of one microsecond).
@@ -714,8 +742,7 @@ fn a_run_started_at_capacity_16_grows_geometrically_and_stays_exact() {
             // Every submission is one the host waits on (stats.submits), growth included: the
             // workload's clear, the megakernel's upload and the device-driven multi-pass's
             // moved inputs ride with the next launch or chunk. The host-driven multi-pass adds
-            // one after its last round, for the caller's ranges and its timestamps together
-            // (its timer reads mid-run only after 64 rounds; this tree has fewer).
+            // one after its last round, for the caller's ranges and its timestamps together.
             let after_rounds = (kind == StrategyKind::MultipassHost) as u64;
             assert_eq!(
                 gpu.submissions() - before,

@@ -554,7 +554,8 @@ impl GpuRenderer {
         let kept = self.resolve_readback.lock().unwrap().take();
         let rb = TimedReadback::reuse(kept, gpu, "resolve read-back", 0, image);
         // The last bucket's resolve, recorded, submitted before anything else touches the
-        // samples (the next bucket's clear) or after the last bucket with the image's copy.
+        // samples (the next bucket's clear) or after the last bucket with the image's copy
+        // (one submission and one wait for both).
         let mut resolving: Option<wgpu::CommandEncoder> = None;
         let add_resolve = |ms: Option<f64>, out: &mut GpuFrame| {
             out.resolve_gpu_ms = out.resolve_gpu_ms.zip(ms).map(|(a, b)| a + b);
@@ -699,12 +700,19 @@ impl GpuRenderer {
             if recut {
                 continue;
             }
-            resolving = Some(self.record_resolve(
+            let enc = self.record_resolve(
                 gpu,
                 (&tile_frame, data.background),
                 (samples, rgba, depth),
                 &rb,
-            )?);
+            )?;
+            // Buckets handed out by the caller (several devices) resolve at once, so that a
+            // failure belongs to the bucket the caller last gave; a frame's wait until the next
+            // bucket, or the image's read.
+            match tiles_only {
+                true => add_resolve(self.finish_resolve(gpu, (enc, rgba), &rb, &[])?.0, &mut out),
+                false => resolving = Some(enc),
+            }
             out.buckets += 1;
             done.push(tile);
         }
@@ -765,7 +773,6 @@ impl GpuRenderer {
         })
     }
 
-    /// Resolves one bucket's samples into the image buffers; its GPU ms when timed.
     /// Records the resolve of bucket `f` (`samples` into its pixels of `rgba` and `depth`) in an
     /// encoder of its own, its pass timed by `rb`; [`GpuRenderer::finish_resolve`] submits it.
     fn record_resolve(

@@ -39,8 +39,10 @@ pub struct RunStats {
     /// Host round trips: submissions the host waited on. Megakernel: one per launch plus one per
     /// host compaction (and the co-residency probe, on a scheduler's first run); device-driven
     /// multi-pass: one per chunk of rounds; host-driven multi-pass: one per round. Uploads,
-    /// clears and growth's copies ride with these, so they are all of a run's submissions but
-    /// the host-driven multi-pass's final read of the caller's ranges and of its timestamps
+    /// clears, growth's copies and timestamps ride with these, so they are all of a run's
+    /// submissions but the host-driven multi-pass's one after its last round (the caller's
+    /// ranges and its last timestamps) and, with `MultipassConfig::stage_timing`, the
+    /// device-driven multi-pass's read of each submission's stage timestamps
     /// ([`Gpu::submissions`](crate::Gpu::submissions) counts them all).
     pub submits: u64,
     /// Megakernel: relaunches whose live items went through the host (read back and written

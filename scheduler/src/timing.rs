@@ -154,14 +154,14 @@ impl StageTimer {
     }
 }
 
-/// Times every pass of a run of many short submissions (relaunches, host-driven rounds) and
-/// reads the timestamps back only when its query set is full or the run ends, so timing costs
-/// no host wait per submission. `total_ms` is `None` when the adapter has no timestamp queries.
+/// Times every pass of a run of many short submissions (host-driven rounds) and brings the
+/// timestamps back through the run's own read-back, in the submission that fills its query set
+/// and after the run's last one, so timing costs no submission or wait of its own. The total is
+/// `None` when the adapter has no timestamp queries.
 pub(crate) struct RunTimer {
     inner: StageTimer,
     used: u32,
     passes: u32,
-    full: bool,
 }
 
 impl RunTimer {
@@ -172,7 +172,6 @@ impl RunTimer {
             inner: StageTimer::new(gpu, 1, passes),
             used: 0,
             passes,
-            full: false,
         }
     }
 
@@ -182,28 +181,33 @@ impl RunTimer {
         self.inner.writes(0)
     }
 
-    /// Call after the last pass of a submission, in its encoder: resolves the queries when the
-    /// set is full, so [`RunTimer::after_wait`] can read them once the submission finished.
-    pub fn end_submission(&mut self, enc: &mut wgpu::CommandEncoder) {
-        if self.used == self.passes {
-            self.inner.resolve(enc);
-            self.full = true;
-        }
-    }
-
-    /// Call after waiting for the submission: reads the timestamps back if the set was full.
-    pub fn after_wait(&mut self, gpu: &Gpu) -> Result<(), RunError> {
-        if self.full {
-            self.inner.collect(gpu)?;
-            self.used = 0;
-            self.full = false;
-        }
-        Ok(())
-    }
-
-    /// Most words [`RunTimer::copy_rest`] copies.
+    /// Most words [`RunTimer::end_submission`] and [`RunTimer::copy_rest`] copy.
     pub fn words(&self) -> u64 {
         4 * self.passes as u64
+    }
+
+    /// Call after the last pass of a submission, in its encoder: when the query set is full,
+    /// records its resolve and copy into `rb` from word `dst_word` and returns the words copied,
+    /// which [`RunTimer::after_wait`] reads from what the wait brings back; else 0.
+    pub fn end_submission(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        rb: &crate::readback::Readback,
+        dst_word: u64,
+    ) -> u64 {
+        match self.used == self.passes {
+            true => self.inner.copy_pending(enc, rb, dst_word),
+            false => 0,
+        }
+    }
+
+    /// Call after waiting for the submission: adds the timestamps in `words` (what
+    /// [`RunTimer::end_submission`] copied; they start a new query set) when the set was full.
+    pub fn after_wait(&mut self, words: &[u32]) {
+        if self.used == self.passes {
+            self.inner.collect_words(words);
+            self.used = 0;
+        }
     }
 
     /// Records, in the run's last encoder, the resolve of the timestamps not yet read and their

@@ -377,10 +377,11 @@ impl HostMultipass {
                 }
             }
             rb.copy(&mut enc, &d.counts[1 - par], 0, 0, count_words);
-            timer.end_submission(&mut enc);
+            // A full query set's timestamps come back after the counts, in the same wait.
+            let stamps = timer.end_submission(&mut enc, &rb, count_words);
             gpu.submit(enc);
-            let out = rb.read(gpu, count_words)?;
-            timer.after_wait(gpu)?;
+            let out = rb.read(gpu, count_words + stamps)?;
+            timer.after_wait(&out[count_words as usize..]);
             stats.submits += 1;
             stats.rounds += 1;
             for q in 0..nq {
