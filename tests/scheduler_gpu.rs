@@ -258,6 +258,17 @@ fn stress_configs() -> Vec<(&'static str, MegakernelConfig)> {
             },
         ),
         (
+            // Held sinks run in their priority turn, not after other held work.
+            "local queues, sinks not deferred, short launches",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(2),
+                max_iterations: 64,
+                local_queues: true,
+                defer_local_sinks: false,
+                ..base.clone()
+            },
+        ),
+        (
             // A local batch of 1,024-thread workgroups holds four times the items, in buffers
             // of the slots buffer sized from the batch; emits go through the outbox.
             "local queues, 1,024-thread workgroups, outbox enqueue, short launches",
@@ -1095,7 +1106,7 @@ fn guided_claims_take_a_workgroups_share_of_the_pending_items() {
 /// the next link and one `tip` (a sink), both kept local, on one workgroup. Run in priority order
 /// (tips first) every level would take two local batches; with the tips deferred until they fill
 /// a step or nothing else is held, the 100 links take one batch each and the 100 tips one
-/// between them. Every item runs once.
+/// between them; without the deferral they take about 200. Every item runs once.
 #[test]
 fn held_items_that_emit_nothing_wait_for_held_work_that_does() {
     let gpu = gpu();
@@ -1122,33 +1133,47 @@ fn held_items_that_emit_nothing_wait_for_held_work_that_does() {
         &[(0, false)],
     );
     let program = Program::new(vec![link, tip], user).unwrap();
-    let s = Scheduler::megakernel(
-        &gpu,
-        &program,
-        MegakernelConfig {
-            workgroups: Workgroups::Fixed(1),
-            local_queues: true,
-            ..Default::default()
-        },
-    )
-    .unwrap();
-    let seen = gpu.storage_buffer("seen", depth as u64).unwrap();
-    let bind = program.user.bind_group(&gpu, &[&seen]).unwrap();
-    let stats = s
-        .run(&gpu, &[Seed::new("link", &[0])], Some(&bind))
+    for defer in [true, false] {
+        let s = Scheduler::megakernel(
+            &gpu,
+            &program,
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(1),
+                local_queues: true,
+                defer_local_sinks: defer,
+                ..Default::default()
+            },
+        )
         .unwrap();
-    eprintln!("{stats:?}");
-    assert_eq!(stats.executed, [depth as u64, depth as u64]);
-    let words = gpu.read_words(&seen, 0, depth as u64).unwrap();
-    assert!(words.iter().all(|&c| c == 0x10001), "{words:?}");
-    // The seed's claimed batch, 99 local link batches, the tips' one; a launch cut short by a
-    // loop bound (lavapipe) spills what is held and may add a batch per relaunch.
-    let bound = depth as u64 + 1 + 2 * (stats.launches as u64 - 1);
-    assert!(
-        stats.batches <= bound,
-        "{} batches, at most {bound}",
-        stats.batches
-    );
+        let seen = gpu.storage_buffer("seen", depth as u64).unwrap();
+        let bind = program.user.bind_group(&gpu, &[&seen]).unwrap();
+        let stats = s
+            .run(&gpu, &[Seed::new("link", &[0])], Some(&bind))
+            .unwrap();
+        eprintln!("defer {defer}: {stats:?}");
+        assert_eq!(stats.executed, [depth as u64, depth as u64]);
+        let words = gpu.read_words(&seen, 0, depth as u64).unwrap();
+        assert!(words.iter().all(|&c| c == 0x10001), "{words:?}");
+        if defer {
+            // The seed's claimed batch, 99 local link batches, the tips' one; a launch cut
+            // short by a loop bound (lavapipe) spills what is held and may add a batch per
+            // relaunch.
+            let bound = depth as u64 + 1 + 2 * (stats.launches as u64 - 1);
+            assert!(
+                stats.batches <= bound,
+                "{} batches, at most {bound}",
+                stats.batches
+            );
+        } else {
+            // Without the deferral (`MegakernelConfig::defer_local_sinks` off) each link's
+            // tip takes a turn of its own.
+            assert!(
+                stats.batches >= 3 * depth as u64 / 2,
+                "{} batches without the deferral",
+                stats.batches
+            );
+        }
+    }
 }
 
 /// `Scheduler::run_reading` returns the ranges as the run left them, on every strategy: a

@@ -205,6 +205,12 @@ pub struct Cli {
     #[arg(long, help_heading = "Scheduler")]
     pub no_local_queues: bool,
 
+    /// With local queues, held items of a procedure that emits nothing run in their priority
+    /// turn instead of waiting for other held work (`MegakernelConfig::defer_local_sinks`
+    /// off): the A/B of the deferral.
+    #[arg(long, help_heading = "Scheduler")]
+    pub no_defer_local_sinks: bool,
+
     /// Megakernel claims take at most the workgroup's share of the pending items,
     /// ceil(pending / workgroups), one step's worth at least: guided self-scheduling
     /// (`MegakernelConfig::guided_claims`). Default: the workload's choice, on for Reyes frames
@@ -468,6 +474,7 @@ impl Cli {
                 _ => None,
             },
             local_bytes: self.local_bytes,
+            defer_local_sinks: !self.no_defer_local_sinks,
             fused_rounds: match self.fused_rounds {
                 FusedRounds::Auto => None,
                 FusedRounds::On => Some(true),

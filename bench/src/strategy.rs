@@ -159,6 +159,8 @@ pub struct GpuConfig {
     pub local_queues: Option<bool>,
     /// `MegakernelConfig::local_bytes`; `None`: its default.
     pub local_bytes: Option<u32>,
+    /// `MegakernelConfig::defer_local_sinks` (default `true`).
+    pub defer_local_sinks: bool,
     /// `MultipassConfig::fused_rounds` (the device-driven multi-pass); `None`: by adapter.
     pub fused_rounds: Option<bool>,
 }
@@ -180,6 +182,7 @@ impl Default for GpuConfig {
             subgroups: Some(false),
             local_queues: None,
             local_bytes: None,
+            defer_local_sinks: true,
             fused_rounds: None,
         }
     }
@@ -253,6 +256,7 @@ pub fn compile(
                 local_bytes: config
                     .local_bytes
                     .unwrap_or(MegakernelConfig::default().local_bytes),
+                defer_local_sinks: config.defer_local_sinks,
                 initial_capacity: capacity,
                 ..Default::default()
             },

@@ -154,6 +154,12 @@ pub struct MegakernelConfig {
     /// target is left the megakernel runs without local queues and warns. Global memory: the
     /// slots buffer grows by the area in use (at most this) times the workgroups.
     pub local_bytes: u32,
+    /// With local queues, held items of a procedure that emits nothing (a sink) wait while they
+    /// are fewer than a step and other held work exists (`LOCAL_DEFER`, docs/scheduler.md 2.7).
+    /// Default `true`: H200, deep tree 1.34 -> 1.15 ms, irregular 0.164 -> 0.148, binary 0.122
+    /// -> 0.124 (docs/results.md, 2026-12-04 (fourth session)); `false` (`schedbench
+    /// --no-defer-local-sinks`) runs held sinks in their priority turn, as before, for that A/B.
+    pub defer_local_sinks: bool,
 }
 
 /// Most tickets one batch of a 256-thread workgroup may list for direct enqueue
@@ -184,6 +190,7 @@ impl Default for MegakernelConfig {
             size_from_last_run: true,
             local_queues: false,
             local_bytes: LOCAL_MAX_BYTES,
+            defer_local_sinks: true,
         }
     }
 }

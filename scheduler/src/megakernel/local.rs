@@ -29,6 +29,8 @@ pub(crate) struct LocalPlan {
     pub off: Vec<u32>,
     pub wg_words: u32,
     pub credit_max: Vec<u32>,
+    /// Held sinks wait for other held work (`MegakernelConfig::defer_local_sinks`).
+    pub defer_sinks: bool,
 }
 
 impl LocalPlan {
@@ -39,6 +41,7 @@ impl LocalPlan {
             off: vec![0; nq],
             wg_words: 0,
             credit_max: vec![0; nq],
+            defer_sinks: true,
         }
     }
 
@@ -99,7 +102,8 @@ impl LocalPlan {
         // A held target that emits nothing runs after other held work until it fills a step.
         let defer: Vec<u32> = (0..nq)
             .map(|t| {
-                (on && self.cap[t] > 0 && program.procs[t].emits.iter().all(|&e| e == 0)) as u32
+                let sink = program.procs[t].emits.iter().all(|&e| e == 0);
+                (self.defer_sinks && on && self.cap[t] > 0 && sink) as u32
             })
             .collect();
         format!(
@@ -196,7 +200,7 @@ mod tests {
     }
 
     /// Only a local target that emits nothing is deferred: `leaf` once it is kept local, never
-    /// `split`, which emits.
+    /// `split`, which emits; and none with the deferral off.
     #[test]
     fn only_local_sinks_are_deferred() {
         let p = program();
@@ -215,10 +219,15 @@ mod tests {
         let leaf =
             Procedure::new("leaf", node, 1).body("fn leaf_execute(item: Node, inv: Invocation) {}");
         let both = Program::new(vec![split, leaf], UserBindings::none()).unwrap();
-        let plan = LocalPlan::new(&both, &[256, 1024], 1 << 20);
+        let mut plan = LocalPlan::new(&both, &[256, 1024], 1 << 20);
         assert!(
             plan.wgsl(&both)
                 .contains("LOCAL_DEFER: array<u32, 2> = array<u32, 2>(0u, 1u)")
+        );
+        plan.defer_sinks = false;
+        assert!(
+            plan.wgsl(&both)
+                .contains("LOCAL_DEFER: array<u32, 2> = array<u32, 2>(0u, 0u)")
         );
         assert!(!LocalPlan::none(2).wgsl(&both).contains("(0u, 1u)"));
     }

@@ -226,6 +226,7 @@ impl Megakernel {
         if config.local_queues && program.has_local() {
             // In the slots buffer, past the queues: no workgroup memory.
             plan = local::LocalPlan::new(program, &batch, config.local_bytes);
+            plan.defer_sinks = config.defer_local_sinks;
             if plan.active() {
                 source = generate(&plan, direct);
             } else {
