@@ -562,7 +562,7 @@ impl GpuRenderer {
         };
         while let Some(tile) = todo.pop().or_else(&mut *next) {
             if let Some(enc) = resolving.take() {
-                let (ms, _) = self.finish_resolve(gpu, (enc, rgba), &rb, &[])?;
+                let (ms, _) = self.finish_resolve(gpu, enc, &rb, &[])?;
                 add_resolve(ms, &mut out);
             }
             let tile_frame = f.with_tile(tile);
@@ -710,7 +710,7 @@ impl GpuRenderer {
             // failure belongs to the bucket the caller last gave; a frame's wait until the next
             // bucket, or the image's read.
             match tiles_only {
-                true => add_resolve(self.finish_resolve(gpu, (enc, rgba), &rb, &[])?.0, &mut out),
+                true => add_resolve(self.finish_resolve(gpu, enc, &rb, &[])?.0, &mut out),
                 false => resolving = Some(enc),
             }
             out.buckets += 1;
@@ -718,7 +718,7 @@ impl GpuRenderer {
         }
         let mut read = match resolving {
             Some(enc) => {
-                let (ms, read) = self.finish_resolve(gpu, (enc, rgba), &rb, image)?;
+                let (ms, read) = self.finish_resolve(gpu, enc, &rb, image)?;
                 add_resolve(ms, &mut out);
                 read
             }
@@ -802,18 +802,16 @@ impl GpuRenderer {
         Ok(enc)
     }
 
-    /// Submits a resolve [`GpuRenderer::record_resolve`] recorded into `rgba`, with `ranges`
-    /// copied after it, and waits once: the resolve's GPU ms (`None` without timestamps) and
-    /// the ranges.
+    /// Submits a resolve [`GpuRenderer::record_resolve`] recorded, with `ranges` copied after
+    /// it, and waits once: the resolve's GPU ms (`None` without timestamps) and the ranges.
     fn finish_resolve(
         &self,
         gpu: &Gpu,
-        (mut enc, rgba): (wgpu::CommandEncoder, &wgpu::Buffer),
+        mut enc: wgpu::CommandEncoder,
         rb: &TimedReadback,
         ranges: &[ReadRange],
     ) -> Result<(Option<f64>, Vec<Vec<u32>>), RunError> {
-        // No counters: `rgba` only stands for their (empty) source.
-        rb.copy(&mut enc, rgba, true, ranges);
+        rb.copy(&mut enc, None, true, ranges);
         gpu.submit(enc);
         let words = rb.read(gpu, ranges)?;
         let mut ms = gpu.timestamps.then_some(0.0);

@@ -159,16 +159,22 @@ impl TimedReadback {
     }
 
     /// Records, after the submission's last pass: the counters (the first `counters` words of
-    /// `src`), the timed pass's timestamps where `timed` (a pass took [`Self::pass_writes`]),
-    /// and `ranges`.
+    /// `src`; `None` for a read-back of no counters), the timed pass's timestamps where `timed`
+    /// (a pass took [`Self::pass_writes`]), and `ranges`.
     pub fn copy(
         &self,
         enc: &mut wgpu::CommandEncoder,
-        src: &wgpu::Buffer,
+        src: Option<&wgpu::Buffer>,
         timed: bool,
         ranges: &[ReadRange],
     ) {
-        self.rb.copy(enc, src, 0, 0, self.counters);
+        assert!(
+            src.is_some() || self.counters == 0,
+            "TimedReadback: counters without their buffer"
+        );
+        if let Some(src) = src {
+            self.rb.copy(enc, src, 0, 0, self.counters);
+        }
         if timed {
             self.rb.copy_span(enc, &self.timer, 0, self.counters);
         }

@@ -3,40 +3,10 @@
 use crate::error::RunError;
 use crate::gpu::Gpu;
 
-/// Times passes one at a time: begin/end timestamps of a pass, resolved and read back with the
-/// pass's other results, summed over the passes timed. `total_ms` is `None` when the adapter
-/// has no timestamp queries ([`Gpu::timestamps`]).
-///
-/// Per pass: give [`PassTimer::writes`] to the pass descriptor's `timestamp_writes`, call
-/// [`PassTimer::resolve`] on the encoder after the pass, submit, then [`PassTimer::collect`].
-pub struct PassTimer(StageTimer);
-
-impl PassTimer {
-    /// A timer with a query set of two timestamps (none without timestamp queries).
-    pub fn new(gpu: &Gpu) -> PassTimer {
-        PassTimer(StageTimer::new(gpu, 1, 1))
-    }
-
-    /// The timestamp writes for the pass's descriptor; `None` without timestamp queries.
-    pub fn writes(&self) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
-        self.0.writes(0)
-    }
-
-    /// Records the resolve after the timed pass, in the same encoder.
-    pub fn resolve(&self, enc: &mut wgpu::CommandEncoder) {
-        self.0.resolve(enc)
-    }
-
-    /// Reads the last pass's time back (one bounded wait) and adds it to the total. Errors:
-    /// [`RunError::Timeout`], [`RunError::Device`].
-    pub fn collect(&mut self, gpu: &Gpu) -> Result<(), RunError> {
-        self.0.collect(gpu)
-    }
-
-    /// GPU milliseconds of every pass collected so far; `None` without timestamp queries.
-    pub fn total_ms(&self) -> Option<f64> {
-        self.0.stage_ms().map(|ms| ms[0])
-    }
+/// The u64 timestamp at `words[at..at + 2]`, as a query resolve writes it (little-endian),
+/// read as a word pair: a slice of words need not be 8-byte aligned.
+fn timestamp(words: &[u32], at: usize) -> u64 {
+    words[at] as u64 | (words[at + 1] as u64) << 32
 }
 
 /// Times many passes per submission and adds each pass's time to its stage, so that a
@@ -106,11 +76,11 @@ impl StageTimer {
     /// Reads the passes since the last collect back into their stages.
     pub fn collect(&mut self, gpu: &Gpu) -> Result<(), RunError> {
         let n = self.pending.borrow().len() as u64;
-        if self.set.is_some() && n > 0 {
-            let bytes = gpu.read_buffer(&self.resolved, 0, 16 * n)?;
-            self.collect_words(&bytemuck::pod_collect_to_vec::<u8, u32>(&bytes));
-        }
-        self.pending.borrow_mut().clear();
+        let words = match self.set.is_some() && n > 0 {
+            true => bytemuck::pod_collect_to_vec(&gpu.read_buffer(&self.resolved, 0, 16 * n)?),
+            false => Vec::new(),
+        };
+        self.collect_words(&words);
         Ok(())
     }
 
@@ -140,10 +110,9 @@ impl StageTimer {
         if self.set.is_none() {
             return;
         }
-        // Little-endian u64 timestamps, read as word pairs (a word slice need not be 8-aligned).
-        let t = |i: usize| words[2 * i] as u64 | (words[2 * i + 1] as u64) << 32;
         for (k, s) in stages.into_iter().enumerate() {
-            self.stage_ns[s] += t(2 * k + 1).saturating_sub(t(2 * k)) as f64 * self.period_ns;
+            let (begin, end) = (timestamp(words, 4 * k), timestamp(words, 4 * k + 2));
+            self.stage_ns[s] += end.saturating_sub(begin) as f64 * self.period_ns;
         }
     }
 
@@ -330,7 +299,7 @@ impl SpanTimer {
     /// without timestamp queries.
     pub fn ms(&self, words: &[u32]) -> Option<f64> {
         self.set.as_ref()?;
-        let t = |i: usize| words[i] as u64 | (words[i + 1] as u64) << 32;
-        Some(t(2).saturating_sub(t(0)) as f64 * self.period_ns / 1e6)
+        let (begin, end) = (timestamp(words, 0), timestamp(words, 2));
+        Some(end.saturating_sub(begin) as f64 * self.period_ns / 1e6)
     }
 }

@@ -675,7 +675,7 @@ impl Megakernel {
                 }
                 pass.dispatch_workgroups(workgroups, 1, 1);
             }
-            rb.copy(&mut enc, &d.ctrl, true, reads);
+            rb.copy(&mut enc, Some(&d.ctrl), true, reads);
             gpu.submit(enc);
             let words = rb.read(gpu, reads)?;
             rb.add_ms(&words, &mut gpu_ms);

@@ -208,9 +208,9 @@ impl HostMultipass {
     /// Runs the program to completion from `seeds`; `user` is bind group 1, if the program has
     /// one; `max_queue_bytes` bounds the item storage of this run (two copies of every queue).
     /// `reads`: buffer ranges read back once after the last round into the kept read-back
-    /// buffer, with the timestamps not yet read (one submission and wait), one vector per range (a copy every round, to save that one wait, cost more: H200,
-    /// the deep tree's 201 rounds 19.9 -> 21.9 ms of wall time; docs/results.md, 2026-12-04
-    /// (third session)). Errors: every [`RunError`] but `NoAdapter` (see
+    /// buffer, with the timestamps not yet read (one submission and wait), one vector per
+    /// range (a copy every round, to save that one wait, cost more: H200, the deep tree's 201
+    /// rounds 19.9 -> 21.9 ms of wall time; docs/results.md, 2026-12-04 (third session)). Errors: every [`RunError`] but `NoAdapter` (see
     /// `docs/scheduler.md`, section 6).
     pub fn run(
         &self,

@@ -503,7 +503,7 @@ impl Multipass {
                 stage_timer.as_ref(),
                 user,
             );
-            rb.copy(&mut enc, &d.ctrl, stage_timer.is_none(), reads);
+            rb.copy(&mut enc, Some(&d.ctrl), stage_timer.is_none(), reads);
             if let Some(st) = &stage_timer {
                 st.resolve(&mut enc);
             }

@@ -255,7 +255,7 @@ impl FrontierBfs {
                 }
             }
             // The counters and the GPU time come back in one wait.
-            self.readback.copy(&mut enc, &self.ctrl, true, &[]);
+            self.readback.copy(&mut enc, Some(&self.ctrl), true, &[]);
             gpu.submit(enc);
             let words = self.readback.read(gpu, &[])?;
             self.readback.add_ms(&words, &mut gpu_ms);
