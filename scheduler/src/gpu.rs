@@ -30,6 +30,32 @@ fn spin_wait_from_env() -> Duration {
     }
 }
 
+/// wgpu's environment variable for its validation of indirect calls ([`instance_flags`]).
+pub const INDIRECT_VALIDATION_ENV: &str = "WGPU_VALIDATION_INDIRECT_CALL";
+
+/// The instance flags of [`Gpu::instance_from_env`]: wgpu's defaults as its `WGPU_*`
+/// environment variables change them, but without `VALIDATION_INDIRECT_CALL` unless
+/// `env_sets_indirect_validation` ([`INDIRECT_VALIDATION_ENV`] is set: `1` keeps it, `0` drops
+/// it as wgpu reads it).
+///
+/// That validation precedes every indirect dispatch with a one-thread dispatch of wgpu's own
+/// (gfx-rs/wgpu#6567), one more dispatch and barrier per round of the device-driven
+/// multi-pass: on the H200 its rounds took 7-15% longer with it (docs/results.md, 2026-12-02,
+/// "fused rounds"). It guards against arguments past `max_compute_workgroups_per_dimension`,
+/// and on D3D12 it is what fills `@builtin(num_workgroups)` of an indirect dispatch. Every
+/// indirect dispatch and draw in this workspace is safe without it: each sizes its grid
+/// within the limit on the device (the multi-pass's plan, the frontier BFS's plan, the
+/// raster peer's tiles and draw) and none reads `num_workgroups` (docs/scheduler.md 5.1).
+/// A program that records its own indirect dispatches on a [`Gpu`]'s device must keep the
+/// same rules, or set `WGPU_VALIDATION_INDIRECT_CALL=1`.
+pub fn instance_flags(env_sets_indirect_validation: bool) -> wgpu::InstanceFlags {
+    let mut flags = wgpu::InstanceFlags::from_env_or_default();
+    if !env_sets_indirect_validation {
+        flags.remove(wgpu::InstanceFlags::VALIDATION_INDIRECT_CALL);
+    }
+    flags
+}
+
 /// An adapter, its device and queue, and what they can do.
 pub struct Gpu {
     /// The adapter the device was opened on.
@@ -80,14 +106,13 @@ impl Gpu {
     }
 
     /// The wgpu instance [`Gpu::from_env`] opens its adapter from: the backends of
-    /// `WGPU_BACKEND`, else the primary ones, and wgpu's default flags as its environment
-    /// variables change them (`WGPU_VALIDATION_INDIRECT_CALL=0` turns off the validation
-    /// dispatch wgpu adds before every indirect dispatch; `docs/scheduler.md` 5.1 says when
-    /// that is safe). A window's surface is made from it before [`Gpu::from_env_for_surface`].
+    /// `WGPU_BACKEND`, else the primary ones, and the flags of [`instance_flags`] (wgpu's,
+    /// without its indirect-call validation unless `WGPU_VALIDATION_INDIRECT_CALL` asks for
+    /// it). A window's surface is made from it before [`Gpu::from_env_for_surface`].
     pub fn instance_from_env() -> wgpu::Instance {
         wgpu::Instance::new(wgpu::InstanceDescriptor {
             backends: wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY),
-            flags: wgpu::InstanceFlags::from_env_or_default(),
+            flags: instance_flags(std::env::var_os(INDIRECT_VALIDATION_ENV).is_some()),
             ..wgpu::InstanceDescriptor::new_without_display_handle()
         })
     }
@@ -590,5 +615,26 @@ fn dump_wgsl(label: &str, source: &str) {
     match written {
         Ok(()) => log::info!("shader module `{label}` written to {}", path.display()),
         Err(e) => log::warn!("{DUMP_WGSL_ENV}: could not write {}: {e}", path.display()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Without the variable the validation is off; with it, wgpu's reading of it decides.
+    /// (The test leaves the process environment alone: the variable is read only through
+    /// `from_env_or_default`, and CI does not set it.)
+    #[test]
+    fn indirect_validation_is_off_unless_the_environment_asks() {
+        assert!(!instance_flags(false).contains(wgpu::InstanceFlags::VALIDATION_INDIRECT_CALL));
+        let asked = std::env::var(INDIRECT_VALIDATION_ENV).ok();
+        let on = instance_flags(true).contains(wgpu::InstanceFlags::VALIDATION_INDIRECT_CALL);
+        match asked.as_deref() {
+            Some("0") => assert!(!on),
+            Some(_) => assert!(on),
+            // Unset: wgpu's default, which validates in release and debug builds alike.
+            None => assert!(on),
+        }
     }
 }

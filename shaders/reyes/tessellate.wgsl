@@ -193,7 +193,10 @@ fn tile_dispatch() {
     let n = min(atomicLoad(&tess_counts[T_TILES]), tess.tile_capacity);
     atomicStore(&tess_counts[T_TILES], n);
     atomicStore(&tess_counts[T_DISPATCH], min(n, TILE_ROW));
-    atomicStore(&tess_counts[T_DISPATCH + 1u], (n + TILE_ROW - 1u) / TILE_ROW);
+    // Rows stay within the dispatch limit, as wgpu's indirect validation (off by default,
+    // scheduler::gpu::instance_flags) would require: n <= tile_capacity, and a tile buffer of
+    // 4 bytes a tile within a 4 GiB binding holds at most 32,768 rows; the min only states it.
+    atomicStore(&tess_counts[T_DISPATCH + 1u], min((n + TILE_ROW - 1u) / TILE_ROW, 65535u));
     atomicStore(&tess_counts[T_DISPATCH + 2u], 1u);
 }
 

@@ -62,16 +62,21 @@ var<workgroup> wg_scan: array<u32, 256>;
 var<workgroup> wg_beg: array<u32, 256>;
 var<workgroup> wg_off: array<u32, 256>;
 
+// Workgroups of the expansion of a frontier of n vertices, one per 256 within the dispatch
+// limit: `plan` writes it as the indirect dispatch and `expand` strides by it, instead of
+// reading @builtin(num_workgroups), which D3D12 reports as 0 without wgpu's indirect validation.
+fn groups(n: u32) -> u32 { return min((n + 255u) / 256u, 65535u); }
+
 @compute @workgroup_size(256)
-fn expand(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>,
-          @builtin(num_workgroups) nwg: vec3<u32>) {
+fn expand(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>) {
     if lid == 0u {
         wg_n = atomicLoad(&ctrl[0]);
         wg_level = atomicLoad(&ctrl[2]);
     }
     let n = workgroupUniformLoad(&wg_n);
     let next = workgroupUniformLoad(&wg_level) + 1u;
-    for (var seg = wid.x * 256u; seg < n; seg += nwg.x * 256u) {
+    let stride = groups(n) * 256u;
+    for (var seg = wid.x * 256u; seg < n; seg += stride) {
         let i = seg + lid;
         var b = 0u;
         var d = 0u;
@@ -131,7 +136,7 @@ fn plan() {
         atomicAdd(&ctrl[2], 1u);
         atomicAdd(&ctrl[3], n);
     }
-    args[0] = min((n + 255u) / 256u, 65535u);
+    args[0] = groups(n);
     args[1] = 1u;
     args[2] = 1u;
 }
