@@ -58,8 +58,20 @@ fn q_at_limit(q: u32) -> bool { return params[q * 4u + 2u] != 0u; }
 // buffer (k + 1) % 2 bound here, so no dispatch reads its own arguments as storage.
 @group(2) @binding(0) var<storage, read_write> indirect: array<u32>;
 
-// This round's inputs, inputs run, and workgroups of the dispatch, for procedure q.
-var<workgroup> wg_round: vec3<u32>;
+// This workgroup's copy of what the plan wrote for its round (R_* entries): its procedure's
+// inputs, inputs run and workgroups, then the round's workgroups (all procedures), the round's
+// index in the chunk and the chunk's length. Read once at the start by parallel lanes
+// (`mp_round_inputs`; the fused round reads every procedure's at once), so no workgroup's start
+// or end waits on a chain of global loads, and `finish_workgroup` compares its count with the
+// round's own G_WGS, which the next round's plan may overwrite while this workgroup finishes.
+const R_COUNT: u32 = 0u;
+const R_RUN: u32 = 1u;
+const R_WGS: u32 = 2u;
+const R_ALL: u32 = 3u;
+const R_K: u32 = 4u;
+const R_CHUNK: u32 = 5u;
+const R_WORDS: u32 = 6u;
+var<workgroup> wg_round: array<u32, R_WORDS>;
 var<workgroup> wg_item_emits: array<atomic<u32>, 256u * NQ>;
 var<workgroup> wg_last: u32;
 var<private> sched_proc: u32;
@@ -91,6 +103,29 @@ fn sched_append_slot(t: u32) -> u32 {
     return at;
 }
 
+// The mp_ctrl word of entry j of procedure q's round copy (`wg_round`).
+fn round_word(q: u32, j: u32) -> u32 {
+    switch j {
+        case 0u: { return cw(q, C_COUNT); }
+        case 1u: { return cw(q, C_RUN); }
+        case 2u: { return cw(q, C_WGS); }
+        case 3u: { return gw(G_WGS); }
+        case 4u: { return gw(G_K); }
+        default: { return gw(G_CHUNK); }
+    }
+}
+
+// Procedure q's round copy, one load per lane (a procedure's own dispatch).
+fn mp_round_inputs(q: u32, lid: u32) -> array<u32, R_WORDS> {
+    if lid < R_WORDS { wg_round[lid] = atomicLoad(&mp_ctrl[round_word(q, lid)]); }
+    return workgroupUniformLoad(&wg_round);
+}
+
+// The fused round's copy, which `mp_round` filled for the procedure it picked.
+fn mp_fused_round_inputs(q: u32, lid: u32) -> array<u32, R_WORDS> {
+    return workgroupUniformLoad(&wg_round);
+}
+
 fn set_args(slot: u32, x: u32) {
     indirect[slot * 3u] = x;
     indirect[slot * 3u + 1u] = 1u;
@@ -109,16 +144,19 @@ fn mp_plan() { plan_round(0u); }
 // rest; halts with ERR_OVERFLOW when not one input fits. A halted or empty round dispatches
 // nothing, so nothing plans the rounds after it: they keep their zeroed arguments. `k`: the
 // round's index within the chunk.
+// Its loads are independent and issued before any store, and the counts stay in `cnt`, so the
+// plan, which the whole next round waits for, costs about one round trip to memory, not one
+// per queue.
 fn plan_round(k: u32) {
     var total = 0u;
-    var run: array<u32, NQ>;
-    for (var q = 0u; q < NQ; q++) {
-        let n = atomicLoad(&mp_ctrl[cw(q, C_NEXT)]);
-        atomicStore(&mp_ctrl[cw(q, C_COUNT)], n);
-        run[q] = n;
-        total += n;
-    }
+    var cnt: array<u32, NQ>;
+    for (var q = 0u; q < NQ; q++) { cnt[q] = atomicLoad(&mp_ctrl[cw(q, C_NEXT)]); }
     var ok = atomicLoad(&mp_ctrl[gw(G_HALT)]) == 0u;
+    for (var q = 0u; q < NQ; q++) {
+        atomicStore(&mp_ctrl[cw(q, C_COUNT)], cnt[q]);
+        total += cnt[q];
+    }
+    var run = cnt;
     var partial = false;
     var over_t = 0u;
     var over_m = 0u;
@@ -189,7 +227,7 @@ fn plan_round(k: u32) {
     let max_wgs = select(65535u, 65535u / NQ, FUSED);
     var all_wgs = 0u;
     for (var q = 0u; q < NQ; q++) {
-        let n = atomicLoad(&mp_ctrl[cw(q, C_COUNT)]);
+        let n = cnt[q];
         let per_step = 256u / THREADS[q];
         // Every input is visited: run, or copied to the front of the next round's inputs.
         let wgs = select(0u, min((n + per_step - 1u) / per_step, max_wgs), ok);
@@ -217,36 +255,47 @@ fn plan_round(k: u32) {
 // unless the chunk ends here (the next submission's mp_plan plans it then). Every append of
 // the round precedes the plan: each workgroup's storageBarrier (naga: a device-scope
 // acquire-release fence on Vulkan) comes before its count of finished workgroups, and the last
-// one's after it (docs/scheduler.md 5.1).
-fn finish_workgroup(lid: u32) {
+// one's after it (docs/scheduler.md 5.1). `round`: the workgroup's copy of the plan's words,
+// read when it started (the round's G_WGS, G_K, G_CHUNK).
+fn finish_workgroup(lid: u32, round: array<u32, R_WORDS>) {
     storageBarrier();
     if lid == 0u {
         let done = atomicAdd(&mp_ctrl[gw(G_DONE)], 1u) + 1u;
-        wg_last = select(0u, 1u, done == atomicLoad(&mp_ctrl[gw(G_WGS)]));
+        wg_last = select(0u, 1u, done == round[R_ALL]);
     }
     if workgroupUniformLoad(&wg_last) == 0u { return; }
     storageBarrier();
-    if lid == 0u {
-        let k = atomicLoad(&mp_ctrl[gw(G_K)]) + 1u;
-        if k < atomicLoad(&mp_ctrl[gw(G_CHUNK)]) { plan_round(k); }
-    }
+    let k = round[R_K] + 1u;
+    if lid == 0u && k < round[R_CHUNK] { plan_round(k); }
 }
 
 // A fused round (`MultipassConfig::fused_rounds`): one dispatch of every procedure's workgroups,
 // procedure 0's first (C_WGS of each), so a round costs one indirect dispatch instead of NQ.
+// Lanes read every procedure's round words and the round's own at once (one round trip), then
+// lane 0 finds this workgroup's procedure among them in workgroup memory.
 var<workgroup> wg_pick: vec2<u32>;
+var<workgroup> wg_rounds: array<u32, 3u * NQ + 3u>;
 @compute @workgroup_size(256)
 fn mp_round(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>) {
+    if lid < 3u * NQ + 3u {
+        // R_COUNT, R_RUN, R_WGS of procedure lid / 3, then the round's R_ALL, R_K, R_CHUNK.
+        let q = min(lid / 3u, NQ - 1u);
+        let j = select(lid % 3u, lid - 3u * NQ + R_ALL, lid >= 3u * NQ);
+        wg_rounds[lid] = atomicLoad(&mp_ctrl[round_word(q, j)]);
+    }
+    workgroupBarrier();
     if lid == 0u {
         var first = 0u;
         var q = 0u;
         loop {
-            let n = atomicLoad(&mp_ctrl[cw(q, C_WGS)]);
+            let n = wg_rounds[3u * q + R_WGS];
             if wid.x < first + n || q + 1u == NQ { break; }
             first += n;
             q += 1u;
         }
         wg_pick = vec2<u32>(q, wid.x - first);
+        for (var j = 0u; j < R_ALL; j++) { wg_round[j] = wg_rounds[3u * q + j]; }
+        for (var j = R_ALL; j < R_WORDS; j++) { wg_round[j] = wg_rounds[3u * NQ + j - R_ALL]; }
     }
     let pick = workgroupUniformLoad(&wg_pick);
     run_procedure(pick.x, lid, pick.y);

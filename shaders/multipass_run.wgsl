@@ -14,17 +14,10 @@
 // run (the outputs of the last rounds, so a partial round goes depth first and its live work
 // stays bounded); the older ones are copied, in place, to the front of the next round's inputs.
 fn RUN_PROCEDURE(q: u32, lid: u32, wid: u32) {
-    if lid == 0u {
-        wg_round = vec3<u32>(
-            atomicLoad(&mp_ctrl[cw(q, C_COUNT)]),
-            atomicLoad(&mp_ctrl[cw(q, C_RUN)]),
-            atomicLoad(&mp_ctrl[cw(q, C_WGS)]),
-        );
-    }
-    let round = workgroupUniformLoad(&wg_round);
-    let n = round.x;
-    let keep = n - round.y;
-    let nwg = max(round.z, 1u);
+    let round = ROUND_INPUTS(q, lid);
+    let n = round[R_COUNT];
+    let keep = n - round[R_RUN];
+    let nwg = max(round[R_WGS], 1u);
     let per_step = 256u / THREADS[q];
     let slot = lid / THREADS[q];
     let thread = lid % THREADS[q];
@@ -45,5 +38,5 @@ fn RUN_PROCEDURE(q: u32, lid: u32, wid: u32) {
         MP_EXECUTE(q, idx, Invocation(thread, slot, live, THREADS[q]));
         workgroupBarrier();
     }
-    finish_workgroup(lid);
+    finish_workgroup(lid, round);
 }

@@ -81,9 +81,18 @@ pub(super) fn rounds_source(
     // The loop, its item runner named `mp_execute{suffix}`, as `run_procedure{suffix}` (the
     // file's header comment, up to its first blank line, stays out of the copies).
     let run = run.split_once("\n\n").map_or(run, |(_, body)| body);
+    // The generic loop serves the fused round, which has read its round's words already
+    // (`mp_fused_round_inputs`); a procedure's own loop reads them (`mp_round_inputs`). The
+    // host-driven template has no `ROUND_INPUTS`.
     let instantiate = |suffix: &str| {
+        let inputs = if suffix.is_empty() {
+            "mp_fused_round_inputs"
+        } else {
+            "mp_round_inputs"
+        };
         run.replace("RUN_PROCEDURE", &format!("run_procedure{suffix}"))
             .replace("MP_EXECUTE", &format!("mp_execute{suffix}"))
+            .replace("ROUND_INPUTS", inputs)
     };
     if generic {
         s += &format!(
