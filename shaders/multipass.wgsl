@@ -1,5 +1,6 @@
 // Device-driven multi-pass (Patney & Owens 2008, without their read-back per round): rounds of
-// one indirect dispatch per procedure (or one for all of them: fused rounds, `mp_round` below),
+// one indirect dispatch per dispatch group (each procedure alone; all of them, fused rounds,
+// `mp_round` below; or the producers and the sinks apart, `mp_group_<g>`),
 // every round of a submission recorded up front and sized on the device. Compaction is fused
 // into the producing pass, as in the host-driven variant (`multipass_host.wgsl`): `enqueue_<t>`
 // appends the item straight into queue t's region of the next round's input buffer with one
@@ -115,14 +116,10 @@ fn round_word(q: u32, j: u32) -> u32 {
     }
 }
 
-// Procedure q's round copy, one load per lane (a procedure's own dispatch).
-fn mp_round_inputs(q: u32, lid: u32) -> array<u32, R_WORDS> {
-    if lid < R_WORDS { wg_round[lid] = atomicLoad(&mp_ctrl[round_word(q, lid)]); }
-    return workgroupUniformLoad(&wg_round);
-}
-
-// The fused round's copy, which `mp_round` filled for the procedure it picked.
-fn mp_fused_round_inputs(q: u32, lid: u32) -> array<u32, R_WORDS> {
+// Procedure q's round copy: one load per lane, unless the round's dispatch read it already
+// (`loaded`: a fused round's or a dispatch group's `mp_pick`).
+fn mp_round_inputs(q: u32, lid: u32, loaded: bool) -> array<u32, R_WORDS> {
+    if !loaded && lid < R_WORDS { wg_round[lid] = atomicLoad(&mp_ctrl[round_word(q, lid)]); }
     return workgroupUniformLoad(&wg_round);
 }
 
@@ -222,16 +219,18 @@ fn plan_round(k: u32) {
         }
     }
     // A halted round leaves the whole round's worst case in C_EMITS, for the host's growth.
-    // Fused rounds (FUSED, `MultipassConfig::fused_rounds`) dispatch every procedure's
-    // workgroups together, so each gets at most its share of the dispatch's 65,535.
-    let max_wgs = select(65535u, 65535u / NQ, FUSED);
+    // A round is one indirect dispatch per dispatch group (GROUP[q], NG groups: every
+    // procedure alone, all together with fused rounds, or the sinks apart; `Multipass::new`),
+    // so each procedure gets at most its share of a dispatch's 65,535.
+    let max_wgs = 65535u / MAX_GROUP;
     var all_wgs = 0u;
+    var group_wgs: array<u32, NQ>;
     for (var q = 0u; q < NQ; q++) {
         let n = cnt[q];
         let per_step = 256u / THREADS[q];
         // Every input is visited: run, or copied to the front of the next round's inputs.
         let wgs = select(0u, min((n + per_step - 1u) / per_step, max_wgs), ok);
-        if !FUSED { set_args((k / 2u) * NQ + q, wgs); }
+        group_wgs[GROUP[q]] += wgs;
         all_wgs += wgs;
         if ok {
             atomicStore(&mp_ctrl[cw(q, C_WGS)], wgs);
@@ -243,7 +242,7 @@ fn plan_round(k: u32) {
             atomicStore(&mp_ctrl[cw(q, C_NEXT)], n - run[q]);
         }
     }
-    if FUSED { set_args((k / 2u) * NQ, all_wgs); }
+    for (var g = 0u; g < NG; g++) { set_args((k / 2u) * NQ + g, group_wgs[g]); }
     if ok { atomicAdd(&mp_ctrl[gw(G_PLANNED)], 1u); }
     if ok && total > 0u { atomicAdd(&mp_ctrl[gw(G_ROUNDS)], 1u); }
     atomicStore(&mp_ctrl[gw(G_DONE)], 0u);
@@ -269,14 +268,15 @@ fn finish_workgroup(lid: u32, round: array<u32, R_WORDS>) {
     if lid == 0u && k < round[R_CHUNK] { plan_round(k); }
 }
 
-// A fused round (`MultipassConfig::fused_rounds`): one dispatch of every procedure's workgroups,
-// procedure 0's first (C_WGS of each), so a round costs one indirect dispatch instead of NQ.
-// Lanes read every procedure's round words and the round's own at once (one round trip), then
-// lane 0 finds this workgroup's procedure among them in workgroup memory.
+// A round's dispatch of several procedures (dispatch group g): every procedure's workgroups of
+// the group, in procedure order (C_WGS of each), so the round costs one indirect dispatch for
+// them instead of one each. Lanes read every procedure's round words and the round's own at
+// once (one round trip), then lane 0 finds this workgroup's procedure among the group's in
+// workgroup memory and leaves its round copy in `wg_round`. Returns the procedure and the
+// workgroup's index among that procedure's workgroups.
 var<workgroup> wg_pick: vec2<u32>;
 var<workgroup> wg_rounds: array<u32, 3u * NQ + 3u>;
-@compute @workgroup_size(256)
-fn mp_round(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>) {
+fn mp_pick(lid: u32, w: u32, g: u32) -> vec2<u32> {
     if lid < 3u * NQ + 3u {
         // R_COUNT, R_RUN, R_WGS of procedure lid / 3, then the round's R_ALL, R_K, R_CHUNK.
         let q = min(lid / 3u, NQ - 1u);
@@ -286,17 +286,27 @@ fn mp_round(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wi
     workgroupBarrier();
     if lid == 0u {
         var first = 0u;
-        var q = 0u;
-        loop {
+        var pick = 0u;
+        for (var q = 0u; q < NQ; q++) {
+            if GROUP[q] != g { continue; }
+            pick = q;
             let n = wg_rounds[3u * q + R_WGS];
-            if wid.x < first + n || q + 1u == NQ { break; }
+            if w < first + n { break; }
             first += n;
-            q += 1u;
         }
-        wg_pick = vec2<u32>(q, wid.x - first);
-        for (var j = 0u; j < R_ALL; j++) { wg_round[j] = wg_rounds[3u * q + j]; }
+        wg_pick = vec2<u32>(pick, w - min(first, w));
+        for (var j = 0u; j < R_ALL; j++) { wg_round[j] = wg_rounds[3u * pick + j]; }
         for (var j = R_ALL; j < R_WORDS; j++) { wg_round[j] = wg_rounds[3u * NQ + j - R_ALL]; }
     }
-    let pick = workgroupUniformLoad(&wg_pick);
-    run_procedure(pick.x, lid, pick.y);
+    return workgroupUniformLoad(&wg_pick);
+}
+
+// Fused rounds (`MultipassConfig::fused_rounds`): every procedure in one dispatch group, run
+// through `sched_execute`'s switch. Other groups of several procedures have an entry point
+// `mp_group_<g>` each (generated, scheduler/src/multipass/wgsl.rs) that reaches only its own
+// procedures' bodies, so the driver sizes its registers for them alone.
+@compute @workgroup_size(256)
+fn mp_round(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>) {
+    let pick = mp_pick(lid, wid.x, 0u);
+    run_procedure(pick.x, lid, pick.y, true);
 }

@@ -1,8 +1,8 @@
 // The device-driven multi-pass's loop over one procedure's round inputs (multipass.wgsl).
 // Instantiated by scheduler/src/multipass/wgsl.rs (`rounds_source`): once per procedure t as
-// `run_procedure_<t>` with `mp_execute_<t>`, which calls t's body alone, for t's entry point;
-// and once as `run_procedure` with `mp_execute` (any procedure, by q) for the fused round,
-// `mp_round`.
+// `run_procedure_<t>` with `mp_execute_<t>`, which calls t's body alone, for t's entry point
+// and the dispatch groups that hold t (`mp_group_<g>`); and once as `run_procedure` with
+// `mp_execute` (any procedure, by q) for the fused round, `mp_round`.
 // An entry point that reached every body through sched_execute's switch would get the driver's
 // register allocation and workgroup memory for all of them (on the H200, the host-driven
 // DiceShade took 122 registers instead of 80 when Bound's workgroup memory grew:
@@ -13,8 +13,8 @@
 // for indirect dispatches when wgpu's indirect validation is off. Only the newest C_RUN inputs
 // run (the outputs of the last rounds, so a partial round goes depth first and its live work
 // stays bounded); the older ones are copied, in place, to the front of the next round's inputs.
-fn RUN_PROCEDURE(q: u32, lid: u32, wid: u32) {
-    let round = ROUND_INPUTS(q, lid);
+fn RUN_PROCEDURE(q: u32, lid: u32, wid: u32, loaded: bool) {
+    let round = mp_round_inputs(q, lid, loaded);
     let n = round[R_COUNT];
     let keep = n - round[R_RUN];
     let nwg = max(round[R_WGS], 1u);

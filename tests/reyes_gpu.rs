@@ -532,9 +532,10 @@ fn metal_surfaces_render_like_the_cpu_pipeline_with_tinted_highlights() {
 }
 
 /// Fused multi-pass rounds (every procedure of a round in one dispatch; the default on GPUs,
-/// off on lavapipe) render the same image, bit for bit, and the same counters as a dispatch
-/// per procedure: a round's procedures read their own inputs and append to the next round's, so
-/// running them together changes no item. The teapot's features, as the tests above, so
+/// off on lavapipe), and fused rounds with the sinks in a dispatch of their own, render the
+/// same image, bit for bit, and the same counters as a dispatch per procedure: a round's
+/// procedures read their own inputs and append to the next round's, so running them together
+/// changes no item. The teapot's features, as the tests above, so
 /// lavapipe's shader cache serves the per-procedure program.
 #[test]
 fn fused_multipass_rounds_draw_the_same_image() {
@@ -543,12 +544,13 @@ fn fused_multipass_rounds_draw_the_same_image() {
     let data = FrameData::new(&scene, &small(96, 72)).unwrap();
     let features = data.features();
     let program = reyes::gpu_render::program_for(features).unwrap();
-    let render = |fused| {
+    let render = |fused, fused_sinks_apart| {
         let s = Scheduler::multipass(
             gpu(),
             &program,
             MultipassConfig {
                 fused_rounds: Some(fused),
+                fused_sinks_apart,
                 ..Default::default()
             },
         )
@@ -559,7 +561,7 @@ fn fused_multipass_rounds_draw_the_same_image() {
         let r = reyes::gpu_render::GpuRenderer::new(gpu(), config).unwrap();
         r.render(gpu(), &data).unwrap()
     };
-    let (apart, fused) = (render(false), render(true));
+    let (apart, fused) = (render(false, false), render(true, false));
     assert!(apart.image == fused.image, "images differ");
     assert_eq!(apart.counters, fused.counters);
     assert_eq!(apart.run.rounds, fused.run.rounds, "{:?}", fused.run);
@@ -568,5 +570,24 @@ fn fused_multipass_rounds_draw_the_same_image() {
         "fused {:?}, apart {:?}",
         fused.run,
         apart.run
+    );
+    // The sinks (DiceShade, DiceSmall) in a dispatch of their own, the producers (Bound and the
+    // splits) in another: two dispatch groups of several procedures each.
+    let sinks = render(true, true);
+    assert!(
+        apart.image == sinks.image,
+        "images differ with the sinks apart"
+    );
+    assert_eq!(apart.counters, sinks.counters);
+    assert_eq!(apart.run.rounds, sinks.run.rounds, "{:?}", sinks.run);
+    // Each submission's plan, then per encoded round one dispatch fused, two with the sinks
+    // apart, over the same submissions and encoded rounds.
+    assert_eq!(sinks.run.submits, fused.run.submits);
+    assert_eq!(
+        sinks.run.launches - fused.run.launches,
+        fused.run.launches - fused.run.submits,
+        "two dispatches a round where fused has one: {:?}, fused {:?}",
+        sinks.run,
+        fused.run
     );
 }

@@ -1034,6 +1034,32 @@ fn every_thread_that_calls_enqueue_adds_an_item_on_every_strategy() {
         let counts = gpu.read_words(&seen, 0, 4 * n as u64).unwrap();
         assert!(counts.iter().all(|&c| c == 1), "{kind:?}: {counts:?}");
     }
+    // The device-driven multi-pass's dispatch groups: a round is one dispatch fused, one per
+    // procedure apart, and with the sinks apart one for `fan` and one for `sink` and `once`
+    // together (`mp_group_1`, which picks between their loops).
+    for (fused, sinks_apart, dispatches) in [(true, false, 1), (false, false, 3), (true, true, 2)] {
+        let seen = gpu.storage_buffer("seen", 4 * n as u64).unwrap();
+        let bind = exact.user.bind_group(&gpu, &[&seen]).unwrap();
+        let config = MultipassConfig {
+            initial_capacity: 64,
+            fused_rounds: Some(fused),
+            fused_sinks_apart: sinks_apart,
+            ..Default::default()
+        };
+        let s = Scheduler::multipass(&gpu, &exact, config).unwrap();
+        for run in 0..2 {
+            let stats = s.run(&gpu, &seeds, Some(&bind)).unwrap();
+            let what = format!("fused {fused}, sinks apart {sinks_apart}, run {run}: {stats:?}");
+            assert_eq!(stats.executed, [n as u64, 4 * n as u64, n as u64], "{what}");
+            assert_eq!(stats.rounds, 2, "{what}");
+            if run == 1 {
+                // The second run encodes exactly the rounds the first needed, in one chunk.
+                assert_eq!(stats.launches, 1 + 2 * dispatches, "{what}");
+            }
+        }
+        let counts = gpu.read_words(&seen, 0, 4 * n as u64).unwrap();
+        assert!(counts.iter().all(|&c| c == 2), "fused {fused}: {counts:?}");
+    }
     // Declaring 3 for 4 threads' calls is an emit-limit error everywhere.
     let short = program(3);
     for kind in StrategyKind::ALL {

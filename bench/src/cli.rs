@@ -232,7 +232,9 @@ pub struct Cli {
 
     /// How the device-driven multi-pass dispatches a round (`MultipassConfig::fused_rounds`):
     /// `on`, one indirect dispatch of every procedure's workgroups; `off`, one per procedure;
-    /// `auto`, on for GPUs and off for CPU adapters such as lavapipe (docs/scheduler.md 5.1).
+    /// `sinks-apart`, one for the producers and one for the sinks
+    /// (`MultipassConfig::fused_sinks_apart`); `auto`, on for GPUs and off for CPU adapters
+    /// such as lavapipe (docs/scheduler.md 5.1).
     #[arg(long, value_enum, default_value = "auto", help_heading = "Scheduler")]
     pub fused_rounds: FusedRounds,
 }
@@ -246,6 +248,8 @@ pub enum FusedRounds {
     On,
     /// One indirect dispatch per procedure.
     Off,
+    /// One indirect dispatch for the procedures that emit, one for those that do not.
+    SinksApart,
 }
 
 /// `--enqueue`: how megakernel items reach their queue.
@@ -477,9 +481,10 @@ impl Cli {
             defer_local_sinks: !self.no_defer_local_sinks,
             fused_rounds: match self.fused_rounds {
                 FusedRounds::Auto => None,
-                FusedRounds::On => Some(true),
+                FusedRounds::On | FusedRounds::SinksApart => Some(true),
                 FusedRounds::Off => Some(false),
             },
+            fused_sinks_apart: self.fused_rounds == FusedRounds::SinksApart,
         }
     }
 }

@@ -163,6 +163,8 @@ pub struct GpuConfig {
     pub defer_local_sinks: bool,
     /// `MultipassConfig::fused_rounds` (the device-driven multi-pass); `None`: by adapter.
     pub fused_rounds: Option<bool>,
+    /// `MultipassConfig::fused_sinks_apart` (default `false`).
+    pub fused_sinks_apart: bool,
 }
 
 impl Default for GpuConfig {
@@ -184,6 +186,7 @@ impl Default for GpuConfig {
             local_bytes: None,
             defer_local_sinks: true,
             fused_rounds: None,
+            fused_sinks_apart: false,
         }
     }
 }
@@ -267,6 +270,7 @@ pub fn compile(
             MultipassConfig {
                 initial_capacity: capacity,
                 fused_rounds: config.fused_rounds,
+                fused_sinks_apart: config.fused_sinks_apart,
                 ..Default::default()
             },
         ),

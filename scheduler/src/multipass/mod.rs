@@ -1,6 +1,7 @@
 //! The multi-pass baseline (Patney & Owens 2008), device-driven: rounds of one indirect
-//! dispatch per procedure, sized on the device by a one-thread plan from the previous round's
-//! counts; children are appended to the next round's inputs with one atomic add each
+//! dispatch per dispatch group (every procedure alone; all together, fused rounds, the default
+//! on GPUs; or the producers and the sinks apart), sized on the device by a plan that the last
+//! workgroup of the round before runs from its counts; children are appended to the next round's inputs with one atomic add each
 //! (compaction fused into the producer, no scan). Rounds are encoded in chunks, the first as
 //! long as the previous run needed, so a repeated run is one submission; the host reads back
 //! only between chunks. A round whose outputs would not fit is refused on the device with its
@@ -67,6 +68,14 @@ pub struct MultipassConfig {
     /// kernel holding every procedure ran 1.25-1.5x slower (docs/scheduler.md 5.1). Ignored with `stage_timing`, which
     /// times each procedure's dispatches apart (docs/scheduler.md 5.1).
     pub fused_rounds: Option<bool>,
+    /// With fused rounds, dispatch the sinks (procedures that emit nothing: Reyes' DiceShade
+    /// and DiceSmall, the tree's leaves) apart from the producers: two indirect dispatches a
+    /// round, each kernel reaching only its own procedures' bodies, so the driver sizes the
+    /// sinks' registers without the producers' (the host-driven Reyes passes: Bound 127
+    /// registers, DiceShade 80; one kernel for all takes the larger, docs/scheduler.md 5.1).
+    /// Default `false`: not yet measured on a GPU. Ignored without fused rounds, or when every
+    /// procedure is a sink or none is.
+    pub fused_sinks_apart: bool,
 }
 
 impl Default for MultipassConfig {
@@ -80,7 +89,26 @@ impl Default for MultipassConfig {
             item_layout: None,
             size_from_last_run: true,
             fused_rounds: None,
+            fused_sinks_apart: false,
         }
+    }
+}
+
+/// The dispatch groups of `program`'s rounds: every procedure alone without `fused`; with it
+/// all together, or with `sinks_apart` the producers, then the sinks (procedures that emit
+/// nothing), where there are both.
+fn dispatch_groups(program: &Program, fused: bool, sinks_apart: bool) -> wgsl::DispatchGroups {
+    let all: Vec<usize> = (0..program.queue_count()).collect();
+    if !fused {
+        return all.into_iter().map(|q| vec![q]).collect();
+    }
+    let (sinks, producers): (Vec<usize>, Vec<usize>) = all
+        .iter()
+        .partition(|&&q| program.procs[q].emits.iter().all(|&e| e == 0));
+    if sinks_apart && !sinks.is_empty() && !producers.is_empty() {
+        vec![producers, sinks]
+    } else {
+        vec![all]
     }
 }
 
@@ -95,6 +123,10 @@ pub struct Multipass {
     program: Program,
     config: MultipassConfig,
     kernels: Kernels,
+    /// The round's indirect dispatches: the procedures of each ([`wgsl::DispatchGroups`]).
+    groups: wgsl::DispatchGroups,
+    /// The pipeline (index into `kernels.pipelines`) of each dispatch group.
+    group_pipelines: Vec<usize>,
     /// Buffers of the last run, reused when the next run needs the same layout.
     cache: std::sync::Mutex<Option<DeviceRounds>>,
     /// Rounds the last finished run executed (0 before the first): the next run's first
@@ -110,7 +142,8 @@ struct DeviceRounds {
     ctrl: wgpu::Buffer,
     items: [wgpu::Buffer; 2],
     /// Dispatch arguments: round k of a chunk reads its own from `args[k % 2]` (slot
-    /// `(k / 2) × NQ + q`) and may plan round k + 1 into `args[(k + 1) % 2]`.
+    /// `(k / 2) × NQ + g` for dispatch group g) and may plan round k + 1 into
+    /// `args[(k + 1) % 2]`.
     args: [wgpu::Buffer; 2],
     /// `args_bind[j]`: `args[j]` as storage (group 2).
     args_bind: [wgpu::BindGroup; 2],
@@ -140,10 +173,21 @@ impl Multipass {
         }
         let fused = config.fused_rounds.unwrap_or(!gpu.is_cpu_adapter()) && !config.stage_timing;
         config.fused_rounds = Some(fused);
-        let source = wgsl::source(program, items, fused);
+        let groups = dispatch_groups(program, fused, config.fused_sinks_apart);
+        config.fused_sinks_apart = fused && groups.len() == 2;
+        let source = wgsl::source(program, items, &groups);
         let entries: Vec<_> = (0..4).map(|b| storage_entry(b, b == 3)).collect();
-        let eps = wgsl::entry_points(program, fused);
-        let eps: Vec<&str> = eps.iter().map(|s| s.as_str()).collect();
+        let names = wgsl::entry_points(program, &groups);
+        let group_pipelines = (0..groups.len())
+            .map(|g| {
+                let e = wgsl::group_entry(program, &groups, g);
+                names
+                    .iter()
+                    .position(|n| *n == e)
+                    .expect("every group has an entry point")
+            })
+            .collect();
+        let eps: Vec<&str> = names.iter().map(|s| s.as_str()).collect();
         let group2 = [storage_entry(0, false)];
         let kernels = Kernels::new(
             gpu,
@@ -158,6 +202,8 @@ impl Multipass {
             program: program.clone(),
             config,
             kernels,
+            groups,
+            group_pipelines,
             cache: Default::default(),
             learned_rounds: Default::default(),
             readback: Default::default(),
@@ -285,25 +331,17 @@ impl Multipass {
             .write_buffer(&to.ctrl, 0, bytemuck::cast_slice(&ctrl));
     }
 
-    /// Whether rounds are fused (`new` settled `config.fused_rounds` from the adapter).
-    fn fused(&self) -> bool {
-        self.config.fused_rounds == Some(true)
-    }
-
-    /// Indirect dispatches of one round: one per procedure, or one with fused rounds.
+    /// Indirect dispatches of one round: one per procedure, one with fused rounds, two with
+    /// the sinks apart.
     fn dispatches_per_round(&self) -> u64 {
-        if self.fused() {
-            1
-        } else {
-            self.program.queue_count() as u64
-        }
+        self.groups.len() as u64
     }
 
     /// Encodes a chunk of `rounds` rounds (at most `d.max_chunk`): the arguments cleared, the
     /// first round's plan (one thread, a direct dispatch), then per round one indirect dispatch
-    /// per procedure (or one for all, with fused rounds); the last workgroup of each round plans
-    /// the next (`shaders/multipass.wgsl`), so the chunk is `1 + rounds × NQ` dispatches (`1 +
-    /// rounds` fused). `mp_ctrl`'s `G_CHUNK` must hold `rounds`.
+    /// per dispatch group (each procedure, all of them with fused rounds, or producers and
+    /// sinks); the last workgroup of each round plans the next (`shaders/multipass.wgsl`), so
+    /// the chunk is `1 + rounds × groups` dispatches. `mp_ctrl`'s `G_CHUNK` must hold `rounds`.
     /// With `stages`, each procedure's dispatches are timed as their own passes and the plan is
     /// counted to the last stage; else one pass.
     #[allow(clippy::too_many_arguments)]
@@ -367,14 +405,9 @@ impl Multipass {
         plan(&mut pass);
         for k in 0..rounds as usize {
             round(&mut pass, k);
-            if self.fused() {
-                pass.set_pipeline(&p[1 + nq]);
-                pass.dispatch_workgroups_indirect(&d.args[k % 2], args(k, 0));
-                continue;
-            }
-            for q in 0..nq {
-                pass.set_pipeline(&p[1 + q]);
-                pass.dispatch_workgroups_indirect(&d.args[k % 2], args(k, q));
+            for (g, &pipeline) in self.group_pipelines.iter().enumerate() {
+                pass.set_pipeline(&p[pipeline]);
+                pass.dispatch_workgroups_indirect(&d.args[k % 2], args(k, g));
             }
         }
     }

@@ -10,9 +10,24 @@ pub const TEMPLATE: &str = include_str!("../../../shaders/multipass.wgsl");
 /// once for any procedure (`rounds_source`).
 const RUN: &str = include_str!("../../../shaders/multipass_run.wgsl");
 
-/// Entry points in pipeline order: the plan, then the procedures, then (`fused`) the fused
-/// round.
-pub fn entry_points(program: &Program, fused: bool) -> Vec<String> {
+/// How a round's procedures are dispatched: `groups[g]` lists the procedures (in order) of the
+/// round's indirect dispatch `g`. Every procedure alone (no fused rounds), all together
+/// (fused rounds), or the producers and the sinks apart (`MultipassConfig::fused_sinks_apart`).
+pub type DispatchGroups = Vec<Vec<usize>>;
+
+/// The entry point that runs dispatch group `g` of `groups`: a procedure's own, the fused
+/// round's for all of them, else the group's (`mp_group_<g>`).
+pub fn group_entry(program: &Program, groups: &DispatchGroups, g: usize) -> String {
+    match groups[g].as_slice() {
+        [q] => format!("mp_proc_{}", program.procs[*q].proc.name),
+        all if all.len() == program.queue_count() => "mp_round".into(),
+        _ => format!("mp_group_{g}"),
+    }
+}
+
+/// Entry points in pipeline order: the plan, then the procedures, then the entry of every
+/// dispatch group of several procedures (`group_entry`).
+pub fn entry_points(program: &Program, groups: &DispatchGroups) -> Vec<String> {
     let mut e = vec!["mp_plan".to_string()];
     e.extend(
         program
@@ -20,26 +35,66 @@ pub fn entry_points(program: &Program, fused: bool) -> Vec<String> {
             .iter()
             .map(|p| format!("mp_proc_{}", p.proc.name)),
     );
-    if fused {
-        e.push("mp_round".into());
+    for (g, members) in groups.iter().enumerate() {
+        if members.len() > 1 {
+            e.push(group_entry(program, groups, g));
+        }
     }
     e
 }
 
 /// The WGSL for `program` with its queues laid out as `items` (the same layout in the round
-/// buffers of every queue); `fused`: rounds are planned for one dispatch of all procedures
-/// (`MultipassConfig::fused_rounds`).
-pub fn source(program: &Program, items: ItemLayout, fused: bool) -> String {
+/// buffers of every queue), its rounds dispatched as `groups`.
+pub fn source(program: &Program, items: ItemLayout, groups: &DispatchGroups) -> String {
     let args = "@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>";
-    let mut s = rounds_source(program, items, "mp_proc", args, "lid, wid.x", RUN, true);
+    let mut s = rounds_source(
+        program,
+        items,
+        "mp_proc",
+        args,
+        "lid, wid.x, false",
+        RUN,
+        true,
+    );
     // Word `w` of item `at` of queue `t` (the carried inputs' copy).
     let word_at = match items {
         ItemLayout::Interleaved => "q_base(t) + at * WORDS[t] + w",
         ItemLayout::Planar => "q_base(t) + w * q_cap(t) + at",
     };
     s += &format!("fn mp_word_at(t: u32, at: u32, w: u32) -> u32 {{ return {word_at}; }}\n");
-    s += &format!("const FUSED: bool = {fused};\n");
+    let nq = program.queue_count();
+    let mut group_of = vec![0; nq];
+    for (g, members) in groups.iter().enumerate() {
+        for &q in members {
+            group_of[q] = g;
+        }
+    }
+    let list: Vec<String> = group_of.iter().map(|g| format!("{g}u")).collect();
+    s += &format!(
+        "const NG: u32 = {}u;\nconst GROUP: array<u32, {nq}> = array<u32, {nq}>({});\n\
+         const MAX_GROUP: u32 = {}u;\n",
+        groups.len(),
+        list.join(", "),
+        groups.iter().map(Vec::len).max().unwrap_or(1),
+    );
     s += TEMPLATE;
+    // A group of several procedures, not all: a switch over their own loops.
+    for (g, members) in groups.iter().enumerate() {
+        if members.len() < 2 || members.len() == nq {
+            continue;
+        }
+        let cases: String = members
+            .iter()
+            .map(|q| {
+                format!("        case {q}u: {{ run_procedure_{q}({q}u, lid, pick.y, true); }}\n")
+            })
+            .collect();
+        s += &format!(
+            "@compute @workgroup_size(256) fn mp_group_{g}({args}) {{\n    \
+             let pick = mp_pick(lid, wid.x, {g}u);\n    switch pick.x {{\n{cases}        \
+             default: {{}}\n    }}\n}}\n"
+        );
+    }
     s
 }
 
@@ -81,18 +136,9 @@ pub(super) fn rounds_source(
     // The loop, its item runner named `mp_execute{suffix}`, as `run_procedure{suffix}` (the
     // file's header comment, up to its first blank line, stays out of the copies).
     let run = run.split_once("\n\n").map_or(run, |(_, body)| body);
-    // The generic loop serves the fused round, which has read its round's words already
-    // (`mp_fused_round_inputs`); a procedure's own loop reads them (`mp_round_inputs`). The
-    // host-driven template has no `ROUND_INPUTS`.
     let instantiate = |suffix: &str| {
-        let inputs = if suffix.is_empty() {
-            "mp_fused_round_inputs"
-        } else {
-            "mp_round_inputs"
-        };
         run.replace("RUN_PROCEDURE", &format!("run_procedure{suffix}"))
             .replace("MP_EXECUTE", &format!("mp_execute{suffix}"))
-            .replace("ROUND_INPUTS", inputs)
     };
     if generic {
         s += &format!(
