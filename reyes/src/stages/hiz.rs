@@ -185,11 +185,16 @@ pub fn occluded(f: &FrameUniforms, hiz: &Hiz, lo: glam::Vec2, hi: glam::Vec2, z:
 /// at control points at shutter open, without displacement): either pass may hold any item
 /// without changing the image, only the work.
 pub fn front_items(data: &FrameData, items: &[PatchItem], tile: Tile) -> Vec<bool> {
+    front_of(&screen_extents(data, items), tile)
+}
+
+/// [`front_items`] from the items' [`screen_extents`].
+fn front_of(extents: &[Extent], tile: Tile) -> Vec<bool> {
     let grid = CellGrid::of(tile);
     let (nx, ny) = (grid.nx, grid.ny);
-    let extents: Vec<Option<([usize; 4], f32, f32)>> = (items.iter())
-        .map(|item| {
-            let (lo, hi, z0, z1) = screen_extent(data, item)?;
+    let extents: Vec<Option<([usize; 4], f32, f32)>> = (extents.iter())
+        .map(|e| {
+            let (lo, hi, z0, z1) = (*e)?;
             Some((grid.cells(lo, hi), z0, z1))
         })
         .collect();
@@ -221,13 +226,18 @@ pub fn front_items(data: &FrameData, items: &[PatchItem], tile: Tile) -> Vec<boo
 /// is unknown). Control points at shutter open, without displacement: a heuristic for
 /// `--occlusion auto`, never for what may be culled.
 pub fn depth_complexity(data: &FrameData, items: &[PatchItem], tile: Tile) -> f32 {
+    complexity_of(&screen_extents(data, items), tile)
+}
+
+/// [`depth_complexity`] from the items' [`screen_extents`].
+fn complexity_of(extents: &[Extent], tile: Tile) -> f32 {
     let grid = CellGrid::of(tile);
     let mut reached = vec![false; grid.nx * grid.ny];
     let (x0, y0) = (tile.x0 as f32, tile.y0 as f32);
     let (x1, y1) = (x0 + tile.w as f32, y0 + tile.h as f32);
     let mut area = 0.0f64;
-    for item in items {
-        let Some((lo, hi, _, _)) = screen_extent(data, item) else {
+    for e in extents {
+        let Some((lo, hi, _, _)) = *e else {
             return f32::INFINITY;
         };
         let w = (hi.x.min(x1) - lo.x.max(x0)).max(0.0);
@@ -250,9 +260,20 @@ pub fn depth_complexity(data: &FrameData, items: &[PatchItem], tile: Tile) -> f3
     }
 }
 
-/// An item's screen bound and depth range from its control points at shutter open (`None`
-/// when one is not in front of the near plane).
-fn screen_extent(data: &FrameData, item: &PatchItem) -> Option<(glam::Vec2, glam::Vec2, f32, f32)> {
+/// An item's screen bound (pixels, lower and upper corner) and depth range (camera z, near and
+/// far) from its control points at shutter open; `None` when one is not in front of the near
+/// plane.
+type Extent = Option<(glam::Vec2, glam::Vec2, f32, f32)>;
+
+/// Every item's [`Extent`], in order: [`passes`] computes them once for its two uses (each
+/// projects 16 points per item; Killeroo's 11,532 roots cost about 0.5 ms a pass on the
+/// development machine).
+fn screen_extents(data: &FrameData, items: &[PatchItem]) -> Vec<Extent> {
+    items.iter().map(|item| screen_extent(data, item)).collect()
+}
+
+/// One item's [`Extent`].
+fn screen_extent(data: &FrameData, item: &PatchItem) -> Extent {
     let f = &data.frame;
     let info = &data.patch_info[item.patch_id as usize];
     let w = item_weights(item, info, &data.primvars);
@@ -323,28 +344,33 @@ impl CellGrid {
 /// build the pyramid of everything drawn so far and Bound tests against it, so each pass is
 /// culled against all the passes in front of it.
 pub fn passes(data: &FrameData, items: &[PatchItem], tile: Tile) -> (Vec<PatchItem>, Vec<usize>) {
+    let extents = screen_extents(data, items);
     if data.frame.occlusion == OCCLUSION_AUTO
-        && depth_complexity(data, items, tile) < AUTO_MIN_DEPTH_COMPLEXITY
+        && complexity_of(&extents, tile) < AUTO_MIN_DEPTH_COMPLEXITY
     {
         return (items.to_vec(), vec![0]);
     }
-    let front = front_items(data, items, tile);
-    let mut ordered: Vec<PatchItem> = (items.iter().zip(&front))
-        .filter(|(_, f)| **f)
-        .map(|(i, _)| *i)
-        .collect();
+    let front = front_of(&extents, tile);
+    let mut ordered: Vec<PatchItem> = Vec::with_capacity(items.len());
+    ordered.extend(
+        (items.iter().zip(&front))
+            .filter(|(_, f)| **f)
+            .map(|(i, _)| *i),
+    );
     let n = ordered.len();
-    let mut rest: Vec<(f32, PatchItem)> = (items.iter().zip(&front))
-        .filter(|(_, f)| !**f)
-        .map(|(i, _)| {
+    // The rest by depth, sorting (depth, index) pairs rather than the items themselves (a
+    // patch item is hundreds of bytes; the stable sort keeps equal depths in item order).
+    let mut rest: Vec<(f32, usize)> = (items.iter().zip(&front).enumerate())
+        .filter(|(_, (_, f))| !**f)
+        .map(|(k, (i, _))| {
             let zmin = (0..16)
                 .map(|k| cp_point(&i.cp, k).z)
                 .fold(f32::MAX, f32::min);
-            (zmin, *i)
+            (zmin, k)
         })
         .collect();
     rest.sort_by(|a, b| a.0.total_cmp(&b.0));
-    ordered.extend(rest.iter().map(|r| r.1));
+    ordered.extend(rest.iter().map(|r| items[r.1]));
     let mut starts = vec![0, n, n + rest.len() / 2];
     starts.retain(|&s| s == 0 || s < ordered.len());
     starts.dedup();
