@@ -24,7 +24,7 @@ const C_EMITS: u32 = 3u;  // worst-case outputs of this round for this target
 const C_NEXT: u32 = 4u;   // carried inputs + appended outputs = inputs of the next round
 const C_RUN: u32 = 5u;    // inputs this round runs (all but in a partial round)
 const C_KEEP: u32 = 6u;   // inputs this round carries, unrun, to the front of the next
-const C_WGS: u32 = 7u;    // workgroups of this round's dispatch (num_workgroups, see mp_plan)
+const C_WGS: u32 = 7u;    // this procedure's workgroups in its dispatch group's dispatch
 fn cw(q: u32, i: u32) -> u32 { return q * CSTRIDE + i; }
 fn gw(i: u32) -> u32 { return NQ * CSTRIDE + i; }
 const G_ROUNDS: u32 = 0u;
@@ -54,8 +54,8 @@ fn q_at_limit(q: u32) -> bool { return params[q * 4u + 2u] != 0u; }
 @group(0) @binding(1) var<storage, read_write> items_in: array<vec4<u32>>;
 @group(0) @binding(2) var<storage, read_write> items_out: array<vec4<u32>>;
 @group(0) @binding(3) var<storage, read> params: array<u32>;
-// Group 2: the arguments of the rounds the bound dispatch may plan, round k's at slot
-// (k / 2) x NQ + q of buffer k % 2. Round k's dispatches read theirs from buffer k % 2 and have
+// Group 2: the arguments of the rounds the bound dispatch may plan, round k's dispatch group
+// g's at slot (k / 2) x NQ + g of buffer k % 2. Round k's dispatches read theirs from buffer k % 2 and have
 // buffer (k + 1) % 2 bound here, so no dispatch reads its own arguments as storage.
 @group(2) @binding(0) var<storage, read_write> indirect: array<u32>;
 
@@ -221,13 +221,13 @@ fn plan_round(k: u32) {
     // A halted round leaves the whole round's worst case in C_EMITS, for the host's growth.
     // A round is one indirect dispatch per dispatch group (GROUP[q], NG groups: every
     // procedure alone, all together with fused rounds, or the sinks apart; `Multipass::new`),
-    // so each procedure gets at most its share of a dispatch's 65,535.
-    let max_wgs = 65535u / MAX_GROUP;
+    // so each procedure gets at most its share of its group's dispatch's 65,535.
     var all_wgs = 0u;
     var group_wgs: array<u32, NQ>;
     for (var q = 0u; q < NQ; q++) {
         let n = cnt[q];
         let per_step = 256u / THREADS[q];
+        let max_wgs = 65535u / GROUP_LEN[q];
         // Every input is visited: run, or copied to the front of the next round's inputs.
         let wgs = select(0u, min((n + per_step - 1u) / per_step, max_wgs), ok);
         group_wgs[GROUP[q]] += wgs;
@@ -286,17 +286,27 @@ fn mp_pick(lid: u32, w: u32, g: u32) -> vec2<u32> {
     workgroupBarrier();
     if lid == 0u {
         var first = 0u;
-        var pick = 0u;
+        var pick = NQ;
+        var last = 0u;
         for (var q = 0u; q < NQ; q++) {
             if GROUP[q] != g { continue; }
-            pick = q;
+            last = q;
             let n = wg_rounds[3u * q + R_WGS];
-            if w < first + n { break; }
+            if w < first + n { pick = q; break; }
             first += n;
         }
-        wg_pick = vec2<u32>(pick, w - min(first, w));
-        for (var j = 0u; j < R_ALL; j++) { wg_round[j] = wg_rounds[3u * pick + j]; }
+        // A workgroup past the group's workgroups (none: the dispatch's size and C_WGS come
+        // from the same plan) runs no input of its group's last procedure but still counts
+        // itself finished, so the round still ends and is planned.
+        let found = pick < NQ;
+        let q = select(last, pick, found);
+        wg_pick = vec2<u32>(q, select(0u, w - first, found));
+        for (var j = 0u; j < R_ALL; j++) { wg_round[j] = wg_rounds[3u * q + j]; }
         for (var j = R_ALL; j < R_WORDS; j++) { wg_round[j] = wg_rounds[3u * NQ + j - R_ALL]; }
+        if !found {
+            wg_round[R_COUNT] = 0u;
+            wg_round[R_RUN] = 0u;
+        }
     }
     return workgroupUniformLoad(&wg_pick);
 }

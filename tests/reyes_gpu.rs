@@ -544,7 +544,7 @@ fn fused_multipass_rounds_draw_the_same_image() {
     let data = FrameData::new(&scene, &small(96, 72)).unwrap();
     let features = data.features();
     let program = reyes::gpu_render::program_for(features).unwrap();
-    let render = |fused, fused_sinks_apart| {
+    let render_data = |fused, fused_sinks_apart, data: &FrameData| {
         let s = Scheduler::multipass(
             gpu(),
             &program,
@@ -559,8 +559,9 @@ fn fused_multipass_rounds_draw_the_same_image() {
             .features(features)
             .scheduler(s);
         let r = reyes::gpu_render::GpuRenderer::new(gpu(), config).unwrap();
-        r.render(gpu(), &data).unwrap()
+        r.render(gpu(), data).unwrap()
     };
+    let render = |fused, fused_sinks_apart| render_data(fused, fused_sinks_apart, &data);
     let (apart, fused) = (render(false, false), render(true, false));
     assert!(apart.image == fused.image, "images differ");
     assert_eq!(apart.counters, fused.counters);
@@ -589,5 +590,21 @@ fn fused_multipass_rounds_draw_the_same_image() {
         "two dispatches a round where fused has one: {:?}, fused {:?}",
         sinks.run,
         fused.run
+    );
+    // Under a 64 KiB budget, as patches_that_do_not_fit_the_queues_render_in_batches...: the
+    // groups' dispatches through buckets, growth and rounds run in part.
+    let tight = FrameData {
+        memory_budget: Some(64 << 10),
+        ..data.clone()
+    };
+    let b = render_data(true, true, &tight);
+    assert!(
+        apart.image == b.image,
+        "the sinks apart under 64 KiB: image differs"
+    );
+    assert!(
+        b.run.partial_rounds > 0,
+        "no round ran in part: the test no longer tests them ({:?})",
+        b.run
     );
 }

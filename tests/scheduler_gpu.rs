@@ -1010,8 +1010,11 @@ fn every_thread_that_calls_enqueue_adds_an_item_on_every_strategy() {
         let sink = Procedure::new("sink", item.clone(), 1).body(
             "fn sink_execute(item: Word, inv: Invocation) { if inv.live { atomicAdd(&seen[item.v], 1u); } }",
         );
-        let once = Procedure::new("once", item.clone(), 1)
-            .body("fn once_execute(item: Word, inv: Invocation) {}");
+        // `once` marks its own words past the sinks' (item v < 100), so a run that sends
+        // `once`'s workgroups to another procedure's items shows.
+        let once = Procedure::new("once", item.clone(), 1).body(
+            "fn once_execute(item: Word, inv: Invocation) { if inv.live { atomicAdd(&seen[400u + item.v], 1u); } }",
+        );
         let user = UserBindings::storage(
             "@group(1) @binding(0) var<storage, read_write> seen: array<atomic<u32>>;",
             &[(0, false)],
@@ -1022,7 +1025,7 @@ fn every_thread_that_calls_enqueue_adds_an_item_on_every_strategy() {
     let seeds = [Seed::new("fan", &(0..n).collect::<Vec<u32>>())];
     let exact = program(4);
     for kind in StrategyKind::ALL {
-        let seen = gpu.storage_buffer("seen", 4 * n as u64).unwrap();
+        let seen = gpu.storage_buffer("seen", 5 * n as u64).unwrap();
         let bind = exact.user.bind_group(&gpu, &[&seen]).unwrap();
         let s = Scheduler::new(&gpu, &exact, kind, 64).unwrap();
         let stats = s.run(&gpu, &seeds, Some(&bind)).unwrap();
@@ -1031,14 +1034,14 @@ fn every_thread_that_calls_enqueue_adds_an_item_on_every_strategy() {
             [n as u64, 4 * n as u64, n as u64],
             "{kind:?}"
         );
-        let counts = gpu.read_words(&seen, 0, 4 * n as u64).unwrap();
+        let counts = gpu.read_words(&seen, 0, 5 * n as u64).unwrap();
         assert!(counts.iter().all(|&c| c == 1), "{kind:?}: {counts:?}");
     }
     // The device-driven multi-pass's dispatch groups: a round is one dispatch fused, one per
     // procedure apart, and with the sinks apart one for `fan` and one for `sink` and `once`
     // together (`mp_group_1`, which picks between their loops).
     for (fused, sinks_apart, dispatches) in [(true, false, 1), (false, false, 3), (true, true, 2)] {
-        let seen = gpu.storage_buffer("seen", 4 * n as u64).unwrap();
+        let seen = gpu.storage_buffer("seen", 5 * n as u64).unwrap();
         let bind = exact.user.bind_group(&gpu, &[&seen]).unwrap();
         let config = MultipassConfig {
             initial_capacity: 64,
@@ -1057,13 +1060,13 @@ fn every_thread_that_calls_enqueue_adds_an_item_on_every_strategy() {
                 assert_eq!(stats.launches, 1 + 2 * dispatches, "{what}");
             }
         }
-        let counts = gpu.read_words(&seen, 0, 4 * n as u64).unwrap();
+        let counts = gpu.read_words(&seen, 0, 5 * n as u64).unwrap();
         assert!(counts.iter().all(|&c| c == 2), "fused {fused}: {counts:?}");
     }
     // Declaring 3 for 4 threads' calls is an emit-limit error everywhere.
     let short = program(3);
     for kind in StrategyKind::ALL {
-        let seen = gpu.storage_buffer("seen", 4 * n as u64).unwrap();
+        let seen = gpu.storage_buffer("seen", 5 * n as u64).unwrap();
         let bind = short.user.bind_group(&gpu, &[&seen]).unwrap();
         let s = Scheduler::new(&gpu, &short, kind, 64).unwrap();
         match s.run(&gpu, &seeds, Some(&bind)) {

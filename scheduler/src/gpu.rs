@@ -34,25 +34,30 @@ fn spin_wait_from_env() -> Duration {
 pub const INDIRECT_VALIDATION_ENV: &str = "WGPU_VALIDATION_INDIRECT_CALL";
 
 /// The instance flags of [`Gpu::instance_from_env`]: wgpu's defaults as its `WGPU_*`
-/// environment variables change them, but without `VALIDATION_INDIRECT_CALL` unless
-/// `env_sets_indirect_validation` ([`INDIRECT_VALIDATION_ENV`] is set: `1` keeps it, `0` drops
-/// it as wgpu reads it).
+/// environment variables change them, but with `VALIDATION_INDIRECT_CALL` only where
+/// `indirect_env`, the value of [`INDIRECT_VALIDATION_ENV`], asks for it as wgpu reads such a
+/// variable (set to anything but `0`); unset, it is off.
 ///
 /// That validation precedes every indirect dispatch with a one-thread dispatch of wgpu's own
 /// (gfx-rs/wgpu#6567), one more dispatch and barrier per round of the device-driven
-/// multi-pass: on the H200 its rounds took 7-15% longer with it (docs/results.md, 2026-12-02,
-/// "fused rounds"). It guards against arguments past `max_compute_workgroups_per_dimension`,
-/// and on D3D12 it is what fills `@builtin(num_workgroups)` of an indirect dispatch. Every
-/// indirect dispatch and draw in this workspace is safe without it: each sizes its grid
-/// within the limit on the device (the multi-pass's plan, the frontier BFS's plan, the
-/// raster peer's tiles and draw) and none reads `num_workgroups` (docs/scheduler.md 5.1).
-/// A program that records its own indirect dispatches on a [`Gpu`]'s device must keep the
-/// same rules, or set `WGPU_VALIDATION_INDIRECT_CALL=1`.
-pub fn instance_flags(env_sets_indirect_validation: bool) -> wgpu::InstanceFlags {
+/// multi-pass: on the H200 its fused rounds took 7-18% longer with it (docs/results.md,
+/// 2026-12-02, "fused rounds"). It guards against arguments past
+/// `max_compute_workgroups_per_dimension` (and, for draws, ranges past the bound vertex and
+/// index buffers and a first instance without `INDIRECT_FIRST_INSTANCE`), and on D3D12 it is
+/// what fills `@builtin(num_workgroups)` of an indirect dispatch and adds the first vertex and
+/// instance to `vertex_index` and `instance_index` of an indirect draw. Every indirect call in
+/// this workspace is safe without it: each sizes its grid within the limit on the device (the
+/// multi-pass's plan, the frontier BFS's plan, the raster peer's tiles), none reads
+/// `num_workgroups`, and the raster peer's indexed draw covers only the indices it wrote, from
+/// first index, base vertex and first instance 0 (docs/scheduler.md 5.1). A program that
+/// records its own indirect calls on a [`Gpu`]'s device must keep the same rules, or set
+/// `WGPU_VALIDATION_INDIRECT_CALL=1`.
+pub fn instance_flags(indirect_env: Option<&str>) -> wgpu::InstanceFlags {
     let mut flags = wgpu::InstanceFlags::from_env_or_default();
-    if !env_sets_indirect_validation {
-        flags.remove(wgpu::InstanceFlags::VALIDATION_INDIRECT_CALL);
-    }
+    flags.set(
+        wgpu::InstanceFlags::VALIDATION_INDIRECT_CALL,
+        indirect_env.is_some_and(|v| v != "0"),
+    );
     flags
 }
 
@@ -112,7 +117,7 @@ impl Gpu {
     pub fn instance_from_env() -> wgpu::Instance {
         wgpu::Instance::new(wgpu::InstanceDescriptor {
             backends: wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY),
-            flags: instance_flags(std::env::var_os(INDIRECT_VALIDATION_ENV).is_some()),
+            flags: instance_flags(std::env::var(INDIRECT_VALIDATION_ENV).ok().as_deref()),
             ..wgpu::InstanceDescriptor::new_without_display_handle()
         })
     }
@@ -622,19 +627,19 @@ fn dump_wgsl(label: &str, source: &str) {
 mod tests {
     use super::*;
 
-    /// Without the variable the validation is off; with it, wgpu's reading of it decides.
-    /// (The test leaves the process environment alone: the variable is read only through
-    /// `from_env_or_default`, and CI does not set it.)
+    /// Without the variable the validation is off, `0` keeps it off, and any other value
+    /// (wgpu's reading of its `WGPU_*` flags) turns it on; the other flags stay wgpu's.
     #[test]
     fn indirect_validation_is_off_unless_the_environment_asks() {
-        assert!(!instance_flags(false).contains(wgpu::InstanceFlags::VALIDATION_INDIRECT_CALL));
-        let asked = std::env::var(INDIRECT_VALIDATION_ENV).ok();
-        let on = instance_flags(true).contains(wgpu::InstanceFlags::VALIDATION_INDIRECT_CALL);
-        match asked.as_deref() {
-            Some("0") => assert!(!on),
-            Some(_) => assert!(on),
-            // Unset: wgpu's default, which validates in release and debug builds alike.
-            None => assert!(on),
-        }
+        let on = |env| instance_flags(env).contains(wgpu::InstanceFlags::VALIDATION_INDIRECT_CALL);
+        assert!(!on(None));
+        assert!(!on(Some("0")));
+        assert!(on(Some("1")));
+        assert!(on(Some("")));
+        let others = !wgpu::InstanceFlags::VALIDATION_INDIRECT_CALL;
+        assert_eq!(
+            instance_flags(None) & others,
+            wgpu::InstanceFlags::from_env_or_default() & others
+        );
     }
 }

@@ -1,8 +1,9 @@
 //! The multi-pass baseline (Patney & Owens 2008), device-driven: rounds of one indirect
 //! dispatch per dispatch group (every procedure alone; all together, fused rounds, the default
 //! on GPUs; or the producers and the sinks apart), sized on the device by a plan that the last
-//! workgroup of the round before runs from its counts; children are appended to the next round's inputs with one atomic add each
-//! (compaction fused into the producer, no scan). Rounds are encoded in chunks, the first as
+//! workgroup of the round before runs from its counts; children are appended to the next
+//! round's inputs with one atomic add each (compaction fused into the producer, no scan).
+//! Rounds are encoded in chunks, the first as
 //! long as the previous run needed, so a repeated run is one submission; the host reads back
 //! only between chunks. A round whose outputs would not fit is refused on the device with its
 //! inputs intact; the host grows every queue that lacked room and resumes. [`host`] is the

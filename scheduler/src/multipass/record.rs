@@ -21,6 +21,8 @@ pub(crate) struct RecordedRounds {
     /// Planar queues: the device copy of the seeds into their planes.
     scatter: Option<PlanarScatter>,
     item_layout: ItemLayout,
+    /// Indirect dispatches a round (the multi-pass's dispatch groups).
+    dispatches_per_round: u64,
 }
 
 impl Multipass {
@@ -76,6 +78,7 @@ impl Multipass {
                 rounds,
                 scatter,
                 item_layout: self.item_layout(),
+                dispatches_per_round: self.dispatches_per_round(),
             },
             capacity,
         ))
@@ -159,7 +162,7 @@ impl RecordedRounds {
             executed: (0..nq).map(|q| ctrl[c(q, C_EXEC)] as u64).collect(),
             peak_occupancy: (0..nq).map(|q| ctrl[c(q, C_PEAK)] as u64).collect(),
             rounds: ctrl[g(nq, G_ROUNDS)] as u64,
-            launches: 1 + self.rounds as u64 * nq as u64,
+            launches: 1 + self.rounds as u64 * self.dispatches_per_round,
             queue_bytes: self.d.layout.total_words * 4 * 2,
             ..Default::default()
         }))

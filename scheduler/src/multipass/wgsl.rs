@@ -69,13 +69,19 @@ pub fn source(program: &Program, items: ItemLayout, groups: &DispatchGroups) -> 
             group_of[q] = g;
         }
     }
-    let list: Vec<String> = group_of.iter().map(|g| format!("{g}u")).collect();
+    let list = |f: &dyn Fn(usize) -> usize| {
+        (0..nq)
+            .map(|q| format!("{}u", f(q)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    // GROUP[q]: q's dispatch group; GROUP_LEN[q]: how many procedures share its dispatch.
     s += &format!(
         "const NG: u32 = {}u;\nconst GROUP: array<u32, {nq}> = array<u32, {nq}>({});\n\
-         const MAX_GROUP: u32 = {}u;\n",
+         const GROUP_LEN: array<u32, {nq}> = array<u32, {nq}>({});\n",
         groups.len(),
-        list.join(", "),
-        groups.iter().map(Vec::len).max().unwrap_or(1),
+        list(&|q| group_of[q]),
+        list(&|q| groups[group_of[q]].len()),
     );
     s += TEMPLATE;
     // A group of several procedures, not all: a switch over their own loops.
