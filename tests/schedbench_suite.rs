@@ -308,6 +308,56 @@ fn an_unreadable_scene_names_its_file_once_and_exits_1() {
     assert_eq!(err.matches(&name).count(), 1, "{err}");
 }
 
+/// The shared Killeroo missing where `REYES_SHARED_DATA` points: exit 1, the path named once,
+/// and the variable named as the way to point at the data.
+#[test]
+fn a_missing_shared_scene_names_the_variable_that_finds_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
+        .args([
+            "--workload",
+            "reyes",
+            "--strategy",
+            "cpu",
+            "--scene",
+            "killeroo",
+        ])
+        .env("REYES_SHARED_DATA", dir.path())
+        .output()
+        .expect("schedbench runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    let name = dir.path().join("rib/killeroo.rib").display().to_string();
+    assert_eq!(err.matches(&name).count(), 1, "{err}");
+    assert!(err.contains("REYES_SHARED_DATA"), "{err}");
+}
+
+/// The device-driven records say whether wgpu's indirect-call validation was on: off by
+/// default, on with `WGPU_VALIDATION_INDIRECT_CALL=1`; other strategies' records leave it out.
+#[test]
+fn device_driven_records_say_whether_indirect_calls_were_validated() {
+    let record = |strategy: &str, env: Option<&str>| {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_schedbench"));
+        c.args(["--workload", "tree", "--roots", "2", "--depth", "6"])
+            .args(["--strategy", strategy, "--runs", "1", "--json"])
+            .env_remove("WGPU_VALIDATION_INDIRECT_CALL");
+        if let Some(v) = env {
+            c.env("WGPU_VALIDATION_INDIRECT_CALL", v);
+        }
+        let out = c.output().expect("schedbench runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "{strategy}: {err}");
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        let r: serde_json::Value = serde_json::from_str(stdout.lines().next().unwrap()).unwrap();
+        assert_eq!(r["verified"], true, "{r}");
+        r["indirect_validation"].clone()
+    };
+    assert_eq!(record("multipass", None), serde_json::json!(false));
+    assert_eq!(record("multipass", Some("1")), serde_json::json!(true));
+    assert_eq!(record("multipass", Some("0")), serde_json::json!(false));
+    assert_eq!(record("multipass-host", Some("1")), serde_json::Value::Null);
+}
+
 /// An option of one workload given to another is a usage error (exit 2) naming the option and
 /// its workload, never silently ignored; `--preset` and `--scene`, which have defaults, count as
 /// given when they name something else.

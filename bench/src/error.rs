@@ -27,6 +27,14 @@ pub enum Error {
         /// The reader's error.
         source: SceneError,
     },
+    /// A scene of the shared data (`killeroo`) that is not where `reyes::shared_data_dir`
+    /// looks.
+    #[error(
+        "{}: the shared scene is missing; set REYES_SHARED_DATA to the shared data folder \
+         (by default `shared/data` beside the repository)",
+        .0.display()
+    )]
+    SharedScene(PathBuf),
     /// An R-MAT graph that could not be generated.
     #[error("R-MAT scale {scale}: {source}")]
     Graph {

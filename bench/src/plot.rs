@@ -234,6 +234,7 @@ mod tests {
             local_queues: None,
             guided_claims: None,
             queue_order: None,
+            indirect_validation: None,
             idle_polls: 0,
             abandoned: 0,
             queue_growths: 0,

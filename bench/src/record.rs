@@ -68,6 +68,11 @@ pub struct RunRecord {
     /// (`RunStats::queue_order`, `schedbench --priority`); absent for the others.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub queue_order: Option<Vec<String>>,
+    /// Strategies that dispatch indirectly (`multipass`, `frontier`): wgpu's indirect-call
+    /// validation was on (`WGPU_VALIDATION_INDIRECT_CALL`, `scheduler::gpu::instance_flags`;
+    /// off by default); absent for the others.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub indirect_validation: Option<bool>,
     pub idle_polls: u64,
     pub abandoned: u64,
     pub queue_growths: u64,
@@ -128,6 +133,8 @@ impl RunRecord {
             local_queues: (s.workgroup_size > 0).then_some(s.local_queues),
             guided_claims: (s.workgroup_size > 0).then_some(s.guided_claims),
             queue_order: (!s.queue_order.is_empty()).then(|| s.queue_order.clone()),
+            indirect_validation: matches!(k.strategy.name().as_str(), "multipass" | "frontier")
+                .then(scheduler::gpu::indirect_validation),
             ..Self::failed(k, String::new())
         }
     }
@@ -162,6 +169,7 @@ impl RunRecord {
             local_queues: None,
             guided_claims: None,
             queue_order: None,
+            indirect_validation: None,
             idle_polls: 0,
             abandoned: 0,
             queue_growths: 0,

@@ -66,9 +66,19 @@ impl SuiteScene {
     pub fn load(self) -> Result<Scene, Error> {
         match self {
             SuiteScene::Teapot => Ok(scene::builtin_teapot()),
-            SuiteScene::Killeroo => load_scene(&reyes::shared_data_dir().join("rib/killeroo.rib")),
+            SuiteScene::Killeroo => load_shared_scene("rib/killeroo.rib"),
         }
     }
+}
+
+/// A scene of the shared data by its path there (`rib/killeroo.rib`); a missing file is
+/// [`Error::SharedScene`], which says how to point at the data.
+pub fn load_shared_scene(rel: &str) -> Result<Scene, Error> {
+    let path = reyes::shared_data_dir().join(rel);
+    if !path.is_file() {
+        return Err(Error::SharedScene(path));
+    }
+    load_scene(&path)
 }
 
 pub fn load_scene(path: &Path) -> Result<Scene, Error> {

@@ -5,7 +5,7 @@ use crate::catalog::WorkloadName;
 use crate::cli::Cli;
 use crate::error::Error;
 use crate::record::RunRecord;
-use crate::reyes_frames::{ReyesWorkload, load_scene};
+use crate::reyes_frames::{ReyesWorkload, load_scene, load_shared_scene};
 use crate::strategy::Strategy;
 use crate::suite::measure;
 use crate::summary::{best_baseline, cells};
@@ -31,7 +31,7 @@ fn workload(cli: &Cli) -> Result<Box<dyn Workload>, Error> {
         WorkloadName::Reyes => {
             let scene = match cli.scene.as_str() {
                 "teapot" => scene::builtin_teapot(),
-                "killeroo" => load_scene(&reyes::shared_data_dir().join("rib/killeroo.rib"))?,
+                "killeroo" => load_shared_scene("rib/killeroo.rib")?,
                 path => load_scene(Path::new(path))?,
             };
             let size = match (cli.width, cli.height) {
@@ -128,8 +128,14 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
         return;
     };
     println!(
-        "adapter: {}\nworkload: {workload} {params}\nreference: {problem_items} items",
-        gpu.adapter_name()
+        "adapter: {} (wgpu's indirect-call validation {})\nworkload: {workload} {params}\n\
+         reference: {problem_items} items",
+        gpu.adapter_name(),
+        if scheduler::gpu::indirect_validation() {
+            "on"
+        } else {
+            "off"
+        }
     );
     println!(
         "{:<16} {:>10} {:>8} {:>20} {:>20} {:>11} {:>8} {:>7}",

@@ -33,6 +33,18 @@ fn spin_wait_from_env() -> Duration {
 /// wgpu's environment variable for its validation of indirect calls ([`instance_flags`]).
 pub const INDIRECT_VALIDATION_ENV: &str = "WGPU_VALIDATION_INDIRECT_CALL";
 
+/// The value of [`INDIRECT_VALIDATION_ENV`], if set (and UTF-8).
+fn indirect_env() -> Option<String> {
+    std::env::var(INDIRECT_VALIDATION_ENV).ok()
+}
+
+/// Whether [`Gpu::instance_from_env`]'s instances validate indirect calls, as this process's
+/// environment sets it ([`instance_flags`]): what a benchmark record says of its runs.
+pub fn indirect_validation() -> bool {
+    instance_flags(indirect_env().as_deref())
+        .contains(wgpu::InstanceFlags::VALIDATION_INDIRECT_CALL)
+}
+
 /// The instance flags of [`Gpu::instance_from_env`]: wgpu's defaults as its `WGPU_*`
 /// environment variables change them, but with `VALIDATION_INDIRECT_CALL` only where
 /// `indirect_env`, the value of [`INDIRECT_VALIDATION_ENV`], asks for it as wgpu reads such a
@@ -117,7 +129,7 @@ impl Gpu {
     pub fn instance_from_env() -> wgpu::Instance {
         wgpu::Instance::new(wgpu::InstanceDescriptor {
             backends: wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY),
-            flags: instance_flags(std::env::var(INDIRECT_VALIDATION_ENV).ok().as_deref()),
+            flags: instance_flags(indirect_env().as_deref()),
             ..wgpu::InstanceDescriptor::new_without_display_handle()
         })
     }

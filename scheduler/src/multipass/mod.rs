@@ -66,8 +66,8 @@ pub struct MultipassConfig {
     /// CPU adapters. On the H200 fused rounds were faster on all but two workloads, e.g. the
     /// teapot frame 2.18 -> 1.43 ms, the deep tree 4.48 -> 3.01; the large-payload tree and BFS
     /// at scale 20 2-3% slower (docs/results.md, 2026-12-02, "Fused rounds"). On lavapipe the
-    /// kernel holding every procedure ran 1.25-1.5x slower (docs/scheduler.md 5.1). Ignored with `stage_timing`, which
-    /// times each procedure's dispatches apart (docs/scheduler.md 5.1).
+    /// kernel holding every procedure ran 1.25-2x slower (docs/scheduler.md 5.1). Ignored with
+    /// `stage_timing`, which times each procedure's dispatches apart (docs/scheduler.md 5.1).
     pub fused_rounds: Option<bool>,
     /// With fused rounds, dispatch the sinks (procedures that emit nothing: Reyes' DiceShade
     /// and DiceSmall, the tree's leaves) apart from the producers: two indirect dispatches a
