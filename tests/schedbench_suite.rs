@@ -297,15 +297,7 @@ fn assert_exits_2(args: &[&str], expected: &str) {
 fn an_unreadable_scene_names_its_file_once_and_exits_1() {
     let dir = tempfile::tempdir().unwrap();
     let missing = dir.path().join("absent.rib");
-    let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
-        .args(["--workload", "reyes", "--strategy", "cpu", "--scene"])
-        .arg(&missing)
-        .output()
-        .expect("schedbench runs");
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
-    let name = missing.display().to_string();
-    assert_eq!(err.matches(&name).count(), 1, "{err}");
+    reyes_scene_error(missing.to_str().unwrap(), None, &missing);
 }
 
 /// The shared Killeroo missing where `REYES_SHARED_DATA` points: exit 1, the path named once,
@@ -313,23 +305,29 @@ fn an_unreadable_scene_names_its_file_once_and_exits_1() {
 #[test]
 fn a_missing_shared_scene_names_the_variable_that_finds_it() {
     let dir = tempfile::tempdir().unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
-        .args([
-            "--workload",
-            "reyes",
-            "--strategy",
-            "cpu",
-            "--scene",
-            "killeroo",
-        ])
-        .env("REYES_SHARED_DATA", dir.path())
-        .output()
-        .expect("schedbench runs");
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
-    let name = dir.path().join("rib/killeroo.rib").display().to_string();
-    assert_eq!(err.matches(&name).count(), 1, "{err}");
+    let missing = dir.path().join("rib/killeroo.rib");
+    let err = reyes_scene_error("killeroo", Some(dir.path()), &missing);
     assert!(err.contains("REYES_SHARED_DATA"), "{err}");
+}
+
+/// `schedbench --workload reyes --strategy cpu --scene SCENE` (with `REYES_SHARED_DATA` set to
+/// `data` if given) exits 1 and names `missing` once; returns its error output.
+fn reyes_scene_error(
+    scene: &str,
+    data: Option<&std::path::Path>,
+    missing: &std::path::Path,
+) -> String {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_schedbench"));
+    c.args(["--workload", "reyes", "--strategy", "cpu", "--scene", scene]);
+    if let Some(d) = data {
+        c.env("REYES_SHARED_DATA", d);
+    }
+    let out = c.output().expect("schedbench runs");
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    let name = missing.display().to_string();
+    assert_eq!(err.matches(&name).count(), 1, "{err}");
+    err
 }
 
 /// The device-driven records say whether wgpu's indirect-call validation was on: off by

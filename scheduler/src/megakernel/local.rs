@@ -102,7 +102,7 @@ impl LocalPlan {
         // A held target that emits nothing runs after other held work until it fills a step.
         let defer: Vec<u32> = (0..nq)
             .map(|t| {
-                let sink = program.procs[t].emits.iter().all(|&e| e == 0);
+                let sink = program.procs[t].is_sink();
                 (self.defer_sinks && on && self.cap[t] > 0 && sink) as u32
             })
             .collect();

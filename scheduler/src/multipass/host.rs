@@ -210,8 +210,8 @@ impl HostMultipass {
     /// `reads`: buffer ranges read back once after the last round into the kept read-back
     /// buffer, with the timestamps not yet read (one submission and wait), one vector per
     /// range (a copy every round, to save that one wait, cost more: H200, the deep tree's 201
-    /// rounds 19.9 -> 21.9 ms of wall time; docs/results.md, 2026-12-04 (third session)). Errors: every [`RunError`] but `NoAdapter` (see
-    /// `docs/scheduler.md`, section 6).
+    /// rounds 19.9 -> 21.9 ms of wall time; docs/results.md, 2026-12-04 (third session)).
+    /// Errors: every [`RunError`] but `NoAdapter` (see `docs/scheduler.md`, section 6).
     pub fn run(
         &self,
         gpu: &Gpu,

@@ -103,9 +103,8 @@ fn dispatch_groups(program: &Program, fused: bool, sinks_apart: bool) -> wgsl::D
     if !fused {
         return all.into_iter().map(|q| vec![q]).collect();
     }
-    let (sinks, producers): (Vec<usize>, Vec<usize>) = all
-        .iter()
-        .partition(|&&q| program.procs[q].emits.iter().all(|&e| e == 0));
+    let (sinks, producers): (Vec<usize>, Vec<usize>) =
+        all.iter().partition(|&&q| program.procs[q].is_sink());
     if sinks_apart && !sinks.is_empty() && !producers.is_empty() {
         vec![producers, sinks]
     } else {

@@ -51,6 +51,11 @@ impl ProcInfo {
     pub fn words(&self) -> u32 {
         self.layout.words()
     }
+
+    /// It emits nothing (a sink: Reyes' DiceShade, the tree's leaves).
+    pub fn is_sink(&self) -> bool {
+        self.emits.iter().all(|&e| e == 0)
+    }
 }
 
 /// Procedures registered together and validated, with the user's bind group 1: what every
