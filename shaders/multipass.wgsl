@@ -269,11 +269,11 @@ fn finish_workgroup(lid: u32, round: array<u32, R_WORDS>) {
 }
 
 // A round's dispatch of several procedures (dispatch group g): every procedure's workgroups of
-// the group, in procedure order (C_WGS of each), so the round costs one indirect dispatch for
-// them instead of one each. Lanes read every procedure's round words and the round's own at
-// once (one round trip), then lane 0 finds this workgroup's procedure among the group's in
-// workgroup memory and leaves its round copy in `wg_round`. Returns the procedure and the
-// workgroup's index among that procedure's workgroups.
+// the group (C_WGS of each), in the group's order (ORDER: procedure order, or the sinks first),
+// so the round costs one indirect dispatch for them instead of one each. Lanes read every
+// procedure's round words and the round's own at once (one round trip), then lane 0 finds this
+// workgroup's procedure among the group's in workgroup memory and leaves its round copy in
+// `wg_round`. Returns the procedure and the workgroup's index among that procedure's workgroups.
 var<workgroup> wg_pick: vec2<u32>;
 var<workgroup> wg_rounds: array<u32, 3u * NQ + 3u>;
 fn mp_pick(lid: u32, w: u32, g: u32) -> vec2<u32> {
@@ -288,7 +288,8 @@ fn mp_pick(lid: u32, w: u32, g: u32) -> vec2<u32> {
         var first = 0u;
         var pick = NQ;
         var last = 0u;
-        for (var q = 0u; q < NQ; q++) {
+        for (var i = 0u; i < NQ; i++) {
+            let q = ORDER[i];
             if GROUP[q] != g { continue; }
             last = q;
             let n = wg_rounds[3u * q + R_WGS];

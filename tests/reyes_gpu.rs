@@ -544,13 +544,14 @@ fn fused_multipass_rounds_draw_the_same_image() {
     let data = FrameData::new(&scene, &small(96, 72)).unwrap();
     let features = data.features();
     let program = reyes::gpu_render::program_for(features).unwrap();
-    let render_data = |fused, fused_sinks_apart, data: &FrameData| {
+    let render_with = |fused, fused_sinks_apart, fused_sinks_first, data: &FrameData| {
         let s = Scheduler::multipass(
             gpu(),
             &program,
             MultipassConfig {
                 fused_rounds: Some(fused),
                 fused_sinks_apart,
+                fused_sinks_first,
                 ..Default::default()
             },
         )
@@ -561,6 +562,8 @@ fn fused_multipass_rounds_draw_the_same_image() {
         let r = reyes::gpu_render::GpuRenderer::new(gpu(), config).unwrap();
         r.render(gpu(), data).unwrap()
     };
+    let render_data =
+        |fused, sinks_apart, data: &FrameData| render_with(fused, sinks_apart, false, data);
     let render = |fused, fused_sinks_apart| render_data(fused, fused_sinks_apart, &data);
     let (apart, fused) = (render(false, false), render(true, false));
     assert!(apart.image == fused.image, "images differ");
@@ -606,5 +609,19 @@ fn fused_multipass_rounds_draw_the_same_image() {
         b.run.partial_rounds > 0,
         "no round ran in part: the test no longer tests them ({:?})",
         b.run
+    );
+    // The sinks' workgroups first in the fused round's dispatch: the same image and counters,
+    // one dispatch a round, also through buckets and rounds run in part.
+    let first = render_with(true, false, true, &data);
+    assert!(
+        apart.image == first.image,
+        "images differ with the sinks first"
+    );
+    assert_eq!(apart.counters, first.counters);
+    assert_eq!(first.run.launches, fused.run.launches, "{:?}", first.run);
+    let c = render_with(true, false, true, &tight);
+    assert!(
+        apart.image == c.image,
+        "the sinks first under 64 KiB: image differs"
     );
 }

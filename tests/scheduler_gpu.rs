@@ -1039,20 +1039,30 @@ fn every_thread_that_calls_enqueue_adds_an_item_on_every_strategy() {
     }
     // The device-driven multi-pass's dispatch groups: a round is one dispatch fused, one per
     // procedure apart, and with the sinks apart one for `fan` and one for `sink` and `once`
-    // together (`mp_group_1`, which picks between their loops).
-    for (fused, sinks_apart, dispatches) in [(true, false, 1), (false, false, 3), (true, true, 2)] {
+    // together (`mp_group_1`, which picks between their loops); with the sinks first, one
+    // dispatch whose first workgroups go to `sink` and `once`.
+    for (fused, sinks_apart, sinks_first, dispatches) in [
+        (true, false, false, 1),
+        (false, false, false, 3),
+        (true, true, false, 2),
+        (true, false, true, 1),
+    ] {
         let seen = gpu.storage_buffer("seen", 5 * n as u64).unwrap();
         let bind = exact.user.bind_group(&gpu, &[&seen]).unwrap();
         let config = MultipassConfig {
             initial_capacity: 64,
             fused_rounds: Some(fused),
             fused_sinks_apart: sinks_apart,
+            fused_sinks_first: sinks_first,
             ..Default::default()
         };
         let s = Scheduler::multipass(&gpu, &exact, config).unwrap();
         for run in 0..2 {
             let stats = s.run(&gpu, &seeds, Some(&bind)).unwrap();
-            let what = format!("fused {fused}, sinks apart {sinks_apart}, run {run}: {stats:?}");
+            let what = format!(
+                "fused {fused}, sinks apart {sinks_apart}, sinks first {sinks_first}, run {run}: \
+                 {stats:?}"
+            );
             assert_eq!(stats.executed, [n as u64, 4 * n as u64, n as u64], "{what}");
             assert_eq!(stats.rounds, 2, "{what}");
             if run == 1 {

@@ -233,7 +233,8 @@ pub struct Cli {
     /// How the device-driven multi-pass dispatches a round (`MultipassConfig::fused_rounds`):
     /// `on`, one indirect dispatch of every procedure's workgroups; `off`, one per procedure;
     /// `sinks-apart`, one for the producers and one for the sinks
-    /// (`MultipassConfig::fused_sinks_apart`); `auto`, on for GPUs and off for CPU adapters
+    /// (`MultipassConfig::fused_sinks_apart`); `sinks-first`, one with the sinks' workgroups
+    /// before the producers' (`MultipassConfig::fused_sinks_first`); `auto`, on for GPUs and off for CPU adapters
     /// such as lavapipe (docs/scheduler.md 5.1).
     #[arg(long, value_enum, default_value = "auto", help_heading = "Scheduler")]
     pub fused_rounds: FusedRounds,
@@ -250,6 +251,8 @@ pub enum FusedRounds {
     Off,
     /// One indirect dispatch for the procedures that emit, one for those that do not.
     SinksApart,
+    /// One indirect dispatch, the workgroups of the procedures that emit nothing first.
+    SinksFirst,
 }
 
 /// `--enqueue`: how megakernel items reach their queue.
@@ -481,10 +484,11 @@ impl Cli {
             defer_local_sinks: !self.no_defer_local_sinks,
             fused_rounds: match self.fused_rounds {
                 FusedRounds::Auto => None,
-                FusedRounds::On | FusedRounds::SinksApart => Some(true),
+                FusedRounds::On | FusedRounds::SinksApart | FusedRounds::SinksFirst => Some(true),
                 FusedRounds::Off => Some(false),
             },
             fused_sinks_apart: self.fused_rounds == FusedRounds::SinksApart,
+            fused_sinks_first: self.fused_rounds == FusedRounds::SinksFirst,
         }
     }
 }

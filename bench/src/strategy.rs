@@ -165,6 +165,8 @@ pub struct GpuConfig {
     pub fused_rounds: Option<bool>,
     /// `MultipassConfig::fused_sinks_apart` (default `false`).
     pub fused_sinks_apart: bool,
+    /// `MultipassConfig::fused_sinks_first` (default `false`).
+    pub fused_sinks_first: bool,
 }
 
 impl Default for GpuConfig {
@@ -187,6 +189,7 @@ impl Default for GpuConfig {
             defer_local_sinks: true,
             fused_rounds: None,
             fused_sinks_apart: false,
+            fused_sinks_first: false,
         }
     }
 }
@@ -271,6 +274,7 @@ pub fn compile(
                 initial_capacity: capacity,
                 fused_rounds: config.fused_rounds,
                 fused_sinks_apart: config.fused_sinks_apart,
+                fused_sinks_first: config.fused_sinks_first,
                 ..Default::default()
             },
         ),

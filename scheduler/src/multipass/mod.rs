@@ -77,6 +77,12 @@ pub struct MultipassConfig {
     /// Default `false`: not yet measured on a GPU. Ignored without fused rounds, or when every
     /// procedure is a sink or none is.
     pub fused_sinks_apart: bool,
+    /// With fused rounds (the sinks not apart), give the sinks the round's first workgroups
+    /// and the producers the last. A GPU starts a grid's workgroups roughly in order, so a
+    /// round's longest workgroups (Reyes' dice-and-shade of a whole grid) start first instead
+    /// of forming its tail (longest processing time first, Graham 1969). Default `false`: not
+    /// yet measured on a GPU. Ignored without fused rounds or with the sinks apart.
+    pub fused_sinks_first: bool,
 }
 
 impl Default for MultipassConfig {
@@ -91,14 +97,20 @@ impl Default for MultipassConfig {
             size_from_last_run: true,
             fused_rounds: None,
             fused_sinks_apart: false,
+            fused_sinks_first: false,
         }
     }
 }
 
 /// The dispatch groups of `program`'s rounds: every procedure alone without `fused`; with it
-/// all together, or with `sinks_apart` the producers, then the sinks (procedures that emit
-/// nothing), where there are both.
-fn dispatch_groups(program: &Program, fused: bool, sinks_apart: bool) -> wgsl::DispatchGroups {
+/// all together (with `sinks_first`, the sinks, procedures that emit nothing, before the
+/// producers), or with `sinks_apart` the producers, then the sinks, where there are both.
+fn dispatch_groups(
+    program: &Program,
+    fused: bool,
+    sinks_apart: bool,
+    sinks_first: bool,
+) -> wgsl::DispatchGroups {
     let all: Vec<usize> = (0..program.queue_count()).collect();
     if !fused {
         return all.into_iter().map(|q| vec![q]).collect();
@@ -107,6 +119,8 @@ fn dispatch_groups(program: &Program, fused: bool, sinks_apart: bool) -> wgsl::D
         all.iter().partition(|&&q| program.procs[q].is_sink());
     if sinks_apart && !sinks.is_empty() && !producers.is_empty() {
         vec![producers, sinks]
+    } else if sinks_first {
+        vec![[sinks, producers].concat()]
     } else {
         vec![all]
     }
@@ -173,8 +187,15 @@ impl Multipass {
         }
         let fused = config.fused_rounds.unwrap_or(!gpu.is_cpu_adapter()) && !config.stage_timing;
         config.fused_rounds = Some(fused);
-        let groups = dispatch_groups(program, fused, config.fused_sinks_apart);
+        let groups = dispatch_groups(
+            program,
+            fused,
+            config.fused_sinks_apart,
+            config.fused_sinks_first,
+        );
         config.fused_sinks_apart = fused && groups.len() == 2;
+        config.fused_sinks_first =
+            fused && groups.len() == 1 && groups[0].iter().copied().ne(0..program.queue_count());
         let source = wgsl::source(program, items, &groups);
         let entries: Vec<_> = (0..4).map(|b| storage_entry(b, b == 3)).collect();
         let names = wgsl::entry_points(program, &groups);

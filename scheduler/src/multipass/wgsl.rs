@@ -81,13 +81,18 @@ pub fn source(program: &Program, items: ItemLayout, groups: &DispatchGroups) -> 
             .collect::<Vec<_>>()
             .join(", ")
     };
-    // GROUP[q]: q's dispatch group; GROUP_LEN[q]: how many procedures share its dispatch.
+    // GROUP[q]: q's dispatch group; GROUP_LEN[q]: how many procedures share its dispatch;
+    // ORDER: the procedures group by group, each group's in the order its dispatch's
+    // workgroups go to them (`mp_pick`).
+    let order: Vec<usize> = groups.concat();
     s += &format!(
         "const NG: u32 = {}u;\nconst GROUP: array<u32, {nq}> = array<u32, {nq}>({});\n\
-         const GROUP_LEN: array<u32, {nq}> = array<u32, {nq}>({});\n",
+         const GROUP_LEN: array<u32, {nq}> = array<u32, {nq}>({});\n\
+         const ORDER: array<u32, {nq}> = array<u32, {nq}>({});\n",
         groups.len(),
         list(&|q| group_of[q]),
         list(&|q| groups[group_of[q]].len()),
+        list(&|i| order[i]),
     );
     s += TEMPLATE;
     // A group of several procedures, not all: a switch over their own loops.
