@@ -4,27 +4,28 @@
 // every round of a submission recorded up front and sized on the device. Compaction is fused
 // into the producing pass, as in the host-driven variant (`multipass_host.wgsl`): `enqueue_<t>`
 // appends the item straight into queue t's region of the next round's input buffer with one
-// atomicAdd on t's count, so a round has no flags, no scan and no scatter. The plan
-// (`plan_round`) turns the previous round's counts into this round's dispatch sizes: for a
-// chunk's first round a one-thread dispatch (`mp_plan`), for every other round the last
-// workgroup of the round before, when it finishes. An empty queue gets 0 workgroups; an empty
-// round is never planned, so it and every round after it in the chunk keep the zeroed
-// arguments the host cleared. Order within a queue is not kept.
+// atomicAdd on t's count, so a round has no flags, no scan and no scatter.
+// No workgroup waits for the others: a round's appends size the next round's dispatch as they
+// go (an append that begins a new step of items adds one workgroup to the next round's
+// indirect arguments), and every workgroup of a round computes the round's plan itself from
+// the counts its round starts with (`mp_begin`), which no workgroup of the round changes: the
+// round's inputs are in one of three count windows, its appends go to the next, and it clears
+// the one after. So a workgroup ends when its items do, with no fence and no count of finished
+// workgroups (docs/scheduler.md 5.1). A chunk's first round is sized by `mp_plan`. An empty
+// queue gets 0 workgroups; a round with no inputs dispatches nothing, so it and every round
+// after it in the chunk run nothing. Order within a queue is not kept.
 // Generated before this file: tables, procedures, `mp_in_*` / `mp_out_*` accessors,
 // `sched_execute`, `mp_execute` (item i of queue q's region) and `mp_word_at` (word w of it),
 // both in the run's item layout (scheduler/src/item_layout.rs), `enqueue_*`, and the
 // per-procedure entry points, each with its own copy of `run_procedure` (multipass_run.wgsl).
 
 // ---- mp_ctrl layout; host twin: scheduler/src/multipass/layout.rs ----
-const CSTRIDE: u32 = 8u;
-const C_COUNT: u32 = 0u;  // inputs of the current round
-const C_PEAK: u32 = 1u;
-const C_EXEC: u32 = 2u;
-const C_EMITS: u32 = 3u;  // worst-case outputs of this round for this target
-const C_NEXT: u32 = 4u;   // carried inputs + appended outputs = inputs of the next round
-const C_RUN: u32 = 5u;    // inputs this round runs (all but in a partial round)
-const C_KEEP: u32 = 6u;   // inputs this round carries, unrun, to the front of the next
-const C_WGS: u32 = 7u;    // this procedure's workgroups in its dispatch group's dispatch
+const CSTRIDE: u32 = 9u;
+const C_PEAK: u32 = 0u;
+const C_EXEC: u32 = 1u;
+const C_EMITS: u32 = 2u;  // worst-case outputs for this target of the round that halted
+const C_APPEND: u32 = 3u; // + window (0, 1, 2): items appended to the window's inputs
+const C_CARRY: u32 = 6u;  // + window: inputs carried, unrun, to the front of the window's inputs
 fn cw(q: u32, i: u32) -> u32 { return q * CSTRIDE + i; }
 fn gw(i: u32) -> u32 { return NQ * CSTRIDE + i; }
 const G_ROUNDS: u32 = 0u;
@@ -32,12 +33,10 @@ const G_ERROR: u32 = 1u;
 const G_ERR_A: u32 = 2u;
 const G_ERR_B: u32 = 3u;
 const G_HALT: u32 = 4u;
-const G_PLANNED: u32 = 5u; // plans that let their round run, for the host's parity
-const G_PARTIAL: u32 = 6u; // partial rounds (scheduler/src/multipass/partial.rs)
-const G_DONE: u32 = 7u;    // workgroups of the current round that have finished
-const G_WGS: u32 = 8u;     // workgroups the current round dispatched, all procedures together
-const G_K: u32 = 9u;       // the current round's index within the chunk
-const G_CHUNK: u32 = 10u;  // rounds in the chunk (the host's): round G_CHUNK is not planned
+const G_PARTIAL: u32 = 5u; // partial rounds (scheduler/src/multipass/partial.rs)
+const G_RAN: u32 = 6u;     // rounds of the chunk that ran: round G_RAN's inputs are pending
+const G_BASE: u32 = 7u;    // the count window of the chunk's first round's inputs
+const G_CHUNK: u32 = 8u;   // rounds in the chunk (the host's): round G_CHUNK is not sized
 
 const ERR_EMIT: u32 = 1u;
 const ERR_OVERFLOW: u32 = 2u;
@@ -54,27 +53,43 @@ fn q_at_limit(q: u32) -> bool { return params[q * 4u + 2u] != 0u; }
 @group(0) @binding(1) var<storage, read_write> items_in: array<vec4<u32>>;
 @group(0) @binding(2) var<storage, read_write> items_out: array<vec4<u32>>;
 @group(0) @binding(3) var<storage, read> params: array<u32>;
-// Group 2: the arguments of the rounds the bound dispatch may plan, round k's dispatch group
-// g's at slot (k / 2) x NQ + g of buffer k % 2. Round k's dispatches read theirs from buffer k % 2 and have
-// buffer (k + 1) % 2 bound here, so no dispatch reads its own arguments as storage.
-@group(2) @binding(0) var<storage, read_write> indirect: array<u32>;
+// Group 2: the arguments of the next round, round k's dispatch group g's at slot
+// (k / 2) x NQ + g of buffer k % 2. Round k's dispatches read theirs from buffer k % 2 and have
+// buffer (k + 1) % 2 bound here, so no dispatch reads its own arguments as storage. `mp_k.x`:
+// the round's index within its chunk (a dynamic offset per round).
+@group(2) @binding(0) var<storage, read_write> indirect: array<atomic<u32>>;
+@group(2) @binding(1) var<uniform> mp_k: vec4<u32>;
 
-// This workgroup's copy of what the plan wrote for its round (R_* entries): its procedure's
-// inputs, inputs run and workgroups, then the round's workgroups (all procedures), the round's
-// index in the chunk and the chunk's length. Read once at the start by parallel lanes
-// (`mp_round_inputs`; the fused round reads every procedure's at once), so no workgroup's start
-// or end waits on a chain of global loads, and `finish_workgroup` compares its count with the
-// round's own G_WGS, which the next round's plan may overwrite while this workgroup finishes.
-const R_COUNT: u32 = 0u;
-const R_RUN: u32 = 1u;
-const R_WGS: u32 = 2u;
-const R_ALL: u32 = 3u;
-const R_K: u32 = 4u;
-const R_CHUNK: u32 = 5u;
-const R_WORDS: u32 = 6u;
-var<workgroup> wg_round: array<u32, R_WORDS>;
+// Workgroups of procedure q in a round of n inputs: one per step of items (2^STEP_SHIFT[q]), at
+// most its share of its group's dispatch (MAX_WGS[q]; past that, grid-stride), so every
+// argument is valid with wgpu's indirect validation off.
+fn wgs_for(q: u32, n: u32) -> u32 {
+    return min((n + (1u << STEP_SHIFT[q]) - 1u) >> STEP_SHIFT[q], MAX_WGS[q]);
+}
+fn args_x(k: u32, g: u32) -> u32 { return ((k / 2u) * NQ + g) * 3u; }
+
+// What this workgroup runs (`mp_begin`): its procedure, its index among that procedure's
+// workgroups, the procedure's inputs this round (0: nothing to run), how many of the oldest of
+// them are carried unrun, and its workgroups.
+struct Pick {
+    proc: u32,
+    index: u32,
+    count: u32,
+    keep: u32,
+    wgs: u32,
+}
+var<workgroup> wg_pick: Pick;
+// What the appends of this workgroup need: per target t its carried inputs (`W_KEEP + t`, the
+// front of its next-round region), then the next round's window, index and the chunk's length.
+const W_KEEP: u32 = 0u;
+const W_WIN: u32 = NQ;
+const W_K: u32 = NQ + 1u;
+const W_CHUNK: u32 = NQ + 2u;
+var<workgroup> wg_plan: array<u32, NQ + 3u>;
+// The words every workgroup loads at its start: per queue its three windows' appends and
+// carries, then G_HALT, G_BASE, G_CHUNK.
+var<workgroup> wg_words: array<u32, 6u * NQ + 3u>;
 var<workgroup> wg_item_emits: array<atomic<u32>, 256u * NQ>;
-var<workgroup> wg_last: u32;
 var<private> sched_proc: u32;
 var<private> sched_slot: u32;
 var<private> sched_active: bool;
@@ -90,92 +105,102 @@ fn sched_raise(code: u32, a: u32, b: u32) {
 // The slot (index within queue t's region of items_out) of this item's next item to t, or
 // 0xffffffff after raising ERR_EMIT when the item emits more than it declared: the append is
 // refused, so the round's appends never pass its worst case, which the plan made room for.
+// Slots start after the inputs the round carries to the front of t's next inputs. An append
+// that begins a step of t's items (every 256 / THREADS[t]-th slot) adds a workgroup to t's
+// dispatch group in the next round's arguments, so the next round is sized when this one ends.
 fn sched_append_slot(t: u32) -> u32 {
     let j = atomicAdd(&wg_item_emits[sched_slot * NQ + t], 1u);
     if j >= EMITS[sched_proc * NQ + t] {
         sched_raise(ERR_EMIT, sched_proc, t);
         return 0xffffffffu;
     }
-    let at = atomicAdd(&mp_ctrl[cw(t, C_NEXT)], 1u);
+    let at = wg_plan[W_KEEP + t] + atomicAdd(&mp_ctrl[cw(t, C_APPEND + wg_plan[W_WIN])], 1u);
     if at >= q_cap(t) {
         sched_raise(ERR_ROOM, t, at);
         return 0xffffffffu;
     }
+    let k = wg_plan[W_K];
+    let step = at >> STEP_SHIFT[t];
+    if at == step << STEP_SHIFT[t] && step < MAX_WGS[t] && k < wg_plan[W_CHUNK] {
+        atomicAdd(&indirect[args_x(k, GROUP[t])], 1u);
+    }
     return at;
 }
 
-// The mp_ctrl word of entry j of procedure q's round copy (`wg_round`).
-fn round_word(q: u32, j: u32) -> u32 {
-    switch j {
-        case 0u: { return cw(q, C_COUNT); }
-        case 1u: { return cw(q, C_RUN); }
-        case 2u: { return cw(q, C_WGS); }
-        case 3u: { return gw(G_WGS); }
-        case 4u: { return gw(G_K); }
-        default: { return gw(G_CHUNK); }
-    }
-}
-
-// Procedure q's round copy: one load per lane, unless the round's dispatch read it already
-// (`loaded`: a fused round's or a dispatch group's `mp_pick`).
-fn mp_round_inputs(q: u32, lid: u32, loaded: bool) -> array<u32, R_WORDS> {
-    if !loaded && lid < R_WORDS { wg_round[lid] = atomicLoad(&mp_ctrl[round_word(q, lid)]); }
-    return workgroupUniformLoad(&wg_round);
-}
-
-fn set_args(slot: u32, x: u32) {
-    indirect[slot * 3u] = x;
-    indirect[slot * 3u + 1u] = 1u;
-    indirect[slot * 3u + 2u] = 1u;
-}
-
-// The first round of a chunk (its index 0): planned by one thread before it.
+// The first round of a chunk (its index 0), sized by one thread before it from its inputs'
+// window (G_BASE); it clears the window the round appends to.
 @compute @workgroup_size(1)
-fn mp_plan() { plan_round(0u); }
-
-// One thread: takes the previous round's carried and appended counts as this round's inputs
-// and writes every dispatch size of the round (at most 65,535: grid-stride past that, so every
-// argument is valid with wgpu's indirect validation off). When a target cannot hold the
-// round's worst case: halts (nothing run, inputs intact) for the host to grow it, or, when it
-// is at its limit, runs only part of the inputs (partial.rs, the host twin) and carries the
-// rest; halts with ERR_OVERFLOW when not one input fits. A halted or empty round dispatches
-// nothing, so nothing plans the rounds after it: they keep their zeroed arguments. `k`: the
-// round's index within the chunk.
-// Its loads are independent and issued before any store, and the counts stay in `cnt`, so the
-// plan, which the whole next round waits for, costs about one round trip to memory, not one
-// per queue.
-fn plan_round(k: u32) {
-    var total = 0u;
-    var cnt: array<u32, NQ>;
-    for (var q = 0u; q < NQ; q++) { cnt[q] = atomicLoad(&mp_ctrl[cw(q, C_NEXT)]); }
-    var ok = atomicLoad(&mp_ctrl[gw(G_HALT)]) == 0u;
+fn mp_plan() {
+    let win = atomicLoad(&mp_ctrl[gw(G_BASE)]);
+    var group_wgs: array<u32, NQ>;
     for (var q = 0u; q < NQ; q++) {
-        atomicStore(&mp_ctrl[cw(q, C_COUNT)], cnt[q]);
-        total += cnt[q];
+        let n = atomicLoad(&mp_ctrl[cw(q, C_APPEND + win)]) + atomicLoad(&mp_ctrl[cw(q, C_CARRY + win)]);
+        group_wgs[GROUP[q]] += wgs_for(q, n);
+        atomicStore(&mp_ctrl[cw(q, C_APPEND + (win + 1u) % 3u)], 0u);
     }
-    var run = cnt;
-    var partial = false;
+    for (var g = 0u; g < NG; g++) {
+        atomicStore(&indirect[args_x(0u, g)], group_wgs[g]);
+        atomicStore(&indirect[args_x(0u, g) + 1u], 1u);
+        atomicStore(&indirect[args_x(0u, g) + 2u], 1u);
+    }
+}
+
+// The round's plan, the same in every workgroup of the round: each computes it from the words
+// its round starts with (`mp_begin`), which no workgroup of the round changes. The round's
+// inputs are in its window; when a target cannot hold the round's worst case the round halts
+// (nothing run, inputs intact) for the host to grow it, or, when the target is at its limit,
+// runs only part of the inputs (partial.rs, the host twin) and carries the rest;
+// ERR_OVERFLOW when not one input fits. Lanes q < NQ work out queue q's inputs, workgroups
+// (`wgs_for`: the sizes the round before gave this dispatch) and worst case as a target (each
+// from every queue's inputs, so no barrier between), and flag a partial round (1) or an
+// overflow (2); lane 0 then plans (`plan_round`).
+var<workgroup> wg_cnt: array<u32, NQ>;
+var<workgroup> wg_wgs: array<u32, NQ>;
+var<workgroup> wg_worst: array<u32, NQ>;
+var<workgroup> wg_flags: atomic<u32>;
+
+// Lane 0: the round's plan from `wg_cnt`, `wg_worst` and `flags` (the serial part only when a
+// round is partial or refused), then workgroup `w` of dispatch group `g`'s procedure (the
+// group's procedures in ORDER, each with its workgroups). Workgroup 0 of the round's first
+// dispatch group with workgroups keeps the round's books: statistics, the next round's
+// carried counts and arguments' other words, the window after next cleared, or, for a round
+// that halts, the error and every target's worst case for the host's growth.
+fn plan_round(w: u32, g: u32, flags: u32) {
+    let halt = wg_words[6u * NQ];
+    let base = wg_words[6u * NQ + 1u];
+    let chunk = wg_words[6u * NQ + 2u];
+    let k = mp_k.x;
+    let win = (base + k) % 3u;
+    var run: array<u32, NQ>;
+    var total = 0u;
+    for (var q = 0u; q < NQ; q++) {
+        run[q] = wg_cnt[q];
+        total += run[q];
+    }
+    var ok = halt == 0u;
+    let partial = (flags & 1u) != 0u;
+    var over = (flags & 2u) != 0u;
+    // The overflow to report: the first target that cannot grow its way out, else, when no
+    // input fits a partial round, the at-limit target with the largest worst case.
     var over_t = 0u;
     var over_m = 0u;
-    for (var t = 0u; t < NQ; t++) {
-        var m = 0u;
-        for (var p = 0u; p < NQ; p++) { m += run[p] * EMITS[p * NQ + t]; }
-        atomicStore(&mp_ctrl[cw(t, C_EMITS)], m);
-        if q_at_limit(t) && m > q_cap(t) / 2u {
-            if !partial || m > over_m { over_t = t; over_m = m; }
-            partial = true;
-        } else if m > q_cap(t) {
-            if ok {
-                ok = false;
-                if atomicExchange(&mp_ctrl[gw(G_ERROR)], ERR_OVERFLOW) == 0u {
-                    atomicStore(&mp_ctrl[gw(G_ERR_A)], t);
-                    atomicStore(&mp_ctrl[gw(G_ERR_B)], m);
-                }
-                atomicStore(&mp_ctrl[gw(G_HALT)], 1u);
+    if ok && over {
+        for (var t = NQ; t > 0u; t--) {
+            let m = wg_worst[t - 1u];
+            if !(q_at_limit(t - 1u) && m > q_cap(t - 1u) / 2u) && m > q_cap(t - 1u) {
+                over_t = t - 1u;
+                over_m = m;
             }
         }
     }
-    if ok && partial {
+    if ok && !over && partial {
+        for (var t = 0u; t < NQ; t++) {
+            let m = wg_worst[t];
+            if q_at_limit(t) && m > q_cap(t) / 2u && m > over_m {
+                over_t = t;
+                over_m = m;
+            }
+        }
         // Last procedure first: each runs as many inputs as keep every target within half its
         // capacity, and at least one when one fits (partial.rs says why).
         var used: array<u32, NQ>;
@@ -200,115 +225,103 @@ fn plan_round(k: u32) {
             used[p] -= r;
             any = any || r > 0u;
         }
-        if any {
-            atomicAdd(&mp_ctrl[gw(G_PARTIAL)], 1u);
-        } else {
-            ok = false;
+        over = !any;
+    }
+    // Halts for growth (or fails) on an overflow, unless an error has halted the run already.
+    let refused = ok && over;
+    ok = ok && !over;
+    // This workgroup's procedure: the group's procedures in ORDER, each with its workgroups.
+    var first = 0u;
+    var pick = NQ;
+    var book_g = NG;
+    for (var i = 0u; i < NQ; i++) {
+        let q = ORDER[i];
+        let n = wg_wgs[q];
+        if n > 0u && book_g == NG { book_g = GROUP[q]; }
+        if GROUP[q] != g || pick < NQ { continue; }
+        if w < first + n { pick = q; } else { first += n; }
+    }
+    let nk = k + 1u;
+    let next = (win + 1u) % 3u;
+    if w == 0u && g == book_g {
+        if refused {
             if atomicExchange(&mp_ctrl[gw(G_ERROR)], ERR_OVERFLOW) == 0u {
                 atomicStore(&mp_ctrl[gw(G_ERR_A)], over_t);
                 atomicStore(&mp_ctrl[gw(G_ERR_B)], over_m);
             }
             atomicStore(&mp_ctrl[gw(G_HALT)], 1u);
+            // The whole round's worst case, for the host's growth.
+            for (var t = 0u; t < NQ; t++) { atomicStore(&mp_ctrl[cw(t, C_EMITS)], wg_worst[t]); }
         }
-    }
-    if ok {
-        for (var t = 0u; t < NQ; t++) {
-            var m = 0u;
-            for (var p = 0u; p < NQ; p++) { m += run[p] * EMITS[p * NQ + t]; }
-            atomicStore(&mp_ctrl[cw(t, C_EMITS)], m);
-        }
-    }
-    // A halted round leaves the whole round's worst case in C_EMITS, for the host's growth.
-    // A round is one indirect dispatch per dispatch group (GROUP[q], NG groups: every
-    // procedure alone, all together with fused rounds, or the sinks apart; `Multipass::new`),
-    // so each procedure gets at most its share of its group's dispatch's 65,535.
-    var all_wgs = 0u;
-    var group_wgs: array<u32, NQ>;
-    for (var q = 0u; q < NQ; q++) {
-        let n = cnt[q];
-        let per_step = 256u / THREADS[q];
-        let max_wgs = 65535u / GROUP_LEN[q];
-        // Every input is visited: run, or copied to the front of the next round's inputs.
-        let wgs = select(0u, min((n + per_step - 1u) / per_step, max_wgs), ok);
-        group_wgs[GROUP[q]] += wgs;
-        all_wgs += wgs;
         if ok {
-            atomicStore(&mp_ctrl[cw(q, C_WGS)], wgs);
-            atomicMax(&mp_ctrl[cw(q, C_PEAK)], n);
-            atomicAdd(&mp_ctrl[cw(q, C_EXEC)], run[q]);
-            atomicStore(&mp_ctrl[cw(q, C_RUN)], run[q]);
-            atomicStore(&mp_ctrl[cw(q, C_KEEP)], n - run[q]);
-            // The carried inputs lead the next round; the round's appends go after them.
-            atomicStore(&mp_ctrl[cw(q, C_NEXT)], n - run[q]);
+            for (var q = 0u; q < NQ; q++) {
+                atomicMax(&mp_ctrl[cw(q, C_PEAK)], wg_cnt[q]);
+                atomicAdd(&mp_ctrl[cw(q, C_EXEC)], run[q]);
+                let keep = wg_cnt[q] - run[q];
+                // The carried inputs lead the next round's; its appends go after them.
+                atomicStore(&mp_ctrl[cw(q, C_CARRY + next)], keep);
+                atomicStore(&mp_ctrl[cw(q, C_APPEND + (win + 2u) % 3u)], 0u);
+                if keep > 0u && nk < chunk {
+                    atomicAdd(&indirect[args_x(nk, GROUP[q])], wgs_for(q, keep));
+                }
+            }
+            if nk < chunk {
+                for (var h = 0u; h < NG; h++) {
+                    atomicStore(&indirect[args_x(nk, h) + 1u], 1u);
+                    atomicStore(&indirect[args_x(nk, h) + 2u], 1u);
+                }
+            }
+            if partial { atomicAdd(&mp_ctrl[gw(G_PARTIAL)], 1u); }
+            if total > 0u { atomicAdd(&mp_ctrl[gw(G_ROUNDS)], 1u); }
+            atomicMax(&mp_ctrl[gw(G_RAN)], nk);
         }
     }
-    for (var g = 0u; g < NG; g++) { set_args((k / 2u) * NQ + g, group_wgs[g]); }
-    if ok { atomicAdd(&mp_ctrl[gw(G_PLANNED)], 1u); }
-    if ok && total > 0u { atomicAdd(&mp_ctrl[gw(G_ROUNDS)], 1u); }
-    atomicStore(&mp_ctrl[gw(G_DONE)], 0u);
-    atomicStore(&mp_ctrl[gw(G_WGS)], all_wgs);
-    atomicStore(&mp_ctrl[gw(G_K)], k);
+    for (var t = 0u; t < NQ; t++) { wg_plan[W_KEEP + t] = wg_cnt[t] - run[t]; }
+    wg_plan[W_WIN] = next;
+    wg_plan[W_K] = nk;
+    wg_plan[W_CHUNK] = chunk;
+    // A workgroup with nothing to run (a refused round, or past its group's workgroups, which
+    // the sizes rule out) gets its group's last procedure with no inputs.
+    let found = ok && pick < NQ;
+    let q = select(min(pick, NQ - 1u), pick, found);
+    wg_pick = Pick(q, w - first, select(0u, wg_cnt[q], found), wg_cnt[q] - run[q], wg_wgs[q]);
 }
 
-// After a workgroup's last step: the round's last workgroup to finish plans the next round,
-// unless the chunk ends here (the next submission's mp_plan plans it then). Every append of
-// the round precedes the plan: each workgroup's storageBarrier (naga: a device-scope
-// acquire-release fence on Vulkan) comes before its count of finished workgroups, and the last
-// one's after it (docs/scheduler.md 5.1). `round`: the workgroup's copy of the plan's words,
-// read when it started (the round's G_WGS, G_K, G_CHUNK).
-fn finish_workgroup(lid: u32, round: array<u32, R_WORDS>) {
-    storageBarrier();
-    if lid == 0u {
-        let done = atomicAdd(&mp_ctrl[gw(G_DONE)], 1u) + 1u;
-        wg_last = select(0u, 1u, done == round[R_ALL]);
-    }
-    if workgroupUniformLoad(&wg_last) == 0u { return; }
-    storageBarrier();
-    let k = round[R_K] + 1u;
-    if lid == 0u && k < round[R_CHUNK] { plan_round(k); }
-}
-
-// A round's dispatch of several procedures (dispatch group g): every procedure's workgroups of
-// the group (C_WGS of each), in the group's order (ORDER: procedure order, or the sinks first),
-// so the round costs one indirect dispatch for them instead of one each. Lanes read every
-// procedure's round words and the round's own at once (one round trip), then lane 0 finds this
-// workgroup's procedure among the group's in workgroup memory and leaves its round copy in
-// `wg_round`. Returns the procedure and the workgroup's index among that procedure's workgroups.
-var<workgroup> wg_pick: vec2<u32>;
-var<workgroup> wg_rounds: array<u32, 3u * NQ + 3u>;
-fn mp_pick(lid: u32, w: u32, g: u32) -> vec2<u32> {
-    if lid < 3u * NQ + 3u {
-        // R_COUNT, R_RUN, R_WGS of procedure lid / 3, then the round's R_ALL, R_K, R_CHUNK.
-        let q = min(lid / 3u, NQ - 1u);
-        let j = select(lid % 3u, lid - 3u * NQ + R_ALL, lid >= 3u * NQ);
-        wg_rounds[lid] = atomicLoad(&mp_ctrl[round_word(q, j)]);
+// The start of every workgroup of a round: lanes load the round's words at once (one round
+// trip), work out each queue's share in parallel, lane 0 plans (`plan_round`), and every lane
+// gets the workgroup's `Pick`.
+fn mp_begin(lid: u32, w: u32, g: u32) -> Pick {
+    if lid < 6u * NQ {
+        // Queue lid / 6's appends (j < 3) and carries (j >= 3) of window j % 3.
+        wg_words[lid] = atomicLoad(&mp_ctrl[cw(lid / 6u, C_APPEND + lid % 6u)]);
+    } else if lid < 6u * NQ + 3u {
+        let j = lid - 6u * NQ;
+        wg_words[lid] = atomicLoad(&mp_ctrl[gw(select(select(G_CHUNK, G_BASE, j == 1u), G_HALT, j == 0u))]);
+    } else if lid == 255u {
+        atomicStore(&wg_flags, 0u);
     }
     workgroupBarrier();
-    if lid == 0u {
-        var first = 0u;
-        var pick = NQ;
-        var last = 0u;
-        for (var i = 0u; i < NQ; i++) {
-            let q = ORDER[i];
-            if GROUP[q] != g { continue; }
-            last = q;
-            let n = wg_rounds[3u * q + R_WGS];
-            if w < first + n { pick = q; break; }
-            first += n;
+    if lid < NQ {
+        // Every queue's inputs (for the worst case), this one's kept.
+        let win = (wg_words[6u * NQ + 1u] + mp_k.x) % 3u;
+        var m = 0u;
+        for (var p = 0u; p < NQ; p++) {
+            let n = wg_words[p * 6u + win] + wg_words[p * 6u + 3u + win];
+            m += n * EMITS[p * NQ + lid];
+            if p == lid {
+                wg_cnt[lid] = n;
+                wg_wgs[lid] = wgs_for(lid, n);
+            }
         }
-        // A workgroup past the group's workgroups (none: the dispatch's size and C_WGS come
-        // from the same plan) runs no input of its group's last procedure but still counts
-        // itself finished, so the round still ends and is planned.
-        let found = pick < NQ;
-        let q = select(last, pick, found);
-        wg_pick = vec2<u32>(q, select(0u, w - first, found));
-        for (var j = 0u; j < R_ALL; j++) { wg_round[j] = wg_rounds[3u * q + j]; }
-        for (var j = R_ALL; j < R_WORDS; j++) { wg_round[j] = wg_rounds[3u * NQ + j - R_ALL]; }
-        if !found {
-            wg_round[R_COUNT] = 0u;
-            wg_round[R_RUN] = 0u;
+        wg_worst[lid] = m;
+        if q_at_limit(lid) && m > q_cap(lid) / 2u {
+            atomicOr(&wg_flags, 1u);
+        } else if m > q_cap(lid) {
+            atomicOr(&wg_flags, 2u);
         }
     }
+    workgroupBarrier();
+    if lid == 0u { plan_round(w, g, atomicLoad(&wg_flags)); }
     return workgroupUniformLoad(&wg_pick);
 }
 
@@ -318,6 +331,6 @@ fn mp_pick(lid: u32, w: u32, g: u32) -> vec2<u32> {
 // procedures' bodies, so the driver sizes its registers for them alone.
 @compute @workgroup_size(256)
 fn mp_round(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>) {
-    let pick = mp_pick(lid, wid.x, 0u);
-    run_procedure(pick.x, lid, pick.y, true);
+    let pick = mp_begin(lid, wid.x, 0u);
+    run_procedure(pick.proc, pick, lid);
 }

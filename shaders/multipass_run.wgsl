@@ -8,20 +8,20 @@
 // DiceShade took 122 registers instead of 80 when Bound's workgroup memory grew:
 // docs/scheduler.md 4).
 
-// Runs procedure q over this round's inputs, grid-stride, items_per_step items per step. The
-// workgroup count comes from mp_ctrl, not @builtin(num_workgroups), which D3D12 reports as 0
-// for indirect dispatches when wgpu's indirect validation is off. Only the newest C_RUN inputs
-// run (the outputs of the last rounds, so a partial round goes depth first and its live work
-// stays bounded); the older ones are copied, in place, to the front of the next round's inputs.
-fn RUN_PROCEDURE(q: u32, lid: u32, wid: u32, loaded: bool) {
-    let round = mp_round_inputs(q, lid, loaded);
-    let n = round[R_COUNT];
-    let keep = n - round[R_RUN];
-    let nwg = max(round[R_WGS], 1u);
+// Runs procedure q over this round's inputs as this workgroup's `Pick` (`mp_begin`) gives
+// them, grid-stride, items_per_step items per step. The workgroup count comes from the pick,
+// not @builtin(num_workgroups), which D3D12 reports as 0 for indirect dispatches when wgpu's
+// indirect validation is off. Only the newest inputs run (all but `pick.keep`: the outputs of
+// the last rounds, so a partial round goes depth first and its live work stays bounded); the
+// older ones are copied, in place, to the front of the next round's inputs.
+fn RUN_PROCEDURE(q: u32, pick: Pick, lid: u32) {
+    let n = pick.count;
+    let keep = pick.keep;
+    let nwg = max(pick.wgs, 1u);
     let per_step = 256u / THREADS[q];
     let slot = lid / THREADS[q];
     let thread = lid % THREADS[q];
-    for (var first = wid * per_step; first < n; first += nwg * per_step) {
+    for (var first = pick.index * per_step; first < n; first += nwg * per_step) {
         let idx = first + slot;
         let live = idx >= keep && idx < n;
         if idx < keep {
@@ -38,5 +38,4 @@ fn RUN_PROCEDURE(q: u32, lid: u32, wid: u32, loaded: bool) {
         MP_EXECUTE(q, idx, Invocation(thread, slot, live, THREADS[q]));
         workgroupBarrier();
     }
-    finish_workgroup(lid, round);
 }

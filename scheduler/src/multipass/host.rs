@@ -107,7 +107,7 @@ pub(crate) fn source(program: &Program, items: ItemLayout) -> String {
         items,
         "mp_host",
         args,
-        "lid, wid.x, nwg.x",
+        &|t| format!("run_procedure_{t}({t}u, lid, wid.x, nwg.x);"),
         RUN,
         false,
     ) + TEMPLATE

@@ -74,14 +74,16 @@ pub struct MultipassConfig {
     /// round, each kernel reaching only its own procedures' bodies, so the driver sizes the
     /// sinks' registers without the producers' (the host-driven Reyes passes: Bound 127
     /// registers, DiceShade 80; one kernel for all takes the larger, docs/scheduler.md 5.1).
-    /// Default `false`: not yet measured on a GPU. Ignored without fused rounds, or when every
-    /// procedure is a sink or none is.
+    /// Default `false`: on the H200 Killeroo gained 1.5-2% and the teapot lost 14-16%
+    /// (docs/results.md, 2026-12-05). Ignored without fused rounds, or when every procedure is
+    /// a sink or none is.
     pub fused_sinks_apart: bool,
     /// With fused rounds (the sinks not apart), give the sinks the round's first workgroups
     /// and the producers the last. A GPU starts a grid's workgroups roughly in order, so a
     /// round's longest workgroups (Reyes' dice-and-shade of a whole grid) start first instead
-    /// of forming its tail (longest processing time first, Graham 1969). Default `false`: not
-    /// yet measured on a GPU. Ignored without fused rounds or with the sinks apart.
+    /// of forming its tail (longest processing time first, Graham 1969). Default `false`: on
+    /// the H200 it changed nothing measurable (Killeroo -0.8%, the deep tree +2.3%;
+    /// docs/results.md, 2026-12-05). Ignored without fused rounds or with the sinks apart.
     pub fused_sinks_first: bool,
 }
 
@@ -159,8 +161,11 @@ struct DeviceRounds {
     /// `(k / 2) × NQ + g` for dispatch group g) and may plan round k + 1 into
     /// `args[(k + 1) % 2]`.
     args: [wgpu::Buffer; 2],
-    /// `args_bind[j]`: `args[j]` as storage (group 2).
+    /// `args_bind[j]`: `args[j]` as storage and the round indices (group 2).
     args_bind: [wgpu::BindGroup; 2],
+    /// Bytes between round indices in `round_index`: round k binds group 2 at offset
+    /// `k × index_stride` (`mp_k`, a dynamic offset).
+    index_stride: u32,
     /// Rounds a chunk may hold (the arguments' slots).
     max_chunk: u32,
     /// `bind[parity]`: round r reads `items[r % 2]` and writes `items[(r + 1) % 2]`.
@@ -209,7 +214,21 @@ impl Multipass {
             })
             .collect();
         let eps: Vec<&str> = names.iter().map(|s| s.as_str()).collect();
-        let group2 = [storage_entry(0, false)];
+        // The next round's arguments, and the round's index within its chunk (`mp_k`, a
+        // uniform at a dynamic offset per round).
+        let group2 = [
+            storage_entry(0, false),
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: true,
+                    min_binding_size: wgpu::BufferSize::new(16),
+                },
+                count: None,
+            },
+        ];
         let kernels = Kernels::new(
             gpu,
             program,
@@ -288,14 +307,46 @@ impl Multipass {
                 ],
             )
         });
+        let index_stride = gpu
+            .device
+            .limits()
+            .min_uniform_buffer_offset_alignment
+            .max(16);
+        let indices: Vec<u32> = (0..max_chunk)
+            .flat_map(|k| {
+                let mut entry = vec![0u32; index_stride as usize / 4];
+                entry[0] = k;
+                entry
+            })
+            .collect();
+        // Round k's index within its chunk at byte k × index_stride, for every round a chunk
+        // may hold (the bind groups keep the buffer).
+        let round_index = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("round indices"),
+            size: (indices.len() * 4) as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        gpu.queue
+            .write_buffer(&round_index, 0, bytemuck::cast_slice(&indices));
         let args_bind = [0, 1].map(|j| {
             gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("round dispatch args"),
                 layout: self.kernels.group2.as_ref().expect("multipass has group 2"),
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: args[j].as_entire_binding(),
-                }],
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: args[j].as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                            buffer: &round_index,
+                            offset: 0,
+                            size: wgpu::BufferSize::new(16),
+                        }),
+                    },
+                ],
             })
         });
         Ok(DeviceRounds {
@@ -305,6 +356,7 @@ impl Multipass {
             items,
             args,
             args_bind,
+            index_stride,
             max_chunk,
             bind,
         })
@@ -315,7 +367,7 @@ impl Multipass {
         let nq = self.program.queue_count();
         let mut ctrl = vec![0u32; ctrl_words(nq)];
         for (q, items) in live.iter().enumerate() {
-            ctrl[c(q, C_NEXT)] = (items.len() / d.layout.words[q] as usize) as u32;
+            ctrl[c(q, C_APPEND)] = (items.len() / d.layout.words[q] as usize) as u32;
             self.item_layout()
                 .write_items(&gpu.queue, &d.items[0], &d.layout, q, items);
         }
@@ -339,7 +391,7 @@ impl Multipass {
         let nq = self.program.queue_count();
         let mut ctrl = vec![0u32; ctrl_words(nq)];
         for (q, &n) in counts.iter().enumerate() {
-            ctrl[c(q, C_NEXT)] = n;
+            ctrl[c(q, C_APPEND)] = n;
             self.item_layout().encode_copy(
                 enc,
                 (&from.items[parity], &from.layout),
@@ -401,12 +453,12 @@ impl Multipass {
         // Round k: its items' parity, the arguments it may plan, where its own are.
         let round = |pass: &mut wgpu::ComputePass, k: usize| {
             pass.set_bind_group(0, &d.bind[(first_round as usize + k) % 2], &[]);
-            pass.set_bind_group(2, &d.args_bind[(k + 1) % 2], &[]);
+            pass.set_bind_group(2, &d.args_bind[(k + 1) % 2], &[k as u32 * d.index_stride]);
         };
         let args = |k: usize, q: usize| ((k / 2 * nq + q) * 12) as u64;
         let plan = |pass: &mut wgpu::ComputePass| {
             pass.set_bind_group(0, &d.bind[first_round as usize % 2], &[]);
-            pass.set_bind_group(2, &d.args_bind[0], &[]);
+            pass.set_bind_group(2, &d.args_bind[0], &[0]);
             pass.set_pipeline(&p[0]);
             pass.dispatch_workgroups(1, 1, 1);
         };
@@ -433,11 +485,14 @@ impl Multipass {
         }
     }
 
-    /// Sets `G_CHUNK`, the rounds of the next chunk, before its submission.
-    fn set_chunk(&self, gpu: &Gpu, d: &DeviceRounds, rounds: u32) {
-        let at = g(self.program.queue_count(), G_CHUNK) as u64 * 4;
+    /// Sets up the next chunk before its submission: none of its rounds ran yet (`G_RAN`),
+    /// its first round's inputs are in count window `base` (`G_BASE`), and it has `rounds`
+    /// rounds (`G_CHUNK`).
+    fn set_chunk(&self, gpu: &Gpu, d: &DeviceRounds, base: usize, rounds: u32) {
+        let at = g(self.program.queue_count(), G_RAN) as u64 * 4;
+        let words = [0, base as u32, rounds];
         gpu.queue
-            .write_buffer(&d.ctrl, at, bytemuck::bytes_of(&rounds));
+            .write_buffer(&d.ctrl, at, bytemuck::cast_slice(&words));
     }
 
     /// Runs the program to completion from `seeds`; `user` is bind group 1, if the program has
@@ -547,7 +602,10 @@ impl Multipass {
             let mut enc = moved
                 .take()
                 .unwrap_or_else(|| gpu.device.create_command_encoder(&Default::default()));
-            self.set_chunk(gpu, &d, rounds);
+            // Round r since the upload reads items[r % 2] and count window r % 3.
+            let base = (since_upload % WINDOWS as u64) as usize;
+            let first_round = since_upload;
+            self.set_chunk(gpu, &d, base, rounds);
             self.encode_rounds(
                 &mut enc,
                 &d,
@@ -589,7 +647,10 @@ impl Multipass {
                 )));
             }
             let halted = error == ERR_OVERFLOW;
-            let next: Vec<u32> = (0..nq).map(|q| ctrl[c(q, C_NEXT)]).collect();
+            // The inputs of the round after the last that ran (or of the refused round).
+            let ran = ctrl[g(nq, G_RAN)] as u64;
+            let pending = pending_window(nq, ctrl, base);
+            let next: Vec<u32> = (0..nq).map(|q| window_count(ctrl, q, pending)).collect();
             if !halted && next.iter().all(|&n| n == 0) {
                 self.accumulate(&mut stats, ctrl);
                 results = rb.ranges(&words, reads);
@@ -638,7 +699,7 @@ impl Multipass {
                     });
                 }
                 capacity = grown;
-                let parity = ctrl[g(nq, G_PLANNED)] as usize % 2;
+                let parity = ((first_round + ran) % 2) as usize;
                 let new = self.device_rounds(
                     gpu,
                     QueueLayout::new(&self.program, capacity.clone())?,

@@ -18,7 +18,7 @@
 //!
 //! The plan makes progress (some `k_p > 0`) exactly when some input can run within the room;
 //! otherwise the round is a real overflow and the run fails with `RunError::QueueOverflow`,
-//! nothing lost. WGSL twin: `mp_plan` in `shaders/multipass.wgsl`.
+//! nothing lost. WGSL twin: `plan_round` in `shaders/multipass.wgsl`.
 
 /// Per queue: true when its capacity has reached its limit (`max_cap`), so it cannot grow.
 pub fn at_limit(capacity: &[u32], max_cap: &[u32]) -> Vec<bool> {

@@ -63,7 +63,7 @@ impl Multipass {
         let nq = seeded.len();
         let mut ctrl = vec![0u32; ctrl_words(nq)];
         for (q, &n) in seeded.iter().enumerate() {
-            ctrl[c(q, C_NEXT)] = n;
+            ctrl[c(q, C_APPEND)] = n;
         }
         ctrl[g(nq, G_CHUNK)] = rounds;
         let ctrl_start = gpu.upload("mp_ctrl at start", &ctrl)?;
@@ -149,7 +149,8 @@ impl RecordedRounds {
                 program.procs[a].proc.name, capacity[a]
             )));
         }
-        let left: u64 = (0..nq).map(|q| ctrl[c(q, C_NEXT)] as u64).sum();
+        let pending = pending_window(nq, ctrl, 0);
+        let left: u64 = (0..nq).map(|q| window_count(ctrl, q, pending) as u64).sum();
         if left > 0 {
             return Ok(Outcome::Incomplete(format!(
                 "{left} items left after {} rounds",

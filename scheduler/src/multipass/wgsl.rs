@@ -53,21 +53,6 @@ pub fn entry_points(program: &Program, groups: &DispatchGroups) -> Vec<String> {
 /// buffers of every queue), its rounds dispatched as `groups`.
 pub fn source(program: &Program, items: ItemLayout, groups: &DispatchGroups) -> String {
     let args = "@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>";
-    let mut s = rounds_source(
-        program,
-        items,
-        "mp_proc",
-        args,
-        "lid, wid.x, false",
-        RUN,
-        true,
-    );
-    // Word `w` of item `at` of queue `t` (the carried inputs' copy).
-    let word_at = match items {
-        ItemLayout::Interleaved => "q_base(t) + at * WORDS[t] + w",
-        ItemLayout::Planar => "q_base(t) + w * q_cap(t) + at",
-    };
-    s += &format!("fn mp_word_at(t: u32, at: u32, w: u32) -> u32 {{ return {word_at}; }}\n");
     let nq = program.queue_count();
     let mut group_of = vec![0; nq];
     for (g, members) in groups.iter().enumerate() {
@@ -75,6 +60,21 @@ pub fn source(program: &Program, items: ItemLayout, groups: &DispatchGroups) -> 
             group_of[q] = g;
         }
     }
+    // A procedure's own entry point: its workgroups are its dispatch group's (a group of one,
+    // without fused rounds); `mp_begin` plans the round and finds the workgroup's share.
+    let body = |t: usize| {
+        format!(
+            "let pick = mp_begin(lid, wid.x, {}u); run_procedure_{t}({t}u, pick, lid);",
+            group_of[t]
+        )
+    };
+    let mut s = rounds_source(program, items, "mp_proc", args, &body, RUN, true);
+    // Word `w` of item `at` of queue `t` (the carried inputs' copy).
+    let word_at = match items {
+        ItemLayout::Interleaved => "q_base(t) + at * WORDS[t] + w",
+        ItemLayout::Planar => "q_base(t) + w * q_cap(t) + at",
+    };
+    s += &format!("fn mp_word_at(t: u32, at: u32, w: u32) -> u32 {{ return {word_at}; }}\n");
     let list = |f: &dyn Fn(usize) -> usize| {
         (0..nq)
             .map(|q| format!("{}u", f(q)))
@@ -83,16 +83,25 @@ pub fn source(program: &Program, items: ItemLayout, groups: &DispatchGroups) -> 
     };
     // GROUP[q]: q's dispatch group; GROUP_LEN[q]: how many procedures share its dispatch;
     // ORDER: the procedures group by group, each group's in the order its dispatch's
-    // workgroups go to them (`mp_pick`).
+    // workgroups go to them (`mp_begin`).
+    // STEP_SHIFT[q]: log2 of q's items per step (256 / threads per item, a power of two);
+    // MAX_WGS[q]: q's share of its group's dispatch, 65,535 / GROUP_LEN[q]. Tables, so that
+    // an append's test for a new step is a mask and a shift, not two divisions.
     let order: Vec<usize> = groups.concat();
+    let per_step =
+        |q: usize| crate::program::WORKGROUP_SIZE / program.procs[q].proc.threads_per_item;
     s += &format!(
         "const NG: u32 = {}u;\nconst GROUP: array<u32, {nq}> = array<u32, {nq}>({});\n\
          const GROUP_LEN: array<u32, {nq}> = array<u32, {nq}>({});\n\
-         const ORDER: array<u32, {nq}> = array<u32, {nq}>({});\n",
+         const ORDER: array<u32, {nq}> = array<u32, {nq}>({});\n\
+         const STEP_SHIFT: array<u32, {nq}> = array<u32, {nq}>({});\n\
+         const MAX_WGS: array<u32, {nq}> = array<u32, {nq}>({});\n",
         groups.len(),
         list(&|q| group_of[q]),
         list(&|q| groups[group_of[q]].len()),
         list(&|i| order[i]),
+        list(&|q| per_step(q).trailing_zeros() as usize),
+        list(&|q| 65_535 / groups[group_of[q]].len()),
     );
     s += TEMPLATE;
     // A group of several procedures, not all: a switch over their own loops.
@@ -102,13 +111,11 @@ pub fn source(program: &Program, items: ItemLayout, groups: &DispatchGroups) -> 
         }
         let cases: String = members
             .iter()
-            .map(|q| {
-                format!("        case {q}u: {{ run_procedure_{q}({q}u, lid, pick.y, true); }}\n")
-            })
+            .map(|q| format!("        case {q}u: {{ run_procedure_{q}({q}u, pick, lid); }}\n"))
             .collect();
         s += &format!(
             "@compute @workgroup_size(256) fn mp_group_{g}({args}) {{\n    \
-             let pick = mp_pick(lid, wid.x, {g}u);\n    switch pick.x {{\n{cases}        \
+             let pick = mp_begin(lid, wid.x, {g}u);\n    switch pick.proc {{\n{cases}        \
              default: {{}}\n    }}\n}}\n"
         );
     }
@@ -120,16 +127,17 @@ pub fn source(program: &Program, items: ItemLayout, groups: &DispatchGroups) -> 
 /// `mp_in`/`mp_out` in the layout `items`, and per procedure `t` an append-style
 /// `enqueue_<name>`, `mp_execute_<t>` (runs item `at` of t's inputs through t's body alone),
 /// `run`'s loop instantiated as `run_procedure_<t>`, and the entry point
-/// `{entry}_<name>({args})`, which calls `run_procedure_<t>(t, {call})`. With `generic`, also
-/// `mp_execute` and `run_procedure` for any procedure, by `q` (through `sched_execute`'s
-/// switch). Each entry point reaches only its own procedure's code, so the driver allocates
-/// registers and workgroup memory for that procedure alone (`shaders/multipass_run.wgsl`).
+/// `{entry}_<name>({args})`, whose statements are `body(t)` (they call `run_procedure_<t>`).
+/// With `generic`, also `mp_execute` and `run_procedure` for any procedure, by `q` (through
+/// `sched_execute`'s switch). Each entry point reaches only its own procedure's code, so the
+/// driver allocates registers and workgroup memory for that procedure alone
+/// (`shaders/multipass_run.wgsl`).
 pub(super) fn rounds_source(
     program: &Program,
     items: ItemLayout,
     entry: &str,
     args: &str,
-    call: &str,
+    body: &dyn Fn(usize) -> String,
     run: &str,
     generic: bool,
 ) -> String {
@@ -170,11 +178,12 @@ pub(super) fn rounds_source(
              let at = sched_append_slot({t}u);\n    if at == 0xffffffffu {{ return; }}\n    \
              mp_out_store_{ty}({store_at}, item);\n}}\n\
              fn mp_execute_{t}(t: u32, at: u32, inv: Invocation) {{ {run_item} }}\n\
-             @compute @workgroup_size(256) fn {entry}_{name}({args}) {{ run_procedure_{t}({t}u, {call}); }}\n",
+             @compute @workgroup_size(256) fn {entry}_{name}({args}) {{ {body} }}\n",
             name = p.proc.name,
             ty = p.layout.name,
             store_at = item_at(&format!("{t}u")),
             run_item = run_item(&p.layout.name, "mp_in", &item_at("t"), &p.proc.execute_fn()),
+            body = body(t),
         );
         s += &instantiate(&format!("_{t}"));
     }
