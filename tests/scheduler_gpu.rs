@@ -1041,11 +1041,11 @@ fn every_thread_that_calls_enqueue_adds_an_item_on_every_strategy() {
     // procedure apart, and with the sinks apart one for `fan` and one for `sink` and `once`
     // together (`mp_group_1`, which picks between their loops); with the sinks first, one
     // dispatch whose first workgroups go to `sink` and `once`.
-    for (fused, sinks_apart, sinks_first, dispatches) in [
-        (true, false, false, 1),
-        (false, false, false, 3),
-        (true, true, false, 2),
-        (true, false, true, 1),
+    for (fused, sinks_apart, sinks_first, dispatches, name) in [
+        (true, false, false, 1, "fused"),
+        (false, false, false, 3, "per-procedure"),
+        (true, true, false, 2, "sinks-apart"),
+        (true, false, true, 1, "sinks-first"),
     ] {
         let seen = gpu.storage_buffer("seen", 5 * n as u64).unwrap();
         let bind = exact.user.bind_group(&gpu, &[&seen]).unwrap();
@@ -1065,6 +1065,7 @@ fn every_thread_that_calls_enqueue_adds_an_item_on_every_strategy() {
             );
             assert_eq!(stats.executed, [n as u64, 4 * n as u64, n as u64], "{what}");
             assert_eq!(stats.rounds, 2, "{what}");
+            assert_eq!(stats.round_dispatch, name, "{what}");
             if run == 1 {
                 // The second run encodes exactly the rounds the first needed, in one chunk.
                 assert_eq!(stats.launches, 1 + 2 * dispatches, "{what}");

@@ -73,6 +73,11 @@ pub struct RunRecord {
     /// off by default); absent for the others.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub indirect_validation: Option<bool>,
+    /// Device-driven multi-pass: how its rounds were dispatched (`RunStats::round_dispatch`:
+    /// `fused`, `per-procedure`, `sinks-apart`, `sinks-first`; `--fused-rounds` resolved for
+    /// the adapter); absent for the others.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub round_dispatch: Option<String>,
     pub idle_polls: u64,
     pub abandoned: u64,
     pub queue_growths: u64,
@@ -135,6 +140,7 @@ impl RunRecord {
             queue_order: (!s.queue_order.is_empty()).then(|| s.queue_order.clone()),
             indirect_validation: matches!(k.strategy.name().as_str(), "multipass" | "frontier")
                 .then(scheduler::gpu::indirect_validation),
+            round_dispatch: (!s.round_dispatch.is_empty()).then(|| s.round_dispatch.clone()),
             ..Self::failed(k, String::new())
         }
     }
@@ -170,6 +176,7 @@ impl RunRecord {
             guided_claims: None,
             queue_order: None,
             indirect_validation: None,
+            round_dispatch: None,
             idle_polls: 0,
             abandoned: 0,
             queue_growths: 0,

@@ -189,7 +189,14 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
                 .queue_order
                 .as_ref()
                 .map_or(String::new(), |o| format!(", queue order {}", o.join(",")));
-            let line = format!("{}: {l} items{e}{w}{local}{guided}{order}", r.strategy);
+            let rounds = r
+                .round_dispatch
+                .as_ref()
+                .map_or(String::new(), |d| format!(", {d} rounds"));
+            let line = format!(
+                "{}: {l} items{e}{w}{local}{guided}{order}{rounds}",
+                r.strategy
+            );
             if !queues.contains(&line) {
                 queues.push(line);
             }

@@ -427,6 +427,7 @@ mod tests {
             guided_claims: None,
             queue_order: None,
             indirect_validation: None,
+            round_dispatch: None,
             idle_polls: 50,
             abandoned: 0,
             queue_growths: 0,

@@ -11,6 +11,10 @@ pub struct RunStats {
     /// Megakernel: how items reached their queue, `direct` or `outbox`
     /// (`MegakernelConfig::direct_enqueue`); empty for the other strategies.
     pub enqueue: String,
+    /// Device-driven multi-pass: how a round's procedures were dispatched, as configured and
+    /// resolved for the adapter (`fused`, `per-procedure`, `sinks-apart` or `sinks-first`;
+    /// `MultipassConfig::fused_rounds` and its companions); empty for the other strategies.
+    pub round_dispatch: String,
     /// Items executed, per procedure (program order).
     pub executed: Vec<u64>,
     /// Multi-pass: rounds that ran some work.

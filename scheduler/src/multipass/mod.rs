@@ -260,6 +260,21 @@ impl Multipass {
         self.config.item_layout.unwrap_or_default()
     }
 
+    /// How a round's procedures are dispatched, resolved for the adapter: `fused`,
+    /// `per-procedure`, `sinks-apart` or `sinks-first` ([`RunStats::round_dispatch`]).
+    pub fn round_dispatch(&self) -> &'static str {
+        match (
+            self.config.fused_rounds,
+            self.config.fused_sinks_apart,
+            self.config.fused_sinks_first,
+        ) {
+            (Some(false) | None, ..) => "per-procedure",
+            (_, true, _) => "sinks-apart",
+            (_, _, true) => "sinks-first",
+            _ => "fused",
+        }
+    }
+
     /// Buffers of one layout; `at_limit[q]`: queue q cannot grow, so a round it cannot hold
     /// runs in part ([`partial`]) instead of halting for growth.
     /// `max_chunk`: the most rounds one submission or record encodes.
@@ -558,6 +573,7 @@ impl Multipass {
         let mut stats = RunStats {
             strategy: "multipass".into(),
             item_layout: self.item_layout().name().into(),
+            round_dispatch: self.round_dispatch().into(),
             executed: vec![0; nq],
             peak_occupancy: vec![0; nq],
             ..Default::default()

@@ -23,6 +23,8 @@ pub(crate) struct RecordedRounds {
     item_layout: ItemLayout,
     /// Indirect dispatches a round (the multi-pass's dispatch groups).
     dispatches_per_round: u64,
+    /// [`Multipass::round_dispatch`].
+    round_dispatch: &'static str,
 }
 
 impl Multipass {
@@ -79,6 +81,7 @@ impl Multipass {
                 scatter,
                 item_layout: self.item_layout(),
                 dispatches_per_round: self.dispatches_per_round(),
+                round_dispatch: self.round_dispatch(),
             },
             capacity,
         ))
@@ -160,6 +163,7 @@ impl RecordedRounds {
         Ok(Outcome::Done(RunStats {
             strategy: "multipass".into(),
             item_layout: self.item_layout.name().into(),
+            round_dispatch: self.round_dispatch.into(),
             executed: (0..nq).map(|q| ctrl[c(q, C_EXEC)] as u64).collect(),
             peak_occupancy: (0..nq).map(|q| ctrl[c(q, C_PEAK)] as u64).collect(),
             rounds: ctrl[g(nq, G_ROUNDS)] as u64,
