@@ -995,6 +995,49 @@ fn multipass_stage_timing_keeps_results_and_splits_the_time_by_procedure() {
 /// `enqueue_*` adds one item per call by every thread, on every strategy: a 4-thread item whose
 /// threads each enqueue one child emits 4, one guarded by `inv.thread == 0u` emits 1, and the
 /// declared maximum counts the calls of all the item's threads together.
+/// A round with more workgroups than its dispatch may have: a 256-thread procedure (one item a
+/// step) with 40,000 inputs in a fused round of two procedures, whose share of the dispatch is
+/// 65,535 / 2 = 32,767 workgroups. Round 0 is sized by `mp_plan`, round 1 by its inputs'
+/// appends (which stop adding workgroups at the share); both stride over every input, so
+/// each runs exactly once.
+#[test]
+fn device_driven_rounds_past_the_dispatch_limit_run_every_input_once() {
+    let gpu = gpu();
+    let item = ItemType::new("Word", "struct Word { v: u32 }");
+    let wide = Procedure::new("wide", item.clone(), 256)
+        .emits("mark", 1)
+        .body("fn wide_execute(item: Word, inv: Invocation) { if inv.thread == 0u { enqueue_mark(item); } }");
+    let mark = Procedure::new("mark", item.clone(), 256).body(
+        "fn mark_execute(item: Word, inv: Invocation) { if inv.live && inv.thread == 0u { atomicAdd(&seen[item.v], 1u); } }",
+    );
+    let user = UserBindings::storage(
+        "@group(1) @binding(0) var<storage, read_write> seen: array<atomic<u32>>;",
+        &[(0, false)],
+    );
+    let program = Program::new(vec![wide, mark], user).unwrap();
+    let n = 40_000u32;
+    let seeds = [Seed::new("wide", &(0..n).collect::<Vec<u32>>())];
+    let seen = gpu.storage_buffer("seen", n as u64).unwrap();
+    let bind = program.user.bind_group(&gpu, &[&seen]).unwrap();
+    let config = MultipassConfig {
+        fused_rounds: Some(true),
+        ..Default::default()
+    };
+    let s = Scheduler::multipass(&gpu, &program, config).unwrap();
+    let stats = s.run(&gpu, &seeds, Some(&bind)).unwrap();
+    assert_eq!(stats.executed, [n as u64, n as u64], "{stats:?}");
+    assert_eq!(stats.rounds, 2, "{stats:?}");
+    let counts = gpu.read_words(&seen, 0, n as u64).unwrap();
+    let wrong: Vec<(usize, u32)> = counts
+        .iter()
+        .enumerate()
+        .filter(|&(_, &c)| c != 1)
+        .map(|(i, &c)| (i, c))
+        .take(8)
+        .collect();
+    assert!(wrong.is_empty(), "inputs not run exactly once: {wrong:?}");
+}
+
 #[test]
 fn every_thread_that_calls_enqueue_adds_an_item_on_every_strategy() {
     let gpu = gpu();
