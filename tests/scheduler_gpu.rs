@@ -992,9 +992,6 @@ fn multipass_stage_timing_keeps_results_and_splits_the_time_by_procedure() {
     }
 }
 
-/// `enqueue_*` adds one item per call by every thread, on every strategy: a 4-thread item whose
-/// threads each enqueue one child emits 4, one guarded by `inv.thread == 0u` emits 1, and the
-/// declared maximum counts the calls of all the item's threads together.
 /// A round with more workgroups than its dispatch may have: a 256-thread procedure (one item a
 /// step) with 40,000 inputs in a fused round of two procedures, whose share of the dispatch is
 /// 65,535 / 2 = 32,767 workgroups. Round 0 is sized by `mp_plan`, round 1 by its inputs'
@@ -1038,6 +1035,9 @@ fn device_driven_rounds_past_the_dispatch_limit_run_every_input_once() {
     assert!(wrong.is_empty(), "inputs not run exactly once: {wrong:?}");
 }
 
+/// `enqueue_*` adds one item per call by every thread, on every strategy: a 4-thread item whose
+/// threads each enqueue one child emits 4, one guarded by `inv.thread == 0u` emits 1, and the
+/// declared maximum counts the calls of all the item's threads together.
 #[test]
 fn every_thread_that_calls_enqueue_adds_an_item_on_every_strategy() {
     let gpu = gpu();

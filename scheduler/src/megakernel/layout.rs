@@ -77,15 +77,7 @@ pub fn q(queue: usize, i: usize) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// The value of `const NAME: u32 = Nu;` in the WGSL template.
-    fn wgsl_const(src: &str, name: &str) -> Option<usize> {
-        let line = src
-            .lines()
-            .find(|l| l.starts_with(&format!("const {name}: u32 = ")))?;
-        let v = line.split('=').nth(1)?.trim().split('u').next()?;
-        v.parse().ok()
-    }
+    use crate::wgsl::wgsl_const;
 
     #[test]
     fn hot_words_have_lines_of_their_own() {

@@ -48,6 +48,7 @@ pub fn pending_window(nq: usize, ctrl: &[u32], base: usize) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::wgsl::wgsl_const;
 
     /// Every word index of `shaders/multipass.wgsl`'s mp_ctrl layout equals its host twin's.
     #[test]
@@ -74,16 +75,7 @@ mod tests {
             ("ERR_ROOM", ERR_ROOM as usize),
         ];
         for (name, host) in twins {
-            let prefix = format!("const {name}: u32 = ");
-            let line = wgsl
-                .lines()
-                .find_map(|l| l.trim().strip_prefix(prefix.as_str()))
-                .unwrap_or_else(|| panic!("{name} is not a u32 constant of multipass.wgsl"));
-            let value: usize = line
-                .split_once("u;")
-                .and_then(|(v, _)| v.parse().ok())
-                .unwrap_or_else(|| panic!("{name}: cannot read `{line}`"));
-            assert_eq!(value, host, "{name}");
+            assert_eq!(wgsl_const(wgsl, name), Some(host), "{name}");
         }
         // The globals (G_*) fit the words after the queues' strides; the windows, a stride.
         assert!(G_CHUNK < ctrl_words(1) - CSTRIDE);

@@ -81,24 +81,21 @@ pub fn source(program: &Program, items: ItemLayout, groups: &DispatchGroups) -> 
             .collect::<Vec<_>>()
             .join(", ")
     };
-    // GROUP[q]: q's dispatch group; GROUP_LEN[q]: how many procedures share its dispatch;
-    // ORDER: the procedures group by group, each group's in the order its dispatch's
+    // GROUP[q]: q's dispatch group; ORDER: the procedures group by group, each group's in the order its dispatch's
     // workgroups go to them (`mp_begin`).
     // STEP_SHIFT[q]: log2 of q's items per step (256 / threads per item, a power of two);
-    // MAX_WGS[q]: q's share of its group's dispatch, 65,535 / GROUP_LEN[q]. Tables, so that
+    // MAX_WGS[q]: q's share of its group's dispatch, 65,535 / (procedures sharing it). Tables, so that
     // an append's test for a new step is a mask and a shift, not two divisions.
     let order: Vec<usize> = groups.concat();
     let per_step =
         |q: usize| crate::program::WORKGROUP_SIZE / program.procs[q].proc.threads_per_item;
     s += &format!(
         "const NG: u32 = {}u;\nconst GROUP: array<u32, {nq}> = array<u32, {nq}>({});\n\
-         const GROUP_LEN: array<u32, {nq}> = array<u32, {nq}>({});\n\
          const ORDER: array<u32, {nq}> = array<u32, {nq}>({});\n\
          const STEP_SHIFT: array<u32, {nq}> = array<u32, {nq}>({});\n\
          const MAX_WGS: array<u32, {nq}> = array<u32, {nq}>({});\n",
         groups.len(),
         list(&|q| group_of[q]),
-        list(&|q| groups[group_of[q]].len()),
         list(&|i| order[i]),
         list(&|q| per_step(q).trailing_zeros() as usize),
         list(&|q| 65_535 / groups[group_of[q]].len()),
