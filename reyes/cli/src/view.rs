@@ -493,7 +493,14 @@ impl ApplicationHandler for Viewer {
                     self.dirty = true;
                 }
             }
-            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+            // winit makes a synthetic press for every key already down when the window gains
+            // focus: a key held while focusing the window (or, on a busy machine, a focus
+            // change handled after the key went down) is not a press meant for the viewer.
+            WindowEvent::KeyboardInput {
+                event,
+                is_synthetic: false,
+                ..
+            } if event.state == ElementState::Pressed => {
                 match self.key(&event.logical_key, event.repeat) {
                     Ok(true) => event_loop.exit(),
                     Ok(false) => {}
