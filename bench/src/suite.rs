@@ -29,8 +29,19 @@ pub struct SuiteOptions {
 /// nothing on CPU adapters).
 pub const WARM_UP: Duration = Duration::from_millis(500);
 
+/// A run whose whole call (its read-back and the check against the CPU reference included)
+/// takes longer than this leaves the GPU idle long enough for its clocks to fall: on the H200,
+/// Killeroo 1080p's 1.2 ms frames, each followed by about 25 ms of checking, ran at the boost
+/// clock seven times and then at a quarter of it (docs/results.md, 2026-12-05 third session).
+pub const SLOW_CHECK: Duration = Duration::from_millis(5);
+
+/// Full GPU load before the next timed run after a [`SLOW_CHECK`] one (nothing on CPU
+/// adapters): the busy share of the GPU's time stays above a half, as during the warm-up.
+pub const KEEP_UP: Duration = Duration::from_millis(20);
+
 /// Runs a strategy once untimed (compilation, buffer sizing and the megakernel's probe are not
-/// the strategy's cost), raises the GPU's clocks, then `runs` timed, verified runs. A run that
+/// the strategy's cost), raises the GPU's clocks, then `runs` timed, verified runs, raising
+/// the clocks again for [`KEEP_UP`] after each run slower than [`SLOW_CHECK`]. A run that
 /// fails ends the strategy's runs at this size with a failed record; an unverified warm-up
 /// run is recorded as a failure too.
 pub fn measure(
@@ -65,12 +76,23 @@ pub fn measure(
     }
     let mut out = Vec::new();
     for run in 0..runs {
-        match w.run(gpu, strategy) {
+        let start = Instant::now();
+        let result = w.run(gpu, strategy);
+        let slow = start.elapsed() > SLOW_CHECK;
+        match result {
             Ok(m) => out.push(RunRecord::new(&key(run), &m)),
             Err(e) => {
                 out.push(RunRecord::failed(&key(run), e.to_string()));
                 break;
             }
+        }
+        if slow
+            && strategy.is_gpu()
+            && run + 1 < runs
+            && let Err(e) = scheduler::clocks::raise_clocks(gpu, KEEP_UP)
+        {
+            out.push(RunRecord::failed(&key(run + 1), e.to_string()));
+            break;
         }
     }
     out
