@@ -270,9 +270,6 @@ pub(crate) fn cast_out(l: &Leaf) -> String {
     }
 }
 
-/// WGSL accessors `{prefix}_load_word`, `{prefix}_store_word`, `{prefix}_load_vec4` and
-/// `{prefix}_store_vec4` over `buffer`, a storage `array<vec4<u32>>` addressed in u32 words
-/// (`*_vec4` take a 4-aligned word index).
 /// The value of `const NAME: u32 = Nu;` at the start of a line of `src` (a WGSL template):
 /// tests check host twins of shader layouts with it.
 #[cfg(test)]
@@ -284,6 +281,9 @@ pub(crate) fn wgsl_const(src: &str, name: &str) -> Option<usize> {
     v.parse().ok()
 }
 
+/// WGSL accessors `{prefix}_load_word`, `{prefix}_store_word`, `{prefix}_load_vec4` and
+/// `{prefix}_store_vec4` over `buffer`, a storage `array<vec4<u32>>` addressed in u32 words
+/// (`*_vec4` take a 4-aligned word index).
 pub(crate) fn vec4_word_accessors(prefix: &str, buffer: &str) -> String {
     format!(
         "fn {prefix}_load_word(i: u32) -> u32 {{ return {buffer}[i >> 2u][i & 3u]; }}\n\
