@@ -10,6 +10,11 @@ use std::time::{Duration, Instant};
 
 use crate::error::RunError;
 
+/// Most workgroups a dispatch may have along one dimension: WebGPU's (and wgpu's default)
+/// `max_compute_workgroups_per_dimension`. Every grid this crate dispatches, directly or
+/// through indirect arguments it plans on the device, stays within it.
+pub const MAX_WORKGROUPS_PER_DIMENSION: u32 = 65_535;
+
 /// How long any single wait for the GPU may last before the run is abandoned with an error.
 /// Generous, because lavapipe on two cores is slow; a real GPU finishes in milliseconds.
 pub const DEFAULT_GPU_TIMEOUT: Duration = Duration::from_secs(120);

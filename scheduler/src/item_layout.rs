@@ -5,7 +5,7 @@
 //! size; interleaved touches one sector per thread per access, but moves an item whose size is
 //! a whole number of `vec4`s 16 bytes at a time (docs/scheduler.md, "Item layout").
 
-use crate::gpu::Gpu;
+use crate::gpu::{Gpu, MAX_WORKGROUPS_PER_DIMENSION};
 use crate::program::Program;
 use crate::queue_layout::QueueLayout;
 use crate::wgsl::{StructLayout, cast_in, cast_out, load_store_fns};
@@ -274,7 +274,10 @@ impl PlanarScatter {
             };
             pass.set_bind_group(0, &bound[at].1, &[]);
             let words = n as u64 * self.words[q] as u64;
-            pass.dispatch_workgroups(words.div_ceil(256).clamp(1, 65_535) as u32, 1, 1);
+            let wgs = words
+                .div_ceil(256)
+                .clamp(1, MAX_WORKGROUPS_PER_DIMENSION.into());
+            pass.dispatch_workgroups(wgs as u32, 1, 1);
         }
     }
 }

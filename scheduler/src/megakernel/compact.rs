@@ -8,7 +8,7 @@
 use super::DeviceQueues;
 use super::layout::*;
 use crate::error::RunError;
-use crate::gpu::Gpu;
+use crate::gpu::{Gpu, MAX_WORKGROUPS_PER_DIMENSION};
 use crate::item_layout::ItemLayout;
 use crate::program::Program;
 
@@ -151,7 +151,7 @@ impl DeviceCompaction {
         let most = reserved.iter().copied().max().unwrap_or(0);
         Ok(CompactionPass {
             bind,
-            workgroups: most.div_ceil(256).clamp(1, 65_535),
+            workgroups: most.div_ceil(256).clamp(1, MAX_WORKGROUPS_PER_DIMENSION),
             queues: nq as u32,
         })
     }

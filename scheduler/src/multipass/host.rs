@@ -9,7 +9,7 @@
 use std::time::Instant;
 
 use crate::error::RunError;
-use crate::gpu::Gpu;
+use crate::gpu::{Gpu, MAX_WORKGROUPS_PER_DIMENSION};
 use crate::growth::{grow, start_capacity};
 use crate::item_layout::ItemLayout;
 use crate::multipass::partial::{at_limit, needs_partial, partial_round};
@@ -372,7 +372,8 @@ impl HostMultipass {
                     }
                     let per_step = self.program.procs[q].items_per_step;
                     pass.set_pipeline(&self.kernels.pipelines[q]);
-                    pass.dispatch_workgroups(k.div_ceil(per_step).min(65_535), 1, 1);
+                    let wgs = k.div_ceil(per_step).min(MAX_WORKGROUPS_PER_DIMENSION);
+                    pass.dispatch_workgroups(wgs, 1, 1);
                     stats.launches += 1;
                 }
             }

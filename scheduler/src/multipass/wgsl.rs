@@ -2,6 +2,7 @@
 //! the run's item layout, enqueue functions that append to the next round's inputs, one entry
 //! point per procedure, and `shaders/multipass.wgsl`.
 
+use crate::gpu::MAX_WORKGROUPS_PER_DIMENSION;
 use crate::item_layout::{ItemLayout, run_item};
 use crate::program::Program;
 
@@ -81,11 +82,11 @@ pub fn source(program: &Program, items: ItemLayout, groups: &DispatchGroups) -> 
             .collect::<Vec<_>>()
             .join(", ")
     };
-    // GROUP[q]: q's dispatch group; ORDER: the procedures group by group, each group's in the order its dispatch's
-    // workgroups go to them (`mp_begin`).
+    // GROUP[q]: q's dispatch group; ORDER: the procedures group by group, each group's in the
+    // order its dispatch's workgroups go to them (`mp_begin`).
     // STEP_SHIFT[q]: log2 of q's items per step (256 / threads per item, a power of two);
-    // MAX_WGS[q]: q's share of its group's dispatch, 65,535 / (procedures sharing it). Tables, so that
-    // an append's test for a new step is a mask and a shift, not two divisions.
+    // MAX_WGS[q]: q's share of its group's dispatch, 65,535 / (procedures sharing it). Tables,
+    // so that an append's test for a new step is a mask and a shift, not two divisions.
     let order: Vec<usize> = groups.concat();
     let per_step =
         |q: usize| crate::program::WORKGROUP_SIZE / program.procs[q].proc.threads_per_item;
@@ -98,7 +99,7 @@ pub fn source(program: &Program, items: ItemLayout, groups: &DispatchGroups) -> 
         list(&|q| group_of[q]),
         list(&|i| order[i]),
         list(&|q| per_step(q).trailing_zeros() as usize),
-        list(&|q| 65_535 / groups[group_of[q]].len()),
+        list(&|q| MAX_WORKGROUPS_PER_DIMENSION as usize / groups[group_of[q]].len()),
     );
     s += TEMPLATE;
     // A group of several procedures, not all: a switch over their own loops.
