@@ -185,11 +185,12 @@ fn plan_round(w: u32, g: u32, flags: u32) {
     var over_t = 0u;
     var over_m = 0u;
     if ok && over {
-        for (var t = NQ; t > 0u; t--) {
-            let m = wg_worst[t - 1u];
-            if !(q_at_limit(t - 1u) && m > q_cap(t - 1u) / 2u) && m > q_cap(t - 1u) {
-                over_t = t - 1u;
+        for (var t = 0u; t < NQ; t++) {
+            let m = wg_worst[t];
+            if !(q_at_limit(t) && m > q_cap(t) / 2u) && m > q_cap(t) {
+                over_t = t;
                 over_m = m;
+                break;
             }
         }
     }
