@@ -963,32 +963,62 @@ fn device_driven_multipass_counts_its_rounds_and_dispatches() {
     }
 }
 
+/// Both multi-passes with stage timing: the same result, rounds and counts as without, one time
+/// per procedure plus queue work (none for the host-driven one, whose host plans the rounds),
+/// adding up to the run's GPU time. On a small tree, and on a chain of 151 rounds, more than
+/// the host-driven timer's query set holds (64 rounds of passes): its full sets come back with
+/// the rounds' counts.
 #[test]
 fn multipass_stage_timing_keeps_results_and_splits_the_time_by_procedure() {
     let gpu = gpu();
-    let params = small_tree(5);
-    let reference = params.reference();
-    let run = TreeRun::new(&gpu, params).unwrap();
-    let s = Scheduler::multipass(
-        &gpu,
-        &run.program,
-        MultipassConfig {
+    let chain = TreeParams {
+        roots: 3,
+        max_depth: 150,
+        fanout: Fanout::Fixed(1),
+        work: 1,
+        payload_words: 1,
+        seed: 5,
+    };
+    for params in [small_tree(5), chain] {
+        let reference = params.reference();
+        let run = TreeRun::new(&gpu, params).unwrap();
+        let nq = run.program.queue_count();
+        let device = MultipassConfig {
             stage_timing: true,
             ..Default::default()
-        },
-    )
-    .unwrap();
-    let (stats, result) = run.run(&gpu, &s).unwrap();
-    assert_eq!(result, reference);
-    if gpu.timestamps {
-        let nq = run.program.queue_count();
-        assert_eq!(stats.stage_gpu_ms.len(), nq + 1, "{stats:?}");
-        assert!(stats.stage_gpu_ms.iter().all(|&t| t >= 0.0));
-        let sum: f64 = stats.stage_gpu_ms.iter().sum();
-        assert!((sum - stats.gpu_ms.unwrap()).abs() < 1e-9);
-    } else {
-        eprintln!("adapter has no timestamp queries: only the results are checked");
-        assert!(stats.stage_gpu_ms.is_empty());
+        };
+        let host = HostMultipassConfig {
+            stage_timing: true,
+            ..Default::default()
+        };
+        let timed = [
+            Scheduler::multipass(&gpu, &run.program, device).unwrap(),
+            Scheduler::multipass_host(&gpu, &run.program, host).unwrap(),
+        ];
+        for s in &timed {
+            let (stats, result) = run.run(&gpu, s).unwrap();
+            let kind = s.kind();
+            assert_eq!(result, reference, "{kind:?}");
+            let plain = Scheduler::new(&gpu, &run.program, kind, 1 << 16).unwrap();
+            let (untimed, _) = run.run(&gpu, &plain).unwrap();
+            assert_eq!(stats.rounds, untimed.rounds, "{kind:?}");
+            assert_eq!(stats.executed, untimed.executed, "{kind:?}");
+            if !gpu.timestamps {
+                eprintln!("adapter has no timestamp queries: only the results are checked");
+                assert!(stats.stage_gpu_ms.is_empty(), "{kind:?}");
+                continue;
+            }
+            assert_eq!(stats.stage_gpu_ms.len(), nq + 1, "{kind:?}: {stats:?}");
+            assert!(stats.stage_gpu_ms.iter().all(|&t| t >= 0.0), "{stats:?}");
+            // Every procedure ran, so each has time.
+            assert!(stats.stage_gpu_ms[..nq].iter().all(|&t| t > 0.0), "{stats:?}");
+            if kind == StrategyKind::MultipassHost {
+                assert_eq!(stats.stage_gpu_ms[nq], 0.0, "{stats:?}");
+                assert!(untimed.stage_gpu_ms.is_empty(), "{untimed:?}");
+            }
+            let sum: f64 = stats.stage_gpu_ms.iter().sum();
+            assert!((sum - stats.gpu_ms.unwrap()).abs() < 1e-9, "{kind:?}: {stats:?}");
+        }
     }
 }
 

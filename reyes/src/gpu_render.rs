@@ -343,6 +343,15 @@ impl GpuRenderer {
                     ..Default::default()
                 },
             )?,
+            StrategyKind::MultipassHost => Scheduler::multipass_host(
+                gpu,
+                program,
+                scheduler::HostMultipassConfig {
+                    initial_capacity: INITIAL_CAPACITY,
+                    stage_timing,
+                    ..Default::default()
+                },
+            )?,
             // lavapipe ends every loop of an invocation after 65,535 iterations in total over
             // the persistent loop and what it nests; blurred micropolygons sample in loops that
             // grow with the blur, so there each launch runs one turn (the host relaunches).
@@ -383,7 +392,6 @@ impl GpuRenderer {
                     ..Default::default()
                 },
             )?,
-            _ => Scheduler::new(gpu, program, strategy, INITIAL_CAPACITY)?,
         })
     }
 

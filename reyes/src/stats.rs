@@ -406,8 +406,8 @@ fn stage_times(g: &GpuFrame) -> StageTimes {
 /// so they carry none.
 fn whole_note(strategy: &str) -> Option<String> {
     (strategy == "megakernel").then(|| {
-        "stages interleave inside one megakernel launch; multipass --stage-times times each \
-         procedure"
+        "stages interleave inside one megakernel launch; multipass or multipass-host with \
+         --stage-times times each procedure"
             .into()
     })
 }

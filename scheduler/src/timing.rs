@@ -124,35 +124,46 @@ impl StageTimer {
 }
 
 /// Times every pass of a run of many short submissions (host-driven rounds) and brings the
-/// timestamps back through the run's own read-back, in the submission that fills its query set
-/// and after the run's last one, so timing costs no submission or wait of its own. The total is
-/// `None` when the adapter has no timestamp queries.
+/// timestamps back through the run's own read-back, in the submission after which its query
+/// set could not hold another submission's passes and after the run's last one, so timing
+/// costs no submission or wait of its own. Each pass counts to a stage (one, or one per
+/// procedure with stage timing). The times are `None` when the adapter has no timestamp
+/// queries.
 pub(crate) struct RunTimer {
     inner: StageTimer,
     used: u32,
     passes: u32,
+    per_submission: u32,
 }
 
 impl RunTimer {
-    /// Up to `passes` timed passes between read-backs.
-    pub fn new(gpu: &Gpu, passes: u32) -> RunTimer {
-        let passes = passes.max(1);
+    /// `stages` buckets of time; at most `per_submission` timed passes a submission; room for
+    /// `submissions` submissions' passes between read-backs.
+    pub fn new(gpu: &Gpu, stages: usize, per_submission: u32, submissions: u32) -> RunTimer {
+        let per_submission = per_submission.max(1);
+        let passes = per_submission * submissions.max(1);
         RunTimer {
-            inner: StageTimer::new(gpu, 1, passes),
+            inner: StageTimer::new(gpu, stages.max(1), passes),
             used: 0,
             passes,
+            per_submission,
         }
     }
 
-    /// Timestamp writes for the next pass.
-    pub fn writes(&mut self) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+    /// Timestamp writes for the next pass, counted to `stage`.
+    pub fn writes(&mut self, stage: usize) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
         self.used += 1;
-        self.inner.writes(0)
+        self.inner.writes(stage)
     }
 
     /// Most words [`RunTimer::end_submission`] and [`RunTimer::copy_rest`] copy.
     pub fn words(&self) -> u64 {
         4 * self.passes as u64
+    }
+
+    /// Whether the query set could not hold another submission's passes.
+    fn full(&self) -> bool {
+        self.used + self.per_submission > self.passes
     }
 
     /// Call after the last pass of a submission, in its encoder: when the query set is full,
@@ -164,7 +175,7 @@ impl RunTimer {
         rb: &crate::readback::Readback,
         dst_word: u64,
     ) -> u64 {
-        match self.used == self.passes {
+        match self.full() {
             true => self.inner.copy_pending(enc, rb, dst_word),
             false => 0,
         }
@@ -173,7 +184,7 @@ impl RunTimer {
     /// Call after waiting for the submission: adds the timestamps in `words` (what
     /// [`RunTimer::end_submission`] copied; they start a new query set) when the set was full.
     pub fn after_wait(&mut self, words: &[u32]) {
-        if self.used == self.passes {
+        if self.full() {
             self.inner.collect_words(words);
             self.used = 0;
         }
@@ -191,11 +202,11 @@ impl RunTimer {
         self.inner.copy_pending(enc, rb, dst_word)
     }
 
-    /// The GPU time of every timed pass, the rest read from `words` (what
-    /// [`RunTimer::copy_rest`] copied, after the wait).
-    pub fn finish(mut self, words: &[u32]) -> Option<f64> {
+    /// The GPU ms of every stage, the rest read from `words` (what [`RunTimer::copy_rest`]
+    /// copied, after the wait); their sum is the run's GPU time.
+    pub fn finish(mut self, words: &[u32]) -> Option<Vec<f64>> {
         self.inner.collect_words(words);
-        self.inner.stage_ms().map(|ms| ms[0])
+        self.inner.stage_ms()
     }
 }
 

@@ -305,8 +305,9 @@ pub struct RenderCmd {
     #[arg(long, value_name = "OUT.exr")]
     pub exr: Option<PathBuf>,
 
-    /// Multipass: time each procedure's passes on their own (the times go to --stats'
-    /// `gpu_ms_per_stage`; the extra pass boundaries add a little time, and rounds are not fused).
+    /// Multipass and multipass-host: time each procedure's passes on their own (the times go
+    /// to --stats' `gpu_ms_per_stage`; the extra pass boundaries add a little time, and the
+    /// device-driven multi-pass's rounds are not fused).
     #[arg(long)]
     pub stage_times: bool,
 

@@ -275,7 +275,7 @@ fn gpu_renderer(
     let strategy = a.render.strategy_for(gpu);
     if a.stage_times && strategy == StrategyKind::Megakernel {
         log::warn!(
-            "--stage-times: the megakernel's stages share one launch; only multipass times them apart"
+            "--stage-times: the megakernel's stages share one launch; only the multi-passes time them apart"
         );
     }
     let config = RendererConfig::new(strategy)

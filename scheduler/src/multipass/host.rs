@@ -53,6 +53,11 @@ pub struct HostMultipassConfig {
     /// graph search that runs again keeps its storage. `false` starts every run at
     /// `initial_capacity` (tests use it to exercise growth run after run).
     pub size_from_last_run: bool,
+    /// Time each procedure's dispatch as a pass of its own ([`RunStats::stage_gpu_ms`]: one
+    /// entry per procedure, then one for queue work, always 0 here: the host plans the rounds),
+    /// as `MultipassConfig::stage_timing` does for the device-driven multi-pass, so that the
+    /// two can be compared procedure by procedure. Default `false`: a round is one pass.
+    pub stage_timing: bool,
 }
 
 impl Default for HostMultipassConfig {
@@ -63,6 +68,7 @@ impl Default for HostMultipassConfig {
             max_rounds: 100_000,
             item_layout: None,
             size_from_last_run: true,
+            stage_timing: false,
         }
     }
 }
@@ -256,7 +262,13 @@ impl HostMultipass {
         // The caller's ranges follow the counts.
         let count_words = (nq + EXTRA_WORDS) as u64;
         let kept = self.readback.lock().unwrap().take();
-        let mut timer = RunTimer::new(gpu, 64);
+        // Timestamps come back once per 64 rounds: one pass a round, or with stage timing one
+        // per procedure (stages 0..nq; stage nq, queue work, has no pass here).
+        let stages = self.config.stage_timing;
+        let mut timer = match stages {
+            true => RunTimer::new(gpu, nq + 1, nq as u32, 64),
+            false => RunTimer::new(gpu, 1, 1, 64),
+        };
         let words = count_words + ranges_words(reads) + timer.words();
         let rb = Readback::reuse(kept, gpu, "round counts read-back", words);
         let cached = self.cache.lock().unwrap().take();
@@ -357,22 +369,32 @@ impl HostMultipass {
                 gpu.queue
                     .write_buffer(&d.counts[1 - par], 0, bytemuck::cast_slice(&carried));
             }
-            {
+            // One pass of the round's dispatches, or with stage timing one per procedure.
+            let dispatches: Vec<(usize, u32)> = run
+                .iter()
+                .enumerate()
+                .filter(|&(_, &k)| k > 0)
+                .map(|(q, &k)| {
+                    let per_step = self.program.procs[q].items_per_step;
+                    (q, k.div_ceil(per_step).min(MAX_WORKGROUPS_PER_DIMENSION))
+                })
+                .collect();
+            let passes: Vec<&[(usize, u32)]> = match stages {
+                true => dispatches.chunks(1).collect(),
+                false => vec![&dispatches[..]],
+            };
+            for group in passes {
+                let stage = if stages { group[0].0 } else { 0 };
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("multipass-host round"),
-                    timestamp_writes: timer.writes(),
+                    timestamp_writes: timer.writes(stage),
                 });
                 pass.set_bind_group(0, &d.bind[par], &[]);
                 if let Some(u) = user {
                     pass.set_bind_group(1, u, &[]);
                 }
-                for (q, &k) in run.iter().enumerate() {
-                    if k == 0 {
-                        continue;
-                    }
-                    let per_step = self.program.procs[q].items_per_step;
+                for &(q, wgs) in group {
                     pass.set_pipeline(&self.kernels.pipelines[q]);
-                    let wgs = k.div_ceil(per_step).min(MAX_WORKGROUPS_PER_DIMENSION);
                     pass.dispatch_workgroups(wgs, 1, 1);
                     stats.launches += 1;
                 }
@@ -432,7 +454,11 @@ impl HostMultipass {
             true => Vec::new(),
             false => split_ranges(&words[count_words as usize..], reads),
         };
-        stats.gpu_ms = timer.finish(words.get(at as usize..).unwrap_or(&[]));
+        let stage_ms = timer.finish(words.get(at as usize..).unwrap_or(&[]));
+        stats.gpu_ms = stage_ms.as_ref().map(|ms| ms.iter().sum());
+        if stages {
+            stats.stage_gpu_ms = stage_ms.unwrap_or_default();
+        }
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
         *self.cache.lock().unwrap() = Some(d);
         *self.readback.lock().unwrap() = Some(rb);
