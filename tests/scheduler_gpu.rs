@@ -1011,13 +1011,19 @@ fn multipass_stage_timing_keeps_results_and_splits_the_time_by_procedure() {
             assert_eq!(stats.stage_gpu_ms.len(), nq + 1, "{kind:?}: {stats:?}");
             assert!(stats.stage_gpu_ms.iter().all(|&t| t >= 0.0), "{stats:?}");
             // Every procedure ran, so each has time.
-            assert!(stats.stage_gpu_ms[..nq].iter().all(|&t| t > 0.0), "{stats:?}");
+            assert!(
+                stats.stage_gpu_ms[..nq].iter().all(|&t| t > 0.0),
+                "{stats:?}"
+            );
             if kind == StrategyKind::MultipassHost {
                 assert_eq!(stats.stage_gpu_ms[nq], 0.0, "{stats:?}");
                 assert!(untimed.stage_gpu_ms.is_empty(), "{untimed:?}");
             }
             let sum: f64 = stats.stage_gpu_ms.iter().sum();
-            assert!((sum - stats.gpu_ms.unwrap()).abs() < 1e-9, "{kind:?}: {stats:?}");
+            assert!(
+                (sum - stats.gpu_ms.unwrap()).abs() < 1e-9,
+                "{kind:?}: {stats:?}"
+            );
         }
     }
 }
