@@ -212,7 +212,7 @@ pub struct Executed {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(untagged)]
 pub enum StageTimes {
-    /// Every procedure timed apart (multi-pass with `--stage-times`).
+    /// Every procedure timed apart (either multi-pass with `--stage-times`).
     PerStage {
         /// GPU ms of Bound.
         bound: f64,
@@ -224,7 +224,8 @@ pub enum StageTimes {
         diceshade: f64,
         /// GPU ms of DiceSmall.
         dicesmall: f64,
-        /// Multi-pass's queue bookkeeping passes (counts, prefix sums, compaction).
+        /// The device-driven multi-pass's round planning (`mp_plan`); 0 for the host-driven
+        /// one, whose host plans the rounds.
         queue_work: f64,
         /// GPU ms of the resolve pass.
         resolve: Option<f64>,

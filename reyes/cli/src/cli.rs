@@ -305,9 +305,10 @@ pub struct RenderCmd {
     #[arg(long, value_name = "OUT.exr")]
     pub exr: Option<PathBuf>,
 
-    /// Multipass and multipass-host: time each procedure's passes on their own (the times go
-    /// to --stats' `gpu_ms_per_stage`; the extra pass boundaries add a little time, and the
-    /// device-driven multi-pass's rounds are not fused).
+    /// Multipass and multipass-host: time each procedure's passes on their own and print the
+    /// last run's times (also in --stats' `gpu_ms_per_stage`; the extra pass boundaries add a
+    /// little time, and the device-driven multi-pass's rounds are not fused). The megakernel's
+    /// stages share one launch: it warns and times the run as one.
     #[arg(long)]
     pub stage_times: bool,
 

@@ -23,7 +23,7 @@ use reyes::frame::{FrameData, SceneFeatures};
 use reyes::gpu_render::{GpuRenderer, RendererConfig};
 use reyes::image::FrameImage;
 use reyes::scene::Scene;
-use reyes::stats::{RunSummary, frame_stats};
+use reyes::stats::{RunSummary, StageTimes, frame_stats};
 use scheduler::{Gpu, StrategyKind};
 use std::process::ExitCode;
 
@@ -410,6 +410,9 @@ fn write_frame(
         let text = serde_json::to_string_pretty(&stats).unwrap();
         reyes::output::write_atomic(p, (text + "\n").as_bytes())?;
     }
+    if let Some(line) = stage_text(&stats.gpu_ms_per_stage) {
+        reyes_cli::progress::note(line);
+    }
     reyes_cli::progress::note(format!(
         "wrote {} ({}x{}, {}{}: {} grids, {} micropolygons, {})",
         out.image.display(),
@@ -428,6 +431,29 @@ fn write_frame(
         times_text(stats.runs.as_ref(), stats.gpu_ms, frame.wall_ms)
     ));
     Ok(())
+}
+
+/// With `--stage-times` (each procedure timed apart), the last frame's GPU ms per stage as one
+/// line, so that they are seen without `--stats`; `None` for a run timed as one.
+fn stage_text(stages: &StageTimes) -> Option<String> {
+    let StageTimes::PerStage {
+        bound,
+        splitu,
+        splitv,
+        diceshade,
+        dicesmall,
+        queue_work,
+        resolve,
+    } = stages
+    else {
+        return None;
+    };
+    let resolve = resolve.map_or("n/a".into(), |r| format!("{r:.3}"));
+    Some(format!(
+        "GPU ms per stage (last run): bound {bound:.3}, splitu {splitu:.3}, splitv {splitv:.3}, \
+         diceshade {diceshade:.3}, dicesmall {dicesmall:.3}, queue work {queue_work:.3}, \
+         resolve {resolve}"
+    ))
 }
 
 /// `--compare-to`: the image error of `image` against the reference, printed (stderr) and
@@ -532,5 +558,29 @@ mod tests {
             "GPU 1.500 ms, wall 9.0 ms"
         );
         assert_eq!(times_text(None, None, 9.0), "GPU n/a, wall 9.0 ms");
+    }
+
+    #[test]
+    fn stage_times_print_one_line_only_when_timed_apart() {
+        let apart = StageTimes::PerStage {
+            bound: 0.25,
+            splitu: 0.1,
+            splitv: 0.0926,
+            diceshade: 0.9,
+            dicesmall: 0.2,
+            queue_work: 0.0,
+            resolve: None,
+        };
+        assert_eq!(
+            stage_text(&apart).unwrap(),
+            "GPU ms per stage (last run): bound 0.250, splitu 0.100, splitv 0.093, diceshade \
+             0.900, dicesmall 0.200, queue work 0.000, resolve n/a"
+        );
+        let whole = StageTimes::Whole {
+            schedule: Some(1.0),
+            note: None,
+            resolve: Some(0.03),
+        };
+        assert_eq!(stage_text(&whole), None);
     }
 }
