@@ -22,6 +22,19 @@ fn small_tree(seed: u32) -> TreeParams {
     }
 }
 
+/// A chain of 151 rounds (fan-out 1, depth 150): more than the host-driven timer's query set
+/// holds (64 rounds of passes).
+fn chain_tree() -> TreeParams {
+    TreeParams {
+        roots: 3,
+        max_depth: 150,
+        fanout: Fanout::Fixed(1),
+        work: 1,
+        payload_words: 1,
+        seed: 5,
+    }
+}
+
 #[test]
 fn tree_matches_cpu_reference_on_every_strategy() {
     let gpu = gpu();
@@ -43,14 +56,7 @@ fn tree_matches_cpu_reference_on_every_strategy() {
 #[test]
 fn host_driven_timestamps_come_back_with_the_rounds() {
     let gpu = gpu();
-    let params = TreeParams {
-        roots: 3,
-        max_depth: 150,
-        fanout: Fanout::Fixed(1),
-        work: 1,
-        payload_words: 1,
-        seed: 5,
-    };
+    let params = chain_tree();
     let reference = params.reference();
     let run = TreeRun::new(&gpu, params).unwrap();
     let s = Scheduler::new(&gpu, &run.program, StrategyKind::MultipassHost, 1 << 10).unwrap();
@@ -971,15 +977,7 @@ fn device_driven_multipass_counts_its_rounds_and_dispatches() {
 #[test]
 fn multipass_stage_timing_keeps_results_and_splits_the_time_by_procedure() {
     let gpu = gpu();
-    let chain = TreeParams {
-        roots: 3,
-        max_depth: 150,
-        fanout: Fanout::Fixed(1),
-        work: 1,
-        payload_words: 1,
-        seed: 5,
-    };
-    for params in [small_tree(5), chain] {
+    for params in [small_tree(5), chain_tree()] {
         let reference = params.reference();
         let run = TreeRun::new(&gpu, params).unwrap();
         let nq = run.program.queue_count();
