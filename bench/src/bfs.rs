@@ -40,6 +40,10 @@ impl ScheduledProblem for BfsParams {
         workloads::bfs::megakernel_procedure_steps(gpu)
     }
 
+    fn guided_claims(gpu: &Gpu) -> bool {
+        workloads::bfs::megakernel_guided_claims(gpu)
+    }
+
     fn describe(&self) -> String {
         BfsParams::describe(self)
     }

@@ -142,7 +142,7 @@ pub struct GpuConfig {
     /// the default order.
     pub priority: Vec<String>,
     /// `MegakernelConfig::guided_claims`; `None`: the workload's choice
-    /// ([`GpuConfig::or_guided_claims`]; on for Reyes frames on GPUs, off elsewhere).
+    /// ([`GpuConfig::or_guided_claims`]; on for Reyes frames and BFS on GPUs, off elsewhere).
     pub guided_claims: Option<bool>,
     /// How the queues hold items (`MegakernelConfig::item_layout`); `None`: `ItemLayout::for_program`.
     pub item_layout: Option<ItemLayout>,

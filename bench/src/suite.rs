@@ -11,6 +11,7 @@ use crate::strategy::{GpuConfig, Strategy};
 use crate::workload::{Prepared, Workload};
 use crate::{plot, summary};
 use scheduler::Gpu;
+use scheduler::clocks::ClockKeeper;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -25,25 +26,18 @@ pub struct SuiteOptions {
     pub command: String,
 }
 
-/// Full GPU load before each GPU strategy's timed runs (`scheduler::clocks::raise_clocks`;
+/// Full GPU load before each GPU strategy's timed runs (`scheduler::clocks::ClockKeeper`;
 /// nothing on CPU adapters).
 pub const WARM_UP: Duration = Duration::from_millis(500);
 
-/// A run whose whole call (its read-back and the check against the CPU reference included)
-/// takes longer than this leaves the GPU idle long enough for its clocks to fall: on the H200,
-/// Killeroo 1080p's 1.2 ms frames, each followed by about 25 ms of checking, ran at the boost
-/// clock seven times and then at a quarter of it (docs/results.md, 2026-12-05 third session).
-pub const SLOW_CHECK: Duration = Duration::from_millis(5);
-
-/// Full GPU load before the next timed run after a [`SLOW_CHECK`] one (nothing on CPU
-/// adapters): the busy share of the GPU's time stays above a half, as during the warm-up.
-pub const KEEP_UP: Duration = Duration::from_millis(20);
-
 /// Runs a strategy once untimed (compilation, buffer sizing and the megakernel's probe are not
-/// the strategy's cost), raises the GPU's clocks, then `runs` timed, verified runs, raising
-/// the clocks again for [`KEEP_UP`] after each run slower than [`SLOW_CHECK`]. A run that
-/// fails ends the strategy's runs at this size with a failed record; an unverified warm-up
-/// run is recorded as a failure too.
+/// the strategy's cost), raises the GPU's clocks for [`WARM_UP`], then `runs` timed, verified
+/// runs, each after raising the clocks again where the checks since the last raise have left
+/// the GPU idle long enough for them to fall (`scheduler::clocks::ClockKeeper`: on the H100,
+/// Killeroo 1080p's 0.8 ms frames, each followed by about 300 ms of checking and 20 ms of load,
+/// fell from 1980 to 345 MHz 1.7 s after the warm-up; docs/results.md, 2026-12-05 (sixth
+/// session)). A run that fails ends the strategy's runs at this size with a failed record; an
+/// unverified warm-up run is recorded as a failure too.
 pub fn measure(
     gpu: &Gpu,
     w: &mut dyn Workload,
@@ -64,35 +58,33 @@ pub fn measure(
         Some(e) if !m.verified => Err(Error::WarmUpMismatch(e)),
         _ => Ok(()),
     });
-    let warm = warm.and_then(|()| {
+    let keeper = warm.and_then(|()| {
         if strategy.is_gpu() {
-            scheduler::clocks::raise_clocks(gpu, WARM_UP).map_err(Error::from)
+            ClockKeeper::new(gpu, WARM_UP)
+                .map(Some)
+                .map_err(Error::from)
         } else {
-            Ok(())
+            Ok(None)
         }
     });
-    if let Err(e) = warm {
-        return vec![RunRecord::failed(&key(0), e.to_string())];
-    }
+    let mut keeper = match keeper {
+        Ok(k) => k,
+        Err(e) => return vec![RunRecord::failed(&key(0), e.to_string())],
+    };
     let mut out = Vec::new();
     for run in 0..runs {
-        let start = Instant::now();
-        let result = w.run(gpu, strategy);
-        let slow = start.elapsed() > SLOW_CHECK;
-        match result {
+        if let Some(k) = keeper.as_mut()
+            && let Err(e) = k.keep_up()
+        {
+            out.push(RunRecord::failed(&key(run), e.to_string()));
+            break;
+        }
+        match w.run(gpu, strategy) {
             Ok(m) => out.push(RunRecord::new(&key(run), &m)),
             Err(e) => {
                 out.push(RunRecord::failed(&key(run), e.to_string()));
                 break;
             }
-        }
-        if slow
-            && strategy.is_gpu()
-            && run + 1 < runs
-            && let Err(e) = scheduler::clocks::raise_clocks(gpu, KEEP_UP)
-        {
-            out.push(RunRecord::failed(&key(run + 1), e.to_string()));
-            break;
         }
     }
     out

@@ -94,6 +94,11 @@ pub trait ScheduledProblem: Clone {
     fn procedure_steps(_gpu: &Gpu) -> Vec<(String, u32)> {
         Vec::new()
     }
+    /// Whether the workload's megakernel claims are guided by what is pending on `gpu`
+    /// (`GpuConfig::guided_claims` when the command line says neither way); default false.
+    fn guided_claims(_gpu: &Gpu) -> bool {
+        false
+    }
     /// Whether the megakernel keeps this problem's declared-local emits in the workgroup
     /// (`GpuConfig::local_queues` when the command line says neither way); default false.
     fn local_queues(&self) -> bool {
@@ -259,6 +264,7 @@ impl<P: ScheduledProblem> Workload for ProblemWorkload<P> {
                 if !schedulers.iter().any(|s| have(&s)) {
                     let config = (self.config.clone())
                         .or_procedure_steps(P::procedure_steps(gpu))
+                        .or_guided_claims(P::guided_claims(gpu))
                         .or_local_queues(local);
                     let s = compile(gpu, P::program(run), strategy, &config, capacity)?;
                     schedulers.push((name.clone(), capacity, local, s));

@@ -755,8 +755,10 @@ impl GpuRenderer {
     }
 
     /// Renders one frame (it compiles pipelines and sizes the queues), raises the GPU's clocks
-    /// for [`WARM_UP`], renders one more frame, then `runs` frames back to back, timing each;
-    /// `progress` advances by one after each timed frame.
+    /// for [`WARM_UP`], renders one more frame, then `runs` frames back to back, timing each,
+    /// raising the clocks again between them where the frames' host work has left the GPU idle
+    /// long enough for them to fall (`scheduler::clocks::ClockKeeper`); `progress` advances by
+    /// one after each timed frame.
     pub fn timed_frames(
         &self,
         gpu: &Gpu,
@@ -765,10 +767,11 @@ impl GpuRenderer {
         progress: &dyn Progress,
     ) -> Result<TimedFrames, RunError> {
         self.render(gpu, data)?;
-        scheduler::clocks::raise_clocks(gpu, WARM_UP)?;
+        let mut keeper = scheduler::clocks::ClockKeeper::new(gpu, WARM_UP)?;
         let mut last = self.render(gpu, data)?;
         let (mut gpu_ms, mut wall_ms) = (Vec::new(), Vec::new());
         for _ in 0..runs.max(1) {
+            keeper.keep_up()?;
             last = self.render(gpu, data)?;
             gpu_ms.push(last.run.gpu_ms.zip(last.resolve_gpu_ms).map(|(a, b)| a + b));
             wall_ms.push(last.wall_ms);

@@ -402,6 +402,17 @@ pub fn megakernel_procedure_steps(gpu: &scheduler::Gpu) -> Vec<(String, u32)> {
     vec![("bfs_vertex".into(), 16), ("bfs_edges".into(), 16)]
 }
 
+/// Whether the BFS megakernel's claims are guided by what is pending
+/// (`MegakernelConfig::guided_claims`): on GPUs, with [`megakernel_procedure_steps`]' 16-step
+/// batches. A level of a small graph has a few thousand items, which full batches of 512 hand
+/// to a few dozen workgroups while the rest poll; a claim of at most the workgroup's share of
+/// what is pending spreads them, and on a large graph batches stay full. H100, scale 16:
+/// 0.317 -> 0.124-0.147 ms (the device-driven multi-pass 0.155); scale 22: 2.28 -> 2.12
+/// (docs/results.md, 2026-12-05 (sixth session)). Off on lavapipe (one workgroup).
+pub fn megakernel_guided_claims(gpu: &scheduler::Gpu) -> bool {
+    !gpu.is_lavapipe()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
