@@ -427,6 +427,23 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
         };
         schedulers.push(("multipass, tiny queues".into(), tiny_multipass(true, None)));
         schedulers.push((
+            // At most two workgroups a procedure: a round's items go grid-stride, many steps
+            // a workgroup, with growth and partial rounds as above.
+            "multipass, two workgroups a procedure, tiny queues".into(),
+            Scheduler::multipass(
+                &gpu,
+                &tree.program,
+                MultipassConfig {
+                    rounds_per_submit: 3,
+                    initial_capacity: 16,
+                    size_from_last_run: false,
+                    max_workgroups: 2,
+                    ..Default::default()
+                },
+            )
+            .unwrap(),
+        ));
+        schedulers.push((
             "multipass".into(),
             Scheduler::new(&gpu, &tree.program, StrategyKind::Multipass, 1 << 12).unwrap(),
         ));

@@ -51,8 +51,14 @@ pub fn entry_points(program: &Program, groups: &DispatchGroups) -> Vec<String> {
 }
 
 /// The WGSL for `program` with its queues laid out as `items` (the same layout in the round
-/// buffers of every queue), its rounds dispatched as `groups`.
-pub fn source(program: &Program, items: ItemLayout, groups: &DispatchGroups) -> String {
+/// buffers of every queue), its rounds dispatched as `groups`, each procedure's share of a
+/// dispatch at most `max_workgroups` workgroups (`MultipassConfig::max_workgroups`).
+pub fn source(
+    program: &Program,
+    items: ItemLayout,
+    groups: &DispatchGroups,
+    max_workgroups: u32,
+) -> String {
     let args = "@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>";
     let nq = program.queue_count();
     let mut group_of = vec![0; nq];
@@ -85,7 +91,8 @@ pub fn source(program: &Program, items: ItemLayout, groups: &DispatchGroups) -> 
     // GROUP[q]: q's dispatch group; ORDER: the procedures group by group, each group's in the
     // order its dispatch's workgroups go to them (`mp_begin`).
     // STEP_SHIFT[q]: log2 of q's items per step (256 / threads per item, a power of two);
-    // MAX_WGS[q]: q's share of its group's dispatch, 65,535 / (procedures sharing it). Tables,
+    // MAX_WGS[q]: q's share of its group's dispatch, 65,535 / (procedures sharing it), at most
+    // `max_workgroups` (past it, grid-stride). Tables,
     // so that an append's test for a new step is a mask and a shift, not two divisions.
     let order: Vec<usize> = groups.concat();
     let per_step =
@@ -99,7 +106,10 @@ pub fn source(program: &Program, items: ItemLayout, groups: &DispatchGroups) -> 
         list(&|q| group_of[q]),
         list(&|i| order[i]),
         list(&|q| per_step(q).trailing_zeros() as usize),
-        list(&|q| MAX_WORKGROUPS_PER_DIMENSION as usize / groups[group_of[q]].len()),
+        list(&|q| {
+            (MAX_WORKGROUPS_PER_DIMENSION as usize / groups[group_of[q]].len())
+                .min(max_workgroups.max(1) as usize)
+        }),
     );
     s += TEMPLATE;
     // A group of several procedures, not all: a switch over their own loops.
