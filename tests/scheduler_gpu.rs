@@ -437,7 +437,7 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
                     rounds_per_submit: 3,
                     initial_capacity: 16,
                     size_from_last_run: false,
-                    max_workgroups: 2,
+                    max_workgroups: Some(2),
                     ..Default::default()
                 },
             )

@@ -90,12 +90,11 @@ pub struct MultipassConfig {
     /// over its items grid-stride. Every device-driven workgroup plans its round before its
     /// items (`mp_begin`), and each append that begins a step of its target's items adds a
     /// workgroup to the next round's arguments with an atomic: fewer workgroups, each with
-    /// more steps, pay both less often. Default 528 (four per SM of the H100 and H200's 132).
-    /// H100, against no cap (docs/results.md, 2026-12-05 (sixth session)): Killeroo 1920x1080
-    /// 1.208 -> 1.123 ms, teapot 0.868 -> 0.848, binary tree 0.190 -> 0.186, large payload
-    /// 0.618 -> 0.607, deep unchanged; 264 workgroups gave the frames the same, 1,056 less.
-    /// At least 1.
-    pub max_workgroups: u32,
+    /// more steps, pay both less often. `None` (the default): [`DEFAULT_MAX_WORKGROUPS`] on
+    /// GPUs; no cap on CPU adapters, where a workgroup's invocations are coroutines and
+    /// lavapipe cuts every loop of an invocation after 65,535 iterations in all (the items of
+    /// many steps would add up their bodies' loops; docs/scheduler.md 4). At least 1.
+    pub max_workgroups: Option<u32>,
 }
 
 impl Default for MultipassConfig {
@@ -111,12 +110,15 @@ impl Default for MultipassConfig {
             fused_rounds: None,
             fused_sinks_apart: false,
             fused_sinks_first: false,
-            max_workgroups: DEFAULT_MAX_WORKGROUPS,
+            max_workgroups: None,
         }
     }
 }
 
-/// [`MultipassConfig::max_workgroups`]' default.
+/// [`MultipassConfig::max_workgroups`] on GPUs: four per SM of the H100 and H200's 132. H100,
+/// against no cap (docs/results.md, 2026-12-05 (sixth session)): Killeroo 1920x1080 1.208 ->
+/// 1.123 ms, teapot 0.868 -> 0.848, binary tree 0.190 -> 0.186, large payload 0.618 -> 0.607,
+/// deep unchanged; 264 gave the frames the same, 1,056 less.
 pub const DEFAULT_MAX_WORKGROUPS: u32 = 528;
 
 /// The dispatch groups of `program`'s rounds: every procedure alone without `fused`; with it
@@ -216,7 +218,12 @@ impl Multipass {
         config.fused_sinks_apart = fused && groups.len() == 2;
         config.fused_sinks_first =
             fused && groups.len() == 1 && groups[0].iter().copied().ne(0..program.queue_count());
-        let source = wgsl::source(program, items, &groups, config.max_workgroups);
+        let max_workgroups = (config.max_workgroups).unwrap_or(if gpu.is_cpu_adapter() {
+            u32::MAX
+        } else {
+            DEFAULT_MAX_WORKGROUPS
+        });
+        let source = wgsl::source(program, items, &groups, max_workgroups);
         let entries: Vec<_> = (0..4).map(|b| storage_entry(b, b == 3)).collect();
         let names = wgsl::entry_points(program, &groups);
         let group_pipelines = (0..groups.len())
