@@ -158,6 +158,13 @@ var<workgroup> wg_cnt: array<u32, NQ>;
 var<workgroup> wg_wgs: array<u32, NQ>;
 var<workgroup> wg_worst: array<u32, NQ>;
 var<workgroup> wg_flags: atomic<u32>;
+// Lane 0's plan: the inputs each queue runs this round (its count, or fewer in a partial
+// round), and a partial round's room used per target. In workgroup memory, not in lane 0's
+// private arrays: the driver sized every kernel's registers for the plan's unrolled loops
+// (DiceShade's entry point 124 registers with it, 64 without; docs/results.md, 2026-12-05
+// (sixth session)), though the plan runs once per workgroup in one lane.
+var<workgroup> wg_run: array<u32, NQ>;
+var<workgroup> wg_used: array<u32, NQ>;
 
 // Lane 0: the round's plan from `wg_cnt`, `wg_worst` and `flags` (the serial part only when a
 // round is partial or refused), then workgroup `w` of dispatch group `g`'s procedure (the
@@ -171,12 +178,8 @@ fn plan_round(w: u32, g: u32, flags: u32) {
     let chunk = wg_words[6u * NQ + 2u];
     let k = mp_k.x;
     let win = (base + k) % 3u;
-    var run: array<u32, NQ>;
     var total = 0u;
-    for (var q = 0u; q < NQ; q++) {
-        run[q] = wg_cnt[q];
-        total += run[q];
-    }
+    for (var q = 0u; q < NQ; q++) { total += wg_cnt[q]; }
     var ok = halt == 0u;
     let partial = (flags & 1u) != 0u;
     var over = (flags & 2u) != 0u;
@@ -204,26 +207,25 @@ fn plan_round(w: u32, g: u32, flags: u32) {
         }
         // Last procedure first: each runs as many inputs as keep every target within half its
         // capacity, and at least one when one fits (partial.rs says why).
-        var used: array<u32, NQ>;
-        for (var t = 0u; t < NQ; t++) { used[t] = run[t]; }
+        for (var t = 0u; t < NQ; t++) { wg_used[t] = wg_run[t]; }
         var any = false;
         for (var i = 0u; i < NQ; i++) {
             let p = NQ - 1u - i;
-            var hard = run[p];
-            var soft = run[p];
+            var hard = wg_run[p];
+            var soft = wg_run[p];
             for (var t = 0u; t < NQ; t++) {
                 let grow = EMITS[p * NQ + t];
                 let shrink = select(0u, 1u, t == p);
                 if grow > shrink {
-                    hard = min(hard, (q_cap(t) - used[t]) / (grow - shrink));
+                    hard = min(hard, (q_cap(t) - wg_used[t]) / (grow - shrink));
                     let half = q_cap(t) / 2u;
-                    soft = min(soft, select(0u, half - used[t], half > used[t]) / (grow - shrink));
+                    soft = min(soft, select(0u, half - wg_used[t], half > wg_used[t]) / (grow - shrink));
                 }
             }
             let r = max(soft, min(hard, 1u));
-            run[p] = r;
-            for (var t = 0u; t < NQ; t++) { used[t] += r * EMITS[p * NQ + t]; }
-            used[p] -= r;
+            wg_run[p] = r;
+            for (var t = 0u; t < NQ; t++) { wg_used[t] += r * EMITS[p * NQ + t]; }
+            wg_used[p] -= r;
             any = any || r > 0u;
         }
         over = !any;
@@ -257,8 +259,8 @@ fn plan_round(w: u32, g: u32, flags: u32) {
         if ok {
             for (var q = 0u; q < NQ; q++) {
                 atomicMax(&mp_ctrl[cw(q, C_PEAK)], wg_cnt[q]);
-                atomicAdd(&mp_ctrl[cw(q, C_EXEC)], run[q]);
-                let keep = wg_cnt[q] - run[q];
+                atomicAdd(&mp_ctrl[cw(q, C_EXEC)], wg_run[q]);
+                let keep = wg_cnt[q] - wg_run[q];
                 // The carried inputs lead the next round's; its appends go after them.
                 atomicStore(&mp_ctrl[cw(q, C_CARRY + next)], keep);
                 atomicStore(&mp_ctrl[cw(q, C_APPEND + (win + 2u) % 3u)], 0u);
@@ -277,7 +279,7 @@ fn plan_round(w: u32, g: u32, flags: u32) {
             atomicMax(&mp_ctrl[gw(G_RAN)], nk);
         }
     }
-    for (var t = 0u; t < NQ; t++) { wg_plan[W_KEEP + t] = wg_cnt[t] - run[t]; }
+    for (var t = 0u; t < NQ; t++) { wg_plan[W_KEEP + t] = wg_cnt[t] - wg_run[t]; }
     wg_plan[W_WIN] = next;
     wg_plan[W_K] = nk;
     wg_plan[W_CHUNK] = chunk;
@@ -285,7 +287,7 @@ fn plan_round(w: u32, g: u32, flags: u32) {
     // the sizes rule out) gets its group's last procedure with no inputs.
     let found = ok && pick < NQ;
     let q = select(min(pick, NQ - 1u), pick, found);
-    wg_pick = Pick(q, w - first, select(0u, wg_cnt[q], found), wg_cnt[q] - run[q], wg_wgs[q]);
+    wg_pick = Pick(q, w - first, select(0u, wg_cnt[q], found), wg_cnt[q] - wg_run[q], wg_wgs[q]);
 }
 
 // The start of every workgroup of a round: lanes load the round's words at once (one round
@@ -311,6 +313,7 @@ fn mp_begin(lid: u32, w: u32, g: u32) -> Pick {
             m += n * EMITS[p * NQ + lid];
             if p == lid {
                 wg_cnt[lid] = n;
+                wg_run[lid] = n;
                 wg_wgs[lid] = wgs_for(lid, n);
             }
         }
