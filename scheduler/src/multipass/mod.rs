@@ -118,7 +118,8 @@ impl Default for MultipassConfig {
 /// [`MultipassConfig::max_workgroups`] on GPUs: four per SM of the H100 and H200's 132. H100,
 /// against no cap (docs/results.md, 2026-12-05 (sixth session)): Killeroo 1920x1080 1.208 ->
 /// 1.123 ms, teapot 0.868 -> 0.848, binary tree 0.190 -> 0.186, large payload 0.618 -> 0.607,
-/// deep unchanged; 264 gave the frames the same, 1,056 less.
+/// deep unchanged; 264 gave the frames the same, 1,056 less (measured before the round plan
+/// left lane 0's registers, `084b9cd`, which took the frames to 0.865 and 0.704 with it).
 pub const DEFAULT_MAX_WORKGROUPS: u32 = 528;
 
 /// The dispatch groups of `program`'s rounds: every procedure alone without `fused`; with it
