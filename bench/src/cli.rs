@@ -213,9 +213,10 @@ pub struct Cli {
 
     /// Megakernel claims take at most the workgroup's share of the pending items,
     /// ceil(pending / workgroups), one step's worth at least: guided self-scheduling
-    /// (`MegakernelConfig::guided_claims`). Default: the workload's choice, on for Reyes frames
-    /// on a GPU, as `reyes render` runs them (`reyes::gpu_render::megakernel_guided_claims`),
-    /// off elsewhere.
+    /// (`MegakernelConfig::guided_claims`). Default: the workload's choice, on a GPU on for
+    /// Reyes frames, as `reyes render` runs them (`reyes::gpu_render::megakernel_guided_claims`),
+    /// and for BFS (`workloads::bfs::megakernel_guided_claims`); off elsewhere and on CPU
+    /// adapters.
     #[arg(long, help_heading = "Scheduler", conflicts_with = "no_guided_claims")]
     pub guided_claims: bool,
 
@@ -238,6 +239,12 @@ pub struct Cli {
     /// such as lavapipe (docs/scheduler.md 5.1).
     #[arg(long, value_enum, default_value = "auto", help_heading = "Scheduler")]
     pub fused_rounds: FusedRounds,
+
+    /// Most workgroups of a procedure in one round of the device-driven multi-pass
+    /// (`MultipassConfig::max_workgroups`); past it the workgroups take the items grid-stride.
+    /// Default: 528 on GPUs, no cap on CPU adapters such as lavapipe (docs/scheduler.md 5.1).
+    #[arg(long, value_name = "WORKGROUPS", help_heading = "Scheduler", value_parser = clap::value_parser!(u32).range(1..))]
+    pub max_workgroups: Option<u32>,
 }
 
 /// `--fused-rounds`: how the device-driven multi-pass dispatches a round.
@@ -489,6 +496,7 @@ impl Cli {
             },
             fused_sinks_apart: self.fused_rounds == FusedRounds::SinksApart,
             fused_sinks_first: self.fused_rounds == FusedRounds::SinksFirst,
+            max_workgroups: self.max_workgroups,
         }
     }
 }

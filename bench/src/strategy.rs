@@ -167,6 +167,8 @@ pub struct GpuConfig {
     pub fused_sinks_apart: bool,
     /// `MultipassConfig::fused_sinks_first` (default `false`).
     pub fused_sinks_first: bool,
+    /// `MultipassConfig::max_workgroups`; `None`: by adapter.
+    pub max_workgroups: Option<u32>,
 }
 
 impl Default for GpuConfig {
@@ -190,6 +192,7 @@ impl Default for GpuConfig {
             fused_rounds: None,
             fused_sinks_apart: false,
             fused_sinks_first: false,
+            max_workgroups: None,
         }
     }
 }
@@ -275,6 +278,7 @@ pub fn compile(
                 fused_rounds: config.fused_rounds,
                 fused_sinks_apart: config.fused_sinks_apart,
                 fused_sinks_first: config.fused_sinks_first,
+                max_workgroups: config.max_workgroups,
                 ..Default::default()
             },
         ),

@@ -307,8 +307,10 @@ pub struct RenderCmd {
 
     /// Multipass and multipass-host: time each procedure's passes on their own and print the
     /// last run's times (also in --stats' `gpu_ms_per_stage`; the extra pass boundaries add a
-    /// little time, and the device-driven multi-pass's rounds are not fused). The megakernel's
-    /// stages share one launch: it warns and times the run as one.
+    /// little time, and the device-driven multi-pass's rounds are not fused; "queue work" is
+    /// the device-driven multi-pass's one-thread plan before each submission's rounds, 0 for
+    /// the host-driven one, whose host plans the rounds). The megakernel's stages share one
+    /// launch: it warns and times the run as one.
     #[arg(long)]
     pub stage_times: bool,
 
