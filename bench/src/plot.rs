@@ -236,6 +236,7 @@ mod tests {
             queue_order: None,
             indirect_validation: None,
             round_dispatch: None,
+            max_workgroups: None,
             idle_polls: 0,
             abandoned: 0,
             queue_growths: 0,

@@ -78,6 +78,11 @@ pub struct RunRecord {
     /// the adapter); absent for the others.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub round_dispatch: Option<String>,
+    /// Device-driven multi-pass: most workgroups of a procedure a round
+    /// (`RunStats::max_workgroups`, `--max-workgroups` resolved for the adapter); absent for
+    /// the others and where there is no cap.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_workgroups: Option<u32>,
     pub idle_polls: u64,
     pub abandoned: u64,
     pub queue_growths: u64,
@@ -141,6 +146,7 @@ impl RunRecord {
             indirect_validation: matches!(k.strategy.name().as_str(), "multipass" | "frontier")
                 .then(scheduler::gpu::indirect_validation),
             round_dispatch: (!s.round_dispatch.is_empty()).then(|| s.round_dispatch.clone()),
+            max_workgroups: s.max_workgroups,
             ..Self::failed(k, String::new())
         }
     }
@@ -177,6 +183,7 @@ impl RunRecord {
             queue_order: None,
             indirect_validation: None,
             round_dispatch: None,
+            max_workgroups: None,
             idle_polls: 0,
             abandoned: 0,
             queue_growths: 0,

@@ -193,8 +193,11 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
                 .round_dispatch
                 .as_ref()
                 .map_or(String::new(), |d| format!(", {d} rounds"));
+            let cap = r.max_workgroups.map_or(String::new(), |n| {
+                format!(", at most {n} workgroups a procedure")
+            });
             let line = format!(
-                "{}: {l} items{e}{w}{local}{guided}{order}{rounds}",
+                "{}: {l} items{e}{w}{local}{guided}{order}{rounds}{cap}",
                 r.strategy
             );
             if !queues.contains(&line) {

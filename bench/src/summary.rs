@@ -428,6 +428,7 @@ mod tests {
             queue_order: None,
             indirect_validation: None,
             round_dispatch: None,
+            max_workgroups: None,
             idle_polls: 50,
             abandoned: 0,
             queue_growths: 0,

@@ -15,6 +15,10 @@ pub struct RunStats {
     /// resolved for the adapter (`fused`, `per-procedure`, `sinks-apart` or `sinks-first`;
     /// `MultipassConfig::fused_rounds` and its companions); empty for the other strategies.
     pub round_dispatch: String,
+    /// Device-driven multi-pass: most workgroups of a procedure a round
+    /// (`MultipassConfig::max_workgroups` resolved for the adapter); `None` for the other
+    /// strategies and where there is no cap (CPU adapters).
+    pub max_workgroups: Option<u32>,
     /// Items executed, per procedure (program order).
     pub executed: Vec<u64>,
     /// Multi-pass: rounds that ran some work.
@@ -103,6 +107,7 @@ impl RunStats {
         self.local_items += o.local_items;
         self.local_queues |= o.local_queues;
         self.guided_claims |= o.guided_claims;
+        self.max_workgroups = self.max_workgroups.or(o.max_workgroups);
         if self.queue_order.is_empty() {
             self.queue_order = o.queue_order.clone();
         }

@@ -219,11 +219,12 @@ impl Multipass {
         config.fused_sinks_apart = fused && groups.len() == 2;
         config.fused_sinks_first =
             fused && groups.len() == 1 && groups[0].iter().copied().ne(0..program.queue_count());
-        let max_workgroups = (config.max_workgroups).unwrap_or(if gpu.is_cpu_adapter() {
-            u32::MAX
-        } else {
-            DEFAULT_MAX_WORKGROUPS
-        });
+        config.max_workgroups = match config.max_workgroups {
+            None if gpu.is_cpu_adapter() => None,
+            None => Some(DEFAULT_MAX_WORKGROUPS),
+            Some(n) => Some(n.max(1)),
+        };
+        let max_workgroups = config.max_workgroups.unwrap_or(u32::MAX);
         let source = wgsl::source(program, items, &groups, max_workgroups);
         let entries: Vec<_> = (0..4).map(|b| storage_entry(b, b == 3)).collect();
         let names = wgsl::entry_points(program, &groups);
@@ -597,6 +598,7 @@ impl Multipass {
             strategy: "multipass".into(),
             item_layout: self.item_layout().name().into(),
             round_dispatch: self.round_dispatch().into(),
+            max_workgroups: self.config.max_workgroups,
             executed: vec![0; nq],
             peak_occupancy: vec![0; nq],
             ..Default::default()

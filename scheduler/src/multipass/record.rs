@@ -25,6 +25,8 @@ pub(crate) struct RecordedRounds {
     dispatches_per_round: u64,
     /// [`Multipass::round_dispatch`].
     round_dispatch: &'static str,
+    /// `MultipassConfig::max_workgroups` as resolved.
+    max_workgroups: Option<u32>,
 }
 
 impl Multipass {
@@ -82,6 +84,7 @@ impl Multipass {
                 item_layout: self.item_layout(),
                 dispatches_per_round: self.dispatches_per_round(),
                 round_dispatch: self.round_dispatch(),
+                max_workgroups: self.config.max_workgroups,
             },
             capacity,
         ))
@@ -164,6 +167,7 @@ impl RecordedRounds {
             strategy: "multipass".into(),
             item_layout: self.item_layout.name().into(),
             round_dispatch: self.round_dispatch.into(),
+            max_workgroups: self.max_workgroups,
             executed: (0..nq).map(|q| ctrl[c(q, C_EXEC)] as u64).collect(),
             peak_occupancy: (0..nq).map(|q| ctrl[c(q, C_PEAK)] as u64).collect(),
             rounds: ctrl[g(nq, G_ROUNDS)] as u64,
