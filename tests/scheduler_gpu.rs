@@ -410,7 +410,7 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
         assert_eq!(subgroups.contains(&true), gpu.subgroups, "{subgroups:?}");
         // Device-driven multi-passes that start every run at 16 slots: growth and partial
         // rounds in most runs.
-        let tiny_multipass = |fused_rounds, item_layout| {
+        let tiny_multipass = |fused_rounds, item_layout, max_workgroups| {
             Scheduler::multipass(
                 &gpu,
                 &tree.program,
@@ -418,30 +418,23 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
                     rounds_per_submit: 3,
                     initial_capacity: 16,
                     size_from_last_run: false,
-                    fused_rounds: Some(fused_rounds),
+                    fused_rounds,
                     item_layout,
+                    max_workgroups,
                     ..Default::default()
                 },
             )
             .unwrap()
         };
-        schedulers.push(("multipass, tiny queues".into(), tiny_multipass(true, None)));
+        schedulers.push((
+            "multipass, tiny queues".into(),
+            tiny_multipass(Some(true), None, None),
+        ));
         schedulers.push((
             // At most two workgroups a procedure: a round's items go grid-stride, many steps
             // a workgroup, with growth and partial rounds as above.
             "multipass, two workgroups a procedure, tiny queues".into(),
-            Scheduler::multipass(
-                &gpu,
-                &tree.program,
-                MultipassConfig {
-                    rounds_per_submit: 3,
-                    initial_capacity: 16,
-                    size_from_last_run: false,
-                    max_workgroups: Some(2),
-                    ..Default::default()
-                },
-            )
-            .unwrap(),
+            tiny_multipass(None, None, Some(2)),
         ));
         schedulers.push((
             "multipass".into(),
@@ -451,7 +444,7 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
             // One dispatch per procedure (the tiny ones above and the planar one fuse each
             // round's procedures into one dispatch), growth and partial rounds as above.
             "multipass, a dispatch per procedure, tiny queues".into(),
-            tiny_multipass(false, None),
+            tiny_multipass(Some(false), None, None),
         ));
         schedulers.push((
             "multipass-host, tiny queues".into(),
@@ -474,7 +467,7 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
             // Planar items: carried inputs copied word by word, growth moves them plane by
             // plane on the device.
             "multipass, planar items, tiny queues".into(),
-            tiny_multipass(true, Some(ItemLayout::Planar)),
+            tiny_multipass(Some(true), Some(ItemLayout::Planar), None),
         ));
         schedulers.push((
             "multipass-host, planar items, tiny queues".into(),
