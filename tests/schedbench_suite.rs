@@ -5,7 +5,8 @@
 
 use serde_json::Value;
 use std::collections::BTreeSet;
-use std::process::Command;
+use std::io::{BufRead, BufReader};
+use std::process::{Command, Stdio};
 
 /// Strategies every workload runs under (scheduler strategies with the megakernel once per
 /// queue policy, and the CPU implementation); `--strategy` names as in the records.
@@ -412,4 +413,29 @@ fn dumped_wgsl_modules_are_whole() {
         names.iter().any(|n| n == "megakernel.wgsl"),
         "dumped: {names:?}"
     );
+}
+
+/// A reader that leaves early (`schedbench ... --json | head -1`) closes the pipe: the output
+/// ends there, but the runs go on to their end and the exit status is theirs (0: every run
+/// verified), not a panic's 101. 2,000 records are far more than a pipe's buffer holds, so
+/// schedbench writes into the closed pipe.
+#[test]
+fn a_closed_pipe_ends_the_output_not_the_run() {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_schedbench"))
+        .args(["--workload", "tree", "--strategy", "cpu", "--roots", "1"])
+        .args(["--depth", "3", "--runs", "2000", "--json"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("schedbench runs");
+    let mut first = String::new();
+    let mut reader = BufReader::new(child.stdout.take().unwrap());
+    reader.read_line(&mut first).unwrap();
+    let r: Value = serde_json::from_str(&first).unwrap();
+    assert_eq!(r["verified"], true, "{first}");
+    drop(reader);
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
 }

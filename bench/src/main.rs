@@ -77,6 +77,8 @@ fn main() -> ExitCode {
         single::run(&cli)
     };
     match result {
+        // A table or record that could not be written (reported when it failed).
+        Ok(true) if reyes_cli::stdout::failed() => ExitCode::FAILURE,
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => {
             log::error!("some run failed or did not match the CPU reference");

@@ -99,7 +99,11 @@ pub fn run(cli: &Cli) -> Result<bool, Error> {
     for s in &strategies {
         for r in measure(&gpu, w.as_mut(), s, &prepared, runs) {
             if cli.json {
-                println!("{}", serde_json::to_string(&r).expect("records serialise"));
+                reyes_cli::outln!(
+                    "schedbench",
+                    "{}",
+                    serde_json::to_string(&r).expect("records serialise")
+                );
             }
             if let Some(e) = r.error.as_ref().filter(|_| !r.verified) {
                 log::error!("{} run {}: {e}", r.strategy, r.run);
@@ -127,7 +131,8 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
     let Some((workload, cs)) = cells(records).into_iter().next() else {
         return;
     };
-    println!(
+    reyes_cli::outln!(
+        "schedbench",
         "adapter: {} (wgpu's indirect-call validation {})\nworkload: {workload} {params}\n\
          reference: {problem_items} items",
         gpu.adapter_name(),
@@ -137,7 +142,8 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
             "off"
         }
     );
-    println!(
+    reyes_cli::outln!(
+        "schedbench",
         "{:<16} {:>10} {:>8} {:>20} {:>20} {:>11} {:>8} {:>7}",
         "strategy",
         "items",
@@ -150,7 +156,8 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
     );
     let fmt = |t: Option<(f64, f64)>| t.map_or("n/a".into(), |(m, d)| format!("{m:.3} ± {d:.3}"));
     for c in &cs {
-        println!(
+        reyes_cli::outln!(
+            "schedbench",
             "{:<16} {:>10} {:>8} {:>20} {:>20} {:>11} {:>8} {:>7}",
             c.strategy,
             c.items,
@@ -206,14 +213,18 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
         }
     }
     if !queues.is_empty() {
-        println!("queues: {}", queues.join("; "));
+        reyes_cli::outln!("schedbench", "queues: {}", queues.join("; "));
     }
-    println!("G items/s: items per GPU time; for runs without GPU time (cpu), per wall time");
+    reyes_cli::outln!(
+        "schedbench",
+        "G items/s: items per GPU time; for runs without GPU time (cpu), per wall time"
+    );
     // GPU time against the first strategy's (the megakernel's when it ran), as before.
     let gpu_timed: Vec<_> = cs.iter().filter_map(|c| c.gpu.map(|g| (c, g.0))).collect();
     if let Some(((first, a), rest)) = gpu_timed.split_first() {
         for (c, b) in rest {
-            println!(
+            reyes_cli::outln!(
+                "schedbench",
                 "ratio {}/{} GPU time: {:.2}x (medians of this invocation)",
                 c.strategy,
                 first.strategy,
@@ -226,7 +237,8 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
     if let Some(best) = best_baseline(&refs) {
         for c in cs.iter().filter(|c| c.megakernel) {
             if let Some(w) = c.wall {
-                println!(
+                reyes_cli::outln!(
+                    "schedbench",
                     "{} wall time / best baseline ({}): {:.2}x",
                     c.strategy,
                     best.strategy,
@@ -258,8 +270,12 @@ fn print_turn_anatomy(records: &[RunRecord]) {
         let r = runs[runs.len() / 2];
         let pairs = r.turn_anatomy.iter().map(|(n, c)| (n.as_str(), *c));
         if let Some(a) = scheduler::megakernel::anatomy::TurnAnatomy::from_named(pairs) {
-            println!("{name}, run {} (median time):", r.run);
-            print!("{}", a.table(r.batches, r.workgroups, r.gpu_ms));
+            reyes_cli::outln!("schedbench", "{name}, run {} (median time):", r.run);
+            reyes_cli::out!(
+                "schedbench",
+                "{}",
+                a.table(r.batches, r.workgroups, r.gpu_ms)
+            );
         }
     }
 }

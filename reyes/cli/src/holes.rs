@@ -78,14 +78,15 @@ pub fn main(a: HolesCmd) -> Result<(), CliError> {
         holes: holes(&frame.image, &reference, f.spp_x * f.spp_y),
     };
     if a.json {
-        println!("{}", serde_json::to_string(&report)?);
+        reyes_cli::outln!("reyes", "{}", serde_json::to_string(&report)?);
     } else {
         let r = &report;
         if !a.no_header {
-            println!("{HOLES_COLUMNS}");
-            println!("{}", markdown_rule(HOLES_COLUMNS));
+            reyes_cli::outln!("reyes", "{HOLES_COLUMNS}");
+            reyes_cli::outln!("reyes", "{}", markdown_rule(HOLES_COLUMNS));
         }
-        println!(
+        reyes_cli::outln!(
+            "reyes",
             "| {} | {} | {}x{} | {}x{} | {} | {} | {} | {} | {} | {} | {:.4} |",
             r.scene,
             r.raster,

@@ -527,6 +527,8 @@ fn main() -> ExitCode {
         Command::Devices => multi::list_devices(),
     };
     match result {
+        // A table or report that could not be written (reported when it failed).
+        Ok(()) if reyes_cli::stdout::failed() => ExitCode::FAILURE,
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("reyes {name}: {e}");

@@ -82,10 +82,10 @@ pub fn main(a: MeasureCmd) -> Result<(), CliError> {
     };
     let out = serde_json::to_value(m.report())?;
     if json {
-        println!("{out}");
+        reyes_cli::outln!("reyes", "{out}");
     } else {
         for (k, v) in out.as_object().into_iter().flatten() {
-            println!("{k:>32}: {v}");
+            reyes_cli::outln!("reyes", "{k:>32}: {v}");
         }
     }
     Ok(())
