@@ -73,10 +73,19 @@ fn host_driven_timestamps_come_back_with_the_rounds() {
 
 /// Waits that poll before they block (`Gpu::spin_wait`) see the same runs finish: exact
 /// results on every strategy, whether the spin outlasts the work (a long spin) or runs out
-/// first and the wait blocks (a spin of one microsecond).
+/// first and the wait blocks (a spin of one microsecond). Unless `SCHED_SPIN_WAIT_US` says
+/// otherwise a GPU polls for `DEFAULT_SPIN_WAIT` and a CPU adapter (lavapipe), whose work
+/// needs the cores, not at all.
 #[test]
 fn waits_that_poll_first_keep_every_result() {
     let mut gpu = gpu();
+    if std::env::var_os(scheduler::gpu::SPIN_WAIT_ENV).is_none() {
+        let expected = match gpu.info.device_type {
+            wgpu::DeviceType::Cpu => std::time::Duration::ZERO,
+            _ => scheduler::gpu::DEFAULT_SPIN_WAIT,
+        };
+        assert_eq!(gpu.spin_wait, expected, "{}", gpu.adapter_name());
+    }
     let params = small_tree(11);
     let reference = params.reference();
     let run = TreeRun::new(&gpu, params).unwrap();

@@ -19,18 +19,32 @@ pub const MAX_WORKGROUPS_PER_DIMENSION: u32 = 65_535;
 /// Generous, because lavapipe on two cores is slow; a real GPU finishes in milliseconds.
 pub const DEFAULT_GPU_TIMEOUT: Duration = Duration::from_secs(120);
 
-/// Microseconds a wait polls before it blocks ([`Gpu::spin_wait`]); unset or 0: none.
+/// Microseconds a wait polls before it blocks ([`Gpu::spin_wait`]); 0: none; unset: the
+/// adapter's default ([`DEFAULT_SPIN_WAIT`] on a GPU, none on a CPU adapter).
 pub const SPIN_WAIT_ENV: &str = "SCHED_SPIN_WAIT_US";
 
-fn spin_wait_from_env() -> Duration {
+/// How long a wait polls before it blocks on a GPU unless [`SPIN_WAIT_ENV`] says otherwise.
+/// Blocking at once costs a short run the wake-up of a blocked thread: on an H100 (driver
+/// 580.159.04) the megakernel's tree and BFS runs of 0.08-1.03 GPU ms took 0.07-0.19 ms less
+/// wall time polling first for up to 1 ms, and the host-driven multi-pass, which waits once a
+/// round, 14-49% less (docs/results.md, 2026-12-05, seventh session). A wait that outlasts
+/// the spin then blocks, so a long run costs one core for 1 ms at most.
+pub const DEFAULT_SPIN_WAIT: Duration = Duration::from_millis(1);
+
+/// The spin of [`SPIN_WAIT_ENV`], else `default`; a value that is not a count of
+/// microseconds is reported and the default kept.
+fn spin_wait_from_env(default: Duration) -> Duration {
     let Ok(v) = std::env::var(SPIN_WAIT_ENV) else {
-        return Duration::ZERO;
+        return default;
     };
     match v.trim().parse() {
         Ok(us) => Duration::from_micros(us),
         Err(_) => {
-            log::warn!("{SPIN_WAIT_ENV}={v:?} is not a count of microseconds: waits block at once");
-            Duration::ZERO
+            log::warn!(
+                "{SPIN_WAIT_ENV}={v:?} is not a count of microseconds: the default, {} us",
+                default.as_micros()
+            );
+            default
         }
     }
 }
@@ -99,10 +113,11 @@ pub struct Gpu {
     /// Bound of every wait for the GPU ([`DEFAULT_GPU_TIMEOUT`] unless changed): a wait that
     /// runs out is a [`RunError::Timeout`].
     pub timeout: Duration,
-    /// How long a wait polls the device before it blocks ([`SPIN_WAIT_ENV`], else zero: it
-    /// blocks at once). Polling costs a CPU core for that long but sees the work finish
-    /// without the wake-up of a blocked thread, which matters for runs of well under a
-    /// millisecond; on a CPU adapter it takes a core from the work it waits for.
+    /// How long a wait polls the device before it blocks ([`SPIN_WAIT_ENV`], else
+    /// [`DEFAULT_SPIN_WAIT`] on a GPU and zero, blocking at once, on a CPU adapter). Polling
+    /// costs a CPU core for that long but sees the work finish without the wake-up of a
+    /// blocked thread, which matters for runs of well under a millisecond; on a CPU adapter it
+    /// would take a core from the work it waits for.
     pub spin_wait: Duration,
     /// wgpu errors not captured by an error scope (validation, out of memory), in order. wgpu's
     /// default handler panics; this device records them instead and [`Gpu::wait`] reports the
@@ -223,6 +238,11 @@ impl Gpu {
                 .unwrap_or_else(|p| p.into_inner())
                 .push(e.to_string());
         }));
+        // A CPU adapter's work needs the cores a spin would take.
+        let spin_wait = spin_wait_from_env(match info.device_type {
+            wgpu::DeviceType::Cpu => Duration::ZERO,
+            _ => DEFAULT_SPIN_WAIT,
+        });
         Ok(Gpu {
             uncaptured,
             coherent: features.contains(wgpu::Features::MEMORY_DECORATION_COHERENT),
@@ -233,7 +253,7 @@ impl Gpu {
             queue,
             info,
             timeout: DEFAULT_GPU_TIMEOUT,
-            spin_wait: spin_wait_from_env(),
+            spin_wait,
             loops_trusted: false,
             submitted: AtomicU64::new(0),
         })
