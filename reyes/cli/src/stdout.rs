@@ -43,8 +43,8 @@ pub fn failed() -> bool {
     STATE.load(Ordering::Relaxed) == FAILED
 }
 
-/// `println!` through [`write`]: `outln!("command", "{x}")`; the command's name prefixes
-/// the error message of a failed write.
+/// `println!` through [`write()`](crate::stdout::write): `outln!("command", "{x}")`; the
+/// command's name prefixes the error message of a failed write.
 #[macro_export]
 macro_rules! outln {
     ($command:expr) => {
@@ -55,7 +55,7 @@ macro_rules! outln {
     };
 }
 
-/// `print!` through [`write`]: `out!("command", "{x}")`.
+/// `print!` through [`write()`](crate::stdout::write): `out!("command", "{x}")`.
 #[macro_export]
 macro_rules! out {
     ($command:expr, $($arg:tt)*) => {
