@@ -50,7 +50,14 @@ fn small_suite_verifies_every_run_and_writes_its_report() {
         );
         assert_eq!(r["verified"], true, "{w} {s} {size}: {}", r["error"]);
         for field in [
-            "params", "adapter", "items", "gpu_ms", "wall_ms", "rounds", "launches",
+            "params",
+            "adapter",
+            "items",
+            "gpu_ms",
+            "wall_ms",
+            "rounds",
+            "launches",
+            "spin_wait_us",
         ] {
             assert!(r.get(field).is_some(), "{w} {s}: no `{field}`");
         }

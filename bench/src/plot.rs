@@ -237,6 +237,7 @@ mod tests {
             indirect_validation: None,
             round_dispatch: None,
             max_workgroups: None,
+            spin_wait_us: 0,
             idle_polls: 0,
             abandoned: 0,
             queue_growths: 0,

@@ -83,6 +83,11 @@ pub struct RunRecord {
     /// the others and where there is no cap.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_workgroups: Option<u32>,
+    /// How long each wait for the GPU polled before it blocked, in microseconds
+    /// (`Gpu::spin_wait`: 1,000 on a GPU, 0 on a CPU adapter, unless `SCHED_SPIN_WAIT_US`);
+    /// it moves wall times, not GPU times.
+    #[serde(default)]
+    pub spin_wait_us: u64,
     pub idle_polls: u64,
     pub abandoned: u64,
     pub queue_growths: u64,
@@ -101,6 +106,8 @@ pub struct RunKey<'a> {
     pub strategy: &'a Strategy,
     pub prepared: &'a Prepared,
     pub adapter: &'a str,
+    /// The device's `Gpu::spin_wait`, in microseconds.
+    pub spin_wait_us: u64,
     pub run: u32,
 }
 
@@ -184,6 +191,7 @@ impl RunRecord {
             indirect_validation: None,
             round_dispatch: None,
             max_workgroups: None,
+            spin_wait_us: k.spin_wait_us,
             idle_polls: 0,
             abandoned: 0,
             queue_growths: 0,

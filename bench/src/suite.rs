@@ -52,6 +52,7 @@ pub fn measure(
         strategy,
         prepared,
         adapter: &adapter,
+        spin_wait_us: gpu.spin_wait.as_micros() as u64,
         run,
     };
     let warm = w.run(gpu, strategy).and_then(|m| match m.mismatch {
@@ -144,6 +145,7 @@ pub fn run_suite(gpu: &Gpu, o: &SuiteOptions) -> Result<bool, Error> {
                             strategy: s,
                             prepared: &p,
                             adapter: &gpu.adapter_name(),
+                            spin_wait_us: gpu.spin_wait.as_micros() as u64,
                             run: 0,
                         };
                         vec![RunRecord::failed(&key, format!("preparing the size: {e}"))]

@@ -28,7 +28,7 @@ pub const SPIN_WAIT_ENV: &str = "SCHED_SPIN_WAIT_US";
 /// 580.159.04) the megakernel's tree and BFS runs of 0.08-1.03 GPU ms took 0.07-0.19 ms less
 /// wall time polling first for up to 1 ms, and the host-driven multi-pass, which waits once a
 /// round, 14-49% less (docs/results.md, 2026-12-05, seventh session). A wait that outlasts
-/// the spin then blocks, so a long run costs one core for 1 ms at most.
+/// the spin then blocks, so each wait costs a core for 1 ms at most.
 pub const DEFAULT_SPIN_WAIT: Duration = Duration::from_millis(1);
 
 /// The spin of [`SPIN_WAIT_ENV`], else `default`; a value that is not a count of
@@ -243,6 +243,11 @@ impl Gpu {
             wgpu::DeviceType::Cpu => Duration::ZERO,
             _ => DEFAULT_SPIN_WAIT,
         });
+        log::debug!(
+            "{}: waits poll for {} us before they block",
+            info.name,
+            spin_wait.as_micros()
+        );
         Ok(Gpu {
             uncaptured,
             coherent: features.contains(wgpu::Features::MEMORY_DECORATION_COHERENT),

@@ -465,7 +465,7 @@ pub struct BenchCmd {
           value_parser = value_parser!(u32).range(0..=MAX_BENCH_FRAMES as i64))]
     pub warmup: u32,
 
-    /// Print one JSON object instead of the table.
+    /// Print one JSON object instead of the table (pretty-printed over several lines).
     #[arg(long)]
     pub json: bool,
 
