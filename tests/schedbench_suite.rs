@@ -446,3 +446,23 @@ fn a_closed_pipe_ends_the_output_not_the_run() {
     assert_eq!(out.status.code(), Some(0), "{err}");
     assert!(!err.contains("panicked"), "{err}");
 }
+
+/// A write to standard output that fails for another reason than a closed pipe (a full disk:
+/// Linux's `/dev/full`) loses output, so the run fails: exit 1 and one line naming standard
+/// output, no panic.
+#[test]
+fn a_failed_write_to_standard_output_exits_1() {
+    let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
+        panic!("/dev/full is needed for this test (Linux)");
+    };
+    let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
+        .args(["--workload", "tree", "--strategy", "cpu", "--roots", "1"])
+        .args(["--depth", "3", "--runs", "3", "--json"])
+        .stdout(full)
+        .output()
+        .expect("schedbench runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert_eq!(err.matches("standard output").count(), 1, "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+}

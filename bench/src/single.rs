@@ -99,11 +99,7 @@ pub fn run(cli: &Cli) -> Result<bool, Error> {
     for s in &strategies {
         for r in measure(&gpu, w.as_mut(), s, &prepared, runs) {
             if cli.json {
-                reyes_cli::outln!(
-                    "schedbench",
-                    "{}",
-                    serde_json::to_string(&r).expect("records serialise")
-                );
+                reyes_cli::outln!("{}", serde_json::to_string(&r).expect("records serialise"));
             }
             if let Some(e) = r.error.as_ref().filter(|_| !r.verified) {
                 log::error!("{} run {}: {e}", r.strategy, r.run);
@@ -132,7 +128,6 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
         return;
     };
     reyes_cli::outln!(
-        "schedbench",
         "adapter: {} (wgpu's indirect-call validation {})\nworkload: {workload} {params}\n\
          reference: {problem_items} items",
         gpu.adapter_name(),
@@ -143,7 +138,6 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
         }
     );
     reyes_cli::outln!(
-        "schedbench",
         "{:<16} {:>10} {:>8} {:>20} {:>20} {:>11} {:>8} {:>7}",
         "strategy",
         "items",
@@ -157,7 +151,6 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
     let fmt = |t: Option<(f64, f64)>| t.map_or("n/a".into(), |(m, d)| format!("{m:.3} ± {d:.3}"));
     for c in &cs {
         reyes_cli::outln!(
-            "schedbench",
             "{:<16} {:>10} {:>8} {:>20} {:>20} {:>11} {:>8} {:>7}",
             c.strategy,
             c.items,
@@ -213,10 +206,9 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
         }
     }
     if !queues.is_empty() {
-        reyes_cli::outln!("schedbench", "queues: {}", queues.join("; "));
+        reyes_cli::outln!("queues: {}", queues.join("; "));
     }
     reyes_cli::outln!(
-        "schedbench",
         "G items/s: items per GPU time; for runs without GPU time (cpu), per wall time"
     );
     // GPU time against the first strategy's (the megakernel's when it ran), as before.
@@ -224,7 +216,6 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
     if let Some(((first, a), rest)) = gpu_timed.split_first() {
         for (c, b) in rest {
             reyes_cli::outln!(
-                "schedbench",
                 "ratio {}/{} GPU time: {:.2}x (medians of this invocation)",
                 c.strategy,
                 first.strategy,
@@ -238,7 +229,6 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
         for c in cs.iter().filter(|c| c.megakernel) {
             if let Some(w) = c.wall {
                 reyes_cli::outln!(
-                    "schedbench",
                     "{} wall time / best baseline ({}): {:.2}x",
                     c.strategy,
                     best.strategy,
@@ -270,12 +260,8 @@ fn print_turn_anatomy(records: &[RunRecord]) {
         let r = runs[runs.len() / 2];
         let pairs = r.turn_anatomy.iter().map(|(n, c)| (n.as_str(), *c));
         if let Some(a) = scheduler::megakernel::anatomy::TurnAnatomy::from_named(pairs) {
-            reyes_cli::outln!("schedbench", "{name}, run {} (median time):", r.run);
-            reyes_cli::out!(
-                "schedbench",
-                "{}",
-                a.table(r.batches, r.workgroups, r.gpu_ms)
-            );
+            reyes_cli::outln!("{name}, run {} (median time):", r.run);
+            reyes_cli::out!("{}", a.table(r.batches, r.workgroups, r.gpu_ms));
         }
     }
 }

@@ -187,7 +187,6 @@ pub fn run_suite(gpu: &Gpu, o: &SuiteOptions) -> Result<bool, Error> {
     let plots = plot::write_plots(&o.out, &records)?;
     let verified = records.iter().filter(|r| r.verified).count();
     reyes_cli::outln!(
-        "schedbench",
         "{} runs ({verified} verified) in {:.0} s: {}, {}, {} plots in {}",
         records.len(),
         start.elapsed().as_secs_f64(),

@@ -209,11 +209,7 @@ pub fn main(a: BenchCmd) -> Result<(), CliError> {
     let mut report = report(&a, &name, &gpu, strategy, &r, step, &frames, &timed);
     report.peer = peer;
     if a.json {
-        reyes_cli::outln!(
-            "reyes",
-            "{}",
-            serde_json::to_string_pretty(&report).unwrap()
-        );
+        reyes_cli::outln!("{}", serde_json::to_string_pretty(&report).unwrap());
     } else {
         print_table(&report);
     }
@@ -347,7 +343,6 @@ pub(crate) fn report(
 
 pub(crate) fn print_table(r: &BenchReport) {
     reyes_cli::outln!(
-        "reyes",
         "reyes bench: {} {}x{} ({}x{} samples), {}, {} frames{}, {}",
         r.scene,
         r.width,
@@ -364,35 +359,26 @@ pub(crate) fn print_table(r: &BenchReport) {
         r.adapter
     );
     if let Some(why) = &r.not_pipelined {
-        reyes_cli::outln!("reyes", "not pipelined: {why}");
+        reyes_cli::outln!("not pipelined: {why}");
     }
     if r.occlusion {
-        reyes_cli::outln!(
-            "reyes",
-            "occlusion culling from the previous frame (two phases)"
-        );
+        reyes_cli::outln!("occlusion culling from the previous frame (two phases)");
     }
-    reyes_cli::outln!("reyes", "{:<14} {:>10} {:>10}", "", "median", "p95");
+    reyes_cli::outln!("{:<14} {:>10} {:>10}", "", "median", "p95");
     let row = |label: &str, s: Option<&Summary>| match s {
-        Some(s) => reyes_cli::outln!("reyes", "{label:<14} {:>10.3} {:>10.3}", s.median, s.p95),
-        None => reyes_cli::outln!("reyes", "{label:<14} {:>10} {:>10}", "n/a", "n/a"),
+        Some(s) => reyes_cli::outln!("{label:<14} {:>10.3} {:>10.3}", s.median, s.p95),
+        None => reyes_cli::outln!("{label:<14} {:>10} {:>10}", "n/a", "n/a"),
     };
     row("wall ms", Some(&r.wall_ms));
     row("GPU ms", r.gpu_ms.as_ref());
     row("wall - GPU ms", r.wall_minus_gpu_ms.as_ref());
     if let Some(note) = wall_minus_gpu_note(r.wall_minus_gpu_ms.as_ref()) {
-        reyes_cli::outln!("reyes", "{note}");
+        reyes_cli::outln!("{note}");
     }
+    reyes_cli::outln!("{:<14} {:>10.0}", "micropolygons", r.micropolygons.median);
+    reyes_cli::outln!("{:<14} {:>10.0}", "occluded", r.occluded.median);
+    reyes_cli::outln!("{:<14} {:>10.1}", "fps", r.fps);
     reyes_cli::outln!(
-        "reyes",
-        "{:<14} {:>10.0}",
-        "micropolygons",
-        r.micropolygons.median
-    );
-    reyes_cli::outln!("reyes", "{:<14} {:>10.0}", "occluded", r.occluded.median);
-    reyes_cli::outln!("reyes", "{:<14} {:>10.1}", "fps", r.fps);
-    reyes_cli::outln!(
-        "reyes",
         "{:<14} {:>10}",
         "re-rendered",
         format!("{} of {}", r.rerendered, r.frames)
@@ -402,7 +388,7 @@ pub(crate) fn print_table(r: &BenchReport) {
         .collect();
     reasons.dedup();
     for why in reasons.iter().take(3) {
-        reyes_cli::outln!("reyes", "  re-rendered: {why}");
+        reyes_cli::outln!("  re-rendered: {why}");
     }
     if let Some(p) = &r.peer {
         print_peer(p);
@@ -413,7 +399,6 @@ pub(crate) fn print_table(r: &BenchReport) {
             .as_ref()
             .map_or("n/a".into(), |g| format!("{:.3}", g.median));
         reyes_cli::outln!(
-            "reyes",
             "device {} ({}): {} frames, {:.1} fps, busy {:.1} ms, median GPU {gpu} ms",
             d.slot,
             d.device,
@@ -445,7 +430,6 @@ fn wall_minus_gpu_note(s: Option<&Summary>) -> Option<String> {
 
 fn print_peer(p: &PeerReport) {
     reyes_cli::outln!(
-        "reyes",
         "peer {}: {}x MSAA{}",
         p.peer,
         p.msaa_samples,
@@ -458,24 +442,22 @@ fn print_peer(p: &PeerReport) {
             )
         }
     );
-    reyes_cli::outln!("reyes", "{:<14} {:>10} {:>10}", "", "median", "p95");
+    reyes_cli::outln!("{:<14} {:>10} {:>10}", "", "median", "p95");
     let row = |label: &str, s: Option<&Summary>| match s {
-        Some(s) => reyes_cli::outln!("reyes", "{label:<14} {:>10.3} {:>10.3}", s.median, s.p95),
-        None => reyes_cli::outln!("reyes", "{label:<14} {:>10} {:>10}", "n/a", "n/a"),
+        Some(s) => reyes_cli::outln!("{label:<14} {:>10.3} {:>10.3}", s.median, s.p95),
+        None => reyes_cli::outln!("{label:<14} {:>10} {:>10}", "n/a", "n/a"),
     };
     row("wall ms", Some(&p.wall_ms));
     row("GPU ms", p.gpu_ms.as_ref());
-    reyes_cli::outln!("reyes", "{:<14} {:>10.0}", "triangles", p.triangles.median);
-    reyes_cli::outln!("reyes", "{:<14} {:>10.1}", "fps", p.fps);
+    reyes_cli::outln!("{:<14} {:>10.0}", "triangles", p.triangles.median);
+    reyes_cli::outln!("{:<14} {:>10.1}", "fps", p.fps);
     reyes_cli::outln!(
-        "reyes",
         "{:<14} {:>10}",
         "redrawn",
         format!("{} of {}", p.redrawn, p.per_frame.len())
     );
     for d in &p.difference {
         reyes_cli::outln!(
-            "reyes",
             "image vs Reyes at {:.1} deg: PSNR {}, {:.2}% of pixels off by more than {}/255 \
              (max {}), covered {} vs {}",
             d.angle_deg,

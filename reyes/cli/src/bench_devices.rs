@@ -110,11 +110,7 @@ pub fn main(a: BenchCmd) -> Result<(), CliError> {
     bar.finish_and_clear();
     let report = report?;
     if a.json {
-        reyes_cli::outln!(
-            "reyes",
-            "{}",
-            serde_json::to_string_pretty(&report).unwrap()
-        );
+        reyes_cli::outln!("{}", serde_json::to_string_pretty(&report).unwrap());
     } else {
         crate::bench::print_table(&report);
     }

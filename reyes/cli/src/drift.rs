@@ -53,26 +53,24 @@ pub fn main(a: DriftCmd) -> Result<(), CliError> {
             "paths": rows.iter().map(|r| r.json()).collect::<Vec<_>>(),
             "split_tree": tree.json(),
         });
-        reyes_cli::outln!("reyes", "{}", serde_json::to_string(&v).unwrap());
+        reyes_cli::outln!("{}", serde_json::to_string(&v).unwrap());
         return Ok(());
     }
     reyes_cli::outln!(
-        "reyes",
         "{name} at {width}x{height}: {} patches, {} paths each (2 alternating + {} random), \
          distances in pixels",
         scene.patches.len(),
         2 + o.random_paths,
         o.random_paths
     );
-    reyes_cli::outln!("reyes", "\nseeded split paths:");
-    reyes_cli::out!("reyes", "{}", drift::table(&rows));
+    reyes_cli::outln!("\nseeded split paths:");
+    reyes_cli::out!("{}", drift::table(&rows));
     reyes_cli::outln!(
-        "reyes",
         "\nthe renderer's own split tree (cpu_render): max split depth {}, {} grids, {} depth-limited",
         tree.max_depth,
         tree.grids,
         tree.depth_limited
     );
-    reyes_cli::out!("reyes", "{}", drift::table(&tree.rows));
+    reyes_cli::out!("{}", drift::table(&tree.rows));
     Ok(())
 }

@@ -78,15 +78,14 @@ pub fn main(a: HolesCmd) -> Result<(), CliError> {
         holes: holes(&frame.image, &reference, f.spp_x * f.spp_y),
     };
     if a.json {
-        reyes_cli::outln!("reyes", "{}", serde_json::to_string(&report)?);
+        reyes_cli::outln!("{}", serde_json::to_string(&report)?);
     } else {
         let r = &report;
         if !a.no_header {
-            reyes_cli::outln!("reyes", "{HOLES_COLUMNS}");
-            reyes_cli::outln!("reyes", "{}", markdown_rule(HOLES_COLUMNS));
+            reyes_cli::outln!("{HOLES_COLUMNS}");
+            reyes_cli::outln!("{}", markdown_rule(HOLES_COLUMNS));
         }
         reyes_cli::outln!(
-            "reyes",
             "| {} | {} | {}x{} | {}x{} | {} | {} | {} | {} | {} | {} | {:.4} |",
             r.scene,
             r.raster,

@@ -82,10 +82,10 @@ pub fn main(a: MeasureCmd) -> Result<(), CliError> {
     };
     let out = serde_json::to_value(m.report())?;
     if json {
-        reyes_cli::outln!("reyes", "{out}");
+        reyes_cli::outln!("{out}");
     } else {
         for (k, v) in out.as_object().into_iter().flatten() {
-            reyes_cli::outln!("reyes", "{k:>32}: {v}");
+            reyes_cli::outln!("{k:>32}: {v}");
         }
     }
     Ok(())

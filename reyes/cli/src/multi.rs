@@ -26,7 +26,7 @@ use std::thread::{Scope, ScopedJoinHandle};
 pub fn list_devices() -> Result<(), CliError> {
     let list = devices::adapters(&scheduler::Gpu::instance_from_env(), required_features());
     for a in &list {
-        reyes_cli::outln!("reyes", "{}", a.describe());
+        reyes_cli::outln!("{}", a.describe());
     }
     let all = devices::usable_indices(&list);
     if all.is_empty() {
@@ -47,7 +47,7 @@ pub fn list_devices() -> Result<(), CliError> {
         .into());
     }
     let all: Vec<String> = all.iter().map(usize::to_string).collect();
-    reyes_cli::outln!("reyes", "--devices all: {}", all.join(","));
+    reyes_cli::outln!("--devices all: {}", all.join(","));
     Ok(())
 }
 

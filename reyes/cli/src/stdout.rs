@@ -11,6 +11,7 @@
 
 use std::fmt;
 use std::io::{self, Write};
+use std::path::Path;
 use std::sync::atomic::{AtomicU8, Ordering};
 
 /// Writing: 0, the pipe closed by its reader: 1, another error: 2.
@@ -21,8 +22,9 @@ const FAILED: u8 = 2;
 
 /// Writes `args` to standard output and flushes it, unless an earlier write failed. A
 /// closed pipe (`ErrorKind::BrokenPipe`) silences the rest of the output; another error is
-/// reported (`command: standard output: ERROR`) and silences it too.
-pub fn write(command: &str, args: fmt::Arguments) {
+/// reported (`COMMAND: standard output: ERROR`, the command as it was called) and silences
+/// it too.
+pub fn write(args: fmt::Arguments) {
     if STATE.load(Ordering::Relaxed) != OPEN {
         return;
     }
@@ -32,7 +34,9 @@ pub fn write(command: &str, args: fmt::Arguments) {
             STATE.store(CLOSED, Ordering::Relaxed);
         } else {
             STATE.store(FAILED, Ordering::Relaxed);
-            eprintln!("{command}: standard output: {e}");
+            let command = std::env::args_os().next().unwrap_or_default();
+            let command = Path::new(&command).file_name().unwrap_or_default();
+            eprintln!("{}: standard output: {e}", command.to_string_lossy());
         }
     }
 }
@@ -43,22 +47,21 @@ pub fn failed() -> bool {
     STATE.load(Ordering::Relaxed) == FAILED
 }
 
-/// `println!` through [`write()`](crate::stdout::write): `outln!("command", "{x}")`; the
-/// command's name prefixes the error message of a failed write.
+/// `println!` through [`write()`](crate::stdout::write).
 #[macro_export]
 macro_rules! outln {
-    ($command:expr) => {
-        $crate::stdout::write($command, format_args!("\n"))
+    () => {
+        $crate::stdout::write(format_args!("\n"))
     };
-    ($command:expr, $($arg:tt)*) => {
-        $crate::stdout::write($command, format_args!("{}\n", format_args!($($arg)*)))
+    ($($arg:tt)*) => {
+        $crate::stdout::write(format_args!("{}\n", format_args!($($arg)*)))
     };
 }
 
-/// `print!` through [`write()`](crate::stdout::write): `out!("command", "{x}")`.
+/// `print!` through [`write()`](crate::stdout::write).
 #[macro_export]
 macro_rules! out {
-    ($command:expr, $($arg:tt)*) => {
-        $crate::stdout::write($command, format_args!($($arg)*))
+    ($($arg:tt)*) => {
+        $crate::stdout::write(format_args!($($arg)*))
     };
 }
