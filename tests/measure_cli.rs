@@ -3,7 +3,7 @@
 //! from the environment (lavapipe in CI), and prints a table whose rows are verified; usage
 //! errors exit 2, a missing binary names itself. It checks results and files, never speed.
 
-use std::process::{Command, Output};
+use std::process::{Command, Output, Stdio};
 
 fn measure(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_measure"))
@@ -70,4 +70,28 @@ fn a_missing_binary_is_named() {
     assert_eq!(o.status.code(), Some(1));
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(e.contains("no `schedbench` in"), "{e}");
+}
+
+/// A reader that left before the table came (`measure ... | head -0`, the pipe closed) ends
+/// the output only: the status is the runs' (0, every row verified) and `--out` has the table.
+#[test]
+fn a_closed_pipe_keeps_the_runs_status_and_files() {
+    let out = tempfile::tempdir().unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_measure"))
+        .args([
+            "trees", "--size", "small", "--runs", "1", "--only", "binary",
+        ])
+        .arg("--out")
+        .arg(out.path())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("measure runs");
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    let table = std::fs::read_to_string(out.path().join("table.md")).unwrap();
+    assert!(table.contains("| trees | binary | megakernel |"), "{table}");
 }

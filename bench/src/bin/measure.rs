@@ -255,9 +255,14 @@ fn measure(cli: &Cli) -> Result<bool, Error> {
     }
     let mut stdout = std::io::stdout().lock();
     let shown = if cli.markdown { &markdown } else { &text };
-    stdout
+    match stdout
         .write_all(shown.as_bytes())
         .and_then(|()| stdout.flush())
-        .map_err(Error::Table)?;
+    {
+        // A reader that left (`measure ... | head`) ends the output only, as for `schedbench`
+        // and `reyes` (reyes_cli::stdout): the status stays the runs'.
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
+        written => written.map_err(Error::Table)?,
+    }
     Ok(table.all_good())
 }
