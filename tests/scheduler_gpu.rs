@@ -80,9 +80,9 @@ fn host_driven_timestamps_come_back_with_the_rounds() {
 fn waits_that_poll_first_keep_every_result() {
     let mut gpu = gpu();
     if std::env::var_os(scheduler::gpu::SPIN_WAIT_ENV).is_none() {
-        let expected = match gpu.info.device_type {
-            wgpu::DeviceType::Cpu => std::time::Duration::ZERO,
-            _ => scheduler::gpu::DEFAULT_SPIN_WAIT,
+        let expected = match gpu.is_cpu_adapter() {
+            true => std::time::Duration::ZERO,
+            false => scheduler::gpu::DEFAULT_SPIN_WAIT,
         };
         assert_eq!(gpu.spin_wait, expected, "{}", gpu.adapter_name());
     }

@@ -238,17 +238,7 @@ impl Gpu {
                 .unwrap_or_else(|p| p.into_inner())
                 .push(e.to_string());
         }));
-        // A CPU adapter's work needs the cores a spin would take.
-        let spin_wait = spin_wait_from_env(match info.device_type {
-            wgpu::DeviceType::Cpu => Duration::ZERO,
-            _ => DEFAULT_SPIN_WAIT,
-        });
-        log::debug!(
-            "{}: waits poll for {} us before they block",
-            info.name,
-            spin_wait.as_micros()
-        );
-        Ok(Gpu {
+        let mut gpu = Gpu {
             uncaptured,
             coherent: features.contains(wgpu::Features::MEMORY_DECORATION_COHERENT),
             timestamps: features.contains(wgpu::Features::TIMESTAMP_QUERY),
@@ -258,10 +248,21 @@ impl Gpu {
             queue,
             info,
             timeout: DEFAULT_GPU_TIMEOUT,
-            spin_wait,
+            spin_wait: Duration::ZERO,
             loops_trusted: false,
             submitted: AtomicU64::new(0),
-        })
+        };
+        // A CPU adapter's work needs the cores a spin would take.
+        gpu.spin_wait = spin_wait_from_env(match gpu.is_cpu_adapter() {
+            true => Duration::ZERO,
+            false => DEFAULT_SPIN_WAIT,
+        });
+        log::debug!(
+            "{}: waits poll for {} us before they block",
+            gpu.info.name,
+            gpu.spin_wait.as_micros()
+        );
+        Ok(gpu)
     }
 
     /// Finishes `enc` and submits it to the queue, counted in [`Gpu::submissions`]. Every
