@@ -2,6 +2,7 @@
 
 use crate::strategy::Strategy;
 use crate::workload::{Measurement, Prepared};
+use scheduler::Gpu;
 use serde::{Deserialize, Serialize};
 
 /// A run, verified or not. Times in milliseconds; scheduler counters are zero where they do not
@@ -105,9 +106,8 @@ pub struct RunKey<'a> {
     pub workload: &'a str,
     pub strategy: &'a Strategy,
     pub prepared: &'a Prepared,
-    pub adapter: &'a str,
-    /// The device's `Gpu::spin_wait`, in microseconds.
-    pub spin_wait_us: u64,
+    /// The device it ran on (its name and `Gpu::spin_wait` go into the record).
+    pub gpu: &'a Gpu,
     pub run: u32,
 }
 
@@ -169,7 +169,7 @@ impl RunRecord {
             item_layout: None,
             enqueue: None,
             workgroup_size: None,
-            adapter: k.adapter.to_string(),
+            adapter: k.gpu.adapter_name(),
             run: k.run,
             items: 0,
             problem_items: k.prepared.problem_items,
@@ -191,7 +191,7 @@ impl RunRecord {
             indirect_validation: None,
             round_dispatch: None,
             max_workgroups: None,
-            spin_wait_us: k.spin_wait_us,
+            spin_wait_us: k.gpu.spin_wait.as_micros() as u64,
             idle_polls: 0,
             abandoned: 0,
             queue_growths: 0,

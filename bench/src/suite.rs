@@ -45,14 +45,12 @@ pub fn measure(
     prepared: &Prepared,
     runs: u32,
 ) -> Vec<RunRecord> {
-    let adapter = gpu.adapter_name();
     let name = w.name();
     let key = |run| RunKey {
         workload: &name,
         strategy,
         prepared,
-        adapter: &adapter,
-        spin_wait_us: gpu.spin_wait.as_micros() as u64,
+        gpu,
         run,
     };
     let warm = w.run(gpu, strategy).and_then(|m| match m.mismatch {
@@ -144,8 +142,7 @@ pub fn run_suite(gpu: &Gpu, o: &SuiteOptions) -> Result<bool, Error> {
                             workload: &name,
                             strategy: s,
                             prepared: &p,
-                            adapter: &gpu.adapter_name(),
-                            spin_wait_us: gpu.spin_wait.as_micros() as u64,
+                            gpu,
                             run: 0,
                         };
                         vec![RunRecord::failed(&key, format!("preparing the size: {e}"))]
