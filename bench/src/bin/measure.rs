@@ -20,7 +20,6 @@ use measure::read::read;
 use measure::run::{self, Build, Runner};
 use measure::table::Table;
 use std::ffi::OsString;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
@@ -167,6 +166,8 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     cli.check();
     match measure(&cli) {
+        // The table could not be written (reported when it failed).
+        Ok(true) if reyes_cli::stdout::failed() => ExitCode::FAILURE,
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::FAILURE,
         Err(e) => {
@@ -253,16 +254,8 @@ fn measure(cli: &Cli) -> Result<bool, Error> {
             })?;
         }
     }
-    let mut stdout = std::io::stdout().lock();
-    let shown = if cli.markdown { &markdown } else { &text };
-    match stdout
-        .write_all(shown.as_bytes())
-        .and_then(|()| stdout.flush())
-    {
-        // A reader that left (`measure ... | head`) ends the output only, as for `schedbench`
-        // and `reyes` (reyes_cli::stdout): the status stays the runs'.
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
-        written => written.map_err(Error::Table)?,
-    }
+    // Through reyes_cli::stdout, as schedbench and reyes print: a reader that left (`measure
+    // ... | head`) ends the output only, the status stays the runs' and --out keeps the table.
+    reyes_cli::out!("{}", if cli.markdown { &markdown } else { &text });
     Ok(table.all_good())
 }

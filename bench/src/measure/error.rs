@@ -95,7 +95,4 @@ pub enum Error {
         /// The builds' folders, joined by " or ".
         dirs: String,
     },
-    /// The table could not be written to stdout.
-    #[error("writing the table: {0}")]
-    Table(#[source] std::io::Error),
 }
