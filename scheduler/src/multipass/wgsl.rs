@@ -52,7 +52,8 @@ pub fn entry_points(program: &Program, groups: &DispatchGroups) -> Vec<String> {
 
 /// The WGSL for `program` with its queues laid out as `items` (the same layout in the round
 /// buffers of every queue), its rounds dispatched as `groups`, each procedure's share of a
-/// dispatch at most `max_workgroups` workgroups (`MultipassConfig::max_workgroups`).
+/// dispatch at most `max_workgroups` workgroups (`MultipassConfig::max_workgroups` as
+/// `Multipass::new` resolves it: at least 1).
 pub fn source(
     program: &Program,
     items: ItemLayout,
@@ -108,7 +109,7 @@ pub fn source(
         list(&|q| per_step(q).trailing_zeros() as usize),
         list(&|q| {
             (MAX_WORKGROUPS_PER_DIMENSION as usize / groups[group_of[q]].len())
-                .min(max_workgroups.max(1) as usize)
+                .min(max_workgroups as usize)
         }),
     );
     s += TEMPLATE;
