@@ -452,9 +452,10 @@ fn a_closed_pipe_ends_the_output_not_the_run() {
 /// output, no panic.
 #[test]
 fn a_failed_write_to_standard_output_exits_1() {
-    let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
-        panic!("/dev/full is needed for this test (Linux)");
-    };
+    let full = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/full")
+        .expect("/dev/full (Linux)");
     let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
         .args(["--workload", "tree", "--strategy", "cpu", "--roots", "1"])
         .args(["--depth", "3", "--runs", "3", "--json"])
