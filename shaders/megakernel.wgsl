@@ -588,7 +588,8 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         // The outbox's writes visible to the whole workgroup, for the copy. Direct enqueue wrote
         // the slots themselves: the release barrier before the flags orders them, and the
         // step's workgroupBarrier above is all the workgroup needs (a device-scope fence less).
-        if !DIRECT_ENQUEUE { storageBarrier(); }
+        // A sink's batch (q emits nothing) wrote neither outbox nor slots: no fence.
+        if !DIRECT_ENQUEUE && !sched_is_sink(q) { storageBarrier(); }
 
         // 3. Reserve tickets for what was emitted: lane t for target queue t, all in parallel;
         //    lane q counts the batch in its statistics (registers, added to ctrl at exit).
@@ -745,7 +746,12 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
                 }
             }
         }
-        storageBarrier(); // release: payloads before the flags that publish them
+        // Release: payloads (global slots and the workgroup's held items alike) before the
+        // flags that publish them and before the next local batch reads them. A sink's batch
+        // wrote no item: it has nothing to release (its inputs' CONSUMED marks are read only
+        // between launches), so it skips the device-scope fence. Every held item was written
+        // by an emitting batch, whose fence still follows it.
+        if !sched_is_sink(q) { storageBarrier(); }
 
         // 5. Publish: flag new slots with the batch stamp, mark processed inputs consumed.
         for (var t = 0u; t < NQ; t++) {

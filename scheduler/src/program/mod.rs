@@ -292,7 +292,7 @@ impl Program {
         parts
     }
 
-    /// Constant tables: queue count, threads per item, item words, emit table.
+    /// Constant tables: queue count, threads per item, item words, emit table, sinks.
     pub(crate) fn tables_wgsl(&self) -> String {
         let nq = self.procs.len();
         let list = |f: &dyn Fn(&ProcInfo) -> u32| {
@@ -307,12 +307,23 @@ impl Program {
             .iter()
             .flat_map(|p| p.emits.iter().map(|e| format!("{e}u")))
             .collect();
+        let sinks: Vec<String> = (0..nq)
+            .filter(|&q| self.procs[q].is_sink())
+            .map(|q| format!("q == {q}u"))
+            .collect();
+        let sinks = if sinks.is_empty() {
+            "false".to_string()
+        } else {
+            sinks.join(" || ")
+        };
         format!(
             "const NQ: u32 = {nq}u;\n\
              const THREADS: array<u32, {nq}> = array<u32, {nq}>({});\n\
              const WORDS: array<u32, {nq}> = array<u32, {nq}>({});\n\
              // EMITS[q * NQ + t]: worst-case items procedure q emits to queue t per item\n\
-             const EMITS: array<u32, {n2}> = array<u32, {n2}>({});\n",
+             const EMITS: array<u32, {n2}> = array<u32, {n2}>({});\n\
+             // Whether procedure q emits nothing: comparisons, not a table indexed at run time\n\
+             fn sched_is_sink(q: u32) -> bool {{ return {sinks}; }}\n",
             list(&|p| p.proc.threads_per_item),
             list(&|p| p.words()),
             emits.join(", "),

@@ -600,6 +600,37 @@ mod tests {
         assert!(m.contains("takes `Word` items, not `Pair`"), "{m}");
     }
 
+    /// The megakernel skips a sink's release fence by `sched_is_sink` (docs/scheduler.md
+    /// 2.2): it must name exactly the procedures that declare no emits.
+    #[test]
+    fn the_sink_test_names_exactly_the_procedures_without_emits() {
+        let source = |name: &str, to: &str| {
+            Procedure::new(name, word(), 1).emits(to, 1).body(&format!(
+                "fn {name}_execute(item: Word, inv: Invocation) {{ enqueue_{to}(item); }}"
+            ))
+        };
+        let chain = Program::new(
+            vec![source("a", "sink"), sink(), source("b", "sink")],
+            UserBindings::none(),
+        )
+        .unwrap();
+        assert!(
+            chain
+                .tables_wgsl()
+                .contains("fn sched_is_sink(q: u32) -> bool { return q == 1u; }")
+        );
+        let cycle = Program::new(
+            vec![source("a", "b"), source("b", "a")],
+            UserBindings::none(),
+        )
+        .unwrap();
+        assert!(
+            cycle
+                .tables_wgsl()
+                .contains("fn sched_is_sink(q: u32) -> bool { return false; }")
+        );
+    }
+
     #[test]
     fn a_procedure_running_another_s_function_declares_what_it_enqueues() {
         let one = Procedure::new("one", word(), 1)
