@@ -106,11 +106,11 @@ fn sched_raise(code: u32, a: u32, b: u32) {
 // 0xffffffff after raising ERR_EMIT when the item emits more than it declared: the append is
 // refused, so the round's appends never pass its worst case, which the plan made room for.
 // Slots start after the inputs the round carries to the front of t's next inputs. An append
-// that begins a step of t's items (every 256 / THREADS[t]-th slot) adds a workgroup to t's
+// that begins a step of t's items (every 256 / sched_threads(t)-th slot) adds a workgroup to t's
 // dispatch group in the next round's arguments, so the next round is sized when this one ends.
 fn sched_append_slot(t: u32) -> u32 {
     let j = atomicAdd(&wg_item_emits[sched_slot * NQ + t], 1u);
-    if j >= EMITS[sched_proc * NQ + t] {
+    if j >= sched_emits(sched_proc * NQ + t) {
         sched_raise(ERR_EMIT, sched_proc, t);
         return 0xffffffffu;
     }
@@ -214,7 +214,7 @@ fn plan_round(w: u32, g: u32, flags: u32) {
             var hard = wg_run[p];
             var soft = wg_run[p];
             for (var t = 0u; t < NQ; t++) {
-                let grow = EMITS[p * NQ + t];
+                let grow = sched_emits(p * NQ + t);
                 let shrink = select(0u, 1u, t == p);
                 if grow > shrink {
                     hard = min(hard, (q_cap(t) - wg_used[t]) / (grow - shrink));
@@ -224,7 +224,7 @@ fn plan_round(w: u32, g: u32, flags: u32) {
             }
             let r = max(soft, min(hard, 1u));
             wg_run[p] = r;
-            for (var t = 0u; t < NQ; t++) { wg_used[t] += r * EMITS[p * NQ + t]; }
+            for (var t = 0u; t < NQ; t++) { wg_used[t] += r * sched_emits(p * NQ + t); }
             wg_used[p] -= r;
             any = any || r > 0u;
         }
@@ -310,7 +310,7 @@ fn mp_begin(lid: u32, w: u32, g: u32) -> Pick {
         var m = 0u;
         for (var p = 0u; p < NQ; p++) {
             let n = wg_words[p * 6u + win] + wg_words[p * 6u + 3u + win];
-            m += n * EMITS[p * NQ + lid];
+            m += n * sched_emits(p * NQ + lid);
             if p == lid {
                 wg_cnt[lid] = n;
                 wg_run[lid] = n;

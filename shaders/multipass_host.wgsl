@@ -50,7 +50,7 @@ fn sched_raise(code: u32, a: u32, b: u32) {
 // refused, so the round's appends never pass its worst case, which the host made room for.
 fn sched_append_slot(t: u32) -> u32 {
     let j = atomicAdd(&wg_item_emits[sched_slot * NQ + t], 1u);
-    if j >= EMITS[sched_proc * NQ + t] {
+    if j >= sched_emits(sched_proc * NQ + t) {
         sched_raise(ERR_EMIT, sched_proc, t);
         return 0xffffffffu;
     }

@@ -13,18 +13,18 @@ fn RUN_PROCEDURE(q: u32, lid: u32, wid: u32, nwg: u32) {
     if lid == 0u { wg_n = counts_in[q]; }
     let n = workgroupUniformLoad(&wg_n);
     let skip = counts_in[H_SKIP + q];
-    let per_step = 256u / THREADS[q];
-    let slot = lid / THREADS[q];
-    let thread = lid % THREADS[q];
+    let per_step = 256u / sched_threads(q);
+    let slot = lid / sched_threads(q);
+    let thread = lid % sched_threads(q);
     for (var first = wid * per_step; first < n; first += nwg * per_step) {
         let idx = first + slot;
         let live = idx < n;
-        for (var t = thread; t < NQ; t += THREADS[q]) { atomicStore(&wg_item_emits[slot * NQ + t], 0u); }
+        for (var t = thread; t < NQ; t += sched_threads(q)) { atomicStore(&wg_item_emits[slot * NQ + t], 0u); }
         workgroupBarrier();
         sched_proc = q;
         sched_slot = slot;
         sched_active = live;
-        MP_EXECUTE(q, skip + idx, Invocation(thread, slot, live, THREADS[q]));
+        MP_EXECUTE(q, skip + idx, Invocation(thread, slot, live, sched_threads(q)));
         workgroupBarrier();
     }
 }

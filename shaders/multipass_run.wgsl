@@ -18,24 +18,24 @@ fn RUN_PROCEDURE(q: u32, pick: Pick, lid: u32) {
     let n = pick.count;
     let keep = pick.keep;
     let nwg = max(pick.wgs, 1u);
-    let per_step = 256u / THREADS[q];
-    let slot = lid / THREADS[q];
-    let thread = lid % THREADS[q];
+    let per_step = 256u / sched_threads(q);
+    let slot = lid / sched_threads(q);
+    let thread = lid % sched_threads(q);
     for (var first = pick.index * per_step; first < n; first += nwg * per_step) {
         let idx = first + slot;
         let live = idx >= keep && idx < n;
         if idx < keep {
-            for (var w = thread; w < WORDS[q]; w += THREADS[q]) {
+            for (var w = thread; w < sched_words(q); w += sched_threads(q)) {
                 let at = mp_word_at(q, idx, w);
                 mp_out_store_word(at, mp_in_load_word(at));
             }
         }
-        for (var t = thread; t < NQ; t += THREADS[q]) { atomicStore(&wg_item_emits[slot * NQ + t], 0u); }
+        for (var t = thread; t < NQ; t += sched_threads(q)) { atomicStore(&wg_item_emits[slot * NQ + t], 0u); }
         workgroupBarrier();
         sched_proc = q;
         sched_slot = slot;
         sched_active = live;
-        MP_EXECUTE(q, idx, Invocation(thread, slot, live, THREADS[q]));
+        MP_EXECUTE(q, idx, Invocation(thread, slot, live, sched_threads(q)));
         workgroupBarrier();
     }
 }

@@ -18,6 +18,34 @@ pub fn validate(label: &str, source: &str) -> Result<naga::Module, RunError> {
     Ok(module)
 }
 
+/// A constant table as a WGSL function, `fn NAME(i: u32) -> u32`: entry `i` of `values`, as a
+/// chain of `select`s over the entries that differ from the most common value (which an index
+/// past the end gets, as a clamped array access would get some entry: callers index within it).
+/// A table of one value is that constant, whatever the index.
+/// The scheduler's tables (threads, words and emits per procedure) are indexed by values known
+/// only at run time, and naga writes such an access to a `const` array as a store of the whole
+/// array into a function variable, then a load (SPIR-V has no dynamic extract): the multi-passes
+/// call these instead (`Program::tables_wgsl`). Selects on a value known at compile time fold
+/// away.
+pub fn table_fn(name: &str, values: &[u32]) -> String {
+    let mut counts = std::collections::BTreeMap::new();
+    for &v in values {
+        *counts.entry(v).or_insert(0usize) += 1;
+    }
+    // Most common first, the smaller value on a tie: the same text for the same table.
+    let common = counts
+        .iter()
+        .max_by_key(|&(&v, &c)| (c, std::cmp::Reverse(v)))
+        .map_or(0, |(&v, _)| v);
+    let mut s = format!("fn {name}(i: u32) -> u32 {{\n    var r = {common}u;\n");
+    for (i, &v) in values.iter().enumerate() {
+        if v != common {
+            s += &format!("    r = select(r, {v}u, i == {i}u);\n");
+        }
+    }
+    s + "    return r;\n}\n"
+}
+
 /// One 32-bit scalar of a struct, flattened: the WGSL expression that reaches it from the struct
 /// value (e.g. `.cp[3].x`), its word offset, and its scalar kind.
 #[derive(Debug, Clone, PartialEq)]
@@ -299,6 +327,24 @@ mod tests {
 
     const SRC: &str = "struct Inner { a: vec3<f32>, b: u32 }
         struct Item { id: u32, p: array<vec4<f32>, 2>, inner: Inner, k: i32 }";
+
+    /// A table as selects over the entries that differ from its most common value; one value
+    /// is a constant; either is valid WGSL.
+    #[test]
+    fn a_table_function_selects_only_the_uncommon_entries() {
+        let f = table_fn("f", &[2, 0, 2, 5]);
+        assert_eq!(
+            f,
+            "fn f(i: u32) -> u32 {\n    var r = 2u;\n    r = select(r, 0u, i == 1u);\n    \
+             r = select(r, 5u, i == 3u);\n    return r;\n}\n"
+        );
+        let one = table_fn("g", &[3, 3]);
+        assert_eq!(
+            one,
+            "fn g(i: u32) -> u32 {\n    var r = 3u;\n    return r;\n}\n"
+        );
+        validate("tables", &(f + &one)).unwrap();
+    }
 
     #[test]
     fn layout_follows_wgsl_alignment_rules() {

@@ -79,7 +79,7 @@ pub fn source(
     let mut s = rounds_source(program, items, "mp_proc", args, &body, RUN, true);
     // Word `w` of item `at` of queue `t` (the carried inputs' copy).
     let word_at = match items {
-        ItemLayout::Interleaved => "q_base(t) + at * WORDS[t] + w",
+        ItemLayout::Interleaved => "q_base(t) + at * sched_words(t) + w",
         ItemLayout::Planar => "q_base(t) + w * q_cap(t) + at",
     };
     s += &format!("fn mp_word_at(t: u32, at: u32, w: u32) -> u32 {{ return {word_at}; }}\n");
@@ -164,7 +164,7 @@ pub(super) fn rounds_source(
     s += &items.typed_fns(program, "mp_out");
     // Where item `at` of queue `t` starts, and (planar) the stride between its words.
     let item_at = |t: &str| match items {
-        ItemLayout::Interleaved => format!("q_base({t}) + at * WORDS[{t}]"),
+        ItemLayout::Interleaved => format!("q_base({t}) + at * sched_words({t})"),
         ItemLayout::Planar => format!("q_base({t}) + at, q_cap({t})"),
     };
     // The loop, its item runner named `mp_execute{suffix}`, as `run_procedure{suffix}` (the

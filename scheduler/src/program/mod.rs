@@ -292,8 +292,16 @@ impl Program {
         parts
     }
 
-    /// Constant tables: queue count, threads per item, item words, emit table, sinks.
+    /// Constant tables: queue count, threads per item, item words, the emit table and the sink
+    /// test. The tables twice: as `const` arrays (`THREADS`, `WORDS`, `EMITS`), which the
+    /// megakernel indexes, and as select functions ([`crate::wgsl::table_fn`]: `sched_threads`,
+    /// `sched_words`, `sched_emits`), which both multi-passes call. naga writes a run-time index
+    /// into a `const` array as a store of the whole array to a function variable and a load; the
+    /// functions took 2-5% off the device-driven multi-pass on every workload of the H100 and
+    /// 2.4-3.8% off the megakernel's frames, but made its trees with local queues 1.6-3.6x
+    /// slower, for a reason not found yet (docs/results.md, 2026-12-05 (eighth session)).
     pub(crate) fn tables_wgsl(&self) -> String {
+        use crate::wgsl::table_fn;
         let nq = self.procs.len();
         let list = |f: &dyn Fn(&ProcInfo) -> u32| {
             self.procs
@@ -302,11 +310,9 @@ impl Program {
                 .collect::<Vec<_>>()
                 .join(", ")
         };
-        let emits: Vec<String> = self
-            .procs
-            .iter()
-            .flat_map(|p| p.emits.iter().map(|e| format!("{e}u")))
-            .collect();
+        let of = |f: &dyn Fn(&ProcInfo) -> u32| self.procs.iter().map(f).collect::<Vec<u32>>();
+        let emits: Vec<u32> = self.procs.iter().flat_map(|p| p.emits.clone()).collect();
+        let emits_list: Vec<String> = emits.iter().map(|e| format!("{e}u")).collect();
         let sinks: Vec<String> = (0..nq)
             .filter(|&q| self.procs[q].is_sink())
             .map(|q| format!("q == {q}u"))
@@ -323,10 +329,15 @@ impl Program {
              // EMITS[q * NQ + t]: worst-case items procedure q emits to queue t per item\n\
              const EMITS: array<u32, {n2}> = array<u32, {n2}>({});\n\
              // Whether procedure q emits nothing: comparisons, not a table indexed at run time\n\
-             fn sched_is_sink(q: u32) -> bool {{ return {sinks}; }}\n",
+             fn sched_is_sink(q: u32) -> bool {{ return {sinks}; }}\n\
+             // The same tables as functions, for the multi-passes\n\
+             {}{}{}",
             list(&|p| p.proc.threads_per_item),
             list(&|p| p.words()),
-            emits.join(", "),
+            emits_list.join(", "),
+            table_fn("sched_threads", &of(&|p| p.proc.threads_per_item)),
+            table_fn("sched_words", &of(&|p| p.words())),
+            table_fn("sched_emits", &emits),
             n2 = nq * nq
         )
     }
