@@ -546,8 +546,9 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         if from_local {
             // A local batch: its worst-case output in every target promised from the credit
             // (the leader saw that it covers it). It runs from the buffer it filled
-            // (`sched_local_in`), while q's emits fill the other. Its items were written before
-            // the last batch's release barrier, which every lane passed: visible here.
+            // (`sched_local_in`), while q's emits fill the other. Each item was written by an
+            // emitting batch before that batch's release barrier, which every lane passed (a
+            // sink's batch writes none and skips it): visible here.
             if lid < NQ { wg_credit[lid] -= n * EMITS[q * NQ + lid]; }
             sched_local_par ^= 1u << q;
         }

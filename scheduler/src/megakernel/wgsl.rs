@@ -43,7 +43,7 @@ pub fn source(
         guided_claims,
     } = switches;
     let planar = items == ItemLayout::Planar;
-    let mut s = program.tables_wgsl();
+    let mut s = program.tables_wgsl(false);
     s += &format!("const ITEMS_PLANAR: bool = {planar};\n");
     s += &format!("const TURN_ANATOMY: bool = {anatomy};\n");
     s += &format!("const GUIDED_CLAIMS: bool = {guided_claims};\n");
@@ -258,6 +258,28 @@ mod tests {
             Default::default(),
             &plan,
         )
+    }
+
+    /// The megakernel indexes its tables as arrays (docs/scheduler.md 8) and tests for a sink
+    /// at both of its release fences (2.2).
+    #[test]
+    fn the_megakernel_indexes_arrays_and_skips_a_sink_s_fences() {
+        let word = ItemType::new("Word", "struct Word { v: u32 }");
+        let source = Procedure::new("source", word.clone(), 1)
+            .emits("sink", 1)
+            .body("fn source_execute(item: Word, inv: Invocation) { enqueue_sink(item); }");
+        let sink =
+            Procedure::new("sink", word, 1).body("fn sink_execute(item: Word, inv: Invocation) {}");
+        let p = Program::new(vec![source, sink], UserBindings::none()).unwrap();
+        let src = plain_source(&p);
+        assert!(src.contains("THREADS[") && src.contains("EMITS["), "{src}");
+        assert!(!src.contains("fn sched_threads"), "{src}");
+        assert!(src.contains("return q == 1u;"), "{src}");
+        assert_eq!(
+            src.matches("!sched_is_sink(q) { storageBarrier(); }")
+                .count(),
+            2
+        );
     }
 
     #[test]

@@ -150,7 +150,7 @@ pub(super) fn rounds_source(
     run: &str,
     generic: bool,
 ) -> String {
-    let mut s = program.tables_wgsl();
+    let mut s = program.tables_wgsl(true);
     s += &program.common_wgsl();
     s += &crate::wgsl::vec4_word_accessors("mp_in", "items_in");
     s += &crate::wgsl::vec4_word_accessors("mp_out", "items_out");
@@ -197,4 +197,33 @@ pub(super) fn rounds_source(
         s += &instantiate(&format!("_{t}"));
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::{ItemLayout, ItemType, Procedure, Program, UserBindings};
+
+    /// Both multi-passes read the tables through functions, never a `const` array indexed at
+    /// run time (`Program::tables_wgsl`).
+    #[test]
+    fn the_multi_passes_read_the_tables_through_functions() {
+        let word = ItemType::new("Word", "struct Word { v: u32 }");
+        let source = Procedure::new("source", word.clone(), 4)
+            .emits("sink", 2)
+            .body("fn source_execute(item: Word, inv: Invocation) { enqueue_sink(item); }");
+        let sink =
+            Procedure::new("sink", word, 1).body("fn sink_execute(item: Word, inv: Invocation) {}");
+        let p = Program::new(vec![source, sink], UserBindings::none()).unwrap();
+        for items in [ItemLayout::Interleaved, ItemLayout::Planar] {
+            let device = super::source(&p, items, &vec![vec![0], vec![1]], 528);
+            let host = super::super::host::source(&p, items);
+            for src in [device, host] {
+                for table in ["THREADS", "WORDS", "EMITS"] {
+                    assert!(!src.contains(&format!("{table}[")), "{table}: {src}");
+                }
+                assert!(src.contains("sched_threads(") && src.contains("sched_emits("));
+                crate::wgsl::validate("multipass", &src).unwrap();
+            }
+        }
+    }
 }

@@ -292,27 +292,38 @@ impl Program {
         parts
     }
 
-    /// Constant tables: queue count, threads per item, item words, the emit table and the sink
-    /// test. The tables twice: as `const` arrays (`THREADS`, `WORDS`, `EMITS`), which the
-    /// megakernel indexes, and as select functions ([`crate::wgsl::table_fn`]: `sched_threads`,
-    /// `sched_words`, `sched_emits`), which both multi-passes call. naga writes a run-time index
-    /// into a `const` array as a store of the whole array to a function variable and a load; the
-    /// functions took 2-5% off the device-driven multi-pass on every workload of the H100 and
-    /// 2.4-3.8% off the megakernel's frames, but made its trees with local queues 1.6-3.6x
-    /// slower, for a reason not found yet (docs/results.md, 2026-12-05 (eighth session)).
-    pub(crate) fn tables_wgsl(&self) -> String {
+    /// Constant tables: the queue count, then threads per item, item words and the emit table.
+    /// `functions: false` (the megakernel): as `const` arrays (`THREADS`, `WORDS`, `EMITS`),
+    /// with the sink test `sched_is_sink`. `functions: true` (both multi-passes): as functions of
+    /// selects ([`crate::wgsl::table_fn`]: `sched_threads`, `sched_words`, `sched_emits`).
+    /// naga writes a run-time index into a `const` array as a store of the whole array to a
+    /// function variable and a load; the functions took 2-5% off the device-driven multi-pass
+    /// on every workload of the H100 and 2.4-3.8% off the megakernel's frames, but made the
+    /// megakernel's 64-root trees with local queues 1.6-3.6x slower, for a reason not found
+    /// yet (docs/scheduler.md 8; docs/results.md, 2026-12-05 (eighth session)).
+    pub(crate) fn tables_wgsl(&self, functions: bool) -> String {
         use crate::wgsl::table_fn;
         let nq = self.procs.len();
-        let list = |f: &dyn Fn(&ProcInfo) -> u32| {
-            self.procs
-                .iter()
-                .map(|p| format!("{}u", f(p)))
+        let threads: Vec<u32> = self.procs.iter().map(|p| p.proc.threads_per_item).collect();
+        let words: Vec<u32> = self.procs.iter().map(|p| p.words()).collect();
+        let emits: Vec<u32> = self.procs.iter().flat_map(|p| p.emits.clone()).collect();
+        if functions {
+            return format!(
+                "const NQ: u32 = {nq}u;\n\
+                 {}{}\
+                 // sched_emits(q * NQ + t): worst-case items procedure q emits to queue t per item\n\
+                 {}",
+                table_fn("sched_threads", &threads),
+                table_fn("sched_words", &words),
+                table_fn("sched_emits", &emits),
+            );
+        }
+        let list = |v: &[u32]| {
+            v.iter()
+                .map(|x| format!("{x}u"))
                 .collect::<Vec<_>>()
                 .join(", ")
         };
-        let of = |f: &dyn Fn(&ProcInfo) -> u32| self.procs.iter().map(f).collect::<Vec<u32>>();
-        let emits: Vec<u32> = self.procs.iter().flat_map(|p| p.emits.clone()).collect();
-        let emits_list: Vec<String> = emits.iter().map(|e| format!("{e}u")).collect();
         let sinks: Vec<String> = (0..nq)
             .filter(|&q| self.procs[q].is_sink())
             .map(|q| format!("q == {q}u"))
@@ -329,15 +340,10 @@ impl Program {
              // EMITS[q * NQ + t]: worst-case items procedure q emits to queue t per item\n\
              const EMITS: array<u32, {n2}> = array<u32, {n2}>({});\n\
              // Whether procedure q emits nothing: comparisons, not a table indexed at run time\n\
-             fn sched_is_sink(q: u32) -> bool {{ return {sinks}; }}\n\
-             // The same tables as functions, for the multi-passes\n\
-             {}{}{}",
-            list(&|p| p.proc.threads_per_item),
-            list(&|p| p.words()),
-            emits_list.join(", "),
-            table_fn("sched_threads", &of(&|p| p.proc.threads_per_item)),
-            table_fn("sched_words", &of(&|p| p.words())),
-            table_fn("sched_emits", &emits),
+             fn sched_is_sink(q: u32) -> bool {{ return {sinks}; }}\n",
+            list(&threads),
+            list(&words),
+            list(&emits),
             n2 = nq * nq
         )
     }

@@ -616,7 +616,7 @@ mod tests {
         .unwrap();
         assert!(
             chain
-                .tables_wgsl()
+                .tables_wgsl(false)
                 .contains("fn sched_is_sink(q: u32) -> bool { return q == 1u; }")
         );
         let cycle = Program::new(
@@ -626,7 +626,7 @@ mod tests {
         .unwrap();
         assert!(
             cycle
-                .tables_wgsl()
+                .tables_wgsl(false)
                 .contains("fn sched_is_sink(q: u32) -> bool { return false; }")
         );
     }
