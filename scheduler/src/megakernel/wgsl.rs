@@ -264,14 +264,7 @@ mod tests {
     /// at both of its release fences (2.2).
     #[test]
     fn the_megakernel_indexes_arrays_and_skips_a_sink_s_fences() {
-        let word = ItemType::new("Word", "struct Word { v: u32 }");
-        let source = Procedure::new("source", word.clone(), 1)
-            .emits("sink", 1)
-            .body("fn source_execute(item: Word, inv: Invocation) { enqueue_sink(item); }");
-        let sink =
-            Procedure::new("sink", word, 1).body("fn sink_execute(item: Word, inv: Invocation) {}");
-        let p = Program::new(vec![source, sink], UserBindings::none()).unwrap();
-        let src = plain_source(&p);
+        let src = plain_source(&crate::program::source_to_sink(1, 1));
         assert!(src.contains("THREADS[") && src.contains("EMITS["), "{src}");
         assert!(!src.contains("fn sched_threads"), "{src}");
         assert!(src.contains("return q == 1u;"), "{src}");

@@ -201,19 +201,13 @@ pub(super) fn rounds_source(
 
 #[cfg(test)]
 mod tests {
-    use crate::{ItemLayout, ItemType, Procedure, Program, UserBindings};
+    use crate::ItemLayout;
 
     /// Both multi-passes read the tables through functions, never a `const` array indexed at
     /// run time (`Program::tables_wgsl`).
     #[test]
     fn the_multi_passes_read_the_tables_through_functions() {
-        let word = ItemType::new("Word", "struct Word { v: u32 }");
-        let source = Procedure::new("source", word.clone(), 4)
-            .emits("sink", 2)
-            .body("fn source_execute(item: Word, inv: Invocation) { enqueue_sink(item); }");
-        let sink =
-            Procedure::new("sink", word, 1).body("fn sink_execute(item: Word, inv: Invocation) {}");
-        let p = Program::new(vec![source, sink], UserBindings::none()).unwrap();
+        let p = crate::program::source_to_sink(4, 2);
         for items in [ItemLayout::Interleaved, ItemLayout::Planar] {
             let device = super::source(&p, items, &vec![vec![0], vec![1]], 528);
             let host = super::super::host::source(&p, items);

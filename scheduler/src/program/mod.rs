@@ -349,6 +349,19 @@ impl Program {
     }
 }
 
+/// Test fixture: `source` (`threads` threads per item, up to `emits` items to `sink`) and
+/// `sink`, which emits nothing, over one-word items.
+#[cfg(test)]
+pub(crate) fn source_to_sink(threads: u32, emits: u32) -> Program {
+    let word = crate::ItemType::new("Word", "struct Word { v: u32 }");
+    let source = Procedure::new("source", word.clone(), threads)
+        .emits("sink", emits)
+        .body("fn source_execute(item: Word, inv: Invocation) { enqueue_sink(item); }");
+    let sink =
+        Procedure::new("sink", word, 1).body("fn sink_execute(item: Word, inv: Invocation) {}");
+    Program::new(vec![source, sink], UserBindings::none()).unwrap()
+}
+
 fn is_identifier(s: &str) -> bool {
     let mut c = s.chars();
     matches!(c.next(), Some(ch) if ch.is_ascii_alphabetic() || ch == '_')
