@@ -567,6 +567,66 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
     );
 }
 
+/// The megakernel's slots through atomic loads and stores (`Gpu::coherent` false: a device
+/// without `MEMORY_DECORATION_COHERENT`), which wgpu's Vulkan backend never takes on its own
+/// since it always reports the feature: every stress configuration (tiny queues, growth on
+/// the device and through the host, planar items, direct and outbox enqueue, local queues)
+/// runs random trees of small and large items exactly.
+#[test]
+fn megakernels_with_atomic_slots_match_the_cpu_reference_exactly() {
+    let mut gpu = gpu();
+    gpu.coherent = false;
+    let mut rng = Lcg(0xa70c);
+    let (mut runs, mut grown, mut local_runs) = (0, 0, 0);
+    for payload in [1u32, 62] {
+        let shape = TreeParams {
+            roots: 1,
+            max_depth: 1,
+            fanout: Fanout::Uniform(4),
+            work: 0,
+            payload_words: payload,
+            seed: 0,
+        };
+        let mut tree = TreeRun::new(&gpu, shape).unwrap();
+        let schedulers: Vec<(&str, Scheduler)> = stress_configs()
+            .into_iter()
+            .map(|(name, c)| (name, Scheduler::megakernel(&gpu, &tree.program, c).unwrap()))
+            .collect();
+        for _ in 0..4 {
+            let params = TreeParams {
+                roots: 1 + rng.below(8),
+                max_depth: 4 + rng.below(5),
+                fanout: Fanout::Uniform(2 + rng.below(3)),
+                work: rng.below(4),
+                payload_words: payload,
+                seed: rng.below(1 << 30),
+            };
+            let reference = params.reference();
+            tree.set_params(params.clone()).unwrap();
+            for (name, s) in &schedulers {
+                let (stats, result) = tree
+                    .run(&gpu, s)
+                    .unwrap_or_else(|e| panic!("{name}, {}: {e}", params.describe()));
+                assert_eq!(
+                    result,
+                    reference,
+                    "{name}, {}: {stats:?}",
+                    params.describe()
+                );
+                runs += 1;
+                grown += (stats.queue_growths > 0) as u32;
+                local_runs += (stats.local_items > 0) as u32;
+            }
+        }
+    }
+    eprintln!("{runs} runs with atomic slots: {grown} grew a queue, {local_runs} ran local queues");
+    // The paths that move items (growth) and hold them (local queues) must have run.
+    assert!(
+        grown > 10 && local_runs > 10,
+        "{grown} grown, {local_runs} local"
+    );
+}
+
 /// A megakernel whose workgroup memory would pass the device's limit (`.shared` arrays grow
 /// with the workgroup size) is refused when it is built, naming the bytes; the same program
 /// at 256 threads builds.
