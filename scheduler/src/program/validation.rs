@@ -10,6 +10,10 @@
 //!   (a static call graph: a call that is never taken still counts);
 //! - every `@group(1)` variable has a [`crate::UserBindings`] layout entry of the same binding
 //!   and access, and nothing but the scheduler uses another group.
+//!
+//! Then naga's SPIR-V backend writes every execute function, as wgpu will when a strategy makes
+//! its pipeline, so that a panic of that backend on code its validator accepted is an error
+//! naming the procedure (`check_spirv`).
 
 use naga::{Block, Handle, Span, Statement};
 
@@ -240,7 +244,103 @@ pub(crate) fn check(program: &Program) -> Result<Vec<String>, RunError> {
     check_execute_functions(&shared, &module)?;
     check_enqueue_targets(&shared, &module)?;
     check_user_bindings(&shared, &module)?;
+    check_spirv(&shared)?;
     Ok(dynamic_item_indexing(&shared, &module, &info))
+}
+
+/// Writes each procedure's execute function (an entry point that calls it) as SPIR-V with
+/// naga's backend, as wgpu's Vulkan backend does when a strategy's pipeline is made, and turns
+/// a failure or a panic of that backend on code its validator accepted into a
+/// [`RunError::Program`] naming the procedure; without it the panic reached the caller of
+/// `Megakernel::new` or `Kernels::new`. One known cause in naga 30.0.1: a pointer to a member
+/// of a struct passed to a function (`f(&item.cp)`, "Expression [N] is not cached"). The
+/// default panic hook still prints naga's message before the error is returned.
+fn check_spirv(shared: &SharedSource) -> Result<(), RunError> {
+    use naga::back::spv;
+    let start = std::time::Instant::now();
+    let procs = &shared.program.procs;
+    let mut text = shared.text.clone();
+    // A procedure that runs another's execute function (`Procedure::execute_of`) is checked
+    // through that one.
+    let own: Vec<_> = procs
+        .iter()
+        .filter(|p| p.proc.execute_of.is_none())
+        .collect();
+    for p in &own {
+        text += &format!(
+            "@compute @workgroup_size(1) fn sched_spirv_{name}() {{\n    var item: {ty};\n    \
+             {name}_execute(item, Invocation(0u, 0u, true, {threads}u));\n}}\n",
+            name = p.proc.name,
+            ty = p.layout.name,
+            threads = p.proc.threads_per_item
+        );
+    }
+    // The source validated above with these entry points added: a failure here is not the
+    // user's, and the strategies' own compilation will report it.
+    let module = match naga::front::wgsl::parse_str(&text) {
+        Ok(module) => module,
+        Err(e) => {
+            log::debug!("SPIR-V check skipped: {}", e.emit_to_string(&text));
+            return Ok(());
+        }
+    };
+    let info = match naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::all(),
+    )
+    .validate(&module)
+    {
+        Ok(info) => info,
+        Err(e) => {
+            log::debug!("SPIR-V check skipped: {}", e.emit_to_string(&text));
+            return Ok(());
+        }
+    };
+    // The bounds-check policies wgpu-hal 30.0.1's Vulkan backend uses with checks on.
+    let restrict = naga::proc::BoundsCheckPolicy::Restrict;
+    let options = spv::Options {
+        bounds_check_policies: naga::proc::BoundsCheckPolicies {
+            index: restrict,
+            buffer: restrict,
+            image_load: restrict,
+            binding_array: naga::proc::BoundsCheckPolicy::Unchecked,
+        },
+        ..Default::default()
+    };
+    for p in &own {
+        let entry = format!("sched_spirv_{}", p.proc.name);
+        let pipeline = spv::PipelineOptions {
+            shader_stage: naga::ShaderStage::Compute,
+            entry_point: entry,
+        };
+        let written = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            spv::write_vec(&module, &info, &options, Some(&pipeline))
+        }));
+        let why = match written {
+            Ok(Ok(_)) => continue,
+            Ok(Err(e)) => format!("fails: {e}"),
+            Err(panic) => {
+                let message = (panic.downcast_ref::<String>().cloned())
+                    .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                    .unwrap_or_default();
+                format!("panics: {message}")
+            }
+        };
+        return Err(RunError::Program(format!(
+            "procedure `{}`: naga's SPIR-V backend, which wgpu runs when a pipeline is made, \
+             {why}. The body passed validation, so this is a naga bug; a known cause is a \
+             pointer to a member of a struct passed to a function (`f(&item.cp)`): copy the \
+             member into a local `var` and pass a pointer to that (docs/scheduler.md, \
+             \"Writing fast procedures\")",
+            p.proc.name
+        )));
+    }
+    log::debug!(
+        "SPIR-V of {} execute functions written by naga: {:.1} ms",
+        own.len(),
+        start.elapsed().as_secs_f64() * 1e3
+    );
+    Ok(())
 }
 
 /// Notes for each run-time index into an array or matrix reached from a parameter (a value)
@@ -531,6 +631,36 @@ mod tests {
 
     fn sink() -> Procedure {
         Procedure::new("sink", word(), 1).body("fn sink_execute(item: Word, inv: Invocation) {}")
+    }
+
+    /// naga 30.0.1's SPIR-V backend panics on a pointer to a struct member passed to a
+    /// function, which its validator accepts: an error naming the procedure, not a panic when
+    /// a strategy makes its pipeline; the same body through a local copy is accepted.
+    #[test]
+    fn a_body_that_naga_s_spir_v_backend_cannot_write_is_an_error_naming_the_procedure() {
+        let item = ItemType::new("Net", "struct Net { cp: array<vec4<f32>, 4>, n: u32 }");
+        let program = |call: &str| {
+            let body = format!(
+                "fn first(a: ptr<function, array<vec4<f32>, 4>>) -> f32 {{ return (*a)[0].x; }}\n\
+                 fn net_execute(item_value: Net, inv: Invocation) {{\n    \
+                     var item = item_value;\n    {call}\n    \
+                     if first(&cp) > 0.0 {{ enqueue_sink(Word(item.n)); }}\n}}"
+            );
+            let net = Procedure::new("net", item.clone(), 1)
+                .emits("sink", 1)
+                .body(&body);
+            Program::new(vec![net, sink()], UserBindings::none())
+        };
+        let err = match program("var cp = item.cp; if first(&item.cp) > 1.0 { return; }") {
+            Err(RunError::Program(m)) => m,
+            Err(e) => panic!("expected a program error, got {e}"),
+            Ok(_) => panic!("expected a program error, the program was accepted"),
+        };
+        assert!(
+            err.contains("procedure `net`") && err.contains("SPIR-V") && err.contains("panics"),
+            "{err}"
+        );
+        program("var cp = item.cp;").unwrap();
     }
 
     #[test]
