@@ -803,6 +803,61 @@ fn multi_pass_rounds_that_cannot_fit_a_queue_at_its_limit_run_in_part_and_stay_e
     }
 }
 
+/// A megakernel whose queues, at their limit, cannot hold a tree's breadth (it claims each
+/// queue oldest first, so a tree fills it level by level) sets the oldest half of the live
+/// items aside on the host and runs the newest, depth first (`megakernel/park.rs`): the tree
+/// the multi-passes run in part above completes exactly, with local queues and without, and
+/// with planar items; one that cannot run a single item still overflows, nothing lost.
+#[test]
+fn a_megakernel_whose_queues_cannot_hold_a_tree_s_breadth_parks_work_and_stays_exact() {
+    let gpu = gpu();
+    let params = TreeParams {
+        roots: 2,
+        max_depth: 9,
+        fanout: Fanout::Fixed(2),
+        work: 1,
+        payload_words: 2,
+        seed: 7,
+    };
+    let reference = params.reference();
+    let run = TreeRun::new(&gpu, params).unwrap();
+    let mk = |max_capacity, local_queues, item_layout| {
+        Scheduler::megakernel(
+            &gpu,
+            &run.program,
+            MegakernelConfig {
+                initial_capacity: 16,
+                max_capacity,
+                local_queues,
+                item_layout: Some(item_layout),
+                size_from_last_run: false,
+                ..Default::default()
+            },
+        )
+        .unwrap()
+    };
+    for (local, layout) in [
+        (false, ItemLayout::Interleaved),
+        (true, ItemLayout::Interleaved),
+        (false, ItemLayout::Planar),
+    ] {
+        let (stats, result) = run.run(&gpu, &mk(32, local, layout)).unwrap();
+        assert_eq!(result, reference, "local {local}, {layout:?}: {stats:?}");
+        eprintln!(
+            "local {local}, {layout:?}: {} launches, {} items parked",
+            stats.launches, stats.parked_items
+        );
+        assert!(stats.parked_items > 0, "{stats:?}");
+        assert!(stats.peak_occupancy.iter().all(|&p| p <= 32), "{stats:?}");
+    }
+    // A branch emits up to two branches: two slots hold the roots, but one root alone
+    // leaves no room for its children, so the split that parks the other cannot help.
+    match run.run(&gpu, &mk(2, false, ItemLayout::Interleaved)) {
+        Err(RunError::QueueOverflow { queue, .. }) => assert_eq!(queue, "branch"),
+        other => panic!("expected an overflow of `branch`, got {other:?}"),
+    }
+}
+
 /// Growths a queue needs from 16 slots to hold `items` (what it must hold at most: every item
 /// the run ever put in it), plus two for a jump to a refused batch's worst case and rounding.
 fn growth_bound(stats: &RunStats) -> u64 {

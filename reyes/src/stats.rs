@@ -89,6 +89,9 @@ pub struct FrameStats {
     pub queue_growths: u64,
     /// Multi-pass rounds that took only part of a queue (its output would not fit).
     pub partial_rounds: u64,
+    /// Megakernel: live items set aside on the host and run later, because queues at their
+    /// limits could not hold the work's breadth (`scheduler::RunStats::parked_items`).
+    pub parked_items: u64,
     /// Most items held at once, per queue (in `executed`'s order).
     pub peak_queue_items: Vec<u64>,
     /// `peak_queue_items` in bytes (`size_of::<PatchItem>()`, 224, per item), summed.
@@ -352,6 +355,7 @@ pub fn frame_stats(
         rounds: g.run.rounds,
         queue_growths: g.run.queue_growths,
         partial_rounds: g.run.partial_rounds,
+        parked_items: g.run.parked_items,
         peak_queue_items: g.run.peak_occupancy.clone(),
         peak_queue_bytes,
         queue_bytes_allocated: g.run.queue_bytes,

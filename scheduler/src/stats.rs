@@ -59,6 +59,10 @@ pub struct RunStats {
     pub host_compactions: u64,
     /// Megakernel: slots whose bounded wait ran out and were handed to the next launch.
     pub abandoned: u64,
+    /// Megakernel: live items set aside on the host, and run later, because queues at their
+    /// capacity limits could not hold the work's breadth (`megakernel/park.rs`); 0 when the
+    /// queues had room.
+    pub parked_items: u64,
     /// Queues grown because live work did not fit.
     pub queue_growths: u64,
     /// Multi-pass (both): rounds that ran only part of their inputs because a queue at its
@@ -115,6 +119,7 @@ impl RunStats {
         self.launches += o.launches;
         self.submits += o.submits;
         self.host_compactions += o.host_compactions;
+        self.parked_items += o.parked_items;
         self.abandoned += o.abandoned;
         self.queue_growths += o.queue_growths;
         self.partial_rounds += o.partial_rounds;

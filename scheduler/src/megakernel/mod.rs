@@ -10,6 +10,7 @@ mod config;
 pub use config::*;
 pub(crate) mod layout;
 pub(crate) mod local;
+mod park;
 pub use local::LOCAL_MAX_BYTES;
 pub(crate) mod record;
 pub(crate) mod wgsl;
@@ -617,6 +618,8 @@ impl Megakernel {
         let rb = TimedReadback::reuse(kept, gpu, "ctrl read-back", ctrl_words(nq) as u64, reads);
         let results;
         let mut start = Start::Upload(live);
+        // Live items set aside while the queues at their limits cannot hold them (park.rs).
+        let mut parked = park::Parked::default();
         loop {
             let layout = QueueLayout::new(&self.program, capacity.clone())?;
             if dq
@@ -709,6 +712,10 @@ impl Megakernel {
             }
             stats.abandoned += ctrl[g(nq, G_ABANDONED)] as u64;
             if ctrl[g(nq, G_PENDING)] == 0 && ctrl[g(nq, G_ABANDONED)] == 0 {
+                if let Some(chunk) = parked.take() {
+                    start = Start::Upload(chunk.into_iter().map(Cow::Owned).collect());
+                    continue;
+                }
                 results = rb.ranges(&words, reads);
                 break;
             }
@@ -774,11 +781,22 @@ impl Megakernel {
             }
             if progress == 0 && !grew {
                 if let Some((q, needed, _)) = stuck {
-                    return Err(RunError::QueueOverflow {
-                        queue: self.program.procs[q].proc.name.clone(),
-                        capacity: capacity[q] as u64,
-                        needed_more_than: needed,
-                    });
+                    // The queues at their limits hold the work's breadth: the oldest half of
+                    // it waits on the host while the newest runs, depth first (park.rs).
+                    stats.submits += 1;
+                    stats.host_compactions += 1;
+                    let live =
+                        compact::host_compact(gpu, &self.program, d, ctrl, self.item_layout())?;
+                    let Some((rest, n)) = parked.split(live, &d.layout.words) else {
+                        return Err(RunError::QueueOverflow {
+                            queue: self.program.procs[q].proc.name.clone(),
+                            capacity: capacity[q] as u64,
+                            needed_more_than: needed,
+                        });
+                    };
+                    stats.parked_items += n;
+                    start = Start::Upload(rest.into_iter().map(Cow::Owned).collect());
+                    continue;
                 }
                 if ctrl[g(nq, G_ABANDONED)] == 0 {
                     return Err(RunError::NoProgress(
