@@ -11,6 +11,7 @@ pub use config::*;
 pub(crate) mod layout;
 pub(crate) mod local;
 mod park;
+mod relaunch;
 pub use local::LOCAL_MAX_BYTES;
 pub(crate) mod record;
 pub(crate) mod wgsl;
@@ -24,7 +25,7 @@ use compact::{CompactionPass, DeviceCompaction};
 
 use crate::error::RunError;
 use crate::gpu::Gpu;
-use crate::growth::{grow, kept_capacity, with_slack};
+use crate::growth::{kept_capacity, with_slack};
 use crate::item_layout::ItemLayout;
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed, WORKGROUP_SIZE};
@@ -719,66 +720,13 @@ impl Megakernel {
                 results = rb.ranges(&words, reads);
                 break;
             }
-            // Work is left. Live items per queue: every ticket reserved in this launch (seeds
-            // included) that did not run; the executed ones are exactly the consumed slots.
-            let reserved: Vec<u32> = (0..nq).map(|q| ctrl[layout::q(q, Q_RESERVE)]).collect();
-            let live: Vec<u32> = (0..nq)
-                .map(|q| reserved[q].saturating_sub(ctrl[layout::q(q, Q_EXECUTED)]))
-                .collect();
-            let expected = ctrl[g(nq, G_PENDING)] as u64 + ctrl[g(nq, G_ABANDONED)] as u64;
-            if live.iter().map(|&n| n as u64).sum::<u64>() != expected {
-                // On lavapipe the likely cause is known: its loop cut ended a body's loops.
-                let hint = if gpu.is_lavapipe() {
-                    "; on lavapipe every loop of an invocation, the bodies' included, shares \
-                     one 65,535-iteration cut with the persistent loop, so a body with long \
-                     loops is cut short there (docs/scheduler.md, section 4): run it with a \
-                     multi-pass strategy on lavapipe, or with shorter loops"
-                } else {
-                    ""
-                };
-                return Err(RunError::Device(format!(
-                    "queue accounting mismatch after a launch: {live:?} live by queue, \
-                     {expected} pending{hint}"
-                )));
-            }
-            // A launch that ran out of room costs a relaunch: its queues grow fourfold.
-            let out_of_room = (0..nq).any(|q| ctrl[layout::q(q, Q_BLOCKED)] != 0);
-            let mut grew = false;
-            // A queue at its limit that blocked a launch in which nothing ran; a blocked queue
-            // is named before one that is merely full.
-            let mut stuck: Option<(usize, u64, bool)> = None;
-            for q in 0..nq {
-                let n = live[q];
-                let blocked = ctrl[layout::q(q, Q_BLOCKED)] != 0;
-                // Capacity bounds the tickets of one launch (seeds included). A queue grows
-                // before the next launch when it refused a batch for want of room, or when its
-                // tickets, or its live items plus the worst-case output to it of the largest
-                // refused batch (of any queue), passed half its capacity (the next launch, with
-                // more room elsewhere, would likely run out): at least doubling
-                // ([`ROOM_GROWTH`]-fold after a launch that ran out of room), straight to live +
-                // that worst case when more.
-                let demand = ctrl[layout::q(q, Q_DEMAND)] as u64;
-                let half = capacity[q] as u64 / 2;
-                if blocked || reserved[q] as u64 > half || n as u64 + demand > half {
-                    if capacity[q] >= max_cap[q] {
-                        // A blocked claim needed room beyond the whole capacity.
-                        let needed = if blocked {
-                            capacity[q] as u64
-                        } else {
-                            n as u64
-                        };
-                        if stuck.is_none_or(|s| blocked && !s.2) {
-                            stuck = Some((q, needed, blocked));
-                        }
-                        continue;
-                    }
-                    let factor = if out_of_room { ROOM_GROWTH } else { 1 };
-                    let need = (n as u64 + demand).max(factor * capacity[q] as u64);
-                    capacity[q] = grow(capacity[q], need, max_cap[q]);
-                    stats.queue_growths += 1;
-                    grew = true;
-                }
-            }
+            // Work is left: live items per queue, and the queues grown for the next launch.
+            let relaunch::Sizing {
+                reserved,
+                live,
+                grew,
+                stuck,
+            } = relaunch::size(gpu, nq, ctrl, &mut capacity, &max_cap, &mut stats)?;
             if progress == 0 && !grew {
                 if let Some((q, needed, _)) = stuck {
                     // The queues at their limits hold the work's breadth: the oldest half of
