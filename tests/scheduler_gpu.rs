@@ -856,6 +856,23 @@ fn a_megakernel_whose_queues_cannot_hold_a_tree_s_breadth_parks_work_and_stays_e
         Err(RunError::QueueOverflow { queue, .. }) => assert_eq!(queue, "branch"),
         other => panic!("expected an overflow of `branch`, got {other:?}"),
     }
+    // Parked work takes launches of its own: a run that uses up `max_launches` says so.
+    let few = Scheduler::megakernel(
+        &gpu,
+        &run.program,
+        MegakernelConfig {
+            initial_capacity: 16,
+            max_capacity: 32,
+            max_launches: 20,
+            size_from_last_run: false,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    match run.run(&gpu, &few) {
+        Err(RunError::NoProgress(m)) => assert!(m.contains("parked"), "{m}"),
+        other => panic!("expected launches used up, got {other:?}"),
+    }
 }
 
 /// Growths a queue needs from 16 slots to hold `items` (what it must hold at most: every item

@@ -24,8 +24,9 @@ pub enum RunError {
     /// The device reported an error.
     #[error("GPU device error: {0}")]
     Device(String),
-    /// A queue could not hold the live work even after growing to its limit. Nothing was lost:
-    /// the run stopped with the queues intact.
+    /// A queue could not hold the live work even after growing to its limit: the multi-passes'
+    /// partial rounds, or the megakernel's parked work, could not run even one item more.
+    /// Nothing was lost: the run stopped with the queues intact.
     #[error(
         "queue `{queue}` overflowed: capacity {capacity} items, live work needs more than \
          {needed_more_than}; no item was lost (more room: a larger `max_capacity` in the \

@@ -104,6 +104,8 @@ pub struct Gpu {
     pub info: wgpu::AdapterInfo,
     /// `@coherent` storage buffers are available, so queue payloads may use plain loads/stores.
     /// Without it the queue moves payload words with atomic loads/stores (always coherent).
+    /// Clearing it before a scheduler is built forces that path (the tests do; wgpu's Vulkan
+    /// backend reports the feature on every device).
     pub coherent: bool,
     /// Timestamp queries at pass boundaries are available: runs report GPU time.
     pub timestamps: bool,

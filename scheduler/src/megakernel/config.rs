@@ -102,7 +102,9 @@ pub struct MegakernelConfig {
     /// Slots per queue at the start of a run (at least twice the seeds).
     pub initial_capacity: u32,
     /// A queue grows (at least doubling) up to this many slots, and never past its share of
-    /// the largest storage binding; beyond that the run reports [`RunError::QueueOverflow`](crate::RunError::QueueOverflow).
+    /// the largest storage binding. At that limit a launch that can run nothing parks half of
+    /// the live work on the host and runs the rest first (`RunStats::parked_items`); only a
+    /// single live item that cannot run is a [`RunError::QueueOverflow`](crate::RunError::QueueOverflow).
     pub max_capacity: u32,
     /// Launches per run before it stops with [`RunError::NoProgress`](crate::RunError::NoProgress) (default 10,000).
     pub max_launches: u32,

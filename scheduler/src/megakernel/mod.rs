@@ -642,8 +642,9 @@ impl Megakernel {
             let d = dq.as_ref().unwrap();
             if stats.launches >= self.config.max_launches as u64 {
                 return Err(RunError::NoProgress(format!(
-                    "work left after {} megakernel launches",
-                    stats.launches
+                    "work left after {} megakernel launches{}",
+                    stats.launches,
+                    park::launches_hint(stats.parked_items)
                 )));
             }
             let mut enc = gpu.device.create_command_encoder(&Default::default());

@@ -57,6 +57,19 @@ impl Parked {
     }
 }
 
+/// What to add to the error of a run that used up its launches after parking `parked_items`
+/// items: parked work runs in launches of its own, the likely cause.
+pub(super) fn launches_hint(parked_items: u64) -> String {
+    match parked_items {
+        0 => String::new(),
+        n => format!(
+            " ({n} items were parked on the host because queues at their limits could not \
+             hold the work's breadth: a larger `max_launches`, `max_capacity` or memory budget \
+             lets it finish)"
+        ),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::Parked;

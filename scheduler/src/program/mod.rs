@@ -87,10 +87,14 @@ impl Program {
     /// and itself runs its own); no procedure calls
     /// `enqueue_<t>` (directly or through helpers) for a target it did not declare with
     /// [`Procedure::emits`]; every `@group(1)` variable has a layout entry of the same binding
-    /// and storage access.
+    /// and storage access; naga's SPIR-V backend, which wgpu runs when a strategy makes its
+    /// pipeline, writes every execute function (it panics on some code its validator accepts).
     ///
     /// Errors: [`RunError::Program`]. A WGSL error names where it is: the procedure and the
     /// line and column within its body (or the user WGSL, or the item struct), with the line.
+    /// A failure of the SPIR-V backend names the procedure only (the backend gives no line);
+    /// its panic is caught (not under `panic = "abort"`), but the default panic hook prints
+    /// naga's message first.
     /// User WGSL must also avoid the identifiers of the scheduler's generated code (`ctrl`,
     /// `slots`, `NQ`, `Q_*`, `wg_*`, `mp_*`, ...); a clash there is reported by the strategy's
     /// constructor.

@@ -330,8 +330,8 @@ fn check_spirv(shared: &SharedSource) -> Result<(), RunError> {
             "procedure `{}`: naga's SPIR-V backend, which wgpu runs when a pipeline is made, \
              {why}. The body passed validation, so this is a naga bug; a known cause is a \
              pointer to a member of a struct passed to a function (`f(&item.cp)`): copy the \
-             member into a local `var` and pass a pointer to that (docs/scheduler.md, \
-             \"Writing fast procedures\")",
+             member into a local `var` and pass a pointer to that (docs/scheduler.md, section \
+             1, `Program::new`). A panic message printed above is this one, caught",
             p.proc.name
         )));
     }
