@@ -265,6 +265,47 @@ fn guided_claims_are_asked_for_and_recorded() {
     assert_eq!(guided(&["--no-guided-claims"]), serde_json::json!(false));
 }
 
+/// `--max-capacity` bounds every strategy's queues: a tree whose breadth passes the limit
+/// still runs exactly on each, the multi-passes in partial rounds and the megakernel with
+/// work parked on the host, and the records count both.
+#[test]
+fn a_queue_limit_runs_every_strategy_depth_first_and_is_recorded() {
+    let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
+        .args(["--workload", "tree", "--roots", "2", "--depth", "9"])
+        .args([
+            "--fanout",
+            "fixed:2",
+            "--payload",
+            "2",
+            "--max-capacity",
+            "32",
+        ])
+        .args(["--strategy", "all", "--runs", "1", "--json"])
+        .output()
+        .expect("schedbench runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let records: Vec<serde_json::Value> = (stdout.lines())
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let by = |name: &str| {
+        let r = records.iter().find(|r| r["strategy"] == name);
+        r.unwrap_or_else(|| panic!("no {name} record: {stdout}"))
+            .clone()
+    };
+    for r in &records {
+        assert_eq!(r["verified"], true, "{r}");
+    }
+    assert!(
+        by("megakernel")["parked_items"].as_u64().unwrap() > 0,
+        "{stdout}"
+    );
+    for mp in ["multipass", "multipass-host"] {
+        assert!(by(mp)["partial_rounds"].as_u64().unwrap() > 0, "{stdout}");
+    }
+}
+
 /// The first JSON record of `schedbench --workload tree --strategy megakernel --runs 1 --json
 /// ARGS`, which must exit 0 with a verified run.
 fn first_json_record(args: &[&str]) -> serde_json::Value {

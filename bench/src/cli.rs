@@ -183,6 +183,15 @@ pub struct Cli {
           help_heading = "Scheduler")]
     pub capacity: Option<u32>,
 
+    /// Most slots a queue may grow to, on every strategy (`max_capacity` of their configs):
+    /// under such a limit the multi-passes run partial rounds and the megakernel parks work on
+    /// the host, going depth first, and the records count both (`partial_rounds`,
+    /// `parked_items`); a run overflows only when not one item more can run [default: the
+    /// library's, 2^26 slots or the largest binding].
+    #[arg(long, value_name = "SLOTS", value_parser = value_parser!(u32).range(1..),
+          help_heading = "Scheduler")]
+    pub max_capacity: Option<u32>,
+
     /// Count what the megakernel's loop turns spend per phase (claim, wait for flags, execute,
     /// enqueue, reserve, copy, publish) and print the table after the runs (`MegakernelConfig::turn_anatomy`).
     #[arg(long, help_heading = "Scheduler")]
@@ -475,6 +484,7 @@ impl Cli {
                 _ => None,
             },
             capacity: self.capacity,
+            max_capacity: self.max_capacity,
             turn_anatomy: self.turn_anatomy,
             subgroups: match self.subgroups {
                 true => None,

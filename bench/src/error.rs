@@ -84,9 +84,9 @@ fn run_message(e: &RunError) -> String {
             needed_more_than,
         } => format!(
             "queue `{queue}` overflowed: capacity {capacity} items, live work needs more than \
-             {needed_more_than}; no item was lost (make room with a smaller --payload, or a \
-             smaller tree, fewer items alive at once: fewer --roots, a lower --depth, a smaller \
-             --fanout)"
+             {needed_more_than}; no item was lost (make room with a larger --max-capacity where \
+             one was given, a smaller --payload, or a smaller tree, fewer items alive at once: \
+             fewer --roots, a lower --depth, a smaller --fanout)"
         ),
         other => other.to_string(),
     }
@@ -98,7 +98,7 @@ mod tests {
     use clap::CommandFactory;
 
     /// A queue overflow's advice names only options schedbench has (not the library's "memory
-    /// budget" or "max_capacity", which are no schedbench flags).
+    /// budget" or its config field `max_capacity`, which schedbench sets as `--max-capacity`).
     #[test]
     fn overflow_advice_names_existing_options() {
         let e = Error::Run(RunError::QueueOverflow {

@@ -241,6 +241,8 @@ mod tests {
             idle_polls: 0,
             abandoned: 0,
             queue_growths: 0,
+            partial_rounds: 0,
+            parked_items: 0,
             peak_occupancy: vec![],
             queue_bytes: 0,
             workgroups: 0,

@@ -92,6 +92,12 @@ pub struct RunRecord {
     pub idle_polls: u64,
     pub abandoned: u64,
     pub queue_growths: u64,
+    /// Multi-pass rounds run in part under a queue limit (`RunStats::partial_rounds`).
+    #[serde(default)]
+    pub partial_rounds: u64,
+    /// Megakernel items parked on the host under a queue limit (`RunStats::parked_items`).
+    #[serde(default)]
+    pub parked_items: u64,
     pub peak_occupancy: Vec<u64>,
     pub queue_bytes: u64,
     pub workgroups: u32,
@@ -135,6 +141,8 @@ impl RunRecord {
             idle_polls: s.idle_polls,
             abandoned: s.abandoned,
             queue_growths: s.queue_growths,
+            partial_rounds: s.partial_rounds,
+            parked_items: s.parked_items,
             peak_occupancy: s.peak_occupancy,
             queue_bytes: s.queue_bytes,
             workgroups: s.workgroups,
@@ -195,6 +203,8 @@ impl RunRecord {
             idle_polls: 0,
             abandoned: 0,
             queue_growths: 0,
+            partial_rounds: 0,
+            parked_items: 0,
             peak_occupancy: Vec::new(),
             queue_bytes: 0,
             workgroups: 0,

@@ -150,6 +150,9 @@ pub struct GpuConfig {
     pub direct_enqueue: Option<bool>,
     /// Queue slots at the start of a run; `None` lets the workload choose from its size.
     pub capacity: Option<u32>,
+    /// Most slots a queue may grow to (every strategy's `max_capacity`); `None`: the library's
+    /// default.
+    pub max_capacity: Option<u32>,
     /// `MegakernelConfig::turn_anatomy`.
     pub turn_anatomy: bool,
     /// `MegakernelConfig::subgroups`; `None`: where the adapter has them; default `Some(false)`.
@@ -184,6 +187,7 @@ impl Default for GpuConfig {
             item_layout: None,
             direct_enqueue: None,
             capacity: None,
+            max_capacity: None,
             turn_anatomy: false,
             subgroups: Some(false),
             local_queues: None,
@@ -267,6 +271,9 @@ pub fn compile(
                     .unwrap_or(MegakernelConfig::default().local_bytes),
                 defer_local_sinks: config.defer_local_sinks,
                 initial_capacity: capacity,
+                max_capacity: config
+                    .max_capacity
+                    .unwrap_or(MegakernelConfig::default().max_capacity),
                 ..Default::default()
             },
         ),
@@ -279,6 +286,9 @@ pub fn compile(
                 fused_sinks_apart: config.fused_sinks_apart,
                 fused_sinks_first: config.fused_sinks_first,
                 max_workgroups: config.max_workgroups,
+                max_capacity: config
+                    .max_capacity
+                    .unwrap_or(MultipassConfig::default().max_capacity),
                 ..Default::default()
             },
         ),
@@ -288,6 +298,9 @@ pub fn compile(
             HostMultipassConfig {
                 initial_capacity: capacity,
                 item_layout: config.item_layout,
+                max_capacity: config
+                    .max_capacity
+                    .unwrap_or(HostMultipassConfig::default().max_capacity),
                 ..Default::default()
             },
         ),

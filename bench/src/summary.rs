@@ -433,6 +433,8 @@ mod tests {
             idle_polls: 50,
             abandoned: 0,
             queue_growths: 0,
+            partial_rounds: 0,
+            parked_items: 0,
             peak_occupancy: vec![100],
             queue_bytes: 0,
             workgroups: if mk { 4 } else { 0 },
