@@ -73,7 +73,7 @@ fn ob_off(q: u32, t: u32) -> u32 { return params[8u + NQ * 5u + q * NQ + t]; }
 // items per step); the outbox and the queues' slack are sized for it.
 fn batch_max(q: u32) -> u32 { return params[11u + q * 4u]; }
 // Items the outbox part (q, t) holds: a batch's worst-case output to t.
-fn ob_cap(q: u32, t: u32) -> u32 { return batch_max(q) * EMITS[q * NQ + t]; }
+fn ob_cap(q: u32, t: u32) -> u32 { return batch_max(q) * sched_emits(q * NQ + t); }
 
 const MAX_BATCH: u32 = 1024u;
 const EMPTY: u32 = 0u;            // slot flag: not written yet
@@ -109,7 +109,7 @@ var<workgroup> wg_emitted: atomic<u32>;
 var<workgroup> wg_avail: array<i32, NQ>;
 var<workgroup> wg_stop: u32;
 var<workgroup> wg_pending: u32;
-// Direct enqueue: the tickets this batch took, per target from ES_OFF[q * NQ + t].
+// Direct enqueue: the tickets this batch took, per target from sched_es_off(q * NQ + t).
 var<workgroup> wg_emit_slot: array<u32, EMIT_SLOTS>;
 // Local queues (LOCAL; sizes and buffers: scheduler/src/megakernel/local.rs). In the workgroup's
 // area of `slots` (past every queue's slots), t's filling buffer (`sched_local_out`) holds
@@ -208,7 +208,7 @@ fn sched_raise(code: u32, a: u32, b: u32) {
 // Where enqueue_<t> puts the j-th item emitted to queue t in this batch, or a raised error.
 fn sched_outbox_slot(t: u32) -> u32 {
     let j = sched_take(t, false).x;
-    if j >= sched_batch_n * EMITS[sched_proc * NQ + t] {
+    if j >= sched_batch_n * sched_emits(sched_proc * NQ + t) {
         sched_raise(ERR_EMIT, sched_proc, t);
         return 0xffffffffu;
     }
@@ -221,12 +221,12 @@ fn sched_outbox_slot(t: u32) -> u32 {
 fn sched_direct_slot(t: u32) -> u32 {
     let js = sched_take(t, true);
     let j = js.x;
-    if j >= sched_batch_n * EMITS[sched_proc * NQ + t] {
+    if j >= sched_batch_n * sched_emits(sched_proc * NQ + t) {
         sched_raise(ERR_EMIT, sched_proc, t);
         return 0xffffffffu;
     }
     let s = js.y;
-    wg_emit_slot[ES_OFF[sched_proc * NQ + t] + j] = s;
+    wg_emit_slot[sched_es_off(sched_proc * NQ + t) + j] = s;
     return s;
 }
 
@@ -338,7 +338,7 @@ fn leader_decide() -> u32 {
         wg_turn.w = m;
         atomicStore(&wg_local_n[pick], 0u);
         for (var t = 0u; t < NQ; t++) {
-            if m * EMITS[pick * NQ + t] > wg_credit[t] { return CMD_LOCAL_RESERVE; }
+            if m * sched_emits(pick * NQ + t) > wg_credit[t] { return CMD_LOCAL_RESERVE; }
         }
         return CMD_LOCAL;
     }
@@ -392,14 +392,14 @@ fn spill_local(lid: u32) {
         let m = wg_emit_n[t];
         let base = wg_emit_base[t];
         let held_at = sched_local_out(t);
-        for (var i = lid; i < m * WORDS[t]; i += WG_SIZE) {
+        for (var i = lid; i < m * sched_words(t); i += WG_SIZE) {
             if ITEMS_PLANAR {
                 let plane = i / m;
                 let j = i % m;
                 sched_slot_store_word(q_slot_base(t) + plane * q_cap(t) + base + j,
                     sched_slot_load_word(held_at + plane * LOCAL_CAP[t] + j));
             } else {
-                sched_slot_store_word(q_slot_base(t) + base * WORDS[t] + i, sched_slot_load_word(held_at + i));
+                sched_slot_store_word(q_slot_base(t) + base * sched_words(t) + i, sched_slot_load_word(held_at + i));
             }
         }
     }
@@ -525,8 +525,8 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
             //    parallel reserve the shortfall in each target's budget; without room, spill
             //    what the workgroup holds and claim as usual.
             var took = 0u;
-            if lid < NQ && n * EMITS[q * NQ + lid] > wg_credit[lid] {
-                took = n * EMITS[q * NQ + lid] - wg_credit[lid];
+            if lid < NQ && n * sched_emits(q * NQ + lid) > wg_credit[lid] {
+                took = n * sched_emits(q * NQ + lid) - wg_credit[lid];
                 let old = atomicAdd(&ctrl[lid * QSTRIDE + Q_BUDGET], took);
                 if old + took > q_cap(lid) { atomicStore(&wg_local_fail, 1u); }
             }
@@ -549,7 +549,7 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
             // (`sched_local_in`), while q's emits fill the other. Each item was written by an
             // emitting batch before that batch's release barrier, which every lane passed (a
             // sink's batch writes none and skips it): visible here.
-            if lid < NQ { wg_credit[lid] -= n * EMITS[q * NQ + lid]; }
+            if lid < NQ { wg_credit[lid] -= n * sched_emits(q * NQ + lid); }
             sched_local_par ^= 1u << q;
         }
 
@@ -597,7 +597,7 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         let abandoned = atomicLoad(&wg_abandoned);
         if lid < NQ {
             let t = lid;
-            let promised = n * EMITS[q * NQ + t];
+            let promised = n * sched_emits(q * NQ + t);
             // Local emits: the count cut back to the limit; what was kept stays insured.
             var kept_new = 0u;
             if LOCAL {
@@ -687,15 +687,15 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
                 var chain = 0u;
                 for (var t = 0u; t < NQ; t++) {
                     let k = wg_emit_n[t];
-                    chain = max(chain, u32(k > 0u && !DIRECT_ENQUEUE) + u32(n * EMITS[q * NQ + t] > k));
+                    chain = max(chain, u32(k > 0u && !DIRECT_ENQUEUE) + u32(n * sched_emits(q * NQ + t) > k));
                     if DIRECT_ENQUEUE { an_add(AN_ENQUEUE, k); }
                     if !DIRECT_ENQUEUE {
                         if ITEMS_PLANAR {
-                            an_add(AN_COPY, ((k + WG_SIZE - 1u) / WG_SIZE) * WORDS[t]);
-                        } else if WORDS[t] % 4u == 0u {
-                            an_add(AN_COPY, (k * WORDS[t] + 4u * WG_SIZE - 1u) / (4u * WG_SIZE));
+                            an_add(AN_COPY, ((k + WG_SIZE - 1u) / WG_SIZE) * sched_words(t));
+                        } else if sched_words(t) % 4u == 0u {
+                            an_add(AN_COPY, (k * sched_words(t) + 4u * WG_SIZE - 1u) / (4u * WG_SIZE));
                         } else {
-                            an_add(AN_COPY, (k * WORDS[t] + WG_SIZE - 1u) / WG_SIZE);
+                            an_add(AN_COPY, (k * sched_words(t) + WG_SIZE - 1u) / WG_SIZE);
                         }
                     }
                     an_add(AN_PUBLISH, (k + WG_SIZE - 1u) / WG_SIZE);
@@ -711,8 +711,8 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         //    (queue regions and outbox parts are 16-byte aligned).
         for (var t = 0u; t < NQ && !DIRECT_ENQUEUE; t++) {
             let k = wg_emit_n[t];
-            let words = k * WORDS[t];
-            let dst = q_slot_base(t) + wg_emit_base[t] * WORDS[t];
+            let words = k * sched_words(t);
+            let dst = q_slot_base(t) + wg_emit_base[t] * sched_words(t);
             let src = sched_outbox + ob_off(q, t);
             if ITEMS_PLANAR {
                 // Plane by plane, four planes per trip: four independent loads in flight.
@@ -720,7 +720,7 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
                 let ob = ob_cap(q, t);
                 let to = q_slot_base(t) + wg_emit_base[t];
                 var plane = 0u;
-                for (; plane + 4u <= WORDS[t]; plane += 4u) {
+                for (; plane + 4u <= sched_words(t); plane += 4u) {
                     for (var j = lid; j < k; j += WG_SIZE) {
                         let a = sched_ob_load_word(src + plane * ob + j);
                         let b = sched_ob_load_word(src + (plane + 1u) * ob + j);
@@ -732,12 +732,12 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
                         sched_slot_store_word(to + (plane + 3u) * cap + j, d);
                     }
                 }
-                for (; plane < WORDS[t]; plane++) {
+                for (; plane < sched_words(t); plane++) {
                     for (var j = lid; j < k; j += WG_SIZE) {
                         sched_slot_store_word(to + plane * cap + j, sched_ob_load_word(src + plane * ob + j));
                     }
                 }
-            } else if WORDS[t] % 4u == 0u {
+            } else if sched_words(t) % 4u == 0u {
                 for (var w = lid * 4u; w < words; w += 4u * WG_SIZE) {
                     sched_slot_store_vec4(dst + w, sched_ob_load_vec4(src + w));
                 }
@@ -758,7 +758,7 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         for (var t = 0u; t < NQ; t++) {
             for (var j = lid; j < wg_emit_n[t]; j += WG_SIZE) {
                 var s = wg_emit_base[t] + j;
-                if DIRECT_ENQUEUE { s = wg_emit_slot[ES_OFF[q * NQ + t] + j]; }
+                if DIRECT_ENQUEUE { s = wg_emit_slot[sched_es_off(q * NQ + t) + j]; }
                 atomicStore(&flags[q_flag_base(t) + s], wg_stamp);
             }
         }

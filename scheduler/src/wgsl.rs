@@ -24,9 +24,9 @@ pub fn validate(label: &str, source: &str) -> Result<naga::Module, RunError> {
 /// A table of one value is that constant, whatever the index.
 /// The scheduler's tables (threads, words and emits per procedure) are indexed by values known
 /// only at run time, and naga writes such an access to a `const` array as a store of the whole
-/// array into a function variable, then a load (SPIR-V has no dynamic extract): the multi-passes
-/// call these instead (`Program::tables_wgsl`). Selects on a value known at compile time fold
-/// away.
+/// array into a function variable, then a load (SPIR-V has no dynamic extract): every strategy
+/// calls these instead (`Program::tables_wgsl`; the megakernel keeps threads per item as an
+/// array). Selects on a value known at compile time fold away.
 pub fn table_fn(name: &str, values: &[u32]) -> String {
     let mut counts = std::collections::BTreeMap::new();
     for &v in values {

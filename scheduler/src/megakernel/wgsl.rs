@@ -43,24 +43,23 @@ pub fn source(
         guided_claims,
     } = switches;
     let planar = items == ItemLayout::Planar;
-    let mut s = program.tables_wgsl(false);
+    let mut s = program.tables_wgsl(true);
     s += &format!("const ITEMS_PLANAR: bool = {planar};\n");
     s += &format!("const TURN_ANATOMY: bool = {anatomy};\n");
     s += &format!("const GUIDED_CLAIMS: bool = {guided_claims};\n");
     s += &format!("const WG_SIZE: u32 = {}u;\n", program.workgroup_size());
     let (slots, offsets) = direct.unwrap_or((1, &[]));
     let nq = program.queue_count();
-    let es: Vec<String> = (0..nq * nq)
-        .map(|i| format!("{}u", offsets.get(i).copied().unwrap_or(0)))
+    let es: Vec<u32> = (0..nq * nq)
+        .map(|i| offsets.get(i).copied().unwrap_or(0))
         .collect();
     s += &format!(
         "const DIRECT_ENQUEUE: bool = {};\n\
          const EMIT_SLOTS: u32 = {slots}u;\n\
-         // ES_OFF[q * NQ + t]: where target t's tickets start in a batch of q's ticket list\n\
-         const ES_OFF: array<u32, {n2}> = array<u32, {n2}>({});\n",
+         // sched_es_off(q * NQ + t): where target t's tickets start in a batch of q's ticket list\n\
+         {}",
         direct.is_some(),
-        es.join(", "),
-        n2 = nq * nq
+        crate::wgsl::table_fn("sched_es_off", &es),
     );
     s += &local.wgsl(program);
     s += &program.common_wgsl();
@@ -88,14 +87,14 @@ pub fn source(
         if planar {
             format!("q_slot_base({q}) + s, q_cap({q})")
         } else {
-            format!("q_slot_base({q}) + s * WORDS[{q}]")
+            format!("q_slot_base({q}) + s * sched_words({q})")
         }
     };
     // Outbox item `j` of part (q, t) and its stride.
     let (ob_at, ob_stride) = if planar {
         ("sched_outbox + ob_off(q, t) + j", "ob_cap(q, t)")
     } else {
-        ("sched_outbox + ob_off(q, t) + j * WORDS[t]", "1u")
+        ("sched_outbox + ob_off(q, t) + j * sched_words(t)", "1u")
     };
     // A local batch's item `s` in the buffer it was kept in (planar: stride the buffer's
     // capacity). One call site of `sched_execute` either way (lavapipe inlines it).
@@ -103,8 +102,8 @@ pub fn source(
         ("q_slot_base(q) + s", "sched_local_in(q) + s", ", stride")
     } else {
         (
-            "q_slot_base(q) + s * WORDS[q]",
-            "sched_local_in(q) + s * WORDS[q]",
+            "q_slot_base(q) + s * sched_words(q)",
+            "sched_local_in(q) + s * sched_words(q)",
             "",
         )
     };
@@ -132,7 +131,7 @@ pub fn source(
             let at = if planar {
                 format!("sched_local_out({t}u) + l, LOCAL_CAP[{t}u]")
             } else {
-                format!("sched_local_out({t}u) + l * WORDS[{t}u]")
+                format!("sched_local_out({t}u) + l * sched_words({t}u)")
             };
             format!(
                 "if LOCAL_EDGE[sched_proc * NQ + {t}u] != 0u {{\n        \
@@ -176,7 +175,7 @@ fn claim_wgsl(nq: usize) -> String {
     let mut s = String::from("fn reserve_budget(q: u32, n: u32) -> bool {\n");
     for t in 0..nq {
         s += &format!(
-            "    let e{t} = EMITS[q * NQ + {t}u] * n;\n    var o{t} = 0u;\n    \
+            "    let e{t} = sched_emits(q * NQ + {t}u) * n;\n    var o{t} = 0u;\n    \
              if e{t} > 0u {{ o{t} = atomicAdd(&ctrl[{t}u * QSTRIDE + Q_BUDGET], e{t}); }}\n"
         );
     }
@@ -213,7 +212,7 @@ const TAKE_ONE: &str = "\
 fn sched_take(t: u32, direct: bool) -> vec2<u32> {
     let j = atomicAdd(&wg_emit_count[t], 1u);
     var s = 0u;
-    if direct && j < sched_batch_n * EMITS[sched_proc * NQ + t] {
+    if direct && j < sched_batch_n * sched_emits(sched_proc * NQ + t) {
         s = atomicAdd(&ctrl[t * QSTRIDE + Q_RESERVE], 1u);
     }
     return vec2<u32>(j, s);
@@ -232,7 +231,7 @@ fn sched_take(t: u32, direct: bool) -> vec2<u32> {
         base.x = atomicAdd(&wg_emit_count[t], n);
         if direct {
             // Tickets only for the emits within the batch's declared limit.
-            let limit = sched_batch_n * EMITS[sched_proc * NQ + t];
+            let limit = sched_batch_n * sched_emits(sched_proc * NQ + t);
             let within = min(n, limit - min(limit, base.x));
             if within > 0u { base.y = atomicAdd(&ctrl[t * QSTRIDE + Q_RESERVE], within); }
         }
@@ -260,13 +259,24 @@ mod tests {
         )
     }
 
-    /// The megakernel indexes its tables as arrays (docs/scheduler.md 8) and tests for a sink
-    /// at both of its release fences (2.2).
+    /// The megakernel reads threads per item from a `const` array and its other tables through
+    /// functions (`Program::tables_wgsl`), and tests for a sink at both release fences (2.2).
     #[test]
-    fn the_megakernel_indexes_arrays_and_skips_a_sink_s_fences() {
+    fn the_megakernel_reads_threads_from_an_array_the_rest_through_functions() {
         let src = plain_source(&crate::program::source_to_sink(1, 1));
-        assert!(src.contains("THREADS[") && src.contains("EMITS["), "{src}");
-        assert!(!src.contains("fn sched_threads"), "{src}");
+        assert!(
+            src.contains("THREADS[") && !src.contains("fn sched_threads"),
+            "{src}"
+        );
+        for table in ["WORDS", "EMITS", "ES_OFF"] {
+            assert!(!src.contains(&format!("{table}[")), "{table}: {src}");
+        }
+        for f in ["sched_words", "sched_emits", "sched_es_off"] {
+            assert!(
+                src.contains(&format!("fn {f}(i: u32) -> u32")),
+                "{f}: {src}"
+            );
+        }
         assert!(src.contains("return q == 1u;"), "{src}");
         assert_eq!(
             src.matches("!sched_is_sink(q) { storageBarrier(); }")

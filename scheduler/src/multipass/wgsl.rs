@@ -150,7 +150,7 @@ pub(super) fn rounds_source(
     run: &str,
     generic: bool,
 ) -> String {
-    let mut s = program.tables_wgsl(true);
+    let mut s = program.tables_wgsl(false);
     s += &program.common_wgsl();
     s += &crate::wgsl::vec4_word_accessors("mp_in", "items_in");
     s += &crate::wgsl::vec4_word_accessors("mp_out", "items_out");

@@ -297,37 +297,40 @@ impl Program {
     }
 
     /// Constant tables: the queue count, then threads per item, item words and the emit table.
-    /// `functions: false` (the megakernel): as `const` arrays (`THREADS`, `WORDS`, `EMITS`),
-    /// with the sink test `sched_is_sink`. `functions: true` (both multi-passes): as functions of
-    /// selects ([`crate::wgsl::table_fn`]: `sched_threads`, `sched_words`, `sched_emits`).
-    /// naga writes a run-time index into a `const` array as a store of the whole array to a
-    /// function variable and a load; the functions took 2-5% off the device-driven multi-pass
-    /// on every workload of the H100 and 2.4-3.8% off the megakernel's frames, but made the
-    /// megakernel's 64-root trees with local queues 1.6-3.6x slower, for a reason not found
-    /// yet (docs/scheduler.md 8; docs/results.md, 2026-12-05 (eighth session)).
-    pub(crate) fn tables_wgsl(&self, functions: bool) -> String {
+    /// Item words and emits are functions of selects in every strategy
+    /// ([`crate::wgsl::table_fn`]: `sched_words`, `sched_emits`): naga writes a run-time index
+    /// into a `const` array as a store of the whole array to a function variable and a load,
+    /// and the functions took 2-5% off the device-driven multi-pass on the H100 and 2.8-2.9%
+    /// off the megakernel's frames. Threads per item: `megakernel: false` (both multi-passes)
+    /// the function `sched_threads`; `megakernel: true` a `const` array, `THREADS`, with the
+    /// sink test `sched_is_sink`: as a function it made the megakernel's 64-root trees with
+    /// local queues 1.6-3.6x slower on the H100 (its bisection: docs/results.md, 2026-12-05
+    /// (ninth session)).
+    pub(crate) fn tables_wgsl(&self, megakernel: bool) -> String {
         use crate::wgsl::table_fn;
         let nq = self.procs.len();
         let threads: Vec<u32> = self.procs.iter().map(|p| p.proc.threads_per_item).collect();
         let words: Vec<u32> = self.procs.iter().map(|p| p.words()).collect();
         let emits: Vec<u32> = self.procs.iter().flat_map(|p| p.emits.clone()).collect();
-        if functions {
-            return format!(
-                "const NQ: u32 = {nq}u;\n\
-                 {}{}\
-                 // sched_emits(q * NQ + t): worst-case items procedure q emits to queue t per item\n\
-                 {}",
-                table_fn("sched_threads", &threads),
-                table_fn("sched_words", &words),
-                table_fn("sched_emits", &emits),
-            );
-        }
-        let list = |v: &[u32]| {
-            v.iter()
-                .map(|x| format!("{x}u"))
-                .collect::<Vec<_>>()
-                .join(", ")
+        let threads_fn = match megakernel {
+            true => String::new(),
+            false => table_fn("sched_threads", &threads),
         };
+        let mut s = format!(
+            "const NQ: u32 = {nq}u;\n\
+             {threads_fn}{}\
+             // sched_emits(q * NQ + t): worst-case items procedure q emits to queue t per item\n\
+             {}",
+            table_fn("sched_words", &words),
+            table_fn("sched_emits", &emits),
+        );
+        if !megakernel {
+            return s;
+        }
+        let list = (threads.iter())
+            .map(|x| format!("{x}u"))
+            .collect::<Vec<_>>()
+            .join(", ");
         let sinks: Vec<String> = (0..nq)
             .filter(|&q| self.procs[q].is_sink())
             .map(|q| format!("q == {q}u"))
@@ -337,19 +340,12 @@ impl Program {
         } else {
             sinks.join(" || ")
         };
-        format!(
-            "const NQ: u32 = {nq}u;\n\
-             const THREADS: array<u32, {nq}> = array<u32, {nq}>({});\n\
-             const WORDS: array<u32, {nq}> = array<u32, {nq}>({});\n\
-             // EMITS[q * NQ + t]: worst-case items procedure q emits to queue t per item\n\
-             const EMITS: array<u32, {n2}> = array<u32, {n2}>({});\n\
+        s += &format!(
+            "const THREADS: array<u32, {nq}> = array<u32, {nq}>({list});\n\
              // Whether procedure q emits nothing: comparisons, not a table indexed at run time\n\
-             fn sched_is_sink(q: u32) -> bool {{ return {sinks}; }}\n",
-            list(&threads),
-            list(&words),
-            list(&emits),
-            n2 = nq * nq
-        )
+             fn sched_is_sink(q: u32) -> bool {{ return {sinks}; }}\n"
+        );
+        s
     }
 }
 

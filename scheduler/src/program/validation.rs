@@ -746,7 +746,7 @@ mod tests {
         .unwrap();
         assert!(
             chain
-                .tables_wgsl(false)
+                .tables_wgsl(true)
                 .contains("fn sched_is_sink(q: u32) -> bool { return q == 1u; }")
         );
         let cycle = Program::new(
@@ -756,7 +756,7 @@ mod tests {
         .unwrap();
         assert!(
             cycle
-                .tables_wgsl(false)
+                .tables_wgsl(true)
                 .contains("fn sched_is_sink(q: u32) -> bool { return false; }")
         );
     }
