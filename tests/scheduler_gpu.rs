@@ -750,15 +750,7 @@ fn a_queue_that_cannot_hold_live_work_reports_overflow() {
 #[test]
 fn multi_pass_rounds_that_cannot_fit_a_queue_at_its_limit_run_in_part_and_stay_exact() {
     let gpu = gpu();
-    // Breadth first, the tree's widest level holds several hundred nodes.
-    let params = TreeParams {
-        roots: 2,
-        max_depth: 9,
-        fanout: Fanout::Fixed(2),
-        work: 1,
-        payload_words: 2,
-        seed: 7,
-    };
+    let params = breadth_tree();
     let reference = params.reference();
     let run = TreeRun::new(&gpu, params).unwrap();
     let roomy = Scheduler::new(&gpu, &run.program, StrategyKind::MultipassHost, 1 << 16).unwrap();
@@ -811,37 +803,24 @@ fn multi_pass_rounds_that_cannot_fit_a_queue_at_its_limit_run_in_part_and_stay_e
 #[test]
 fn a_megakernel_whose_queues_cannot_hold_a_tree_s_breadth_parks_work_and_stays_exact() {
     let gpu = gpu();
-    let params = TreeParams {
-        roots: 2,
-        max_depth: 9,
-        fanout: Fanout::Fixed(2),
-        work: 1,
-        payload_words: 2,
-        seed: 7,
-    };
+    let params = breadth_tree();
     let reference = params.reference();
     let run = TreeRun::new(&gpu, params).unwrap();
-    let mk = |max_capacity, local_queues, item_layout| {
-        Scheduler::megakernel(
-            &gpu,
-            &run.program,
-            MegakernelConfig {
-                initial_capacity: 16,
-                max_capacity,
-                local_queues,
-                item_layout: Some(item_layout),
-                size_from_last_run: false,
-                ..Default::default()
-            },
-        )
-        .unwrap()
+    let config = |max_capacity, local_queues, item_layout| MegakernelConfig {
+        initial_capacity: 16,
+        max_capacity,
+        local_queues,
+        item_layout: Some(item_layout),
+        size_from_last_run: false,
+        ..Default::default()
     };
+    let mk = |c| Scheduler::megakernel(&gpu, &run.program, c).unwrap();
     for (local, layout) in [
         (false, ItemLayout::Interleaved),
         (true, ItemLayout::Interleaved),
         (false, ItemLayout::Planar),
     ] {
-        let (stats, result) = run.run(&gpu, &mk(32, local, layout)).unwrap();
+        let (stats, result) = run.run(&gpu, &mk(config(32, local, layout))).unwrap();
         assert_eq!(result, reference, "local {local}, {layout:?}: {stats:?}");
         eprintln!(
             "local {local}, {layout:?}: {} launches, {} items parked",
@@ -852,26 +831,31 @@ fn a_megakernel_whose_queues_cannot_hold_a_tree_s_breadth_parks_work_and_stays_e
     }
     // A branch emits up to two branches: two slots hold the roots, but one root alone
     // leaves no room for its children, so the split that parks the other cannot help.
-    match run.run(&gpu, &mk(2, false, ItemLayout::Interleaved)) {
+    match run.run(&gpu, &mk(config(2, false, ItemLayout::Interleaved))) {
         Err(RunError::QueueOverflow { queue, .. }) => assert_eq!(queue, "branch"),
         other => panic!("expected an overflow of `branch`, got {other:?}"),
     }
     // Parked work takes launches of its own: a run that uses up `max_launches` says so.
-    let few = Scheduler::megakernel(
-        &gpu,
-        &run.program,
-        MegakernelConfig {
-            initial_capacity: 16,
-            max_capacity: 32,
-            max_launches: 20,
-            size_from_last_run: false,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let few = mk(MegakernelConfig {
+        max_launches: 20,
+        ..config(32, false, ItemLayout::Interleaved)
+    });
     match run.run(&gpu, &few) {
         Err(RunError::NoProgress(m)) => assert!(m.contains("parked"), "{m}"),
         other => panic!("expected launches used up, got {other:?}"),
+    }
+}
+
+/// A tree whose widest level, breadth first, holds several hundred nodes (2 roots, depth 9,
+/// 1,024 leaves): more than a queue of 32 slots, by far.
+fn breadth_tree() -> TreeParams {
+    TreeParams {
+        roots: 2,
+        max_depth: 9,
+        fanout: Fanout::Fixed(2),
+        work: 1,
+        payload_words: 2,
+        seed: 7,
     }
 }
 

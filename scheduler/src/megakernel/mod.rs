@@ -728,30 +728,10 @@ impl Megakernel {
                 grew,
                 stuck,
             } = relaunch::size(gpu, nq, ctrl, &mut capacity, &max_cap, &mut stats)?;
-            if progress == 0 && !grew {
-                if let Some((q, needed, _)) = stuck {
-                    // The queues at their limits hold the work's breadth: the oldest half of
-                    // it waits on the host while the newest runs, depth first (park.rs).
-                    stats.submits += 1;
-                    stats.host_compactions += 1;
-                    let live =
-                        compact::host_compact(gpu, &self.program, d, ctrl, self.item_layout())?;
-                    let Some((rest, n)) = parked.split(live, &d.layout.words) else {
-                        return Err(RunError::QueueOverflow {
-                            queue: self.program.procs[q].proc.name.clone(),
-                            capacity: capacity[q] as u64,
-                            needed_more_than: needed,
-                        });
-                    };
-                    stats.parked_items += n;
-                    start = Start::Upload(rest.into_iter().map(Cow::Owned).collect());
-                    continue;
-                }
-                if ctrl[g(nq, G_ABANDONED)] == 0 {
-                    return Err(RunError::NoProgress(
-                        "a megakernel launch executed no item".into(),
-                    ));
-                }
+            if progress == 0 && !grew && stuck.is_none() && ctrl[g(nq, G_ABANDONED)] == 0 {
+                return Err(RunError::NoProgress(
+                    "a megakernel launch executed no item".into(),
+                ));
             }
             start = if grew {
                 // New buffers; the live items move there on the device, in the next launch's pass.
@@ -763,12 +743,24 @@ impl Megakernel {
             } else {
                 stats.submits += 1;
                 stats.host_compactions += 1;
-                Start::Upload(
-                    compact::host_compact(gpu, &self.program, d, ctrl, self.item_layout())?
-                        .into_iter()
-                        .map(Cow::Owned)
-                        .collect(),
-                )
+                let mut items =
+                    compact::host_compact(gpu, &self.program, d, ctrl, self.item_layout())?;
+                if progress == 0
+                    && let Some((q, needed, _)) = stuck
+                {
+                    // The queues at their limits hold the work's breadth: the oldest half of
+                    // it waits on the host while the newest runs, depth first (park.rs).
+                    let Some((rest, n)) = parked.split(items, &d.layout.words) else {
+                        return Err(RunError::QueueOverflow {
+                            queue: self.program.procs[q].proc.name.clone(),
+                            capacity: capacity[q] as u64,
+                            needed_more_than: needed,
+                        });
+                    };
+                    stats.parked_items += n;
+                    items = rest;
+                }
+                Start::Upload(items.into_iter().map(Cow::Owned).collect())
             };
         }
         // Room for one launch of this run: every item it appended to a queue (the executed ones:
