@@ -666,7 +666,20 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         let fresh = !from_local || iter % LOCAL_PROBE_EVERY == LOCAL_PROBE_EVERY - 1u;
         var early = 0u;
         if fresh { early = probe_load(lid); }
-        workgroupBarrier();
+        // Whether the batch published anything to the global queues: always, but for a local
+        // batch whose held items live in workgroup memory (LOCAL_IN_WG), where every lane reads
+        // the emit counts with the barrier it needs here anyway. Such a batch that emitted
+        // only held items has nothing to release or publish: its items are read by this
+        // workgroup's lanes only, which its barriers order (docs/scheduler.md 2.7).
+        var publishes = true;
+        if LOCAL_IN_WG && from_local {
+            let emit_n = workgroupUniformLoad(&wg_emit_n);
+            var sum = 0u;
+            for (var t = 0u; t < NQ; t++) { sum += emit_n[t]; }
+            publishes = sum > 0u;
+        } else {
+            workgroupBarrier();
+        }
         if lid == 0u {
             // Pending: + the children, - this batch, in one atomic. The children are counted
             // before they are published (the count adds below, after a storageBarrier), so
@@ -751,8 +764,10 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         // flags that publish them and before the next local batch reads them. A sink's batch
         // wrote no item: it has nothing to release (its inputs' CONSUMED marks are read only
         // between launches), so it skips the device-scope fence. Every held item was written
-        // by an emitting batch, whose fence still follows it.
-        if !sched_is_sink(q) { storageBarrier(); }
+        // by an emitting batch, whose fence still follows it, or lives in workgroup memory
+        // (LOCAL_IN_WG), which the workgroup's barriers order: a local batch there that
+        // emitted only held items (`publishes` false) skips the fence too.
+        if !sched_is_sink(q) && publishes { storageBarrier(); }
 
         // 5. Publish: flag new slots with the batch stamp, mark processed inputs consumed.
         for (var t = 0u; t < NQ; t++) {
@@ -769,7 +784,7 @@ fn megakernel(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) 
         // only says how many items to claim; a claimer that sees it before a flag waits for
         // the flag (bounded), and the flag is what orders the payload (the release barrier
         // above, the claimer's acquire barrier after its wait).
-        workgroupBarrier();
+        if publishes { workgroupBarrier(); }
         // The new items become claimable: lane t adds target t's, all in parallel.
         if lid < NQ && wg_emit_n[lid] > 0u {
             atomicAdd(&ctrl[lid * QSTRIDE + Q_COUNT], wg_emit_n[lid]);

@@ -273,6 +273,33 @@ fn stress_configs() -> Vec<(&'static str, MegakernelConfig)> {
             },
         ),
         (
+            // The local area in workgroup memory: local batches that emitted only held items
+            // skip the release fence and the publish barrier; tiny queues, impatient waits and
+            // short launches spill held items from workgroup memory.
+            "local area in workgroup memory, tiny queues, short launches, impatient waits",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(3),
+                max_iterations: 24,
+                spin_limit: 1,
+                initial_capacity: 16,
+                local_queues: true,
+                local_workgroup_bytes: 1024,
+                ..base.clone()
+            },
+        ),
+        (
+            "planar items, local area in workgroup memory, outbox enqueue",
+            MegakernelConfig {
+                workgroups: Workgroups::Fixed(3),
+                max_iterations: 40,
+                local_queues: true,
+                local_workgroup_bytes: 3072,
+                direct_enqueue: Some(false),
+                item_layout: Some(ItemLayout::Planar),
+                ..base.clone()
+            },
+        ),
+        (
             // Held sinks run in their priority turn, not after other held work.
             "local queues, sinks not deferred, short launches",
             MegakernelConfig {

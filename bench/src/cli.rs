@@ -240,6 +240,13 @@ pub struct Cli {
     #[arg(long, value_name = "BYTES", help_heading = "Scheduler")]
     pub local_bytes: Option<u32>,
 
+    /// With local queues: keep the local area in workgroup memory, at most this many bytes of
+    /// it (`MegakernelConfig::local_workgroup_bytes`; default 0, the slots buffer). Local
+    /// batches then read held items from workgroup memory, and one that emitted only held items
+    /// skips the release fence; more than a few KiB costs co-resident workgroups.
+    #[arg(long, value_name = "BYTES", help_heading = "Scheduler")]
+    pub local_workgroup_bytes: Option<u32>,
+
     /// How the device-driven multi-pass dispatches a round (`MultipassConfig::fused_rounds`):
     /// `on`, one indirect dispatch of every procedure's workgroups; `off`, one per procedure;
     /// `sinks-apart`, one for the producers and one for the sinks
@@ -498,6 +505,7 @@ impl Cli {
                 _ => None,
             },
             local_bytes: self.local_bytes,
+            local_workgroup_bytes: self.local_workgroup_bytes,
             defer_local_sinks: !self.no_defer_local_sinks,
             fused_rounds: match self.fused_rounds {
                 FusedRounds::Auto => None,

@@ -162,6 +162,8 @@ pub struct GpuConfig {
     pub local_queues: Option<bool>,
     /// `MegakernelConfig::local_bytes`; `None`: its default.
     pub local_bytes: Option<u32>,
+    /// `MegakernelConfig::local_workgroup_bytes`; `None`: its default (0, the slots buffer).
+    pub local_workgroup_bytes: Option<u32>,
     /// `MegakernelConfig::defer_local_sinks` (default `true`).
     pub defer_local_sinks: bool,
     /// `MultipassConfig::fused_rounds` (the device-driven multi-pass); `None`: by adapter.
@@ -192,6 +194,7 @@ impl Default for GpuConfig {
             subgroups: Some(false),
             local_queues: None,
             local_bytes: None,
+            local_workgroup_bytes: None,
             defer_local_sinks: true,
             fused_rounds: None,
             fused_sinks_apart: false,
@@ -269,6 +272,7 @@ pub fn compile(
                 local_bytes: config
                     .local_bytes
                     .unwrap_or(MegakernelConfig::default().local_bytes),
+                local_workgroup_bytes: config.local_workgroup_bytes.unwrap_or(0),
                 defer_local_sinks: config.defer_local_sinks,
                 initial_capacity: capacity,
                 max_capacity: config

@@ -156,6 +156,15 @@ pub struct MegakernelConfig {
     /// target is left the megakernel runs without local queues and warns. Global memory: the
     /// slots buffer grows by the area in use (at most this) times the workgroups.
     pub local_bytes: u32,
+    /// With local queues, keep the local area in workgroup memory instead of the slots
+    /// buffer, at most this many bytes of it (0, the default: the slots buffer, sized by
+    /// `local_bytes`). A local batch then reads its items from workgroup memory, and one that
+    /// emitted only held items skips the device-scope release fence and the publish barrier
+    /// (docs/scheduler.md 2.7). Workgroup memory is what limits co-resident workgroups where
+    /// registers do not: a few KiB keep them (H100: 12 KiB cut the trees' 660 workgroups to
+    /// 264; docs/results.md, 2026-12-05 (tenth session)). The kernel's whole workgroup memory
+    /// must fit the device's `max_compute_workgroup_storage_size`, or building it is an error.
+    pub local_workgroup_bytes: u32,
     /// With local queues, held items of a procedure that emits nothing (a sink) wait while they
     /// are fewer than a step and other held work exists (`LOCAL_DEFER`, docs/scheduler.md 2.7).
     /// Default `true`: H200, deep tree 1.34 -> 1.15 ms, irregular 0.164 -> 0.148, binary 0.122
@@ -192,6 +201,7 @@ impl Default for MegakernelConfig {
             size_from_last_run: true,
             local_queues: false,
             local_bytes: LOCAL_MAX_BYTES,
+            local_workgroup_bytes: 0,
             defer_local_sinks: true,
         }
     }

@@ -8,6 +8,7 @@
 //! the regions and writes their WGSL constants; the protocol is in `shaders/megakernel.wgsl`
 //! (`LOCAL`).
 
+use super::MegakernelConfig;
 use super::claim::worst_batch_output;
 use crate::error::RunError;
 use crate::program::Program;
@@ -31,6 +32,11 @@ pub(crate) struct LocalPlan {
     pub credit_max: Vec<u32>,
     /// Held sinks wait for other held work (`MegakernelConfig::defer_local_sinks`).
     pub defer_sinks: bool,
+    /// The area lives in workgroup memory (`MegakernelConfig::local_workgroup_bytes`): the
+    /// slot accessors send addresses within it there (`workgroup_area_accessors`).
+    pub in_workgroup: bool,
+    /// The bytes the area was sized from (for messages).
+    pub bytes_given: u32,
 }
 
 impl LocalPlan {
@@ -42,7 +48,24 @@ impl LocalPlan {
             wg_words: 0,
             credit_max: vec![0; nq],
             defer_sinks: true,
+            in_workgroup: false,
+            bytes_given: 0,
         }
+    }
+
+    /// The plan a configuration asks for: `local_bytes` of the slots buffer, or, with
+    /// `local_workgroup_bytes` set, that many bytes of workgroup memory (at most `local_bytes`).
+    pub fn for_config(program: &Program, batch: &[u32], config: &MegakernelConfig) -> LocalPlan {
+        let in_workgroup = config.local_workgroup_bytes > 0;
+        let bytes = if in_workgroup {
+            config.local_bytes.min(config.local_workgroup_bytes)
+        } else {
+            config.local_bytes
+        };
+        let mut plan = LocalPlan::new(program, batch, bytes);
+        plan.defer_sinks = config.defer_local_sinks;
+        plan.in_workgroup = in_workgroup;
+        plan
     }
 
     /// Regions for the program's local targets: a full batch (`batch[t]` items, megakernel/
@@ -67,6 +90,7 @@ impl LocalPlan {
             off += 2 * plan.buffer_words(program, t);
         }
         plan.wg_words = off;
+        plan.bytes_given = bytes;
         plan.credit_max = (0..nq)
             .map(|t| worst_batch_output(program, batch, t).min(u32::MAX as u64) as u32)
             .collect();
@@ -116,6 +140,8 @@ impl LocalPlan {
              const LOCAL_OFF: array<u32, {nq}> = array<u32, {nq}>({});\n\
              const LOCAL_STRIDE: array<u32, {nq}> = array<u32, {nq}>({});\n\
              const LOCAL_WG_WORDS: u32 = {}u;\n\
+             // The area is in workgroup memory (`wg_held`), not in the slots buffer\n\
+             const LOCAL_IN_WG: bool = {in_wg};\n\
              // 1 where queue t emits nothing: its held items wait for other held work until\n\
              // they fill a step\n\
              const LOCAL_DEFER: array<u32, {nq}> = array<u32, {nq}>({});\n\
@@ -129,6 +155,38 @@ impl LocalPlan {
             list(&defer),
             list(&self.credit_max),
             n2 = nq * nq,
+            in_wg = on && self.in_workgroup,
+        )
+    }
+
+    /// The `{prefix}_load_word`, `_store_word`, `_load_vec4` and `_store_vec4` slot accessors
+    /// over `{prefix}_g_*` ones (the slots buffer's), sending an address within this
+    /// workgroup's area (`sched_local_wg`, `LOCAL_WG_WORDS` words) to `wg_held`, the area in
+    /// workgroup memory. Addresses stay those of the slots buffer, so that the bodies, the
+    /// held buffers and the spill read and write held items as before; only where they live
+    /// changes.
+    pub fn workgroup_area_accessors(&self, prefix: &str) -> String {
+        format!(
+            "var<workgroup> wg_held: array<u32, {words}>;\n\
+             fn {prefix}_load_word(i: u32) -> u32 {{\n    \
+                 let r = i - sched_local_wg;\n    \
+                 if r < LOCAL_WG_WORDS {{ return wg_held[r]; }}\n    \
+                 return {prefix}_g_load_word(i);\n}}\n\
+             fn {prefix}_store_word(i: u32, w: u32) {{\n    \
+                 let r = i - sched_local_wg;\n    \
+                 if r < LOCAL_WG_WORDS {{ wg_held[r] = w; }} else {{ {prefix}_g_store_word(i, w); }}\n}}\n\
+             fn {prefix}_load_vec4(i: u32) -> vec4<u32> {{\n    \
+                 let r = i - sched_local_wg;\n    \
+                 if r < LOCAL_WG_WORDS {{\n        \
+                     return vec4<u32>(wg_held[r], wg_held[r + 1u], wg_held[r + 2u], wg_held[r + 3u]);\n    }}\n    \
+                 return {prefix}_g_load_vec4(i);\n}}\n\
+             fn {prefix}_store_vec4(i: u32, v: vec4<u32>) {{\n    \
+                 let r = i - sched_local_wg;\n    \
+                 if r < LOCAL_WG_WORDS {{\n        \
+                     wg_held[r] = v.x;\n        wg_held[r + 1u] = v.y;\n        \
+                     wg_held[r + 2u] = v.z;\n        wg_held[r + 3u] = v.w;\n    \
+                 }} else {{\n        {prefix}_g_store_vec4(i, v);\n    }}\n}}\n",
+            words = self.wg_words.max(4)
         )
     }
 }
@@ -230,6 +288,31 @@ mod tests {
                 .contains("LOCAL_DEFER: array<u32, 2> = array<u32, 2>(0u, 0u)")
         );
         assert!(!LocalPlan::none(2).wgsl(&both).contains("(0u, 1u)"));
+    }
+
+    /// The area goes to workgroup memory only where it is asked for and holds an item; its
+    /// accessors send the area's addresses to `wg_held`, of the area's size, and the rest to
+    /// the slots buffer's.
+    #[test]
+    fn a_local_area_in_workgroup_memory_is_declared_and_routed() {
+        let p = program();
+        let mut plan = LocalPlan::new(&p, &[256, 1024], 2048);
+        assert!(plan.wgsl(&p).contains("const LOCAL_IN_WG: bool = false;"));
+        plan.in_workgroup = true;
+        assert!(plan.wgsl(&p).contains("const LOCAL_IN_WG: bool = true;"));
+        let acc = plan.workgroup_area_accessors("sched_slot");
+        assert!(acc.contains(&format!(
+            "var<workgroup> wg_held: array<u32, {}>;",
+            plan.wg_words
+        )));
+        assert!(plan.wg_words * 4 <= 2048);
+        for f in ["load_word", "store_word", "load_vec4", "store_vec4"] {
+            assert!(acc.contains(&format!("fn sched_slot_{f}(")), "{f}");
+            assert!(acc.contains(&format!("sched_slot_g_{f}(i")), "{f}");
+        }
+        let mut none = LocalPlan::none(2);
+        none.in_workgroup = true;
+        assert!(none.wgsl(&p).contains("const LOCAL_IN_WG: bool = false;"));
     }
 
     #[test]

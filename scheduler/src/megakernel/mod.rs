@@ -226,16 +226,15 @@ impl Megakernel {
             );
         }
         if config.local_queues && program.has_local() {
-            // In the slots buffer, past the queues: no workgroup memory.
-            plan = local::LocalPlan::new(program, &batch, config.local_bytes);
-            plan.defer_sinks = config.defer_local_sinks;
+            plan = local::LocalPlan::for_config(program, &batch, &config);
+            let bytes = plan.bytes_given;
             if plan.active() {
                 source = generate(&plan, direct);
             } else {
                 log::warn!(
-                    "megakernel: local queues are on, but {} bytes per workgroup (local_bytes) \
-                     hold no item of any local target: running without them",
-                    config.local_bytes
+                    "megakernel: local queues are on, but {bytes} bytes per workgroup \
+                     (local_bytes, local_workgroup_bytes) hold no item of any local target: \
+                     running without them"
                 );
             }
             log::debug!(
@@ -249,10 +248,19 @@ impl Megakernel {
         // kernel that declares more (lavapipe ran one of 52 KB against its 32 KB).
         let used = local::workgroup_bytes(&source)?;
         if used > limit {
+            let why = if plan.active() && plan.in_workgroup {
+                format!(
+                    "the local area takes {} of them (local_workgroup_bytes: a smaller one fits)",
+                    plan.wg_words * 4
+                )
+            } else {
+                "the procedures' `.shared` arrays scale with the workgroup size: a smaller one \
+                 fits"
+                    .into()
+            };
             return Err(RunError::Program(format!(
                 "megakernel: {used} bytes of workgroup memory at {} threads per workgroup, more \
-                 than {}'s {limit} (the procedures' `.shared` arrays scale with the workgroup \
-                 size: a smaller one fits)",
+                 than {}'s {limit} ({why})",
                 program.workgroup_size(),
                 gpu.adapter_name()
             )));

@@ -63,17 +63,26 @@ pub fn source(
     );
     s += &local.wgsl(program);
     s += &program.common_wgsl();
+    // The slots buffer's accessors; with the local area in workgroup memory they are the
+    // `_g_` ones under accessors that send the area's addresses there.
+    let in_wg = local.active() && local.in_workgroup;
+    let slot = if in_wg { "sched_slot_g" } else { "sched_slot" };
     if coherent {
         s += "@group(0) @binding(1) @coherent var<storage, read_write> slots: array<vec4<u32>>;\n";
-        s += &crate::wgsl::vec4_word_accessors("sched_slot", "slots");
+        s += &crate::wgsl::vec4_word_accessors(slot, "slots");
     } else {
-        s += "@group(0) @binding(1) var<storage, read_write> slots: array<atomic<u32>>;\n\
-              fn sched_slot_load_word(i: u32) -> u32 { return atomicLoad(&slots[i]); }\n\
-              fn sched_slot_store_word(i: u32, w: u32) { atomicStore(&slots[i], w); }\n\
-              fn sched_slot_load_vec4(i: u32) -> vec4<u32> {\n    \
-                  return vec4<u32>(atomicLoad(&slots[i]), atomicLoad(&slots[i + 1u]), atomicLoad(&slots[i + 2u]), atomicLoad(&slots[i + 3u]));\n}\n\
-              fn sched_slot_store_vec4(i: u32, v: vec4<u32>) {\n    \
-                  for (var k = 0u; k < 4u; k++) { atomicStore(&slots[i + k], v[k]); }\n}\n";
+        s += &format!(
+            "@group(0) @binding(1) var<storage, read_write> slots: array<atomic<u32>>;\n\
+             fn {slot}_load_word(i: u32) -> u32 {{ return atomicLoad(&slots[i]); }}\n\
+             fn {slot}_store_word(i: u32, w: u32) {{ atomicStore(&slots[i], w); }}\n\
+             fn {slot}_load_vec4(i: u32) -> vec4<u32> {{\n    \
+                 return vec4<u32>(atomicLoad(&slots[i]), atomicLoad(&slots[i + 1u]), atomicLoad(&slots[i + 2u]), atomicLoad(&slots[i + 3u]));\n}}\n\
+             fn {slot}_store_vec4(i: u32, v: vec4<u32>) {{\n    \
+                 for (var k = 0u; k < 4u; k++) {{ atomicStore(&slots[i + k], v[k]); }}\n}}\n"
+        );
+    }
+    if in_wg {
+        s += &local.workgroup_area_accessors("sched_slot");
     }
     s += &crate::wgsl::vec4_word_accessors("sched_ob", "outbox");
     s += if subgroups { TAKE_SUBGROUP } else { TAKE_ONE };
@@ -281,7 +290,14 @@ mod tests {
         assert_eq!(
             src.matches("!sched_is_sink(q) { storageBarrier(); }")
                 .count(),
-            2
+            1
+        );
+        // The release fence: also skipped by a local batch in workgroup memory that published
+        // nothing (docs/scheduler.md 2.7).
+        assert_eq!(
+            src.matches("!sched_is_sink(q) && publishes { storageBarrier(); }")
+                .count(),
+            1
         );
     }
 
