@@ -232,6 +232,7 @@ mod tests {
             batches: 0,
             local_items: 0,
             local_queues: None,
+            local_workgroup_bytes: None,
             guided_claims: None,
             queue_order: None,
             indirect_validation: None,

@@ -62,6 +62,10 @@ pub struct RunRecord {
     /// Megakernel: it ran with local queues (`RunStats::local_queues`); absent for the others.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub local_queues: Option<bool>,
+    /// Megakernel: bytes of workgroup memory its local area took
+    /// (`RunStats::local_workgroup_bytes`); absent where it is in the slots buffer or none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub local_workgroup_bytes: Option<u32>,
     /// Megakernel: its claims were guided (`RunStats::guided_claims`); absent for the others.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub guided_claims: Option<bool>,
@@ -156,6 +160,7 @@ impl RunRecord {
             enqueue: (!s.enqueue.is_empty()).then(|| s.enqueue.clone()),
             workgroup_size: (s.workgroup_size > 0).then_some(s.workgroup_size),
             local_queues: (s.workgroup_size > 0).then_some(s.local_queues),
+            local_workgroup_bytes: (s.local_workgroup_bytes > 0).then_some(s.local_workgroup_bytes),
             guided_claims: (s.workgroup_size > 0).then_some(s.guided_claims),
             queue_order: (!s.queue_order.is_empty()).then(|| s.queue_order.clone()),
             indirect_validation: matches!(k.strategy.name().as_str(), "multipass" | "frontier")
@@ -194,6 +199,7 @@ impl RunRecord {
             batches: 0,
             local_items: 0,
             local_queues: None,
+            local_workgroup_bytes: None,
             guided_claims: None,
             queue_order: None,
             indirect_validation: None,

@@ -177,9 +177,10 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
             let w = r
                 .workgroup_size
                 .map_or(String::new(), |w| format!(", {w} threads per workgroup"));
-            let local = match r.local_queues {
-                Some(true) => ", local queues",
-                _ => "",
+            let local = match (r.local_queues, r.local_workgroup_bytes) {
+                (Some(true), Some(b)) => format!(", local queues ({b} bytes of workgroup memory)"),
+                (Some(true), None) => ", local queues".into(),
+                _ => String::new(),
             };
             let guided = match r.guided_claims {
                 Some(true) => ", guided claims",

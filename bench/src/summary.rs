@@ -424,6 +424,7 @@ mod tests {
             batches: 10,
             local_items: 0,
             local_queues: None,
+            local_workgroup_bytes: None,
             guided_claims: None,
             queue_order: None,
             indirect_validation: None,

@@ -31,6 +31,10 @@ pub struct RunStats {
     /// Megakernel: it ran with local queues (`MegakernelConfig::local_queues`, and the program
     /// declares a local emit that fits `local_bytes`), whether or not an item ran locally.
     pub local_queues: bool,
+    /// Megakernel: bytes of workgroup memory its local area took
+    /// (`MegakernelConfig::local_workgroup_bytes`); 0 where the area is in the slots buffer or
+    /// there is none.
+    pub local_workgroup_bytes: u32,
     /// Megakernel: its claims were guided by the pending items (`MegakernelConfig::guided_claims`).
     pub guided_claims: bool,
     /// Megakernel under the priority policy: the procedures in the order its workgroups try
@@ -110,6 +114,7 @@ impl RunStats {
         self.batches += o.batches;
         self.local_items += o.local_items;
         self.local_queues |= o.local_queues;
+        self.local_workgroup_bytes = self.local_workgroup_bytes.max(o.local_workgroup_bytes);
         self.guided_claims |= o.guided_claims;
         self.max_workgroups = self.max_workgroups.or(o.max_workgroups);
         if self.queue_order.is_empty() {

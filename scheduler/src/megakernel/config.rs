@@ -163,7 +163,11 @@ pub struct MegakernelConfig {
     /// (docs/scheduler.md 2.7). Workgroup memory is what limits co-resident workgroups where
     /// registers do not: a few KiB keep them (H100: 12 KiB cut the trees' 660 workgroups to
     /// 264; docs/results.md, 2026-12-05 (tenth session)). The kernel's whole workgroup memory
-    /// must fit the device's `max_compute_workgroup_storage_size`, or building it is an error.
+    /// must fit the device's `max_compute_workgroup_storage_size`, or building it is an error
+    /// that says what would fit (the kernel takes about 8 KiB besides, at 256 threads). Like
+    /// `local_bytes` it is a most: an area holds at most a full batch per buffer. Small areas
+    /// make small local batches (on lavapipe 2-4x slower): leave it at 0 but for A/B runs until
+    /// a size is measured to pay.
     pub local_workgroup_bytes: u32,
     /// With local queues, held items of a procedure that emits nothing (a sink) wait while they
     /// are fewer than a step and other held work exists (`LOCAL_DEFER`, docs/scheduler.md 2.7).

@@ -97,6 +97,43 @@ impl LocalPlan {
         plan
     }
 
+    /// Warns where `local_workgroup_bytes` is set but local queues are off: it then does
+    /// nothing.
+    pub fn warn_unused(config: &MegakernelConfig) {
+        if config.local_workgroup_bytes > 0 && !config.local_queues {
+            log::warn!(
+                "megakernel: local_workgroup_bytes (schedbench --local-workgroup-bytes) is set, \
+                 but local queues are off: it has no effect"
+            );
+        }
+    }
+
+    /// Bytes of workgroup memory the area takes (0 where it is in the slots buffer or none).
+    pub fn workgroup_area_bytes(&self) -> u32 {
+        if self.active() && self.in_workgroup {
+            self.wg_words * 4
+        } else {
+            0
+        }
+    }
+
+    /// Why a kernel of `used` bytes of workgroup memory passes the device's `limit`: where this
+    /// plan's area is in workgroup memory, its share and the most that would fit; else the
+    /// procedures' `.shared` arrays, which scale with the workgroup size.
+    pub fn workgroup_overflow_hint(&self, used: u32, limit: u32) -> String {
+        let area = self.workgroup_area_bytes();
+        if area == 0 {
+            return "the procedures' `.shared` arrays scale with the workgroup size: a smaller \
+                    one fits"
+                .into();
+        }
+        let fits = limit.saturating_sub(used - area);
+        format!(
+            "the local area takes {area} of them: local_workgroup_bytes (schedbench \
+             --local-workgroup-bytes) of at most {fits} fits"
+        )
+    }
+
     /// True when some target has room for an item.
     pub fn active(&self) -> bool {
         self.cap.iter().any(|&c| c > 0)
@@ -310,9 +347,20 @@ mod tests {
             assert!(acc.contains(&format!("fn sched_slot_{f}(")), "{f}");
             assert!(acc.contains(&format!("sched_slot_g_{f}(i")), "{f}");
         }
+        // What a kernel past the device's limit is told: the area's share and what fits.
+        assert_eq!(plan.workgroup_area_bytes(), plan.wg_words * 4);
+        let hint = plan.workgroup_overflow_hint(17_000, 16_384);
+        let fits = 16_384 - (17_000 - plan.wg_words * 4);
+        assert!(hint.contains(&format!("of at most {fits} fits")), "{hint}");
+        assert!(hint.contains("--local-workgroup-bytes"), "{hint}");
         let mut none = LocalPlan::none(2);
         none.in_workgroup = true;
         assert!(none.wgsl(&p).contains("const LOCAL_IN_WG: bool = false;"));
+        assert_eq!(none.workgroup_area_bytes(), 0);
+        assert!(
+            none.workgroup_overflow_hint(20_000, 16_384)
+                .contains(".shared")
+        );
     }
 
     #[test]

@@ -50,6 +50,8 @@ pub struct Megakernel {
     /// Words of each workgroup's local area, past the queues in the slots buffer (0 without
     /// local queues; `local::LocalPlan`).
     local_wg_words: u32,
+    /// The local area's bytes in workgroup memory (0: in the slots buffer, or none).
+    local_workgroup_bytes: u32,
     /// Buffers of the last run, reused when the next run needs the same layout.
     cache: std::sync::Mutex<Option<DeviceQueues>>,
     /// The mapped buffer ctrl is read back through after each launch, and the timer whose
@@ -219,6 +221,7 @@ impl Megakernel {
              {most_tickets})",
             if direct { "direct" } else { "outbox" }
         );
+        local::LocalPlan::warn_unused(&config);
         if config.local_queues && !program.has_local() {
             log::warn!(
                 "megakernel: local queues are on, but no procedure keeps an emit local \
@@ -248,16 +251,7 @@ impl Megakernel {
         // kernel that declares more (lavapipe ran one of 52 KB against its 32 KB).
         let used = local::workgroup_bytes(&source)?;
         if used > limit {
-            let why = if plan.active() && plan.in_workgroup {
-                format!(
-                    "the local area takes {} of them (local_workgroup_bytes: a smaller one fits)",
-                    plan.wg_words * 4
-                )
-            } else {
-                "the procedures' `.shared` arrays scale with the workgroup size: a smaller one \
-                 fits"
-                    .into()
-            };
+            let why = plan.workgroup_overflow_hint(used, limit);
             return Err(RunError::Program(format!(
                 "megakernel: {used} bytes of workgroup memory at {} threads per workgroup, more \
                  than {}'s {limit} ({why})",
@@ -299,6 +293,7 @@ impl Megakernel {
             compaction: DeviceCompaction::new(gpu)?,
             one_launch_need: std::sync::Mutex::new(vec![0; nq]),
             local_wg_words: plan.wg_words,
+            local_workgroup_bytes: plan.workgroup_area_bytes(),
         })
     }
 
@@ -609,6 +604,7 @@ impl Megakernel {
             workgroups,
             workgroup_size: self.config.workgroup_size,
             local_queues: self.local_wg_words > 0,
+            local_workgroup_bytes: self.local_workgroup_bytes,
             guided_claims: self.config.guided_claims,
             queue_order: match self.config.policy {
                 QueuePolicy::Priority(_) => (self.priority.iter())

@@ -28,6 +28,7 @@ pub(crate) struct RecordedLaunch {
     direct: bool,
     workgroup_size: u32,
     local_queues: bool,
+    local_workgroup_bytes: u32,
 }
 
 impl Megakernel {
@@ -89,6 +90,7 @@ impl Megakernel {
             direct: self.direct_enqueue(),
             workgroup_size: self.config.workgroup_size,
             local_queues: self.local_wg_words > 0,
+            local_workgroup_bytes: self.local_workgroup_bytes,
         };
         Ok((r, capacity))
     }
@@ -201,6 +203,7 @@ impl RecordedLaunch {
             workgroups: self.workgroups,
             workgroup_size: self.workgroup_size,
             local_queues: self.local_queues,
+            local_workgroup_bytes: self.local_workgroup_bytes,
             queue_bytes: self.dq.slots.size() + self.dq.layout.total_slots * 4,
             ..Default::default()
         };
