@@ -265,6 +265,39 @@ fn guided_claims_are_asked_for_and_recorded() {
     assert_eq!(guided(&["--no-guided-claims"]), serde_json::json!(false));
 }
 
+/// `--local-workgroup-bytes` reaches the megakernel: its records give the area's bytes in
+/// workgroup memory (at most those asked for; absent by default), the run stays exact, and
+/// with local queues off the option does nothing and says so.
+#[test]
+fn a_local_area_in_workgroup_memory_is_asked_for_and_recorded() {
+    let tree = ["--roots", "2", "--depth", "8", "--workgroups", "3"];
+    let area = |flag: &[&str]| {
+        first_json_record(&[&tree[..], flag].concat())["local_workgroup_bytes"].clone()
+    };
+    assert_eq!(area(&[]), serde_json::Value::Null);
+    let bytes = area(&["--local-workgroup-bytes", "2048"]).as_u64().unwrap();
+    assert!(bytes > 0 && bytes <= 2048, "{bytes}");
+    let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
+        .args([
+            "--workload",
+            "tree",
+            "--strategy",
+            "megakernel",
+            "--runs",
+            "1",
+        ])
+        .args(tree)
+        .args(["--no-local-queues", "--local-workgroup-bytes", "2048"])
+        .output()
+        .expect("schedbench runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("local queues are off: it has no effect"),
+        "{err}"
+    );
+}
+
 /// `--max-capacity` bounds every strategy's queues: a tree whose breadth passes the limit
 /// still runs exactly on each, the multi-passes in partial rounds and the megakernel with
 /// work parked on the host, and the records count both.
