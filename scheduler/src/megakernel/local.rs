@@ -35,8 +35,6 @@ pub(crate) struct LocalPlan {
     /// The area lives in workgroup memory (`MegakernelConfig::local_workgroup_bytes`): the
     /// slot accessors send addresses within it there (`workgroup_area_accessors`).
     pub in_workgroup: bool,
-    /// The bytes the area was sized from (for messages).
-    pub bytes_given: u32,
 }
 
 impl LocalPlan {
@@ -49,22 +47,23 @@ impl LocalPlan {
             credit_max: vec![0; nq],
             defer_sinks: true,
             in_workgroup: false,
-            bytes_given: 0,
         }
     }
 
-    /// The plan a configuration asks for: `local_bytes` of the slots buffer, or, with
+    /// The bytes a configuration gives the area: `local_bytes` of the slots buffer, or, with
     /// `local_workgroup_bytes` set, that many bytes of workgroup memory (at most `local_bytes`).
+    pub fn bytes_for(config: &MegakernelConfig) -> u32 {
+        match config.local_workgroup_bytes {
+            0 => config.local_bytes,
+            wg => config.local_bytes.min(wg),
+        }
+    }
+
+    /// The plan a configuration asks for, in [`LocalPlan::bytes_for`] bytes.
     pub fn for_config(program: &Program, batch: &[u32], config: &MegakernelConfig) -> LocalPlan {
-        let in_workgroup = config.local_workgroup_bytes > 0;
-        let bytes = if in_workgroup {
-            config.local_bytes.min(config.local_workgroup_bytes)
-        } else {
-            config.local_bytes
-        };
-        let mut plan = LocalPlan::new(program, batch, bytes);
+        let mut plan = LocalPlan::new(program, batch, LocalPlan::bytes_for(config));
         plan.defer_sinks = config.defer_local_sinks;
-        plan.in_workgroup = in_workgroup;
+        plan.in_workgroup = config.local_workgroup_bytes > 0;
         plan
     }
 
@@ -90,7 +89,6 @@ impl LocalPlan {
             off += 2 * plan.buffer_words(program, t);
         }
         plan.wg_words = off;
-        plan.bytes_given = bytes;
         plan.credit_max = (0..nq)
             .map(|t| worst_batch_output(program, batch, t).min(u32::MAX as u64) as u32)
             .collect();

@@ -230,7 +230,7 @@ impl Megakernel {
         }
         if config.local_queues && program.has_local() {
             plan = local::LocalPlan::for_config(program, &batch, &config);
-            let bytes = plan.bytes_given;
+            let bytes = local::LocalPlan::bytes_for(&config);
             if plan.active() {
                 source = generate(&plan, direct);
             } else {
