@@ -1,4 +1,4 @@
-//! Host twin of the ctrl and params word layouts in `shaders/megakernel.wgsl`.
+//! Host twin of the ctrl and params word layouts in `shaders/megakernel_state.wgsl`.
 //! A test compiles the shader and checks each constant against these. The words every turn
 //! touches (a queue's reserve, head, count and budget; pending, stop, the FIFO sequence, the
 //! idle count) sit 32 words (a 128-byte L2 line) apart, so that the probes' loads do not queue

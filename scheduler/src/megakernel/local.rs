@@ -6,7 +6,7 @@
 //! regions' size, docs/scheduler.md 2.7), no global ticket, no flag, and the bodies read a local
 //! batch through the same slot accessors as a claimed one, from another base. This module sizes
 //! the regions and writes their WGSL constants; the protocol is in `shaders/megakernel.wgsl`
-//! (`LOCAL`).
+//! (`LOCAL`: the loop) and `shaders/megakernel_spill.wgsl`.
 
 use super::MegakernelConfig;
 use super::claim::worst_batch_output;

@@ -1,13 +1,22 @@
 //! Generates the megakernel's WGSL: the program's shared code, queue word accessors (plain
 //! `@coherent` loads where the device has them, atomics otherwise), enqueue functions that write
 //! to the workgroup's outbox or (direct enqueue) straight into the slots, and the loop in
-//! `shaders/megakernel.wgsl`.
+//! `shaders/megakernel*.wgsl` ([`TEMPLATE`]).
 
 use super::local::LocalPlan;
 use crate::item_layout::ItemLayout;
 use crate::program::Program;
 
-pub const TEMPLATE: &str = include_str!("../../../shaders/megakernel.wgsl");
+/// The megakernel's fixed code, one concern per file, concatenated in this order: the state,
+/// where an emit goes, the claim, the spill, the probes, and the loop.
+pub const TEMPLATE: &str = concat!(
+    include_str!("../../../shaders/megakernel_state.wgsl"),
+    include_str!("../../../shaders/megakernel_enqueue.wgsl"),
+    include_str!("../../../shaders/megakernel_claim.wgsl"),
+    include_str!("../../../shaders/megakernel_spill.wgsl"),
+    include_str!("../../../shaders/megakernel_probe.wgsl"),
+    include_str!("../../../shaders/megakernel.wgsl"),
+);
 
 /// Options compiled into the megakernel as constants (each a `MegakernelConfig` field).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -174,7 +183,7 @@ pub fn source(
     s
 }
 
-/// `reserve_budget` and the refused-queue set of `try_claim` (`shaders/megakernel.wgsl`) for
+/// `reserve_budget` and the refused-queue set of `try_claim` (`shaders/megakernel_claim.wgsl`) for
 /// `nq` queues, as straight-line code: arrays indexed at run time likely live in local memory,
 /// a round trip of their own on every claim (the first version, with such arrays, was slower
 /// on the H200; the compiled code could not be read to confirm why). The refused queues are a
@@ -215,7 +224,7 @@ fn claim_wgsl(nq: usize) -> String {
     s
 }
 
-/// `sched_take` (see `shaders/megakernel.wgsl`): every emitting lane takes its own index and
+/// `sched_take` (see `shaders/megakernel_enqueue.wgsl`): every emitting lane takes its own index and
 /// ticket.
 const TAKE_ONE: &str = "\
 fn sched_take(t: u32, direct: bool) -> vec2<u32> {
