@@ -106,6 +106,44 @@ impl LocalPlan {
         }
     }
 
+    /// The local targets whose buffer holds less than one step of their procedure
+    /// (`items_per_step`), as (target, items a buffer, items a step), and the bytes per
+    /// workgroup that would give every local target a step. A local batch of such a target
+    /// runs a part-empty step: on the H100 the trees ran 1.5-4x slower with areas of 1-4 KiB
+    /// (docs/results.md, 2026-12-06, "The local area in workgroup memory at 1-16 KiB").
+    pub fn partial_steps(&self, program: &Program) -> (Vec<(usize, u32, u32)>, u32) {
+        let local: Vec<usize> = (0..self.cap.len()).filter(|&t| self.cap[t] > 0).collect();
+        let short = local
+            .iter()
+            .map(|&t| (t, self.cap[t], program.procs[t].items_per_step))
+            .filter(|&(_, cap, step)| cap < step)
+            .collect();
+        // `new` gives each target an even share of words a buffer, a multiple of 4.
+        let share = local
+            .iter()
+            .map(|&t| {
+                (program.procs[t].items_per_step * program.procs[t].words()).next_multiple_of(4)
+            })
+            .max()
+            .unwrap_or(0);
+        (short, share * 4 * 2 * local.len() as u32)
+    }
+
+    /// Warns where a local target's buffer holds less than a step ([`LocalPlan::partial_steps`]),
+    /// naming the bytes that would hold one.
+    pub fn warn_partial_steps(&self, program: &Program, bytes: u32) {
+        let (short, enough) = self.partial_steps(program);
+        for (t, cap, step) in short {
+            log::warn!(
+                "megakernel: {bytes} bytes of local area per workgroup hold {cap} items of \
+                 `{}` a buffer, less than a step ({step}): its local batches run part-empty \
+                 steps, which ran the trees 1.5-4x slower (docs/scheduler.md 2.7); {enough} bytes \
+                 (local_bytes, local_workgroup_bytes) hold a step of every local target",
+                program.procs[t].proc.name
+            );
+        }
+    }
+
     /// Bytes of workgroup memory the area takes (0 where it is in the slots buffer or none).
     pub fn workgroup_area_bytes(&self) -> u32 {
         if self.active() && self.in_workgroup {
@@ -359,6 +397,20 @@ mod tests {
             none.workgroup_overflow_hint(20_000, 16_384)
                 .contains(".shared")
         );
+    }
+
+    /// A buffer of less than a step is found, with the bytes that hold a step of every local
+    /// target: `split`'s 256 one-thread items of 4 words, two buffers, 8 KiB.
+    #[test]
+    fn a_buffer_of_less_than_a_step_is_found_with_the_bytes_that_hold_one() {
+        let p = program();
+        assert_eq!(p.procs[0].items_per_step, 256);
+        let small = LocalPlan::new(&p, &[256, 1024], 2048);
+        assert_eq!(small.partial_steps(&p), (vec![(0, 64, 256)], 8192));
+        let enough = LocalPlan::new(&p, &[256, 1024], 8192);
+        assert_eq!(enough.cap, vec![256, 0]);
+        assert_eq!(enough.partial_steps(&p), (vec![], 8192));
+        assert_eq!(LocalPlan::none(2).partial_steps(&p), (vec![], 0));
     }
 
     #[test]

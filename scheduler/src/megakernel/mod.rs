@@ -233,6 +233,7 @@ impl Megakernel {
             let bytes = local::LocalPlan::bytes_for(&config);
             if plan.active() {
                 source = generate(&plan, direct);
+                plan.warn_partial_steps(program, bytes);
             } else {
                 log::warn!(
                     "megakernel: local queues are on, but {bytes} bytes per workgroup \
