@@ -243,7 +243,8 @@ pub struct Cli {
     /// With local queues: keep the local area in workgroup memory, at most this many bytes of
     /// it (`MegakernelConfig::local_workgroup_bytes`; default 0, the slots buffer). Local
     /// batches then read held items from workgroup memory, and one that emitted only held items
-    /// skips the release fence; more than a few KiB costs co-resident workgroups.
+    /// skips the release fence. For A/B runs: on the H100 2 KiB or more cost co-resident
+    /// workgroups, and less holds under a step per buffer (a warning says so).
     #[arg(long, value_name = "BYTES", help_heading = "Scheduler")]
     pub local_workgroup_bytes: Option<u32>,
 

@@ -161,13 +161,15 @@ pub struct MegakernelConfig {
     /// `local_bytes`). A local batch then reads its items from workgroup memory, and one that
     /// emitted only held items skips the device-scope release fence and the publish barrier
     /// (docs/scheduler.md 2.7). Workgroup memory is what limits co-resident workgroups where
-    /// registers do not: a few KiB keep them (H100: 12 KiB cut the trees' 660 workgroups to
-    /// 264; docs/results.md, 2026-12-05 (tenth session)). The kernel's whole workgroup memory
+    /// registers do not (H100: 2 KiB cut the trees' 660 workgroups to 528, 4 KiB to 396, 12
+    /// KiB to 264; docs/results.md, 2026-12-05 (tenth session) and 2026-12-06 (eleventh)).
+    /// The kernel's whole workgroup memory
     /// must fit the device's `max_compute_workgroup_storage_size`, or building it is an error
     /// that says what would fit (the kernel takes about 8 KiB besides, at 256 threads). Like
-    /// `local_bytes` it is a most: an area holds at most a full batch per buffer. Small areas
-    /// make small local batches (on lavapipe 2-4x slower): leave it at 0 but for A/B runs until
-    /// a size is measured to pay.
+    /// `local_bytes` it is a most: an area holds at most a full batch per buffer. An area
+    /// whose buffers hold less than a step makes part-empty local batches, and warns: at 1-4
+    /// KiB the H100's trees ran 1.5-4x slower, the deep trees and the one-item chain at most
+    /// 4% faster. Leave it at 0 but for A/B runs.
     pub local_workgroup_bytes: u32,
     /// With local queues, held items of a procedure that emits nothing (a sink) wait while they
     /// are fewer than a step and other held work exists (`LOCAL_DEFER`, docs/scheduler.md 2.7).
