@@ -118,6 +118,13 @@ pub struct Cli {
     #[arg(long, value_parser = value_parser!(u32).range(1..=65535), help_heading = "Scheduler")]
     pub workgroups: Option<u32>,
 
+    /// Launch this share of the probed megakernel workgroups, `A/B` with 0 < A <= B
+    /// (`Workgroups::ProbeShare`) [default: the workload's: 2/5 for trees whose mean fan-out is
+    /// at most one (`TreeParams::megakernel_workgroup_share`) on GPUs, else all].
+    #[arg(long, value_name = "A/B", value_parser = parse_share, conflicts_with = "workgroups",
+          help_heading = "Scheduler")]
+    pub workgroup_share: Option<(u32, u32)>,
+
     /// Threads per megakernel workgroup (for --strategy megakernel and all): 256, 512, 768 or
     /// 1024, within the adapter's limit. Larger workgroups limit the registers each thread may
     /// use (on NVIDIA 80 at 768 threads, 64 at 1024); measured, no workload's default ran
@@ -306,6 +313,17 @@ fn parse_workgroup_size(s: &str) -> Result<u32, String> {
     }
 }
 
+/// `A/B`, 0 < A <= B (or `1`, all).
+fn parse_share(s: &str) -> Result<(u32, u32), String> {
+    let bad = || format!("`{s}` is not a share A/B with 0 < A <= B (e.g. 2/5)");
+    let (a, b) = s.split_once('/').unwrap_or((s, "1"));
+    let (a, b) = (a.trim().parse::<u32>(), b.trim().parse::<u32>());
+    match (a, b) {
+        (Ok(a), Ok(b)) if a > 0 && a <= b => Ok((a, b)),
+        _ => Err(bad()),
+    }
+}
+
 fn parse_preset(s: &str) -> Result<TreePreset, String> {
     TreePreset::parse(s).ok_or_else(|| {
         let names: Vec<_> = TreePreset::ALL.iter().map(|p| p.name()).collect();
@@ -480,6 +498,7 @@ impl Cli {
     pub fn gpu_config(&self) -> GpuConfig {
         GpuConfig {
             workgroups: self.workgroups,
+            workgroup_share: self.workgroup_share,
             workgroup_size: self.workgroup_size,
             batch_steps: self.batch_steps,
             procedure_steps: (!self.procedure_steps.is_empty())
@@ -556,9 +575,22 @@ mod tests {
     }
 
     #[test]
+    fn a_workgroup_share_parses_as_a_fraction_of_at_most_one() {
+        assert_eq!(parse_share("2/5"), Ok((2, 5)));
+        assert_eq!(parse_share("1"), Ok((1, 1)));
+        for bad in ["0/5", "6/5", "2/0", "x/5", "2/", "/5", "-1/5"] {
+            assert!(parse_share(bad).is_err(), "{bad}");
+        }
+        let cli = parse(&["--workgroup-share", "2/5"]).unwrap();
+        assert_eq!(cli.gpu_config().workgroup_share, Some((2, 5)));
+    }
+
+    #[test]
     fn ranges_and_names_are_checked() {
         for bad in [
             &["--workgroups", "0"][..],
+            &["--workgroup-share", "3/2"],
+            &["--workgroups", "64", "--workgroup-share", "1/2"],
             &["--batch-steps", "0"],
             &["--workgroup-size", "384"],
             &["--workgroup-size", "2048"],

@@ -247,6 +247,7 @@ mod tests {
             peak_occupancy: vec![],
             queue_bytes: 0,
             workgroups: 0,
+            probed_workgroups: None,
             turn_anatomy: Vec::new(),
         };
         let records = vec![

@@ -105,6 +105,11 @@ pub struct RunRecord {
     pub peak_occupancy: Vec<u64>,
     pub queue_bytes: u64,
     pub workgroups: u32,
+    /// Megakernel: the co-resident workgroups its probe found, where it launched a share of
+    /// them (`RunStats::probed_workgroups`, `--workgroup-share`); absent where it launched all
+    /// or a fixed count.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub probed_workgroups: Option<u32>,
     /// Megakernel with `--turn-anatomy`: per phase (claim, wait, ...), its count over the run
     /// (`scheduler::megakernel::anatomy::TurnAnatomy::phases`), then `turns`.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -150,6 +155,8 @@ impl RunRecord {
             peak_occupancy: s.peak_occupancy,
             queue_bytes: s.queue_bytes,
             workgroups: s.workgroups,
+            probed_workgroups: (s.probed_workgroups > 0 && s.probed_workgroups != s.workgroups)
+                .then_some(s.probed_workgroups),
             turn_anatomy: s.turn_anatomy.as_ref().map_or(Vec::new(), |a| {
                 let mut v: Vec<(String, u64)> =
                     a.phases().iter().map(|p| (p.0.to_string(), p.2)).collect();
@@ -214,6 +221,7 @@ impl RunRecord {
             peak_occupancy: Vec::new(),
             queue_bytes: 0,
             workgroups: 0,
+            probed_workgroups: None,
             turn_anatomy: Vec::new(),
         }
     }

@@ -197,8 +197,11 @@ fn print_table(gpu: &Gpu, params: &str, problem_items: u64, records: &[RunRecord
             let cap = r.max_workgroups.map_or(String::new(), |n| {
                 format!(", at most {n} workgroups a procedure")
             });
+            let share = r.probed_workgroups.map_or(String::new(), |p| {
+                format!(", {} of {p} co-resident workgroups", r.workgroups)
+            });
             let line = format!(
-                "{}: {l} items{e}{w}{local}{guided}{order}{rounds}{cap}",
+                "{}: {l} items{e}{w}{share}{local}{guided}{order}{rounds}{cap}",
                 r.strategy
             );
             if !queues.contains(&line) {

@@ -126,6 +126,10 @@ impl Strategy {
 pub struct GpuConfig {
     /// Megakernel workgroups; `None` probes the co-resident count.
     pub workgroups: Option<u32>,
+    /// With `workgroups` `None`: launch this share (numerator, denominator) of the probed
+    /// count (`Workgroups::ProbeShare`); `None`: the workload's choice
+    /// ([`GpuConfig::or_workgroup_share`]; all where a workload makes none).
+    pub workgroup_share: Option<(u32, u32)>,
     /// Threads per megakernel workgroup (`MegakernelConfig::workgroup_size`); `None`: its
     /// default (256).
     pub workgroup_size: Option<u32>,
@@ -180,6 +184,7 @@ impl Default for GpuConfig {
     fn default() -> Self {
         GpuConfig {
             workgroups: None,
+            workgroup_share: None,
             workgroup_size: None,
             batch_steps: None,
             procedure_steps: None,
@@ -227,6 +232,13 @@ impl GpuConfig {
         self
     }
 
+    /// This configuration with `workload`'s share of the probed workgroups where the command
+    /// line gave neither a share nor a count.
+    pub fn or_workgroup_share(mut self, workload: (u32, u32)) -> GpuConfig {
+        self.workgroup_share = self.workgroup_share.or(Some(workload));
+        self
+    }
+
     /// This configuration with `workload`'s choice of local queues where the command line
     /// made none.
     pub fn or_local_queues(mut self, workload: bool) -> GpuConfig {
@@ -253,9 +265,17 @@ pub fn compile(
             gpu,
             program,
             MegakernelConfig {
-                workgroups: config
-                    .workgroups
-                    .map_or(Workgroups::Probe { max: 4096 }, Workgroups::Fixed),
+                workgroups: match (config.workgroups, config.workgroup_share) {
+                    (Some(n), _) => Workgroups::Fixed(n),
+                    (None, Some((numerator, denominator))) if numerator != denominator => {
+                        Workgroups::ProbeShare {
+                            max: 4096,
+                            numerator,
+                            denominator,
+                        }
+                    }
+                    (None, _) => Workgroups::Probe { max: 4096 },
+                },
                 workgroup_size: config
                     .workgroup_size
                     .unwrap_or(MegakernelConfig::default().workgroup_size),

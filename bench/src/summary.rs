@@ -439,6 +439,7 @@ mod tests {
             peak_occupancy: vec![100],
             queue_bytes: 0,
             workgroups: if mk { 4 } else { 0 },
+            probed_workgroups: None,
             turn_anatomy: Vec::new(),
         }
     }

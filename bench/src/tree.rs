@@ -23,6 +23,10 @@ impl ScheduledProblem for TreeParams {
         self.megakernel_local_queues()
     }
 
+    fn workgroup_share(&self, gpu: &Gpu) -> (u32, u32) {
+        self.megakernel_workgroup_share(gpu)
+    }
+
     fn reference(&self) -> TreeResult {
         TreeParams::reference(self)
     }

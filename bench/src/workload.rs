@@ -104,6 +104,12 @@ pub trait ScheduledProblem: Clone {
     fn local_queues(&self) -> bool {
         false
     }
+    /// The share (numerator, denominator) of the probed megakernel workgroups this problem
+    /// launches on `gpu` (`GpuConfig::workgroup_share` when the command line gives neither a
+    /// share nor a count); default all, (1, 1).
+    fn workgroup_share(&self, _gpu: &Gpu) -> (u32, u32) {
+        (1, 1)
+    }
 
     /// Points `run` at this problem when its compiled program serves it unchanged (so the
     /// schedulers compiled for it are kept); false (the default) builds a new run.
@@ -138,12 +144,22 @@ pub trait ScheduledProblem: Clone {
 }
 
 /// The GPU run of the program last prepared and the schedulers compiled for it, by strategy
-/// name, initial queue capacity and local queues. Workloads whose problems share a program
+/// name, initial queue capacity, local queues and workgroup share. Workloads whose problems share a program
 /// (tree presets of one payload size and fan-out) can share one, so the suite compiles (and the
 /// megakernel probes its workgroup count) once for all of them.
 pub struct RunSlot<P: ScheduledProblem> {
     run: Option<P::Run>,
-    schedulers: Vec<(String, u32, bool, Scheduler)>,
+    schedulers: Vec<Compiled>,
+}
+
+/// A scheduler compiled for a strategy (`name`), an initial queue capacity, local queues on or
+/// off and a share of the probed workgroups.
+struct Compiled {
+    name: String,
+    capacity: u32,
+    local: bool,
+    share: (u32, u32),
+    scheduler: Scheduler,
 }
 
 /// A [`Workload`] over sizes of a [`ScheduledProblem`]: keeps the GPU run and the schedulers
@@ -258,18 +274,29 @@ impl<P: ScheduledProblem> Workload for ProblemWorkload<P> {
                 let name = strategy.name();
                 let capacity = self.config.capacity.unwrap_or(p.capacity(reference));
                 let local = self.config.local_queues.unwrap_or(p.local_queues());
-                let have = |s: &&(String, u32, bool, Scheduler)| {
-                    s.0 == name && s.1 == capacity && s.2 == local
+                let share = self
+                    .config
+                    .workgroup_share
+                    .unwrap_or(p.workgroup_share(gpu));
+                let have = |s: &&Compiled| {
+                    s.name == name && s.capacity == capacity && s.local == local && s.share == share
                 };
                 if !schedulers.iter().any(|s| have(&s)) {
                     let config = (self.config.clone())
                         .or_procedure_steps(P::procedure_steps(gpu))
                         .or_guided_claims(P::guided_claims(gpu))
-                        .or_local_queues(local);
+                        .or_local_queues(local)
+                        .or_workgroup_share(share);
                     let s = compile(gpu, P::program(run), strategy, &config, capacity)?;
-                    schedulers.push((name.clone(), capacity, local, s));
+                    schedulers.push(Compiled {
+                        name: name.clone(),
+                        capacity,
+                        local,
+                        share,
+                        scheduler: s,
+                    });
                 }
-                let scheduler = &schedulers.iter().find(have).unwrap().3;
+                let scheduler = &schedulers.iter().find(have).unwrap().scheduler;
                 let start = Instant::now();
                 let (stats, out) = P::run(run, gpu, scheduler)?;
                 let wall = ms_since(start);

@@ -37,6 +37,9 @@ pub struct RunStats {
     pub local_workgroup_bytes: u32,
     /// Megakernel: its claims were guided by the pending items (`MegakernelConfig::guided_claims`).
     pub guided_claims: bool,
+    /// Megakernel: the co-resident workgroups its probe found, of which it launched
+    /// `workgroups` (all, or a `Workgroups::ProbeShare` of them); 0 with `Workgroups::Fixed`.
+    pub probed_workgroups: u32,
     /// Megakernel under the priority policy: the procedures in the order its workgroups try
     /// their queues (`QueuePolicy::Priority`, the default order completed); empty under FIFO
     /// and for the other strategies.
@@ -116,6 +119,7 @@ impl RunStats {
         self.local_queues |= o.local_queues;
         self.local_workgroup_bytes = self.local_workgroup_bytes.max(o.local_workgroup_bytes);
         self.guided_claims |= o.guided_claims;
+        self.probed_workgroups = self.probed_workgroups.max(o.probed_workgroups);
         self.max_workgroups = self.max_workgroups.or(o.max_workgroups);
         if self.queue_order.is_empty() {
             self.queue_order = o.queue_order.clone();

@@ -14,8 +14,39 @@ pub enum Workgroups {
         /// Most workgroups the probe launches (and so the most it can report).
         max: u32,
     },
+    /// A share of what the probe finds: `numerator / denominator` of the co-resident
+    /// workgroups (rounded down, at least one), the probe launching at most `max`. For work
+    /// that stays narrow, a few thousand items at a time in long chains: fewer workgroups per
+    /// SM spread its batches over more SMs' issue slots instead of sharing a few
+    /// (docs/scheduler.md 2.3). H100, the deep tree: 2/5 of the 660 probed, 1.15 -> 0.99 ms; the
+    /// binary tree, which fills every workgroup, 0.127 -> 0.155 (docs/results.md, 2026-12-06
+    /// (eleventh session)). Errors: a share of 0 or above 1 is a [`crate::RunError::Program`].
+    ProbeShare {
+        /// Most workgroups the probe launches.
+        max: u32,
+        /// The share's numerator, 1..=`denominator`.
+        numerator: u32,
+        /// The share's denominator, at least 1.
+        denominator: u32,
+    },
     /// Exactly this many (tests use it to oversubscribe on purpose; waits stay bounded).
     Fixed(u32),
+}
+
+impl Workgroups {
+    /// The workgroups a launch has when the probe found `probed` co-resident (`Fixed` ignores
+    /// it): `Probe`'s all, `ProbeShare`'s share of them rounded down, at least one.
+    pub fn of_probed(&self, probed: u32) -> u32 {
+        match *self {
+            Workgroups::Probe { .. } => probed.max(1),
+            Workgroups::ProbeShare {
+                numerator,
+                denominator,
+                ..
+            } => (probed as u64 * numerator as u64 / denominator.max(1) as u64).max(1) as u32,
+            Workgroups::Fixed(n) => n.max(1),
+        }
+    }
 }
 
 /// Which queue a workgroup takes its next batch from.
@@ -210,5 +241,26 @@ impl Default for MegakernelConfig {
             local_workgroup_bytes: 0,
             defer_local_sinks: true,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Workgroups;
+
+    /// A share of the probed width rounds down and keeps one workgroup; the others as given.
+    #[test]
+    fn a_probe_share_takes_its_part_of_the_probed_width() {
+        let share = |numerator, denominator| Workgroups::ProbeShare {
+            max: 4096,
+            numerator,
+            denominator,
+        };
+        assert_eq!(share(2, 5).of_probed(660), 264);
+        assert_eq!(share(2, 5).of_probed(528), 211);
+        assert_eq!(share(1, 1).of_probed(660), 660);
+        assert_eq!(share(2, 5).of_probed(2), 1);
+        assert_eq!(Workgroups::Probe { max: 4096 }.of_probed(660), 660);
+        assert_eq!(Workgroups::Fixed(3).of_probed(660), 3);
     }
 }

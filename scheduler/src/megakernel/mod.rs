@@ -42,6 +42,8 @@ pub struct Megakernel {
     kernels: Kernels,
     /// Workgroups per launch; 0 until the first run's probe (the probe needs the user's group).
     workgroups: std::sync::atomic::AtomicU32,
+    /// Co-resident workgroups the probe found; 0 until it ran, and with `Workgroups::Fixed`.
+    probed: std::sync::atomic::AtomicU32,
     outbox_stride: u32,
     ob_off: Vec<u32>,
     priority: Vec<u32>,
@@ -96,8 +98,8 @@ impl Megakernel {
     /// On lavapipe (adapter name `llvmpipe`) `max_iterations` and `spin_limit` are lowered to
     /// [`LAVAPIPE_MAX_ITERATIONS`] and [`LAVAPIPE_SPIN_LIMIT`], and `idle_backoff` to 0. Errors:
     /// [`RunError::Program`] for `max_iterations` or `spin_limit` outside `1..=30000`,
-    /// `idle_backoff` above 30,000, an unknown procedure name in
-    /// [`QueuePolicy::Priority`], or WGSL that does not compile with the generated code (e.g.
+    /// `idle_backoff` above 30,000, a [`Workgroups::ProbeShare`] of 0 or above 1, an unknown
+    /// procedure name in [`QueuePolicy::Priority`], or WGSL that does not compile with the generated code (e.g.
     /// user WGSL that reuses a template identifier).
     pub fn new(
         gpu: &Gpu,
@@ -122,6 +124,18 @@ impl Megakernel {
         }
         if config.spin_limit == 0 || config.spin_limit > 30_000 {
             return Err(RunError::Program("spin_limit must be 1..=30000".into()));
+        }
+        if let Workgroups::ProbeShare {
+            numerator,
+            denominator,
+            ..
+        } = config.workgroups
+            && (numerator == 0 || numerator > denominator)
+        {
+            return Err(RunError::Program(format!(
+                "a workgroup share of {numerator}/{denominator}: it must be more than 0 and at \
+                 most 1"
+            )));
         }
         let most = gpu.device.limits().max_compute_invocations_per_workgroup;
         if config.workgroup_size > most {
@@ -278,13 +292,14 @@ impl Megakernel {
         )?;
         let workgroups = match config.workgroups {
             Workgroups::Fixed(n) => n.max(1),
-            Workgroups::Probe { .. } => 0,
+            Workgroups::Probe { .. } | Workgroups::ProbeShare { .. } => 0,
         };
         Ok(Megakernel {
             program: program.clone(),
             config,
             kernels,
             workgroups: std::sync::atomic::AtomicU32::new(workgroups),
+            probed: std::sync::atomic::AtomicU32::new(0),
             outbox_stride,
             ob_off,
             priority,
@@ -331,20 +346,31 @@ impl Megakernel {
     /// group, as a run does). Errors: those of a run ([`RunError::Timeout`], [`RunError::Device`]).
     pub fn workgroups(&self, gpu: &Gpu, user: Option<&wgpu::BindGroup>) -> Result<u32, RunError> {
         if self.workgroups.load(std::sync::atomic::Ordering::Relaxed) == 0 {
-            let Workgroups::Probe { max } = self.config.workgroups else {
+            let (Workgroups::Probe { max } | Workgroups::ProbeShare { max, .. }) =
+                self.config.workgroups
+            else {
                 unreachable!()
             };
             let start = Instant::now();
-            let n = self.probe(gpu, max.max(1), user)?;
+            let probed = self.probe(gpu, max.max(1), user)?;
+            let n = self.config.workgroups.of_probed(probed);
             log::debug!(
-                "megakernel co-residency probe: {n} workgroups of at most {max}, {:.1} ms (the \
-                 first launch: includes the driver's deferred compile)",
+                "megakernel co-residency probe: {probed} workgroups of at most {max}, {n} \
+                 launched, {:.1} ms (the first launch: includes the driver's deferred compile)",
                 start.elapsed().as_secs_f64() * 1e3
             );
+            self.probed
+                .store(probed, std::sync::atomic::Ordering::Relaxed);
             self.workgroups
                 .store(n, std::sync::atomic::Ordering::Relaxed);
         }
         Ok(self.workgroups.load(std::sync::atomic::Ordering::Relaxed))
+    }
+
+    /// Co-resident workgroups the probe found (0 before the first run, and with
+    /// [`Workgroups::Fixed`]).
+    pub fn probed_workgroups(&self) -> u32 {
+        self.probed.load(std::sync::atomic::Ordering::Relaxed)
     }
 
     /// Counts workgroups that run at the same time (see `probe` in the shader). A CPU adapter
@@ -603,6 +629,7 @@ impl Megakernel {
             executed: vec![0; nq],
             peak_occupancy: vec![0; nq],
             workgroups,
+            probed_workgroups: self.probed_workgroups(),
             workgroup_size: self.config.workgroup_size,
             local_queues: self.local_wg_words > 0,
             local_workgroup_bytes: self.local_workgroup_bytes,

@@ -29,6 +29,7 @@ pub(crate) struct RecordedLaunch {
     workgroup_size: u32,
     local_queues: bool,
     local_workgroup_bytes: u32,
+    probed_workgroups: u32,
 }
 
 impl Megakernel {
@@ -91,6 +92,7 @@ impl Megakernel {
             workgroup_size: self.config.workgroup_size,
             local_queues: self.local_wg_words > 0,
             local_workgroup_bytes: self.local_workgroup_bytes,
+            probed_workgroups: self.probed_workgroups(),
         };
         Ok((r, capacity))
     }
@@ -201,6 +203,7 @@ impl RecordedLaunch {
             idle_polls: ctrl[g(nq, G_IDLE)] as u64,
             launches: 1,
             workgroups: self.workgroups,
+            probed_workgroups: self.probed_workgroups,
             workgroup_size: self.workgroup_size,
             local_queues: self.local_queues,
             local_workgroup_bytes: self.local_workgroup_bytes,

@@ -699,6 +699,11 @@ pub fn megakernel_procedure_steps(gpu: &scheduler::Gpu) -> Vec<(String, u32)> {
     vec![("leaf".into(), 4)]
 }
 
+/// Most roots of a tree that [`TreeParams::megakernel_workgroup_share`] calls narrow: levels of
+/// about this many items fill under half of the H100's 169K lanes at its probed width (660
+/// workgroups of 256), so fewer workgroups lose them no parallelism.
+pub const NARROW_ROOTS: u32 = 65_536;
+
 impl TreeParams {
     /// Whether the megakernel should keep a workgroup's children local
     /// (`MegakernelConfig::local_queues`; the program declares them local): wherever the tree
@@ -718,6 +723,29 @@ impl TreeParams {
         match self.fanout {
             Fanout::Fixed(k) => k >= 1,
             Fanout::Uniform(k) => k >= 2,
+        }
+    }
+
+    /// The share (numerator, denominator) of the probed workgroups the megakernel should
+    /// launch (`Workgroups::ProbeShare`): 2/5 on a GPU where the tree stays narrow, else all.
+    /// Narrow: a mean fan-out of at most one (one child, or 0..=k children with k <= 2), whose
+    /// levels stay near the roots' count, and at most [`NARROW_ROOTS`] roots. Its batches then
+    /// run faster spread over the SMs at two workgroups per SM than shared at five
+    /// (docs/scheduler.md 2.2, "Presence or claims").
+    /// H100, GPU ms median of 20 (docs/results.md, 2026-12-06 (eleventh session)), all 660
+    /// probed / 396 / 264: deep 1.15 / 1.03 / 0.99, deep of 1,250 roots 1.00 / 0.94 / 0.93;
+    /// irregular (mean 1.5, 528 probed) 0.147 / 0.143 at 396 / 0.148 at 264, binary 0.127 /
+    /// 0.133 / 0.155. All on CPU adapters (lavapipe), where it was not measured.
+    pub fn megakernel_workgroup_share(&self, gpu: &scheduler::Gpu) -> (u32, u32) {
+        let mean_at_most_one = match self.fanout {
+            Fanout::Fixed(k) => k <= 1,
+            Fanout::Uniform(k) => k <= 2,
+        };
+        let narrow = mean_at_most_one && self.roots <= NARROW_ROOTS;
+        if narrow && !gpu.is_cpu_adapter() {
+            (2, 5)
+        } else {
+            (1, 1)
         }
     }
 }
