@@ -1381,6 +1381,55 @@ fn guided_claims_take_a_workgroups_share_of_the_pending_items() {
     assert!((8..=n as u64 / 4).contains(&guided), "{guided} batches");
 }
 
+/// A share of the probed workgroups launches that share of them, rounded down and at least one,
+/// says what the probe found, and keeps the result exact; an empty share or one above 1 is
+/// refused.
+#[test]
+fn a_probe_share_launches_its_part_of_the_probed_workgroups_exactly() {
+    let gpu = gpu();
+    let params = small_tree(11);
+    let reference = params.reference();
+    let run = TreeRun::new(&gpu, params).unwrap();
+    let with = |workgroups| {
+        Scheduler::megakernel(
+            &gpu,
+            &run.program,
+            MegakernelConfig {
+                workgroups,
+                ..Default::default()
+            },
+        )
+    };
+    let all = with(Workgroups::Probe { max: 64 }).unwrap();
+    let (stats, result) = run.run(&gpu, &all).unwrap();
+    assert_eq!(result, reference);
+    assert_eq!(stats.probed_workgroups, stats.workgroups);
+    // Each megakernel probes on its own: on a busy CPU adapter two probes may count
+    // differently, so the share is checked against its own probe.
+    let share = Workgroups::ProbeShare {
+        max: 64,
+        numerator: 1,
+        denominator: 2,
+    };
+    let half = with(share).unwrap();
+    let (stats, result) = run.run(&gpu, &half).unwrap();
+    eprintln!("{stats:?}");
+    assert_eq!(result, reference);
+    assert!((1..=64).contains(&stats.probed_workgroups), "{stats:?}");
+    assert_eq!(stats.workgroups, (stats.probed_workgroups / 2).max(1));
+    for (numerator, denominator) in [(0, 2), (3, 2)] {
+        let bad = Workgroups::ProbeShare {
+            max: 64,
+            numerator,
+            denominator,
+        };
+        let e = with(bad)
+            .err()
+            .expect("an empty or too large share is refused");
+        assert!(e.to_string().contains("workgroup share"), "{e}");
+    }
+}
+
 /// Held work that emits nothing waits for held work that does: a chain of `link`s, each emitting
 /// the next link and one `tip` (a sink), both kept local, on one workgroup. Run in priority order
 /// (tips first) every level would take two local batches; with the tips deferred until they fill
