@@ -118,9 +118,10 @@ pub struct Cli {
     #[arg(long, value_parser = value_parser!(u32).range(1..=65535), help_heading = "Scheduler")]
     pub workgroups: Option<u32>,
 
-    /// Launch this share of the probed megakernel workgroups, `A/B` with 0 < A <= B
-    /// (`Workgroups::ProbeShare`) [default: the workload's: 2/5 for trees whose mean fan-out is
-    /// at most one (`TreeParams::megakernel_workgroup_share`) on GPUs, else all].
+    /// Launch this share of the probed megakernel workgroups, `A/B` with 0 < A <= B, or `1` for
+    /// all (`Workgroups::ProbeShare`); not with --workgroups [default: the workload's: 2/5 on
+    /// GPUs for trees whose mean fan-out is at most one and that have at most 65,536 roots
+    /// (`TreeParams::megakernel_workgroup_share`), else all].
     #[arg(long, value_name = "A/B", value_parser = parse_share, conflicts_with = "workgroups",
           help_heading = "Scheduler")]
     pub workgroup_share: Option<(u32, u32)>,
@@ -251,7 +252,8 @@ pub struct Cli {
     /// it (`MegakernelConfig::local_workgroup_bytes`; default 0, the slots buffer). Local
     /// batches then read held items from workgroup memory, and one that emitted only held items
     /// skips the release fence. For A/B runs: on the H100 2 KiB or more cost co-resident
-    /// workgroups, and less holds under a step per buffer (a warning says so).
+    /// workgroups, and an area whose buffers hold less than a step (under 12 KiB for the
+    /// binary tree) makes part-empty local batches (a warning says so).
     #[arg(long, value_name = "BYTES", help_heading = "Scheduler")]
     pub local_workgroup_bytes: Option<u32>,
 
@@ -315,7 +317,7 @@ fn parse_workgroup_size(s: &str) -> Result<u32, String> {
 
 /// `A/B`, 0 < A <= B (or `1`, all).
 fn parse_share(s: &str) -> Result<(u32, u32), String> {
-    let bad = || format!("`{s}` is not a share A/B with 0 < A <= B (e.g. 2/5)");
+    let bad = || format!("`{s}` is not a share A/B with 0 < A <= B (e.g. 2/5), or 1 (all)");
     let (a, b) = s.split_once('/').unwrap_or((s, "1"));
     let (a, b) = (a.trim().parse::<u32>(), b.trim().parse::<u32>());
     match (a, b) {

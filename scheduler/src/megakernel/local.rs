@@ -129,19 +129,36 @@ impl LocalPlan {
         (short, share * 4 * 2 * local.len() as u32)
     }
 
-    /// Warns where a local target's buffer holds less than a step ([`LocalPlan::partial_steps`]),
-    /// naming the bytes that would hold one.
-    pub fn warn_partial_steps(&self, program: &Program, bytes: u32) {
+    /// Warns, once, where a local target's buffer holds less than a step
+    /// ([`LocalPlan::partial_steps`]), naming the bytes that hold one and, where the area is in
+    /// workgroup memory and those bytes would not fit beside the kernel's `others` bytes within
+    /// the device's `limit`, saying so.
+    pub fn warn_partial_steps(&self, program: &Program, bytes: u32, others: u32, limit: u32) {
         let (short, enough) = self.partial_steps(program);
-        for (t, cap, step) in short {
-            log::warn!(
-                "megakernel: {bytes} bytes of local area per workgroup hold {cap} items of \
-                 `{}` a buffer, less than a step ({step}): its local batches run part-empty \
-                 steps, which ran the trees 1.5-4x slower (docs/scheduler.md 2.7); {enough} bytes \
-                 (local_bytes, local_workgroup_bytes) hold a step of every local target",
-                program.procs[t].proc.name
-            );
+        if short.is_empty() {
+            return;
         }
+        let held: Vec<String> = short
+            .iter()
+            .map(|&(t, cap, step)| format!("{cap} of `{}`'s {step}", program.procs[t].proc.name))
+            .collect();
+        let fits = if self.in_workgroup && others.saturating_add(enough) > limit {
+            format!(
+                "; in workgroup memory that is more than this device's {limit} bytes hold \
+                 beside the kernel's {others}: keep the area in the slots buffer \
+                 (local_workgroup_bytes 0, the default)"
+            )
+        } else {
+            String::new()
+        };
+        log::warn!(
+            "megakernel: {bytes} bytes of local area per workgroup hold less than a step per \
+             buffer ({}): local batches run part-empty steps, which ran the trees 1.5-4x slower \
+             on an H100 (docs/scheduler.md 2.7); {enough} bytes (local_bytes, \
+             local_workgroup_bytes; schedbench --local-bytes, --local-workgroup-bytes) hold a \
+             step of every local target{fits}",
+            held.join(", ")
+        );
     }
 
     /// Bytes of workgroup memory the area takes (0 where it is in the slots buffer or none).

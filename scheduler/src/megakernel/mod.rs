@@ -247,7 +247,6 @@ impl Megakernel {
             let bytes = local::LocalPlan::bytes_for(&config);
             if plan.active() {
                 source = generate(&plan, direct);
-                plan.warn_partial_steps(program, bytes);
             } else {
                 log::warn!(
                     "megakernel: local queues are on, but {bytes} bytes per workgroup \
@@ -265,6 +264,11 @@ impl Megakernel {
         // Checked here, with the sizes that made it: neither wgpu nor every driver refuses a
         // kernel that declares more (lavapipe ran one of 52 KB against its 32 KB).
         let used = local::workgroup_bytes(&source)?;
+        if plan.active() {
+            let bytes = local::LocalPlan::bytes_for(&config);
+            let others = used - plan.workgroup_area_bytes();
+            plan.warn_partial_steps(program, bytes, others, limit);
+        }
         if used > limit {
             let why = plan.workgroup_overflow_hint(used, limit);
             return Err(RunError::Program(format!(
