@@ -132,16 +132,22 @@ impl TreeParams {
         }
     }
 
+    /// Children per inner node on average: K for [`Fanout::Fixed`], K/2 for
+    /// [`Fanout::Uniform`] (exact in an f64).
+    fn mean_fanout(&self) -> f64 {
+        match self.fanout {
+            Fanout::Fixed(k) => k as f64,
+            Fanout::Uniform(k) => k as f64 / 2.0,
+        }
+    }
+
     /// Nodes the tree is expected to have, computed without walking it: with
     /// [`Fanout::Fixed`] (K) exactly `roots * (1 + K + ... + K^depth)`; with
     /// [`Fanout::Uniform`] (0..=K from a hash, mean K/2) the same sum with K/2, the mean over
     /// seeds. Infinite where it does not fit an f64. What a caller checks before a run that
     /// might never end ([`TreeParams::MAX_ITEMS`]).
     pub fn expected_items(&self) -> f64 {
-        let m = match self.fanout {
-            Fanout::Fixed(k) => k as f64,
-            Fanout::Uniform(k) => k as f64 / 2.0,
-        };
+        let m = self.mean_fanout();
         if self.roots == 0 {
             return 0.0;
         }
@@ -720,10 +726,7 @@ impl TreeParams {
     /// workgroup 8.53 -> 5.12 ms. A tree of mean fan-out below one (0..=1) is left without:
     /// not measured.
     pub fn megakernel_local_queues(&self) -> bool {
-        match self.fanout {
-            Fanout::Fixed(k) => k >= 1,
-            Fanout::Uniform(k) => k >= 2,
-        }
+        self.mean_fanout() >= 1.0
     }
 
     /// The share (numerator, denominator) of the probed workgroups the megakernel should
@@ -737,11 +740,7 @@ impl TreeParams {
     /// irregular (mean 1.5, 528 probed) 0.147 / 0.143 at 396 / 0.148 at 264, binary 0.127 /
     /// 0.133 / 0.155. All on CPU adapters (lavapipe), where it was not measured.
     pub fn megakernel_workgroup_share(&self, gpu: &scheduler::Gpu) -> (u32, u32) {
-        let mean_at_most_one = match self.fanout {
-            Fanout::Fixed(k) => k <= 1,
-            Fanout::Uniform(k) => k <= 2,
-        };
-        let narrow = mean_at_most_one && self.roots <= NARROW_ROOTS;
+        let narrow = self.mean_fanout() <= 1.0 && self.roots <= NARROW_ROOTS;
         if narrow && !gpu.is_cpu_adapter() {
             (2, 5)
         } else {
