@@ -71,9 +71,7 @@ impl LocalPlan {
     /// claim.rs) per buffer, lowered evenly where the whole area would pass `bytes`.
     pub fn new(program: &Program, batch: &[u32], bytes: u32) -> LocalPlan {
         let nq = program.queue_count();
-        let targets: Vec<usize> = (0..nq)
-            .filter(|&t| program.procs.iter().any(|p| p.local[t]))
-            .collect();
+        let targets = local_targets(program);
         let mut plan = LocalPlan::none(nq);
         if targets.is_empty() {
             return plan;
@@ -112,32 +110,37 @@ impl LocalPlan {
     /// runs a part-empty step: on the H100 the trees ran 1.5-4x slower with areas of 1-4 KiB
     /// (docs/results.md, 2026-12-06, "The local area in workgroup memory at 1-16 KiB").
     pub fn partial_steps(&self, program: &Program) -> (Vec<(usize, u32, u32)>, u32) {
-        let local: Vec<usize> = (0..self.cap.len()).filter(|&t| self.cap[t] > 0).collect();
-        let short = local
+        if !self.active() {
+            return (Vec::new(), 0);
+        }
+        // `new` gives every declared target an even share of words a buffer, a multiple of 4,
+        // whether or not the share holds one of its items.
+        let targets = local_targets(program);
+        let short = targets
             .iter()
             .map(|&t| (t, self.cap[t], program.procs[t].items_per_step))
-            .filter(|&(_, cap, step)| cap < step)
+            .filter(|&(_, cap, step)| cap > 0 && cap < step)
             .collect();
-        // `new` gives each target an even share of words a buffer, a multiple of 4.
-        let share = local
+        let share = targets
             .iter()
             .map(|&t| {
                 (program.procs[t].items_per_step * program.procs[t].words()).next_multiple_of(4)
             })
             .max()
             .unwrap_or(0);
-        (short, share * 4 * 2 * local.len() as u32)
+        (short, share * 4 * 2 * targets.len() as u32)
     }
 
     /// Warns, once, where a local target's buffer holds less than a step
-    /// ([`LocalPlan::partial_steps`]), naming the bytes that hold one and, where the area is in
-    /// workgroup memory and those bytes would not fit beside the kernel's `others` bytes within
-    /// the device's `limit`, saying so.
-    pub fn warn_partial_steps(&self, program: &Program, bytes: u32, others: u32, limit: u32) {
+    /// ([`LocalPlan::partial_steps`]) in the `bytes` given, naming the bytes that hold one and,
+    /// where the area is in workgroup memory and those would not fit within the device's
+    /// `limit` beside the rest of a kernel of `used` bytes, saying so.
+    pub fn warn_partial_steps(&self, program: &Program, bytes: u32, used: u32, limit: u32) {
         let (short, enough) = self.partial_steps(program);
         if short.is_empty() {
             return;
         }
+        let others = used - self.workgroup_area_bytes();
         let held: Vec<String> = short
             .iter()
             .map(|&(t, cap, step)| format!("{cap} of `{}`'s {step}", program.procs[t].proc.name))
@@ -279,6 +282,13 @@ impl LocalPlan {
             words = self.wg_words.max(4)
         )
     }
+}
+
+/// The queues some procedure keeps local ([`crate::Procedure::local`]), in queue order.
+fn local_targets(program: &Program) -> Vec<usize> {
+    (0..program.queue_count())
+        .filter(|&t| program.procs.iter().any(|p| p.local[t]))
+        .collect()
 }
 
 /// Bytes of workgroup memory the module declares (naga's layout of every `var<workgroup>`).
@@ -428,6 +438,25 @@ mod tests {
         assert_eq!(enough.cap, vec![256, 0]);
         assert_eq!(enough.partial_steps(&p), (vec![], 8192));
         assert_eq!(LocalPlan::none(2).partial_steps(&p), (vec![], 0));
+        // Two local targets, one of 64-word items that 512 bytes give no room: it runs globally
+        // (not short), but `new` still gave it a share, so the bytes count both.
+        let small = ItemType::new("Small", "struct Small { id: u32 }");
+        let big = ItemType::new("Big", "struct Big { w: array<u32, 64> }");
+        let a = Procedure::new("a", small, 1)
+            .emits("a", 1)
+            .emits("b", 1)
+            .local("a")
+            .local("b")
+            .body("fn a_execute(item: Small, inv: Invocation) { enqueue_a(item); var b: Big; enqueue_b(b); }");
+        let b = Procedure::new("b", big, 1).body("fn b_execute(item: Big, inv: Invocation) {}");
+        let two = Program::new(vec![a, b], UserBindings::none()).unwrap();
+        let plan = LocalPlan::new(&two, &[256, 256], 512);
+        assert_eq!(plan.cap, vec![32, 0]);
+        let step_words = 256 * 64;
+        assert_eq!(
+            plan.partial_steps(&two),
+            (vec![(0, 32, 256)], step_words * 4 * 2 * 2)
+        );
     }
 
     #[test]

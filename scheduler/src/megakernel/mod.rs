@@ -40,9 +40,9 @@ pub struct Megakernel {
     program: Program,
     config: MegakernelConfig,
     kernels: Kernels,
-    /// Workgroups per launch; 0 until the first run's probe (the probe needs the user's group).
-    workgroups: std::sync::atomic::AtomicU32,
-    /// Co-resident workgroups the probe found; 0 until it ran, and with `Workgroups::Fixed`.
+    /// Co-resident workgroups the probe found; 0 until the first run's probe (the probe needs
+    /// the user's group), and always with `Workgroups::Fixed`. A launch's workgroups follow from
+    /// it (`Workgroups::of_probed`).
     probed: std::sync::atomic::AtomicU32,
     outbox_stride: u32,
     ob_off: Vec<u32>,
@@ -242,9 +242,9 @@ impl Megakernel {
                  (Procedure::local): running without them"
             );
         }
+        let bytes = local::LocalPlan::bytes_for(&config);
         if config.local_queues && program.has_local() {
             plan = local::LocalPlan::for_config(program, &batch, &config);
-            let bytes = local::LocalPlan::bytes_for(&config);
             if plan.active() {
                 source = generate(&plan, direct);
             } else {
@@ -264,11 +264,7 @@ impl Megakernel {
         // Checked here, with the sizes that made it: neither wgpu nor every driver refuses a
         // kernel that declares more (lavapipe ran one of 52 KB against its 32 KB).
         let used = local::workgroup_bytes(&source)?;
-        if plan.active() {
-            let bytes = local::LocalPlan::bytes_for(&config);
-            let others = used - plan.workgroup_area_bytes();
-            plan.warn_partial_steps(program, bytes, others, limit);
-        }
+        plan.warn_partial_steps(program, bytes, used, limit);
         if used > limit {
             let why = plan.workgroup_overflow_hint(used, limit);
             return Err(RunError::Program(format!(
@@ -294,15 +290,10 @@ impl Megakernel {
             &["megakernel"],
             None,
         )?;
-        let workgroups = match config.workgroups {
-            Workgroups::Fixed(n) => n.max(1),
-            Workgroups::Probe { .. } | Workgroups::ProbeShare { .. } => 0,
-        };
         Ok(Megakernel {
             program: program.clone(),
             config,
             kernels,
-            workgroups: std::sync::atomic::AtomicU32::new(workgroups),
             probed: std::sync::atomic::AtomicU32::new(0),
             outbox_stride,
             ob_off,
@@ -349,7 +340,7 @@ impl Megakernel {
     /// Workgroups per launch, probing on first use (the probe launch needs the user's bind
     /// group, as a run does). Errors: those of a run ([`RunError::Timeout`], [`RunError::Device`]).
     pub fn workgroups(&self, gpu: &Gpu, user: Option<&wgpu::BindGroup>) -> Result<u32, RunError> {
-        if self.workgroups.load(std::sync::atomic::Ordering::Relaxed) == 0 {
+        if self.needs_probe() {
             let (Workgroups::Probe { max } | Workgroups::ProbeShare { max, .. }) =
                 self.config.workgroups
             else {
@@ -365,10 +356,13 @@ impl Megakernel {
             );
             self.probed
                 .store(probed, std::sync::atomic::Ordering::Relaxed);
-            self.workgroups
-                .store(n, std::sync::atomic::Ordering::Relaxed);
         }
-        Ok(self.workgroups.load(std::sync::atomic::Ordering::Relaxed))
+        Ok(self.config.workgroups.of_probed(self.probed_workgroups()))
+    }
+
+    /// Whether the next run probes the workgroup count first (a probing configuration's first).
+    fn needs_probe(&self) -> bool {
+        !matches!(self.config.workgroups, Workgroups::Fixed(_)) && self.probed_workgroups() == 0
     }
 
     /// Co-resident workgroups the probe found (0 before the first run, and with
@@ -583,7 +577,7 @@ impl Megakernel {
     ) -> Result<(RunStats, Vec<Vec<u32>>), RunError> {
         self.kernels.check_user_group(user)?;
         // A first run probes the workgroup count: one submission and wait more.
-        let probed = self.workgroups.load(std::sync::atomic::Ordering::Relaxed) == 0;
+        let probed = self.needs_probe();
         let workgroups = self.workgroups_within(self.workgroups(gpu, user)?, max_queue_bytes);
         let start_time = Instant::now();
         let nq = self.program.queue_count();
