@@ -119,7 +119,7 @@ pub struct Cli {
     pub workgroups: Option<u32>,
 
     /// Launch this share of the probed megakernel workgroups, `A/B` with 0 < A <= B, or `1` for
-    /// all (`Workgroups::ProbeShare`); not with --workgroups [default: the workload's: 2/5 on
+    /// all (`Workgroups::ProbeShare`); not with --workgroups [default: the workload's: 1/5 on
     /// GPUs for trees whose mean fan-out is at most one and that have at most 65,536 roots
     /// (`TreeParams::megakernel_workgroup_share`), else all].
     #[arg(long, value_name = "A/B", value_parser = parse_share, conflicts_with = "workgroups",

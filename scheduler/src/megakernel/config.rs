@@ -18,9 +18,9 @@ pub enum Workgroups {
     /// workgroups (rounded down, at least one), the probe launching at most `max`. For work
     /// that stays narrow, a few thousand items at a time in long chains: fewer workgroups per
     /// SM spread its batches over more SMs' issue slots instead of sharing a few
-    /// (docs/scheduler.md 2.3). H100, the deep tree: 2/5 of the 660 probed, 1.15 -> 0.99 ms; the
-    /// binary tree, which fills every workgroup, 0.127 -> 0.155 (docs/results.md, 2026-12-06
-    /// (eleventh session)). Errors: a share of 0 or above 1 is a [`crate::RunError::Program`].
+    /// (docs/scheduler.md 2.3). H100, the deep tree: 1/5 of the 660 probed, 1.117 -> 0.954 ms;
+    /// the binary tree, which fills every workgroup, 0.127 -> 0.155 at 2/5 (docs/results.md,
+    /// 2026-12-06 (eleventh and twelfth sessions)). Errors: a share of 0 or above 1 is a [`crate::RunError::Program`].
     ProbeShare {
         /// Most workgroups the probe launches.
         max: u32,

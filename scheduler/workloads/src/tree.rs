@@ -730,19 +730,20 @@ impl TreeParams {
     }
 
     /// The share (numerator, denominator) of the probed workgroups the megakernel should
-    /// launch (`Workgroups::ProbeShare`): 2/5 on a GPU where the tree stays narrow, else all.
+    /// launch (`Workgroups::ProbeShare`): 1/5 on a GPU where the tree stays narrow, else all.
     /// Narrow: a mean fan-out of at most one (one child, or 0..=k children with k <= 2), whose
     /// levels stay near the roots' count, and at most [`NARROW_ROOTS`] roots. Its batches then
-    /// run faster spread over the SMs at two workgroups per SM than shared at five
+    /// run faster spread over the SMs, one workgroup per SM where five fit, than shared
     /// (docs/scheduler.md 2.2, "Presence or claims").
-    /// H100, GPU ms median of 20 (docs/results.md, 2026-12-06 (eleventh session)), all 660
-    /// probed / 396 / 264: deep 1.15 / 1.03 / 0.99, deep of 1,250 roots 1.00 / 0.94 / 0.93;
-    /// irregular (mean 1.5, 528 probed) 0.147 / 0.143 at 396 / 0.148 at 264, binary 0.127 /
-    /// 0.133 / 0.155. All on CPU adapters (lavapipe), where it was not measured.
+    /// H100, GPU ms median of 20 (docs/results.md, 2026-12-06 (eleventh session) and (twelfth
+    /// session)), all 660 probed / 396 / 264 / 132: deep 1.15 / 1.03 / 0.99 / -, then 1.117 / - /
+    /// 0.981 / 0.954; deep of 1,250 roots 1.00 / 0.94 / 0.93 / -, then 0.981 / - / 0.920 /
+    /// 0.912; irregular (mean 1.5, 528 probed) 0.147 / 0.143 at 396 / 0.148 at 264, binary
+    /// 0.127 / 0.133 / 0.155. All on CPU adapters (lavapipe), where it was not measured.
     pub fn megakernel_workgroup_share(&self, gpu: &scheduler::Gpu) -> (u32, u32) {
         let narrow = self.mean_fanout() <= 1.0 && self.roots <= NARROW_ROOTS;
         if narrow && !gpu.is_cpu_adapter() {
-            (2, 5)
+            (1, 5)
         } else {
             (1, 1)
         }
