@@ -212,8 +212,22 @@ impl<'a> SharedSource<'a> {
 /// Compiles `program`'s shared WGSL with enqueue stubs and checks it (see the module docs).
 /// Every error is a [`RunError::Program`] naming the procedure, part and line it is about.
 /// Returns performance notes ([`Program::notes`](crate::Program::notes)).
+///
+/// The source is parsed and validated once, with the SPIR-V check's entry points appended
+/// (`spirv_entry_points`): one parse of the program instead of two, about 10-15 ms of every
+/// `Program::new` for Reyes' four procedures on the dev machine. Where that source fails, the
+/// plain one is parsed and validated again for the user's error, which then names what the
+/// user wrote, and the SPIR-V check is skipped as before (a failure of the appended entry
+/// points alone is not the user's: the strategies' own compilation reports it).
 pub(crate) fn check(program: &Program) -> Result<Vec<String>, RunError> {
     let shared = SharedSource::new(program);
+    let own = spirv_checked(&shared);
+    let with_entries = shared.text.clone() + &spirv_entry_points(&own);
+    if let Some((module, info)) = parse_and_validate(&with_entries) {
+        check_module(&shared, &module)?;
+        check_spirv(&own, &module, &info)?;
+        return Ok(dynamic_item_indexing(&shared, &module, &info));
+    }
     let module = naga::front::wgsl::parse_str(&shared.text).map_err(|e| {
         let spans: Vec<(Span, String)> = e.labels().map(|(s, l)| (s, l.to_string())).collect();
         let notes: Vec<String> = e.notes().map(str::to_string).collect();
@@ -241,61 +255,69 @@ pub(crate) fn check(program: &Program) -> Result<Vec<String>, RunError> {
         let spans: Vec<(Span, String)> = e.spans().cloned().collect();
         RunError::Program(shared.report(&message, &spans, &chain, true))
     })?;
-    check_execute_functions(&shared, &module)?;
-    check_enqueue_targets(&shared, &module)?;
-    check_user_bindings(&shared, &module)?;
-    check_spirv(&shared)?;
+    check_module(&shared, &module)?;
+    log::debug!("SPIR-V check skipped: the source with its entry points does not compile");
     Ok(dynamic_item_indexing(&shared, &module, &info))
 }
 
-/// Writes each procedure's execute function (an entry point that calls it) as SPIR-V with
-/// naga's backend, as wgpu's Vulkan backend does when a strategy's pipeline is made, and turns
-/// a failure or a panic of that backend on code its validator accepted into a
-/// [`RunError::Program`] naming the procedure; without it the panic reached the caller of
-/// `Megakernel::new` or `Kernels::new`. One known cause in naga 30.0.1: a pointer to a member
-/// of a struct passed to a function (`f(&item.cp)`, "Expression [N] is not cached"). The
-/// default panic hook still prints naga's message before the error is returned.
-fn check_spirv(shared: &SharedSource) -> Result<(), RunError> {
-    use naga::back::spv;
-    let start = std::time::Instant::now();
-    let procs = &shared.program.procs;
-    let mut text = shared.text.clone();
-    // A procedure that runs another's execute function (`Procedure::execute_of`) is checked
-    // through that one.
-    let own: Vec<_> = procs
-        .iter()
-        .filter(|p| p.proc.execute_of.is_none())
-        .collect();
-    for p in &own {
-        text += &format!(
-            "@compute @workgroup_size(1) fn sched_spirv_{name}() {{\n    var item: {ty};\n    \
-             {name}_execute(item, Invocation(0u, 0u, true, {threads}u));\n}}\n",
-            name = p.proc.name,
-            ty = p.layout.name,
-            threads = p.proc.threads_per_item
-        );
-    }
-    // The source validated above with these entry points added: a failure here is not the
-    // user's, and the strategies' own compilation will report it.
-    let module = match naga::front::wgsl::parse_str(&text) {
-        Ok(module) => module,
-        Err(e) => {
-            log::debug!("SPIR-V check skipped: {}", e.emit_to_string(&text));
-            return Ok(());
-        }
-    };
-    let info = match naga::valid::Validator::new(
+/// What naga cannot know (the module docs' list), checked on a module that compiled.
+fn check_module(shared: &SharedSource, module: &naga::Module) -> Result<(), RunError> {
+    check_execute_functions(shared, module)?;
+    check_enqueue_targets(shared, module)?;
+    check_user_bindings(shared, module)
+}
+
+/// `text` parsed and validated by naga, or `None` where either fails.
+fn parse_and_validate(text: &str) -> Option<(naga::Module, naga::valid::ModuleInfo)> {
+    let module = naga::front::wgsl::parse_str(text).ok()?;
+    let info = naga::valid::Validator::new(
         naga::valid::ValidationFlags::all(),
         naga::valid::Capabilities::all(),
     )
     .validate(&module)
-    {
-        Ok(info) => info,
-        Err(e) => {
-            log::debug!("SPIR-V check skipped: {}", e.emit_to_string(&text));
-            return Ok(());
-        }
-    };
+    .ok()?;
+    Some((module, info))
+}
+
+/// The procedures whose execute function the SPIR-V check writes: a procedure that runs
+/// another's execute function (`Procedure::execute_of`) is checked through that one.
+fn spirv_checked<'p>(shared: &SharedSource<'p>) -> Vec<&'p super::ProcInfo> {
+    (shared.program.procs.iter())
+        .filter(|p| p.proc.execute_of.is_none())
+        .collect()
+}
+
+/// One compute entry point per procedure in `own`, `sched_spirv_<name>`, that calls its
+/// execute function: what `check_spirv` writes as SPIR-V.
+fn spirv_entry_points(own: &[&super::ProcInfo]) -> String {
+    own.iter()
+        .map(|p| {
+            format!(
+                "@compute @workgroup_size(1) fn sched_spirv_{name}() {{\n    var item: {ty};\n    \
+                 {name}_execute(item, Invocation(0u, 0u, true, {threads}u));\n}}\n",
+                name = p.proc.name,
+                ty = p.layout.name,
+                threads = p.proc.threads_per_item
+            )
+        })
+        .collect()
+}
+
+/// Writes each procedure's execute function (its `sched_spirv_<name>` entry point in
+/// `module`) as SPIR-V with naga's backend, as wgpu's Vulkan backend does when a strategy's
+/// pipeline is made, and turns a failure or a panic of that backend on code its validator
+/// accepted into a [`RunError::Program`] naming the procedure; without it the panic reached
+/// the caller of `Megakernel::new` or `Kernels::new`. One known cause in naga 30.0.1: a
+/// pointer to a member of a struct passed to a function (`f(&item.cp)`, "Expression [N] is
+/// not cached"). The default panic hook still prints naga's message before the error is
+/// returned.
+fn check_spirv(
+    own: &[&super::ProcInfo],
+    module: &naga::Module,
+    info: &naga::valid::ModuleInfo,
+) -> Result<(), RunError> {
+    use naga::back::spv;
+    let start = std::time::Instant::now();
     // The bounds-check policies wgpu-hal 30.0.1's Vulkan backend uses with checks on.
     let restrict = naga::proc::BoundsCheckPolicy::Restrict;
     let options = spv::Options {
@@ -307,14 +329,14 @@ fn check_spirv(shared: &SharedSource) -> Result<(), RunError> {
         },
         ..Default::default()
     };
-    for p in &own {
+    for p in own {
         let entry = format!("sched_spirv_{}", p.proc.name);
         let pipeline = spv::PipelineOptions {
             shader_stage: naga::ShaderStage::Compute,
             entry_point: entry,
         };
         let written = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            spv::write_vec(&module, &info, &options, Some(&pipeline))
+            spv::write_vec(module, info, &options, Some(&pipeline))
         }));
         let why = match written {
             Ok(Ok(_)) => continue,
