@@ -118,8 +118,10 @@ pub struct Cli {
     #[arg(long, value_parser = value_parser!(u32).range(1..=65535), help_heading = "Scheduler")]
     pub workgroups: Option<u32>,
 
-    /// Launch this share of the probed megakernel workgroups, `A/B` with 0 < A <= B, or `1` for
-    /// all (`Workgroups::ProbeShare`); not with --workgroups [default: the workload's: 1/5 on
+    /// Launch this share of the probed megakernel workgroups (for --strategy megakernel and
+    /// all), `A/B` with 0 < A <= B, or `1` for all, rounded down and at least one
+    /// (`Workgroups::ProbeShare`; the `queues:` line and the records' `probed_workgroups` give
+    /// what the probe found); not with --workgroups [default: the workload's: 1/5 on
     /// GPUs for trees whose mean fan-out is at most one and that have at most 65,536 roots
     /// (`TreeParams::megakernel_workgroup_share`), else all].
     #[arg(long, value_name = "A/B", value_parser = parse_share, conflicts_with = "workgroups",
