@@ -1413,7 +1413,6 @@ fn a_probe_share_launches_its_part_of_the_probed_workgroups_exactly() {
     };
     let half = with(share).unwrap();
     let (stats, result) = run.run(&gpu, &half).unwrap();
-    eprintln!("{stats:?}");
     assert_eq!(result, reference);
     assert!((1..=64).contains(&stats.probed_workgroups), "{stats:?}");
     assert_eq!(stats.workgroups, (stats.probed_workgroups / 2).max(1));

@@ -123,9 +123,7 @@ impl LocalPlan {
             .collect();
         let share = targets
             .iter()
-            .map(|&t| {
-                (program.procs[t].items_per_step * program.procs[t].words()).next_multiple_of(4)
-            })
+            .map(|&t| buffer_words_for(program, t, program.procs[t].items_per_step))
             .max()
             .unwrap_or(0);
         (short, share * 4 * 2 * targets.len() as u32)
@@ -197,7 +195,7 @@ impl LocalPlan {
 
     /// Words from target `t`'s first buffer to its second (16-byte aligned).
     pub fn buffer_words(&self, program: &Program, t: usize) -> u32 {
-        (self.cap[t] * program.procs[t].words()).next_multiple_of(4)
+        buffer_words_for(program, t, self.cap[t])
     }
 
     /// Its WGSL constants; `edge[q * NQ + t]` from the program.
@@ -282,6 +280,11 @@ impl LocalPlan {
             words = self.wg_words.max(4)
         )
     }
+}
+
+/// Words of one local buffer of `items` items of target `t`, rounded up to 16 bytes.
+fn buffer_words_for(program: &Program, t: usize, items: u32) -> u32 {
+    (items * program.procs[t].words()).next_multiple_of(4)
 }
 
 /// The queues some procedure keeps local ([`crate::Procedure::local`]), in queue order.
