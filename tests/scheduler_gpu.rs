@@ -1028,6 +1028,60 @@ fn a_megakernel_run_after_one_that_grew_needs_exactly_one_launch() {
     assert!(tight.queue_bytes <= budget, "{tight:?} within {budget}");
 }
 
+/// A megakernel reused for another tree on the same queues clears only the flags the last run
+/// wrote (its tickets, below its reserve), not the whole capacity, and every run stays exact.
+/// Without local queues every item of a one-launch run holds a ticket of its queue, so the last
+/// run's reserve in queue q is its `executed[q]`; the next run stamps its seeds over the first
+/// of them and clears the rest. Full binary trees seed every root in `branch` (queue 0).
+#[test]
+fn a_reused_megakernel_clears_only_the_flags_its_last_run_wrote() {
+    let gpu = gpu();
+    let tree = |roots, max_depth| TreeParams {
+        roots,
+        max_depth,
+        fanout: Fanout::Fixed(2),
+        work: 1,
+        payload_words: 1,
+        seed: 3,
+    };
+    let shapes = [tree(8, 6), tree(2, 3), tree(8, 6), tree(8, 6)];
+    let mut run = TreeRun::new(&gpu, shapes[0].clone()).unwrap();
+    let mk = Scheduler::megakernel(
+        &gpu,
+        &run.program,
+        MegakernelConfig {
+            workgroups: Workgroups::Fixed(1),
+            initial_capacity: 1 << 12,
+            local_queues: false,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let mut last: Option<RunStats> = None;
+    for shape in shapes {
+        run.set_params(shape.clone()).unwrap();
+        let (stats, result) = run.run(&gpu, &mk).unwrap();
+        assert_eq!(result, shape.reference(), "{shape:?}");
+        assert_eq!((stats.launches, stats.abandoned), (1, 0), "{stats:?}");
+        let expected = match &last {
+            // New queues: wgpu zero-initializes them, nothing to clear.
+            None => 0,
+            Some(prev) => {
+                assert_eq!(
+                    stats.queue_bytes, prev.queue_bytes,
+                    "the same queues, reused"
+                );
+                let seeds = [shape.roots as u64, 0];
+                (0..2)
+                    .map(|q| prev.executed[q].saturating_sub(seeds[q]))
+                    .sum()
+            }
+        };
+        assert_eq!(stats.flags_cleared, expected, "{shape:?}: {stats:?}");
+        last = Some(stats);
+    }
+}
+
 #[test]
 fn a_queue_memory_budget_is_kept_or_reported_as_overflow() {
     let gpu = gpu();

@@ -66,6 +66,10 @@ pub struct RunStats {
     pub host_compactions: u64,
     /// Megakernel: slots whose bounded wait ran out and were handed to the next launch.
     pub abandoned: u64,
+    /// Megakernel: slot flags (u32 words) cleared on the device before its launches. Only those
+    /// an earlier launch on the same queues may have written (below its last reserve) are
+    /// cleared, not the queues' whole capacity; 0 on new queues, which wgpu zero-initializes.
+    pub flags_cleared: u64,
     /// Megakernel: live items set aside on the host, and run later, because queues at their
     /// capacity limits could not hold the work's breadth (`megakernel/park.rs`); 0 when the
     /// queues had room.
@@ -130,6 +134,7 @@ impl RunStats {
         self.host_compactions += o.host_compactions;
         self.parked_items += o.parked_items;
         self.abandoned += o.abandoned;
+        self.flags_cleared += o.flags_cleared;
         self.queue_growths += o.queue_growths;
         self.partial_rounds += o.partial_rounds;
         self.queue_bytes = self.queue_bytes.max(o.queue_bytes);
