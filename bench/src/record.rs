@@ -95,6 +95,11 @@ pub struct RunRecord {
     pub spin_wait_us: u64,
     pub idle_polls: u64,
     pub abandoned: u64,
+    /// Megakernel: slot flags (words) cleared on the device before its launches, only those
+    /// an earlier launch on the same queues wrote (`RunStats::flags_cleared`); absent for the
+    /// others.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub flags_cleared: Option<u64>,
     pub queue_growths: u64,
     /// Multi-pass rounds run in part under a queue limit (`RunStats::partial_rounds`).
     #[serde(default)]
@@ -149,6 +154,7 @@ impl RunRecord {
             local_items: s.local_items,
             idle_polls: s.idle_polls,
             abandoned: s.abandoned,
+            flags_cleared: (s.workgroup_size > 0).then_some(s.flags_cleared),
             queue_growths: s.queue_growths,
             partial_rounds: s.partial_rounds,
             parked_items: s.parked_items,
@@ -215,6 +221,7 @@ impl RunRecord {
             spin_wait_us: k.gpu.spin_wait.as_micros() as u64,
             idle_polls: 0,
             abandoned: 0,
+            flags_cleared: None,
             queue_growths: 0,
             partial_rounds: 0,
             parked_items: 0,

@@ -433,6 +433,7 @@ mod tests {
             spin_wait_us: 0,
             idle_polls: 50,
             abandoned: 0,
+            flags_cleared: None,
             queue_growths: 0,
             partial_rounds: 0,
             parked_items: 0,
