@@ -618,10 +618,7 @@ impl Megakernel {
             let words = rb.read(gpu, reads)?;
             rb.add_ms(&words, &mut gpu_ms);
             let ctrl = rb.counters(&words);
-            for (q, dirty) in d.dirty.iter_mut().enumerate() {
-                let reserve = ctrl[layout::q(q, Q_RESERVE)].min(d.layout.capacity[q]);
-                *dirty = (*dirty).max(reserve);
-            }
+            d.launched(ctrl);
             stats.launches += 1;
             stats.submits += 1;
             if let Start::Compact { live, .. } = &start {

@@ -29,6 +29,18 @@ pub(super) struct DeviceQueues {
     pub(super) bind: wgpu::BindGroup,
 }
 
+impl DeviceQueues {
+    /// Notes what a launch on these buffers wrote, from its `ctrl` read back: its flags lie
+    /// below each queue's final `Q_RESERVE` (tickets never pass the capacity), which the next
+    /// upload clears (`dirty`).
+    pub(super) fn launched(&mut self, ctrl: &[u32]) {
+        for (q, dirty) in self.dirty.iter_mut().enumerate() {
+            let reserve = ctrl[layout::q(q, Q_RESERVE)].min(self.layout.capacity[q]);
+            *dirty = (*dirty).max(reserve);
+        }
+    }
+}
+
 impl Megakernel {
     /// New buffers for `layout` and `workgroups` (the outbox kept where given: growth keeps
     /// it), their params written and bind group made; every flag `EMPTY` (wgpu zero-initializes
