@@ -121,9 +121,10 @@ pub struct Cli {
     /// Launch this share of the probed megakernel workgroups (for --strategy megakernel and
     /// all), `A/B` with 0 < A <= B, or `1` for all, rounded down and at least one
     /// (`Workgroups::ProbeShare`; the `queues:` line and the records' `probed_workgroups` give
-    /// what the probe found); not with --workgroups [default: the workload's: 1/5 on
-    /// GPUs for trees whose mean fan-out is at most one and that have at most 65,536 roots
-    /// (`TreeParams::megakernel_workgroup_share`), else all].
+    /// what the probe found); not with --workgroups [default: the workload's: on GPUs for
+    /// trees whose mean fan-out is at most one and that have at most 65,536 roots, 1/2 with
+    /// the local area in workgroup memory and 1/5 without it, one workgroup per SM on the
+    /// H100 (`TreeParams::megakernel_workgroup_share`), else all].
     #[arg(long, value_name = "A/B", value_parser = parse_share, conflicts_with = "workgroups",
           help_heading = "Scheduler")]
     pub workgroup_share: Option<(u32, u32)>,
@@ -251,11 +252,13 @@ pub struct Cli {
     pub local_bytes: Option<u32>,
 
     /// With local queues: keep the local area in workgroup memory, at most this many bytes of
-    /// it (`MegakernelConfig::local_workgroup_bytes`; default 0, the slots buffer). Local
-    /// batches then read held items from workgroup memory, and one that emitted only held items
-    /// skips the release fence. For A/B runs: on the H100 2 KiB or more cost co-resident
-    /// workgroups, and an area whose buffers hold less than a step (under 12 KiB for the
-    /// binary tree) makes part-empty local batches (a warning says so).
+    /// it (`MegakernelConfig::local_workgroup_bytes`; 0: the slots buffer) [default: the
+    /// workload's: 12288 on GPUs for trees of mean fan-out one, at most 65,536 roots and one
+    /// payload word (`TreeParams::megakernel_local_workgroup_bytes`), else 0]. Local batches
+    /// then read held items from workgroup memory, and one that emitted only held items skips
+    /// the release fence. On the H100 2 KiB or more cost co-resident workgroups, which only
+    /// the narrow trees can spare, and an area whose buffers hold less than a step (under 12
+    /// KiB for the binary tree) makes part-empty local batches (a warning says so).
     #[arg(long, value_name = "BYTES", help_heading = "Scheduler")]
     pub local_workgroup_bytes: Option<u32>,
 

@@ -166,7 +166,9 @@ pub struct GpuConfig {
     pub local_queues: Option<bool>,
     /// `MegakernelConfig::local_bytes`; `None`: its default.
     pub local_bytes: Option<u32>,
-    /// `MegakernelConfig::local_workgroup_bytes`; `None`: its default (0, the slots buffer).
+    /// `MegakernelConfig::local_workgroup_bytes`; `None`: the workload's choice
+    /// ([`GpuConfig::or_local_workgroup_bytes`]; narrow trees on GPUs, 0 (the slots buffer)
+    /// elsewhere).
     pub local_workgroup_bytes: Option<u32>,
     /// `MegakernelConfig::defer_local_sinks` (default `true`).
     pub defer_local_sinks: bool,
@@ -236,6 +238,13 @@ impl GpuConfig {
     /// line gave neither a share nor a count.
     pub fn or_workgroup_share(mut self, workload: (u32, u32)) -> GpuConfig {
         self.workgroup_share = self.workgroup_share.or(Some(workload));
+        self
+    }
+
+    /// This configuration with `workload`'s local area in workgroup memory where the command
+    /// line gave none.
+    pub fn or_local_workgroup_bytes(mut self, workload: u32) -> GpuConfig {
+        self.local_workgroup_bytes = self.local_workgroup_bytes.or(Some(workload));
         self
     }
 

@@ -23,8 +23,12 @@ impl ScheduledProblem for TreeParams {
         self.megakernel_local_queues()
     }
 
-    fn workgroup_share(&self, gpu: &Gpu) -> (u32, u32) {
-        self.megakernel_workgroup_share(gpu)
+    fn local_workgroup_bytes(&self, gpu: &Gpu) -> u32 {
+        self.megakernel_local_workgroup_bytes(gpu)
+    }
+
+    fn workgroup_share(&self, gpu: &Gpu, local_workgroup_bytes: u32) -> (u32, u32) {
+        self.megakernel_workgroup_share(gpu, local_workgroup_bytes)
     }
 
     fn reference(&self) -> TreeResult {

@@ -104,10 +104,17 @@ pub trait ScheduledProblem: Clone {
     fn local_queues(&self) -> bool {
         false
     }
+    /// Bytes of workgroup memory for the megakernel's local area on `gpu`
+    /// (`GpuConfig::local_workgroup_bytes` when the command line gives none); default 0, the
+    /// slots buffer.
+    fn local_workgroup_bytes(&self, _gpu: &Gpu) -> u32 {
+        0
+    }
     /// The share (numerator, denominator) of the probed megakernel workgroups this problem
-    /// launches on `gpu` (`GpuConfig::workgroup_share` when the command line gives neither a
-    /// share nor a count); default all, (1, 1).
-    fn workgroup_share(&self, _gpu: &Gpu) -> (u32, u32) {
+    /// launches on `gpu` with `local_workgroup_bytes` of local area in workgroup memory
+    /// (`GpuConfig::workgroup_share` when the command line gives neither a share nor a count);
+    /// default all, (1, 1).
+    fn workgroup_share(&self, _gpu: &Gpu, _local_workgroup_bytes: u32) -> (u32, u32) {
         (1, 1)
     }
 
@@ -153,11 +160,12 @@ pub struct RunSlot<P: ScheduledProblem> {
 }
 
 /// A scheduler compiled for a strategy (`name`), an initial queue capacity, local queues on or
-/// off and a share of the probed workgroups.
+/// off, the local area's bytes of workgroup memory and a share of the probed workgroups.
 struct Compiled {
     name: String,
     capacity: u32,
     local: bool,
+    area: u32,
     share: (u32, u32),
     scheduler: Scheduler,
 }
@@ -274,24 +282,35 @@ impl<P: ScheduledProblem> Workload for ProblemWorkload<P> {
                 let name = strategy.name();
                 let capacity = self.config.capacity.unwrap_or(p.capacity(reference));
                 let local = self.config.local_queues.unwrap_or(p.local_queues());
+                let area = (self.config.local_workgroup_bytes).unwrap_or(if local {
+                    p.local_workgroup_bytes(gpu)
+                } else {
+                    0
+                });
                 let share = self
                     .config
                     .workgroup_share
-                    .unwrap_or(p.workgroup_share(gpu));
+                    .unwrap_or(p.workgroup_share(gpu, area));
                 let have = |s: &&Compiled| {
-                    s.name == name && s.capacity == capacity && s.local == local && s.share == share
+                    s.name == name
+                        && s.capacity == capacity
+                        && s.local == local
+                        && s.area == area
+                        && s.share == share
                 };
                 if !schedulers.iter().any(|s| have(&s)) {
                     let config = (self.config.clone())
                         .or_procedure_steps(P::procedure_steps(gpu))
                         .or_guided_claims(P::guided_claims(gpu))
                         .or_local_queues(local)
+                        .or_local_workgroup_bytes(area)
                         .or_workgroup_share(share);
                     let s = compile(gpu, P::program(run), strategy, &config, capacity)?;
                     schedulers.push(Compiled {
                         name: name.clone(),
                         capacity,
                         local,
+                        area,
                         share,
                         scheduler: s,
                     });

@@ -710,6 +710,15 @@ pub fn megakernel_procedure_steps(gpu: &scheduler::Gpu) -> Vec<(String, u32)> {
 /// workgroups of 256), so fewer workgroups lose them no parallelism.
 pub const NARROW_ROOTS: u32 = 65_536;
 
+/// Local area in workgroup memory of a narrow tree's megakernel
+/// ([`TreeParams::megakernel_local_workgroup_bytes`]): a full step (256 items of 3 words) per
+/// buffer of both local targets.
+pub const NARROW_LOCAL_WORKGROUP_BYTES: u32 = 12 * 1024;
+
+/// Least `max_compute_workgroup_storage_size` for which a narrow tree takes the local area in
+/// workgroup memory: the area, the kernel's own 8 KiB, and room to spare.
+pub const NARROW_MIN_WORKGROUP_STORAGE: u32 = 32 * 1024;
+
 impl TreeParams {
     /// Whether the megakernel should keep a workgroup's children local
     /// (`MegakernelConfig::local_queues`; the program declares them local): wherever the tree
@@ -729,23 +738,70 @@ impl TreeParams {
         self.mean_fanout() >= 1.0
     }
 
+    /// Whether the tree is narrow: a mean fan-out of at most one (one child, or 0..=k children
+    /// with k <= 2), whose levels stay near the roots' count, and at most [`NARROW_ROOTS`]
+    /// roots.
+    fn narrow(&self) -> bool {
+        self.mean_fanout() <= 1.0 && self.roots <= NARROW_ROOTS
+    }
+
+    /// Bytes of workgroup memory for the megakernel's local area
+    /// (`MegakernelConfig::local_workgroup_bytes`): [`NARROW_LOCAL_WORKGROUP_BYTES`] for a narrow
+    /// tree that keeps its children local and whose items are at most 3 words (one payload
+    /// word: a buffer holds a step), on a GPU whose workgroups may hold at least
+    /// [`NARROW_MIN_WORKGROUP_STORAGE`] bytes (the area and the kernel's own 8 KiB, with room to
+    /// spare); else 0 (the slots buffer). Its lineages are few and long, so a local turn's cost
+    /// is the chain: with the area a local batch that kept all its children skips the
+    /// device-scope fence and the publish barrier. H100, GPU ms median of 20 (docs/results.md,
+    /// 2026-12-06 (fourteenth session)): the one-item chain 4.761 -> 3.932 ms (2.38 -> 1.97 us
+    /// a local turn), deep 0.949 -> 0.916, 1,250 roots 0.914 -> 0.882, 5,000 roots 0.933 ->
+    /// 0.898, at 132 workgroups either way. Not on CPU
+    /// adapters (lavapipe), where it was not measured. Wide trees keep the slots buffer: the
+    /// area costs them co-resident workgroups (binary 0.127 -> 0.175 ms, docs/results.md,
+    /// 2026-12-06 (eleventh session)).
+    pub fn megakernel_local_workgroup_bytes(&self, gpu: &scheduler::Gpu) -> u32 {
+        let limit = gpu.device.limits().max_compute_workgroup_storage_size;
+        self.local_workgroup_bytes_on(gpu.is_cpu_adapter(), limit)
+    }
+
+    /// [`TreeParams::megakernel_local_workgroup_bytes`] on an adapter that is a CPU or not and
+    /// whose workgroups may hold `max_storage` bytes.
+    fn local_workgroup_bytes_on(&self, cpu_adapter: bool, max_storage: u32) -> u32 {
+        let step_fits = self.payload_words <= 1;
+        let fits = max_storage >= NARROW_MIN_WORKGROUP_STORAGE;
+        match self.narrow() && self.megakernel_local_queues() && step_fits && fits && !cpu_adapter {
+            true => NARROW_LOCAL_WORKGROUP_BYTES,
+            false => 0,
+        }
+    }
+
     /// The share (numerator, denominator) of the probed workgroups the megakernel should
-    /// launch (`Workgroups::ProbeShare`): 1/5 on a GPU where the tree stays narrow, else all.
-    /// Narrow: a mean fan-out of at most one (one child, or 0..=k children with k <= 2), whose
-    /// levels stay near the roots' count, and at most [`NARROW_ROOTS`] roots. Its batches then
-    /// run faster spread over the SMs, one workgroup per SM where five fit, than shared
-    /// (docs/scheduler.md 2.2, "Presence or claims").
+    /// launch (`Workgroups::ProbeShare`) with `local_workgroup_bytes` of local area in
+    /// workgroup memory: on a GPU where the tree stays narrow (as for
+    /// [`TreeParams::megakernel_local_workgroup_bytes`]) one
+    /// workgroup per SM on the H100, whose probe finds five per SM without the area (1/5) and
+    /// two with [`NARROW_LOCAL_WORKGROUP_BYTES`] of it (1/2); else all. Its batches then run
+    /// faster spread over the SMs than shared (docs/scheduler.md 2.2, "Presence or claims").
     /// H100, GPU ms median of 20 (docs/results.md, 2026-12-06 (eleventh session) and (twelfth
     /// session)), all 660 probed / 396 / 264 / 132: deep 1.15 / 1.03 / 0.99 / -, then 1.117 / - /
     /// 0.981 / 0.954; deep of 1,250 roots 1.00 / 0.94 / 0.93 / -, then 0.981 / - / 0.920 /
     /// 0.912; irregular (mean 1.5, 528 probed) 0.147 / 0.143 at 396 / 0.148 at 264, binary
-    /// 0.127 / 0.133 / 0.155. All on CPU adapters (lavapipe), where it was not measured.
-    pub fn megakernel_workgroup_share(&self, gpu: &scheduler::Gpu) -> (u32, u32) {
-        let narrow = self.mean_fanout() <= 1.0 && self.roots <= NARROW_ROOTS;
-        if narrow && !gpu.is_cpu_adapter() {
-            (1, 5)
-        } else {
-            (1, 1)
+    /// 0.127 / 0.133 / 0.155. With the area (fourteenth session): deep 0.917 at 132 (1/2),
+    /// 0.951 at 264. All on CPU adapters (lavapipe), where it was not measured.
+    pub fn megakernel_workgroup_share(
+        &self,
+        gpu: &scheduler::Gpu,
+        local_workgroup_bytes: u32,
+    ) -> (u32, u32) {
+        self.workgroup_share_on(gpu.is_cpu_adapter(), local_workgroup_bytes)
+    }
+
+    /// [`TreeParams::megakernel_workgroup_share`] on an adapter that is a CPU or not.
+    fn workgroup_share_on(&self, cpu_adapter: bool, local_workgroup_bytes: u32) -> (u32, u32) {
+        match (self.narrow() && !cpu_adapter, local_workgroup_bytes) {
+            (false, _) => (1, 1),
+            (true, 0) => (1, 5),
+            (true, _) => (1, 2),
         }
     }
 }
@@ -772,6 +828,79 @@ mod tests {
         assert!(with(Fanout::Uniform(2)).megakernel_local_queues());
         assert!(!with(Fanout::Uniform(1)).megakernel_local_queues());
         assert!(with(Fanout::Uniform(4)).megakernel_local_queues());
+    }
+
+    /// Narrow trees that keep their children local (mean fan-out one, one payload word) take
+    /// the local area in workgroup memory on a GPU with room for it, and one workgroup per SM
+    /// of the H100 with it (1/2 of the probed count) or without it (1/5); the wide presets,
+    /// CPU adapters and small workgroup memories take neither.
+    #[test]
+    fn narrow_trees_take_the_workgroup_area_and_their_share_on_gpus_only() {
+        use super::{
+            Fanout, NARROW_LOCAL_WORKGROUP_BYTES as AREA, NARROW_MIN_WORKGROUP_STORAGE as MIN,
+            NARROW_ROOTS, TreeParams, TreePreset,
+        };
+        let deep = TreePreset::Deep.params();
+        assert_eq!(deep.local_workgroup_bytes_on(false, MIN), AREA);
+        assert_eq!(deep.local_workgroup_bytes_on(false, 48 * 1024), AREA);
+        assert_eq!(deep.local_workgroup_bytes_on(true, MIN), 0, "CPU adapter");
+        assert_eq!(
+            deep.local_workgroup_bytes_on(false, MIN - 1),
+            0,
+            "16 KiB devices"
+        );
+        assert_eq!(deep.workgroup_share_on(false, AREA), (1, 2));
+        assert_eq!(deep.workgroup_share_on(false, 0), (1, 5));
+        assert_eq!(deep.workgroup_share_on(true, 0), (1, 1));
+        let chain = TreeParams {
+            fanout: Fanout::Fixed(1),
+            roots: 1,
+            ..deep.clone()
+        };
+        assert_eq!(chain.local_workgroup_bytes_on(false, MIN), AREA);
+        let heavy_items = TreeParams {
+            payload_words: 2,
+            ..deep.clone()
+        };
+        assert_eq!(
+            heavy_items.local_workgroup_bytes_on(false, MIN),
+            0,
+            "a step would not fit"
+        );
+        let many_roots = TreeParams {
+            roots: NARROW_ROOTS + 1,
+            ..deep.clone()
+        };
+        assert_eq!(many_roots.local_workgroup_bytes_on(false, MIN), 0);
+        assert_eq!(many_roots.workgroup_share_on(false, 0), (1, 1));
+        let dies_out = TreeParams {
+            fanout: Fanout::Uniform(1),
+            ..deep
+        };
+        assert_eq!(
+            dies_out.local_workgroup_bytes_on(false, MIN),
+            0,
+            "no local queues"
+        );
+        for p in [
+            TreePreset::Binary,
+            TreePreset::Irregular,
+            TreePreset::LargePayload,
+            TreePreset::HeavyWork,
+        ] {
+            assert_eq!(
+                p.params().local_workgroup_bytes_on(false, MIN),
+                0,
+                "{}",
+                p.name()
+            );
+            assert_eq!(
+                p.params().workgroup_share_on(false, 0),
+                (1, 1),
+                "{}",
+                p.name()
+            );
+        }
     }
 
     /// The expected size is the exact count for fixed fanouts, the presets all run, and the
