@@ -200,7 +200,9 @@ pub struct MegakernelConfig {
     /// `local_bytes` it is a most: an area holds at most a full batch per buffer. An area
     /// whose buffers hold less than a step makes part-empty local batches, and warns: at 1-4
     /// KiB the H100's trees ran 1.5-4x slower, the deep trees and the one-item chain at most
-    /// 4% faster. Leave it at 0 but for A/B runs.
+    /// 4% faster. Leave it at 0 unless the work is narrow (few items a level, so that
+    /// fewer co-resident workgroups cost nothing: the tree's choice,
+    /// `TreeParams::megakernel_local_workgroup_bytes` in the `workloads` crate) or for A/B runs.
     pub local_workgroup_bytes: u32,
     /// With local queues, held items of a procedure that emits nothing (a sink) wait while they
     /// are fewer than a step and other held work exists (`LOCAL_DEFER`, docs/scheduler.md 2.7).

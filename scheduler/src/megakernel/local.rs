@@ -147,7 +147,7 @@ impl LocalPlan {
             format!(
                 "; in workgroup memory that is more than this device's {limit} bytes hold \
                  beside the kernel's {others}: keep the area in the slots buffer \
-                 (local_workgroup_bytes 0, the default)"
+                 (local_workgroup_bytes 0: the slots buffer)"
             )
         } else {
             String::new()
