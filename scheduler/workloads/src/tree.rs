@@ -755,9 +755,9 @@ impl TreeParams {
     /// device-scope fence and the publish barrier. H100, GPU ms median of 20 (docs/results.md,
     /// 2026-12-06 (fourteenth session)): the one-item chain 4.761 -> 3.932 ms (2.38 -> 1.97 us
     /// a local turn), deep 0.949 -> 0.916, 1,250 roots 0.914 -> 0.882, 5,000 roots 0.933 ->
-    /// 0.898, at 132 workgroups either way. Not on CPU
-    /// adapters (lavapipe), where it was not measured. Wide trees keep the slots buffer: the
-    /// area costs them co-resident workgroups (binary 0.127 -> 0.175 ms, docs/results.md,
+    /// 0.898, at 132 workgroups either way; on the H200 the chain's local turn is 1.96 us. Not
+    /// on CPU adapters (lavapipe), where it was not measured. Wide trees keep the slots buffer:
+    /// the area costs them co-resident workgroups (binary 0.127 -> 0.175 ms, docs/results.md,
     /// 2026-12-06 (eleventh session)).
     pub fn megakernel_local_workgroup_bytes(&self, gpu: &scheduler::Gpu) -> u32 {
         let limit = gpu.device.limits().max_compute_workgroup_storage_size;
@@ -778,16 +778,16 @@ impl TreeParams {
     /// The share (numerator, denominator) of the probed workgroups the megakernel should
     /// launch (`Workgroups::ProbeShare`) with `local_workgroup_bytes` of local area in
     /// workgroup memory: on a GPU where the tree stays narrow (as for
-    /// [`TreeParams::megakernel_local_workgroup_bytes`]) one
-    /// workgroup per SM on the H100, whose probe finds five per SM without the area (1/5) and
-    /// two with [`NARROW_LOCAL_WORKGROUP_BYTES`] of it (1/2); else all. Its batches then run
+    /// [`TreeParams::megakernel_local_workgroup_bytes`]) one workgroup per SM on the H100, whose
+    /// probe finds five per SM for the deep trees without the area (1/5) and two with
+    /// [`NARROW_LOCAL_WORKGROUP_BYTES`] of it (1/2); else all. Its batches then run
     /// faster spread over the SMs than shared (docs/scheduler.md 2.2, "Presence or claims").
     /// H100, GPU ms median of 20 (docs/results.md, 2026-12-06 (eleventh session) and (twelfth
     /// session)), all 660 probed / 396 / 264 / 132: deep 1.15 / 1.03 / 0.99 / -, then 1.117 / - /
     /// 0.981 / 0.954; deep of 1,250 roots 1.00 / 0.94 / 0.93 / -, then 0.981 / - / 0.920 /
     /// 0.912; irregular (mean 1.5, 528 probed) 0.147 / 0.143 at 396 / 0.148 at 264, binary
     /// 0.127 / 0.133 / 0.155. With the area (fourteenth session): deep 0.917 at 132 (1/2),
-    /// 0.951 at 264. All on CPU adapters (lavapipe), where it was not measured.
+    /// 0.951 at 264. On CPU adapters (lavapipe), where it was not measured, all.
     pub fn megakernel_workgroup_share(
         &self,
         gpu: &scheduler::Gpu,
