@@ -23,8 +23,8 @@ impl ScheduledProblem for TreeParams {
         self.megakernel_local_queues()
     }
 
-    fn local_workgroup_bytes(&self, gpu: &Gpu) -> u32 {
-        self.megakernel_local_workgroup_bytes(gpu)
+    fn local_workgroup_bytes(&self, gpu: &Gpu, workgroup_size: u32) -> u32 {
+        self.megakernel_local_workgroup_bytes(gpu, workgroup_size)
     }
 
     fn workgroup_share(&self, gpu: &Gpu, local_workgroup_bytes: u32) -> (u32, u32) {

@@ -5,7 +5,7 @@
 
 use crate::error::Error;
 use crate::strategy::{GpuConfig, Strategy, compile};
-use scheduler::{Gpu, Program, RunError, RunStats, Scheduler};
+use scheduler::{Gpu, MegakernelConfig, Program, RunError, RunStats, Scheduler};
 use std::cell::RefCell;
 use std::fmt::Debug;
 use std::rc::Rc;
@@ -104,10 +104,10 @@ pub trait ScheduledProblem: Clone {
     fn local_queues(&self) -> bool {
         false
     }
-    /// Bytes of workgroup memory for the megakernel's local area on `gpu`
-    /// (`GpuConfig::local_workgroup_bytes` when the command line gives none); default 0, the
-    /// slots buffer.
-    fn local_workgroup_bytes(&self, _gpu: &Gpu) -> u32 {
+    /// Bytes of workgroup memory for the megakernel's local area on `gpu` at `workgroup_size`
+    /// threads a workgroup (`GpuConfig::local_workgroup_bytes` when the command line gives
+    /// none); default 0, the slots buffer.
+    fn local_workgroup_bytes(&self, _gpu: &Gpu, _workgroup_size: u32) -> u32 {
         0
     }
     /// The share (numerator, denominator) of the probed megakernel workgroups this problem
@@ -282,8 +282,10 @@ impl<P: ScheduledProblem> Workload for ProblemWorkload<P> {
                 let name = strategy.name();
                 let capacity = self.config.capacity.unwrap_or(p.capacity(reference));
                 let local = self.config.local_queues.unwrap_or(p.local_queues());
+                let threads = (self.config.workgroup_size)
+                    .unwrap_or(MegakernelConfig::default().workgroup_size);
                 let area = (self.config.local_workgroup_bytes).unwrap_or(if local {
-                    p.local_workgroup_bytes(gpu)
+                    p.local_workgroup_bytes(gpu, threads)
                 } else {
                     0
                 });

@@ -746,9 +746,11 @@ impl TreeParams {
     }
 
     /// Bytes of workgroup memory for the megakernel's local area
-    /// (`MegakernelConfig::local_workgroup_bytes`): [`NARROW_LOCAL_WORKGROUP_BYTES`] for a narrow
-    /// tree that keeps its children local and whose items are at most 3 words (one payload
-    /// word: a buffer holds a step), on a GPU whose workgroups may hold at least
+    /// (`MegakernelConfig::local_workgroup_bytes`) at `workgroup_size` threads a workgroup:
+    /// [`NARROW_LOCAL_WORKGROUP_BYTES`] for a narrow tree that keeps its children local and
+    /// whose items are at most 3 words (one payload word: a buffer holds a step of 256
+    /// threads, the default size and the only one it is taken at), on a GPU whose workgroups
+    /// may hold at least
     /// [`NARROW_MIN_WORKGROUP_STORAGE`] bytes (the area and the kernel's own 8 KiB, with room to
     /// spare); else 0 (the slots buffer). Its lineages are few and long, so a local turn's cost
     /// is the chain: with the area a local batch that kept all its children skips the
@@ -759,15 +761,21 @@ impl TreeParams {
     /// on CPU adapters (lavapipe), where it was not measured. Wide trees keep the slots buffer:
     /// the area costs them co-resident workgroups (binary 0.127 -> 0.175 ms, docs/results.md,
     /// 2026-12-06 (eleventh session)).
-    pub fn megakernel_local_workgroup_bytes(&self, gpu: &scheduler::Gpu) -> u32 {
+    pub fn megakernel_local_workgroup_bytes(
+        &self,
+        gpu: &scheduler::Gpu,
+        workgroup_size: u32,
+    ) -> u32 {
         let limit = gpu.device.limits().max_compute_workgroup_storage_size;
-        self.local_workgroup_bytes_on(gpu.is_cpu_adapter(), limit)
+        self.local_workgroup_bytes_on(gpu.is_cpu_adapter(), limit, workgroup_size)
     }
 
     /// [`TreeParams::megakernel_local_workgroup_bytes`] on an adapter that is a CPU or not and
     /// whose workgroups may hold `max_storage` bytes.
-    fn local_workgroup_bytes_on(&self, cpu_adapter: bool, max_storage: u32) -> u32 {
-        let step_fits = self.payload_words <= 1;
+    fn local_workgroup_bytes_on(&self, cpu_adapter: bool, max_storage: u32, threads: u32) -> u32 {
+        // A larger workgroup has larger steps, and its kernel more workgroup memory of its own.
+        let step_fits = self.payload_words <= 1
+            && threads == scheduler::MegakernelConfig::default().workgroup_size;
         let fits = max_storage >= NARROW_MIN_WORKGROUP_STORAGE;
         match self.narrow() && self.megakernel_local_queues() && step_fits && fits && !cpu_adapter {
             true => NARROW_LOCAL_WORKGROUP_BYTES,
@@ -841,13 +849,22 @@ mod tests {
             NARROW_ROOTS, TreeParams, TreePreset,
         };
         let deep = TreePreset::Deep.params();
-        assert_eq!(deep.local_workgroup_bytes_on(false, MIN), AREA);
-        assert_eq!(deep.local_workgroup_bytes_on(false, 48 * 1024), AREA);
-        assert_eq!(deep.local_workgroup_bytes_on(true, MIN), 0, "CPU adapter");
+        assert_eq!(deep.local_workgroup_bytes_on(false, MIN, 256), AREA);
+        assert_eq!(deep.local_workgroup_bytes_on(false, 48 * 1024, 256), AREA);
         assert_eq!(
-            deep.local_workgroup_bytes_on(false, MIN - 1),
+            deep.local_workgroup_bytes_on(true, MIN, 256),
+            0,
+            "CPU adapter"
+        );
+        assert_eq!(
+            deep.local_workgroup_bytes_on(false, MIN - 1, 256),
             0,
             "16 KiB devices"
+        );
+        assert_eq!(
+            deep.local_workgroup_bytes_on(false, MIN, 512),
+            0,
+            "larger workgroups"
         );
         assert_eq!(deep.workgroup_share_on(false, AREA), (1, 2));
         assert_eq!(deep.workgroup_share_on(false, 0), (1, 5));
@@ -857,13 +874,13 @@ mod tests {
             roots: 1,
             ..deep.clone()
         };
-        assert_eq!(chain.local_workgroup_bytes_on(false, MIN), AREA);
+        assert_eq!(chain.local_workgroup_bytes_on(false, MIN, 256), AREA);
         let heavy_items = TreeParams {
             payload_words: 2,
             ..deep.clone()
         };
         assert_eq!(
-            heavy_items.local_workgroup_bytes_on(false, MIN),
+            heavy_items.local_workgroup_bytes_on(false, MIN, 256),
             0,
             "a step would not fit"
         );
@@ -871,14 +888,14 @@ mod tests {
             roots: NARROW_ROOTS + 1,
             ..deep.clone()
         };
-        assert_eq!(many_roots.local_workgroup_bytes_on(false, MIN), 0);
+        assert_eq!(many_roots.local_workgroup_bytes_on(false, MIN, 256), 0);
         assert_eq!(many_roots.workgroup_share_on(false, 0), (1, 1));
         let dies_out = TreeParams {
             fanout: Fanout::Uniform(1),
             ..deep
         };
         assert_eq!(
-            dies_out.local_workgroup_bytes_on(false, MIN),
+            dies_out.local_workgroup_bytes_on(false, MIN, 256),
             0,
             "no local queues"
         );
@@ -889,7 +906,7 @@ mod tests {
             TreePreset::HeavyWork,
         ] {
             assert_eq!(
-                p.params().local_workgroup_bytes_on(false, MIN),
+                p.params().local_workgroup_bytes_on(false, MIN, 256),
                 0,
                 "{}",
                 p.name()
