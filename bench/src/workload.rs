@@ -284,11 +284,13 @@ impl<P: ScheduledProblem> Workload for ProblemWorkload<P> {
                 let local = self.config.local_queues.unwrap_or(p.local_queues());
                 let threads = (self.config.workgroup_size)
                     .unwrap_or(MegakernelConfig::default().workgroup_size);
-                let area = (self.config.local_workgroup_bytes).unwrap_or(if local {
-                    p.local_workgroup_bytes(gpu, threads)
-                } else {
-                    0
-                });
+                // The area in effect: none without local queues, whatever was asked for (the
+                // megakernel then warns that the option does nothing).
+                let area = match local {
+                    true => (self.config.local_workgroup_bytes)
+                        .unwrap_or_else(|| p.local_workgroup_bytes(gpu, threads)),
+                    false => 0,
+                };
                 let share = self
                     .config
                     .workgroup_share
