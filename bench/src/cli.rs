@@ -255,11 +255,11 @@ pub struct Cli {
     /// it (`MegakernelConfig::local_workgroup_bytes`; 0: the slots buffer) [default: the
     /// workload's: 12288 on GPUs for trees of mean fan-out one, at most 65,536 roots and one
     /// payload word at 256 threads a workgroup (`TreeParams::megakernel_local_workgroup_bytes`),
-    /// else 0]. Local batches
-    /// then read held items from workgroup memory, and one that emitted only held items skips
-    /// the release fence. On the H100 2 KiB or more cost co-resident workgroups, which only
-    /// the narrow trees can spare, and an area whose buffers hold less than a step (under 12
-    /// KiB for the binary tree) makes part-empty local batches (a warning says so).
+    /// else 0]. Local batches then read held items from workgroup memory, and one that emitted
+    /// only held items skips the release fence. On the H100 2 KiB or more cost co-resident
+    /// workgroups, which only the narrow trees can spare, and an area whose buffers hold less
+    /// than a step (under 12 KiB for the binary tree) makes part-empty local batches (a
+    /// warning says so).
     #[arg(long, value_name = "BYTES", help_heading = "Scheduler")]
     pub local_workgroup_bytes: Option<u32>,
 

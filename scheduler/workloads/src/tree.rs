@@ -750,9 +750,8 @@ impl TreeParams {
     /// [`NARROW_LOCAL_WORKGROUP_BYTES`] for a narrow tree that keeps its children local and
     /// whose items are at most 3 words (one payload word: a buffer holds a step of 256
     /// threads, the default size and the only one it is taken at), on a GPU whose workgroups
-    /// may hold at least
-    /// [`NARROW_MIN_WORKGROUP_STORAGE`] bytes (the area and the kernel's own 8 KiB, with room to
-    /// spare); else 0 (the slots buffer). Its lineages are few and long, so a local turn's cost
+    /// may hold at least [`NARROW_MIN_WORKGROUP_STORAGE`] bytes (the area and the kernel's own
+    /// 8 KiB, with room to spare); else 0 (the slots buffer). Its lineages are few and long, so a local turn's cost
     /// is the chain: with the area a local batch that kept all its children skips the
     /// device-scope fence and the publish barrier. H100, GPU ms median of 20 (docs/results.md,
     /// 2026-12-06 (fourteenth session)): the one-item chain 4.761 -> 3.932 ms (2.38 -> 1.97 us
