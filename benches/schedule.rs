@@ -19,6 +19,7 @@ fn trees() -> Vec<(&'static str, TreeParams)> {
                     work: 0,
                     payload_words: 1,
                     seed: 3,
+                    children: Default::default(),
                 },
             ),
         ]

@@ -122,6 +122,23 @@ fn small_suite_verifies_every_run_and_writes_its_report() {
         assert!(png.starts_with(b"\x89PNG") && png.len() > 10_000, "{w}.png");
     }
     assert!(summary.contains("1 (best)"));
+    // `--replot` draws the same plots again from the records alone.
+    let drawn: Vec<Vec<u8>> = (WORKLOADS.iter())
+        .map(|w| std::fs::read(out.join(format!("{w}.png"))).unwrap())
+        .collect();
+    for w in WORKLOADS {
+        std::fs::remove_file(out.join(format!("{w}.png"))).unwrap();
+    }
+    let replot = Command::new(env!("CARGO_BIN_EXE_schedbench"))
+        .arg("--replot")
+        .arg(&out)
+        .output()
+        .expect("schedbench runs");
+    assert!(replot.status.success(), "{replot:?}");
+    for (w, png) in WORKLOADS.iter().zip(&drawn) {
+        let again = std::fs::read(out.join(format!("{w}.png"))).unwrap();
+        assert!(&again == png, "{w}.png drawn differently from the records");
+    }
     // Nothing half-written is left behind.
     for e in std::fs::read_dir(&out).unwrap() {
         let name = e.unwrap().file_name().into_string().unwrap();
@@ -337,6 +354,25 @@ fn a_queue_limit_runs_every_strategy_depth_first_and_is_recorded() {
     for mp in ["multipass", "multipass-host"] {
         assert!(by(mp)["partial_rounds"].as_u64().unwrap() > 0, "{stdout}");
     }
+}
+
+/// `--child-enqueue` builds the tree's program with that form, which the record's params
+/// name; the default (by strategy) adds nothing to them.
+#[test]
+fn the_child_enqueue_form_is_asked_for_and_recorded() {
+    let small = ["--preset", "large-payload", "--roots", "1", "--depth", "4"];
+    for form in ["whole", "words"] {
+        let r = first_json_record(&[&small[..], &["--child-enqueue", form]].concat());
+        let params = r["params"].as_str().unwrap();
+        assert!(params.ends_with(&format!(" children={form}")), "{params}");
+    }
+    let r = first_json_record(&small);
+    assert!(!r["params"].as_str().unwrap().contains("children"), "{r}");
+    assert_exits_2(&["--child-enqueue", "half"], "unknown child enqueue `half`");
+    assert_exits_2(
+        &["--workload", "bfs", "--child-enqueue", "words"],
+        "--child-enqueue applies to --workload tree",
+    );
 }
 
 /// The first JSON record of `schedbench --workload tree --strategy megakernel --runs 1 --json

@@ -2,7 +2,7 @@
 //! No adapter is a failure, never a skip.
 
 use scheduler::*;
-use workloads::tree::{Fanout, TreeParams, TreeRun};
+use workloads::tree::{ChildEnqueue, Fanout, TreeParams, TreeRun};
 
 #[path = "common/adapter.rs"]
 mod adapter;
@@ -19,6 +19,7 @@ fn small_tree(seed: u32) -> TreeParams {
         work: 3,
         payload_words: 5,
         seed,
+        children: Default::default(),
     }
 }
 
@@ -32,6 +33,7 @@ fn chain_tree() -> TreeParams {
         work: 1,
         payload_words: 1,
         seed: 5,
+        children: Default::default(),
     }
 }
 
@@ -39,14 +41,42 @@ fn chain_tree() -> TreeParams {
 fn tree_matches_cpu_reference_on_every_strategy() {
     let gpu = gpu();
     eprintln!("adapter: {}", gpu.adapter_name());
-    let params = small_tree(7);
-    let reference = params.reference();
-    let run = TreeRun::new(&gpu, params).unwrap();
-    for kind in StrategyKind::ALL {
-        let s = Scheduler::new(&gpu, &run.program, kind, 1 << 12).unwrap();
-        let (stats, result) = run.run(&gpu, &s).unwrap();
-        eprintln!("{kind:?}: {stats:?}");
-        assert_eq!(result, reference, "{kind:?}");
+    let reference = small_tree(7).reference();
+    for children in [
+        ChildEnqueue::Whole,
+        ChildEnqueue::Words,
+        ChildEnqueue::ByStrategy,
+    ] {
+        let params = TreeParams {
+            children,
+            ..small_tree(7)
+        };
+        let run = TreeRun::new(&gpu, params).unwrap();
+        for kind in StrategyKind::ALL {
+            let s = Scheduler::new(&gpu, &run.program, kind, 1 << 12).unwrap();
+            let (stats, result) = run.run(&gpu, &s).unwrap();
+            eprintln!("{children:?} {kind:?}: {stats:?}");
+            assert_eq!(result, reference, "{children:?} {kind:?}");
+        }
+        // Both item layouts of both multi-passes (the megakernel's are in the stress test).
+        for item_layout in [ItemLayout::Interleaved, ItemLayout::Planar] {
+            let device = MultipassConfig {
+                initial_capacity: 1 << 12,
+                item_layout: Some(item_layout),
+                ..Default::default()
+            };
+            let host = HostMultipassConfig {
+                initial_capacity: 1 << 12,
+                item_layout: Some(item_layout),
+                ..Default::default()
+            };
+            let device = Scheduler::multipass(&gpu, &run.program, device).unwrap();
+            let host = Scheduler::multipass_host(&gpu, &run.program, host).unwrap();
+            for s in [device, host] {
+                let (_, result) = run.run(&gpu, &s).unwrap();
+                assert_eq!(result, reference, "{children:?} {item_layout:?}");
+            }
+        }
     }
 }
 
@@ -399,7 +429,14 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
     // Runs that ran items from local queues, and of those, runs of several launches (held items
     // spilled at a launch's end or when a local batch found no room).
     let (mut local_runs, mut local_relaunched) = (0, 0);
-    for payload in [1u32, 62] {
+    // Both ways a body hands a child over (`enqueue_<t>` whole, `reserve_<t>` and
+    // `store_word`), on small and large items: the default for 3-word items (words), each form
+    // everywhere for the 62-word items.
+    for (payload, children, trees) in [
+        (1u32, ChildEnqueue::ByStrategy, 25),
+        (62, ChildEnqueue::Whole, 25),
+        (62, ChildEnqueue::Words, 12),
+    ] {
         let shape = TreeParams {
             roots: 1,
             max_depth: 1,
@@ -407,6 +444,7 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
             work: 0,
             payload_words: payload,
             seed: 0,
+            children,
         };
         let mut tree = TreeRun::new(&gpu, shape).unwrap();
         let mut schedulers: Vec<(String, Scheduler)> = stress_configs()
@@ -519,7 +557,7 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
             )
             .unwrap(),
         ));
-        for _ in 0..25 {
+        for _ in 0..trees {
             let fanout = if rng.below(3) == 0 {
                 Fanout::Fixed(1 + rng.below(2))
             } else {
@@ -532,6 +570,7 @@ fn stress_randomized_trees_match_the_cpu_reference_exactly() {
                 work: rng.below(4),
                 payload_words: payload,
                 seed: rng.below(1 << 30),
+                children,
             };
             let reference = params.reference();
             if reference.branches + reference.leaves > 20_000 {
@@ -605,7 +644,8 @@ fn megakernels_with_atomic_slots_match_the_cpu_reference_exactly() {
     gpu.coherent = false;
     let mut rng = Lcg(0xa70c);
     let (mut runs, mut grown, mut local_runs) = (0, 0, 0);
-    for payload in [1u32, 62] {
+    // Children enqueued whole, and (the default) word by word.
+    for (payload, children) in [(1u32, ChildEnqueue::Whole), (62, ChildEnqueue::ByStrategy)] {
         let shape = TreeParams {
             roots: 1,
             max_depth: 1,
@@ -613,6 +653,7 @@ fn megakernels_with_atomic_slots_match_the_cpu_reference_exactly() {
             work: 0,
             payload_words: payload,
             seed: 0,
+            children,
         };
         let mut tree = TreeRun::new(&gpu, shape).unwrap();
         let schedulers: Vec<(&str, Scheduler)> = stress_configs()
@@ -627,6 +668,7 @@ fn megakernels_with_atomic_slots_match_the_cpu_reference_exactly() {
                 work: rng.below(4),
                 payload_words: payload,
                 seed: rng.below(1 << 30),
+                children,
             };
             let reference = params.reference();
             tree.set_params(params.clone()).unwrap();
@@ -883,6 +925,7 @@ fn breadth_tree() -> TreeParams {
         work: 1,
         payload_words: 2,
         seed: 7,
+        children: Default::default(),
     }
 }
 
@@ -906,6 +949,7 @@ fn a_run_started_at_capacity_16_grows_geometrically_and_stays_exact() {
         work: 1,
         payload_words: 2,
         seed: 32,
+        children: Default::default(),
     };
     let reference = params.reference();
     let run = TreeRun::new(&gpu, params.clone()).unwrap();
@@ -998,6 +1042,7 @@ fn a_megakernel_run_after_one_that_grew_needs_exactly_one_launch() {
         work: 1,
         payload_words: 2,
         seed: 5,
+        children: Default::default(),
     };
     let reference = params.reference();
     let run = TreeRun::new(&gpu, params).unwrap();
@@ -1043,6 +1088,7 @@ fn a_reused_megakernel_clears_only_the_flags_its_last_run_wrote() {
         work: 1,
         payload_words: 1,
         seed: 3,
+        children: Default::default(),
     };
     let shapes = [tree(8, 6), tree(2, 3), tree(8, 6), tree(8, 6)];
     let mut run = TreeRun::new(&gpu, shapes[0].clone()).unwrap();

@@ -8,7 +8,7 @@ use clap::error::ErrorKind;
 use clap::{CommandFactory, Parser, value_parser};
 use scheduler::ItemLayout;
 use std::path::PathBuf;
-use workloads::tree::{Fanout, TreeParams, TreePreset};
+use workloads::tree::{ChildEnqueue, Fanout, TreeParams, TreePreset};
 
 const EXAMPLES: &str = "Examples:
   schedbench --workload tree --strategy all --runs 10
@@ -32,6 +32,11 @@ pub struct Cli {
     /// The suite's output folder (created if missing).
     #[arg(long, value_name = "DIR", requires = "suite")]
     pub out: Option<PathBuf>,
+
+    /// Draw a suite's plots again from DIR/runs.jsonl, into DIR, and run nothing (e.g. for a
+    /// suite whose plots a remote machine could not send back).
+    #[arg(long, value_name = "DIR", conflicts_with = "suite")]
+    pub replot: Option<PathBuf>,
 
     /// The suite's problem sizes: `small` runs in minutes on lavapipe, `full` is for a GPU.
     #[arg(long, value_enum, default_value_t = Scale::Full, requires = "suite")]
@@ -89,6 +94,13 @@ pub struct Cli {
     /// Seed of the tree's hashes.
     #[arg(long, help_heading = "Tree")]
     pub seed: Option<u32>,
+
+    /// How a branch hands its children to the queues: whole (built, then `enqueue_<t>`), words
+    /// (`reserve_<t>`, then `store_word` as each word is computed) or by-strategy (each strategy's
+    /// faster form: words, but whole in the multi-passes for items of 16 words or more)
+    /// [default: by-strategy].
+    #[arg(long, value_name = "FORM", value_parser = parse_child_enqueue, help_heading = "Tree")]
+    pub child_enqueue: Option<ChildEnqueue>,
 
     /// Scene: teapot (built in), killeroo (the shared data's), or a RIB/Newell/BPT file.
     #[arg(long, default_value = "teapot", help_heading = "Reyes")]
@@ -307,6 +319,11 @@ pub enum Enqueue {
 // `value_parser` function (the text becomes the usage error, exit 2), not the command's error
 // type (`crate::error::Error`).
 
+fn parse_child_enqueue(s: &str) -> Result<ChildEnqueue, String> {
+    ChildEnqueue::parse(s)
+        .ok_or_else(|| format!("unknown child enqueue `{s}` (known: whole, words, by-strategy)"))
+}
+
 fn parse_item_layout(s: &str) -> Result<ItemLayout, String> {
     ItemLayout::parse(s)
         .ok_or_else(|| format!("unknown item layout `{s}` (known: interleaved, planar)"))
@@ -376,6 +393,7 @@ impl Cli {
             ("--work", self.work.is_some()),
             ("--payload", self.payload.is_some()),
             ("--seed", self.seed.is_some()),
+            ("--child-enqueue", self.child_enqueue.is_some()),
         ];
         let reyes_flags = [
             ("--scene", self.scene != "teapot"),
@@ -412,7 +430,9 @@ impl Cli {
         {
             let given: Vec<&str> = tree_flags
                 .iter()
-                .filter(|(f, given)| *given && !["--preset", "--payload", "--seed"].contains(f))
+                .filter(|(f, given)| {
+                    *given && !["--preset", "--payload", "--seed", "--child-enqueue"].contains(f)
+                })
                 .map(|(f, _)| *f)
                 .collect();
             let flags = if given.is_empty() {
@@ -500,6 +520,7 @@ impl Cli {
             work: self.work.unwrap_or(p.work),
             payload_words: self.payload.unwrap_or(p.payload_words),
             seed: self.seed.unwrap_or(p.seed),
+            children: self.child_enqueue.unwrap_or(p.children),
         }
     }
 

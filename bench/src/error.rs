@@ -57,6 +57,16 @@ pub enum Error {
         /// The I/O error.
         source: std::io::Error,
     },
+    /// A line of a suite's `runs.jsonl` that is not a run record (`--replot`).
+    #[error("{}:{line}: not a run record: {message}", path.display())]
+    Record {
+        /// The records' file.
+        path: PathBuf,
+        /// Its line, from 1.
+        line: usize,
+        /// The parser's error.
+        message: String,
+    },
     /// A plot the plotting backend could not draw.
     #[error("plot {workload}: {message}")]
     Plot {

@@ -71,7 +71,12 @@ fn main() -> ExitCode {
     cli.check();
     reyes::driver_env::ensure_xdg_runtime_dir();
     reyes_cli::logging::init();
-    let result = if cli.suite {
+    let result = if let Some(dir) = &cli.replot {
+        suite::replot(dir).map(|plots| {
+            reyes_cli::outln!("{} plots in {}", plots.len(), dir.display());
+            true
+        })
+    } else if cli.suite {
         run_suite(&cli)
     } else {
         single::run(&cli)

@@ -194,3 +194,29 @@ pub fn run_suite(gpu: &Gpu, o: &SuiteOptions) -> Result<bool, Error> {
     );
     Ok(verified == records.len())
 }
+
+/// Draws the plots of the suite whose records are `dir/runs.jsonl` into `dir` (as
+/// [`run_suite`] does after its runs); returns their paths. Errors: the file cannot be read
+/// ([`Error::File`]), a line is not a record ([`Error::Record`]), a plot cannot be written.
+pub fn replot(dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>, Error> {
+    let path = dir.join("runs.jsonl");
+    let text = std::fs::read_to_string(&path).map_err(|source| Error::File {
+        path: path.clone(),
+        source,
+    })?;
+    let mut records = Vec::new();
+    for (i, l) in text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty())
+    {
+        records.push(
+            serde_json::from_str::<RunRecord>(l).map_err(|e| Error::Record {
+                path: path.clone(),
+                line: i + 1,
+                message: e.to_string(),
+            })?,
+        );
+    }
+    plot::write_plots(dir, &records)
+}

@@ -4,7 +4,8 @@
 //! all `threads_per_item` threads of an item together, in uniform control flow (so it may use
 //! `workgroupBarrier`), also for inactive slots at the end of a batch: `inv.live` is false there,
 //! the item is zeroed, and enqueues are ignored; other side effects must check `inv.live`.
-//! Work is emitted only through generated functions `enqueue_<target>(item)`.
+//! Work is emitted only through generated functions: `enqueue_<target>(item)`, or for an item
+//! written a word at a time `reserve_<target>()` and `store_word(slot, word, value)`.
 
 /// A queue item type: a WGSL struct declaration. Items travel through the queues as
 /// `size / 4` u32 words in naga's storage layout (padding included); only 32-bit `u32`, `i32`,
@@ -74,6 +75,14 @@ pub struct SharedMemory {
 /// [`crate::RunError::EmitLimit`] (the megakernel checks the total of a batch of items, the
 /// multi-pass strategies each item). Calling `enqueue_<target>` for a target not declared with
 /// `emits` is rejected by [`crate::Program::new`], also through helper functions.
+///
+/// **Large items a word at a time.** `let slot = reserve_<target>();` takes the slot
+/// `enqueue_<target>` would fill (same rules: one per call, counted against `emits`), and
+/// `store_word(slot, word, value)` writes its u32 word `word`, so a body need not hold a whole
+/// child in registers (the megakernel's registers are its hungriest procedure's). Word offsets
+/// of each item member come generated as `const <Item>_<member>_word: u32`; guard the stores
+/// with one `if slot_reserved(slot)`; `SCHED_MEGAKERNEL` (a `bool` constant) tells a body which
+/// kind of kernel it is in. docs/scheduler.md, section 1, "Large items word by word".
 #[derive(Debug, Clone)]
 pub struct Procedure {
     /// The procedure's name, a WGSL identifier not starting with `sched_` or `__`; its queue,

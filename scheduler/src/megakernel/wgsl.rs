@@ -178,9 +178,66 @@ pub fn source(
             "fn enqueue_{name}(item: {ty}) {{\n    if !sched_active {{ return; }}\n    {local_store}{store}\n}}\n",
             name = p.proc.name,
         );
+        s += &reserve_fn(t, &p.proc.name, planar, local.cap[t] > 0, direct.is_some());
     }
+    // Guarded word by word, as `enqueue_<name>` is once: a dropped item's words go nowhere.
+    s += "fn store_word(slot: ItemSlot, word: u32, value: u32) {\n    \
+              if slot.at == 0xffffffffu { return; }\n    \
+              let i = slot.at + word * slot.stride;\n    \
+              if slot.outbox != 0u { sched_ob_store_word(i, value); } else { sched_slot_store_word(i, value); }\n}\n";
     s += TEMPLATE;
     s
+}
+
+/// `reserve_<name>()` for target `t`: the slot `enqueue_<name>` would store its item in (local
+/// buffer, direct ticket or outbox, in that order), for `store_word` to fill word by word.
+fn reserve_fn(t: usize, name: &str, planar: bool, local: bool, direct: bool) -> String {
+    let (local_at, local_stride) = if planar {
+        (
+            format!("sched_local_out({t}u) + l"),
+            format!("LOCAL_CAP[{t}u]"),
+        )
+    } else {
+        (
+            format!("sched_local_out({t}u) + l * sched_words({t}u)"),
+            "1u".into(),
+        )
+    };
+    let local = if local {
+        format!(
+            "if LOCAL_EDGE[sched_proc * NQ + {t}u] != 0u {{\n        \
+                 let l = atomicAdd(&wg_local_n[{t}u], 1u);\n        \
+                 if l < wg_local_lim[{t}u] {{ r.at = {local_at}; r.stride = {local_stride}; return r; }}\n    }}\n    "
+        )
+    } else {
+        String::new()
+    };
+    let store = if direct {
+        let (at, stride) = if planar {
+            (format!("q_slot_base({t}u) + s"), format!("q_cap({t}u)"))
+        } else {
+            (
+                format!("q_slot_base({t}u) + s * sched_words({t}u)"),
+                "1u".into(),
+            )
+        };
+        format!(
+            "let s = sched_direct_slot({t}u);\n    if s != 0xffffffffu {{ r.at = {at}; r.stride = {stride}; }}"
+        )
+    } else {
+        let stride = if planar {
+            format!("mk_outbox_stride(sched_proc, {t}u)")
+        } else {
+            "1u".into()
+        };
+        format!(
+            "let at = sched_outbox_slot({t}u);\n    if at != 0xffffffffu {{ r.at = at; r.stride = {stride}; r.outbox = 1u; }}"
+        )
+    };
+    format!(
+        "fn reserve_{name}() -> ItemSlot {{\n    var r = ItemSlot(0xffffffffu, 1u, 0u);\n    \
+         if !sched_active {{ return r; }}\n    {local}{store}\n    return r;\n}}\n"
+    )
 }
 
 /// `reserve_budget` and the refused-queue set of `try_claim` (`shaders/megakernel_claim.wgsl`) for
@@ -275,6 +332,39 @@ mod tests {
             Default::default(),
             &plan,
         )
+    }
+
+    /// A body that stores its child a word at a time compiles into every form of the
+    /// megakernel (outbox or direct enqueue, interleaved or planar items, with or without a
+    /// local buffer for the child), which says it is the megakernel (`SCHED_MEGAKERNEL`).
+    #[test]
+    fn reserved_slots_compile_into_every_form_of_the_megakernel() {
+        let pair = ItemType::new("Pair", "struct Pair { a: u32, b: f32 }");
+        let split = Procedure::new("split", pair.clone(), 1)
+            .emits("split", 1)
+            .local("split")
+            .body(
+                "fn split_execute(item: Pair, inv: Invocation) {\n    \
+                 let slot = reserve_split();\n    \
+                 if slot_reserved(slot) {\n        \
+                 store_word(slot, Pair_a_word, item.a + 1u);\n        \
+                 store_word(slot, Pair_b_word, bitcast<u32>(item.b));\n    }\n}",
+            );
+        let p = Program::new(vec![split], UserBindings::none()).unwrap();
+        for items in [ItemLayout::Interleaved, ItemLayout::Planar] {
+            for direct in [None, Some((256u32, &[0u32][..]))] {
+                for bytes in [0, 1 << 16] {
+                    let plan = super::LocalPlan::new(&p, &[256], bytes);
+                    let src = super::source(&p, true, items, direct, Default::default(), &plan);
+                    assert!(src.contains("const SCHED_MEGAKERNEL: bool = true;"));
+                    assert!(src.contains("fn reserve_split() -> ItemSlot {"));
+                    assert!(src.contains("const Pair_b_word: u32 = 1u;"));
+                    assert_eq!(src.contains("sched_local_out(0u)"), bytes > 0, "{bytes}");
+                    assert_eq!(src.contains("r.outbox = 1u"), direct.is_none());
+                    crate::wgsl::validate("megakernel", &src).unwrap();
+                }
+            }
+        }
     }
 
     /// The megakernel reads threads per item from a `const` array and its other tables through

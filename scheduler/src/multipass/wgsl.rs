@@ -186,16 +186,30 @@ pub(super) fn rounds_source(
             "fn enqueue_{name}(item: {ty}) {{\n    if !sched_active {{ return; }}\n    \
              let at = sched_append_slot({t}u);\n    if at == 0xffffffffu {{ return; }}\n    \
              mp_out_store_{ty}({store_at}, item);\n}}\n\
+             fn reserve_{name}() -> ItemSlot {{\n    var r = ItemSlot(0xffffffffu, 1u, 0u);\n    \
+             if !sched_active {{ return r; }}\n    \
+             let at = sched_append_slot({t}u);\n    if at == 0xffffffffu {{ return r; }}\n    \
+             r.at = {slot_at};\n    r.stride = {slot_stride};\n    return r;\n}}\n\
              fn mp_execute_{t}(t: u32, at: u32, inv: Invocation) {{ {run_item} }}\n\
              @compute @workgroup_size(256) fn {entry}_{name}({args}) {{ {body} }}\n",
             name = p.proc.name,
             ty = p.layout.name,
             store_at = item_at(&format!("{t}u")),
+            slot_at = match items {
+                ItemLayout::Interleaved => format!("q_base({t}u) + at * sched_words({t}u)"),
+                ItemLayout::Planar => format!("q_base({t}u) + at"),
+            },
+            slot_stride = match items {
+                ItemLayout::Interleaved => "1u".to_string(),
+                ItemLayout::Planar => format!("q_cap({t}u)"),
+            },
             run_item = run_item(&p.layout.name, "mp_in", &item_at("t"), &p.proc.execute_fn()),
             body = body(t),
         );
         s += &instantiate(&format!("_{t}"));
     }
+    s += "fn store_word(slot: ItemSlot, word: u32, value: u32) {\n    \
+              if slot.at != 0xffffffffu { mp_out_store_word(slot.at + word * slot.stride, value); }\n}\n";
     s
 }
 
@@ -216,6 +230,8 @@ mod tests {
                     assert!(!src.contains(&format!("{table}[")), "{table}: {src}");
                 }
                 assert!(src.contains("sched_threads(") && src.contains("sched_emits("));
+                assert!(src.contains("const SCHED_MEGAKERNEL: bool = false;"));
+                assert!(src.contains("fn reserve_sink() -> ItemSlot {"));
                 crate::wgsl::validate("multipass", &src).unwrap();
             }
         }

@@ -266,7 +266,12 @@ impl Program {
             "struct Invocation {\n    // thread within the item, 0..threads_per_item\n    thread: u32,\n    \
              // item slot within the workgroup step, 0..items_per_step\n    slot: u32,\n    \
              // false for padding slots at the end of a batch\n    live: bool,\n    \
-             // threads per item of the running procedure\n    threads: u32,\n}"
+             // threads per item of the running procedure\n    threads: u32,\n}\n\
+             // An item's slot taken by `reserve_<name>()`, filled word by word with `store_word`\n\
+             // (word k at `at + k * stride`; `at` 0xffffffff: dropped; `outbox`: in the outbox)\n\
+             struct ItemSlot {\n    at: u32,\n    stride: u32,\n    outbox: u32,\n}\n\
+             // Whether `reserve_<name>()` took a slot (false: its item is dropped)\n\
+             fn slot_reserved(slot: ItemSlot) -> bool { return slot.at != 0xffffffffu; }"
                 .to_string(),
         )];
         let mut seen = Vec::new();
@@ -274,6 +279,13 @@ impl Program {
             if !seen.contains(&p.layout.name) {
                 seen.push(p.layout.name.clone());
                 parts.push((Part::Item(p.layout.name.clone()), p.proc.item.wgsl.clone()));
+                // Where each member starts, in words, for `store_word`.
+                let consts: String = (p.layout.members.iter())
+                    .map(|(m, byte)| {
+                        format!("const {}_{m}_word: u32 = {}u;\n", p.layout.name, byte / 4)
+                    })
+                    .collect();
+                parts.push((Part::Generated, consts));
             }
         }
         for (i, p) in self.procs.iter().enumerate() {
@@ -317,7 +329,9 @@ impl Program {
             false => table_fn("sched_threads", &threads),
         };
         let mut s = format!(
-            "const NQ: u32 = {nq}u;\n\
+            "// Whether the bodies run in the megakernel (true) or a multi-pass kernel (false)\n\
+             const SCHED_MEGAKERNEL: bool = {megakernel};\n\
+             const NQ: u32 = {nq}u;\n\
              {threads_fn}{}\
              // sched_emits(q * NQ + t): worst-case items procedure q emits to queue t per item\n\
              {}",

@@ -40,8 +40,17 @@ impl<'a> SharedSource<'a> {
         let stubs: String = program
             .procs
             .iter()
-            .map(|p| format!("fn enqueue_{}(item: {}) {{}}\n", p.proc.name, p.layout.name))
-            .collect();
+            .map(|p| {
+                format!(
+                    "fn enqueue_{n}(item: {}) {{}}\n\
+                     fn reserve_{n}() -> ItemSlot {{ return ItemSlot(0xffffffffu, 1u, 0u); }}\n",
+                    p.layout.name,
+                    n = p.proc.name
+                )
+            })
+            .collect::<String>()
+            + "fn store_word(slot: ItemSlot, word: u32, value: u32) {}\n\
+               const SCHED_MEGAKERNEL: bool = false;\n";
         shared.push(
             Part::Generated,
             &format!("{stubs}@compute @workgroup_size(1) fn sched_validation() {{}}"),
@@ -528,9 +537,15 @@ fn call_graph(module: &naga::Module) -> Vec<Vec<Handle<naga::Function>>> {
 fn check_enqueue_targets(shared: &SharedSource, module: &naga::Module) -> Result<(), RunError> {
     let calls = call_graph(module);
     let procs = &shared.program.procs;
-    let enqueue: Vec<Option<Handle<naga::Function>>> = procs
+    // Per target, its `enqueue_<t>` and `reserve_<t>` stubs.
+    let enqueue: Vec<Vec<Handle<naga::Function>>> = procs
         .iter()
-        .map(|t| function(module, &format!("enqueue_{}", t.proc.name)))
+        .map(|t| {
+            ["enqueue", "reserve"]
+                .iter()
+                .filter_map(|f| function(module, &format!("{f}_{}", t.proc.name)))
+                .collect()
+        })
         .collect();
     let name_of = |h: Handle<naga::Function>| module.functions[h].name.clone().unwrap_or_default();
     for p in procs {
@@ -551,10 +566,12 @@ fn check_enqueue_targets(shared: &SharedSource, module: &naga::Module) -> Result
             }
         }
         for (t, target) in procs.iter().enumerate() {
-            let Some(stub) = enqueue[t] else { continue };
-            if parent[stub.index()].is_none() || p.emits[t] > 0 {
+            if p.emits[t] > 0 {
                 continue;
             }
+            let Some(&stub) = enqueue[t].iter().find(|s| parent[s.index()].is_some()) else {
+                continue;
+            };
             let mut path = vec![name_of(stub)];
             let mut at = stub;
             while let Some(Some(up)) = parent[at.index()] {
@@ -794,6 +811,25 @@ mod tests {
             m.contains("procedure `two` enqueues to `sink` (one_execute -> enqueue_sink)"),
             "{m}"
         );
+    }
+
+    /// `reserve_<t>` is an enqueue to `t` like `enqueue_<t>`: it needs the declaration too.
+    #[test]
+    fn reserving_a_slot_of_an_undeclared_target_is_reported() {
+        let one = Procedure::new("one", word(), 1).body(
+            "fn one_execute(item: Word, inv: Invocation) {\n    \
+             let s = reserve_sink();\n    store_word(s, Word_v_word, item.v);\n}",
+        );
+        let m = error(vec![one, sink()], UserBindings::none());
+        assert!(
+            m.contains("procedure `one` enqueues to `sink` (one_execute -> reserve_sink)"),
+            "{m}"
+        );
+        let declared = Procedure::new("one", word(), 1).emits("sink", 1).body(
+            "fn one_execute(item: Word, inv: Invocation) {\n    \
+             let s = reserve_sink();\n    store_word(s, Word_v_word, item.v);\n}",
+        );
+        Program::new(vec![declared, sink()], UserBindings::none()).unwrap();
     }
 
     #[test]

@@ -38,6 +38,51 @@ pub struct TreeParams {
     pub payload_words: u32,
     /// Varies the root ids and, with [`Fanout::Uniform`], every node's child count.
     pub seed: u32,
+    /// How `branch` hands its children to the queues (the program only; the tree and its
+    /// result are the same either way).
+    pub children: ChildEnqueue,
+}
+
+/// How the `branch` body hands a child to its queue (docs/scheduler.md 1, "Large items word by
+/// word").
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum ChildEnqueue {
+    /// Builds the child whole, then `enqueue_<t>(child)`: the child's words sit in registers
+    /// beside the parent's.
+    Whole,
+    /// `reserve_<t>()`, then `store_word` of each word as it is computed.
+    Words,
+    /// Each strategy's faster form: words, but whole in the multi-passes for items of
+    /// [`WHOLE_IN_MULTIPASS_MIN_WORDS`] or more (the body branches on `SCHED_MEGAKERNEL`). On
+    /// the H100 (docs/results.md, 2026-12-06 (fifteenth session)) words took the 64-root
+    /// large-payload tree's megakernel from 177 registers to 112 and from 0.538 to 0.449 ms,
+    /// and every other preset's by up to 3%; the multi-passes ran the 3-word items of the other
+    /// presets 0-2% faster by words, but the 64-word ones 2-16% slower (device-driven 0.593 ->
+    /// 0.645 ms at 64 roots, with 128 registers whole and 80 by words).
+    #[default]
+    ByStrategy,
+}
+
+impl ChildEnqueue {
+    /// The command-line name: `whole`, `words` or `by-strategy`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ChildEnqueue::Whole => "whole",
+            ChildEnqueue::Words => "words",
+            ChildEnqueue::ByStrategy => "by-strategy",
+        }
+    }
+
+    /// The form of a command-line name; `None` for an unknown name.
+    pub fn parse(s: &str) -> Option<ChildEnqueue> {
+        [
+            ChildEnqueue::Whole,
+            ChildEnqueue::Words,
+            ChildEnqueue::ByStrategy,
+        ]
+        .into_iter()
+        .find(|c| c.name() == s)
+    }
 }
 
 /// The named trees of the benchmark suite (`schedbench --preset NAME`, `schedbench --suite`):
@@ -123,6 +168,7 @@ impl TreeParams {
             work: 0,
             payload_words: 1,
             seed: 1,
+            children: ChildEnqueue::ByStrategy,
         }
     }
 
@@ -212,8 +258,12 @@ impl TreeParams {
             Fanout::Fixed(k) => format!("fixed:{k}"),
             Fanout::Uniform(k) => format!("uniform:0..{k}"),
         };
+        let children = match self.children {
+            ChildEnqueue::ByStrategy => String::new(),
+            c => format!(" children={}", c.name()),
+        };
         format!(
-            "roots={} depth={} fanout={f} work={} payload={} seed={}",
+            "roots={} depth={} fanout={f} work={} payload={} seed={}{children}",
             self.roots, self.max_depth, self.work, self.payload_words, self.seed
         )
     }
@@ -459,7 +509,7 @@ impl TreeParams {
             // A node's children run next on its workgroup while they fit (docs/scheduler.md 2.7).
             .local("branch")
             .local("leaf")
-            .body(&unrolled(BRANCH_WGSL, p));
+            .body(&unrolled(&branch_body(self.children, p), p));
         let leaf = Procedure::new("leaf", item, 1).body(&unrolled(LEAF_WGSL, p));
         Program::new(vec![branch, leaf], user)
     }
@@ -515,17 +565,59 @@ fn branch_execute(item_value: TreeNode, inv: Invocation) {
     for (var i = 0u; i < tree_cfg[4]; i++) { x = tree_hash(x + i); }
     let c = tree_children(item.id, item.depth);
     for (var j = 0u; j < c; j++) {
+        let id = tree_hash(item.id * 0x9e3779b9u + j + 1u);
+        let depth = item.depth + 1u;
+        CHILD
+    }
+}
+"#;
+
+// A child built whole, then enqueued.
+const CHILD_WHOLE_WGSL: &str = r#"
         var child: TreeNode;
-        child.id = tree_hash(item.id * 0x9e3779b9u + j + 1u);
-        child.depth = item.depth + 1u;
+        child.id = id;
+        child.depth = depth;
         for (var w = 0u; w < TREE_P; w++) {
             child.payload[w] = tree_hash(item.payload[w] ^ child.id ^ (w * 0x85ebca6bu));
         }
         child.payload[0] ^= x;
         if tree_children(child.id, child.depth) > 0u { enqueue_branch(child); } else { enqueue_leaf(child); }
-    }
-}
 "#;
+
+// The same child stored word by word into its reserved slot as each word is computed, so that
+// it never sits whole in registers beside its parent. One `slot_reserved` test guards all the
+// stores: on the H100, stores left to `store_word`'s own test of every word made the 4-root
+// large-payload tree's megakernel 13% slower (0.158 -> 0.180 ms; docs/results.md, fifteenth
+// session).
+const CHILD_WORDS_WGSL: &str = r#"
+        var slot: ItemSlot;
+        if tree_children(id, depth) > 0u { slot = reserve_branch(); } else { slot = reserve_leaf(); }
+        if slot_reserved(slot) {
+            store_word(slot, TreeNode_id_word, id);
+            store_word(slot, TreeNode_depth_word, depth);
+            for (var w = 0u; w < TREE_P; w++) { store_word(slot, TreeNode_payload_word + (w * 1u), tree_hash(item.payload[w] ^ id ^ (w * 0x85ebca6bu)) ^ select(0u, x, (w * 1u) == 0u)); }
+        }
+"#;
+
+/// Smallest item, in words, that [`ChildEnqueue::ByStrategy`] enqueues whole in the
+/// multi-passes. Measured at 3 words (words faster) and 64 (whole faster); 16 is where
+/// [`scheduler::ItemLayout::for_program`] turns to planar queues, a word a plane.
+pub const WHOLE_IN_MULTIPASS_MIN_WORDS: u32 = 16;
+
+/// The `branch` body (payload loops not yet unrolled) for `children` and items of
+/// `payload_words + 2` words.
+fn branch_body(children: ChildEnqueue, payload_words: u32) -> String {
+    let words_everywhere = payload_words + 2 < WHOLE_IN_MULTIPASS_MIN_WORDS;
+    let child = match children {
+        ChildEnqueue::Whole => CHILD_WHOLE_WGSL.to_string(),
+        ChildEnqueue::Words => CHILD_WORDS_WGSL.to_string(),
+        ChildEnqueue::ByStrategy if words_everywhere => CHILD_WORDS_WGSL.to_string(),
+        ChildEnqueue::ByStrategy => format!(
+            "if SCHED_MEGAKERNEL {{{CHILD_WORDS_WGSL}        }} else {{{CHILD_WHOLE_WGSL}        }}"
+        ),
+    };
+    BRANCH_WGSL.replace("CHILD", child.trim())
+}
 
 // Leaves fold in two levels: into the workgroup's accumulators (workgroup atomics), then, once
 // per workgroup step, slot 0 folds those into one of the 256 output buckets: a global atomic
@@ -624,10 +716,13 @@ impl TreeRun {
     /// Another tree of the same payload size: same compiled program, new shape.
     pub fn set_params(&mut self, params: TreeParams) -> Result<(), RunError> {
         if params.payload_words != self.params.payload_words
+            || params.children != self.params.children
             || params.max_children() > self.declared_children
         {
             return Err(RunError::Program(
-                "a tree of another payload size or larger fan-out needs its own program".into(),
+                "a tree of another payload size, child enqueue or larger fan-out needs its own \
+                 program"
+                    .into(),
             ));
         }
         self.seeds = params.seeds();
@@ -983,14 +1078,27 @@ mod tests {
 
     #[test]
     fn payload_loops_unroll_to_one_statement_per_word() {
-        let b = super::unrolled(super::BRANCH_WGSL, 3);
-        assert!(!b.contains("TREE_P"), "{b}");
-        assert!(
-            b.contains(
-                "child.payload[2u] = tree_hash(item.payload[2u] ^ child.id ^ (2u * 0x85ebca6bu));"
-            ),
-            "{b}"
-        );
+        let whole =
+            "child.payload[2u] = tree_hash(item.payload[2u] ^ child.id ^ (2u * 0x85ebca6bu));";
+        let words = "store_word(slot, TreeNode_payload_word + (2u * 1u), tree_hash(item.payload[2u] \
+                     ^ id ^ (2u * 0x85ebca6bu)) ^ select(0u, x, (2u * 1u) == 0u));";
+        for (children, p, line) in [
+            (ChildEnqueue::Whole, 3, whole),
+            (ChildEnqueue::ByStrategy, 14, whole),
+            (ChildEnqueue::Words, 3, words),
+            (ChildEnqueue::ByStrategy, 14, words),
+        ] {
+            let b = super::unrolled(&super::branch_body(children, p), p);
+            assert!(!b.contains("TREE_P") && b.contains(line), "{line}: {b}");
+        }
+        assert!(!super::branch_body(ChildEnqueue::Whole, 62).contains("store_word"));
+        assert!(!super::branch_body(ChildEnqueue::Words, 62).contains("enqueue_"));
+        // By strategy: words everywhere for items under 16 words, whole in the multi-passes
+        // from there.
+        let small = super::branch_body(ChildEnqueue::ByStrategy, 13);
+        assert!(!small.contains("enqueue_") && !small.contains("SCHED_MEGAKERNEL"));
+        let large = super::branch_body(ChildEnqueue::ByStrategy, 14);
+        assert!(large.contains("if SCHED_MEGAKERNEL {") && large.contains("enqueue_"));
         let l = super::unrolled(super::LEAF_WGSL, 2);
         assert!(
             l.contains("h = tree_hash(h ^ item.payload[1u]);") && !l.contains("TREE_P"),
@@ -1065,6 +1173,7 @@ mod tests {
             work: 3,
             payload_words: 5,
             seed: 7,
+            children: Default::default(),
         });
         for p in cases {
             let r = p.reference();
@@ -1082,6 +1191,7 @@ mod tests {
             work: 0,
             payload_words: 3,
             seed: 1,
+            children: Default::default(),
         };
         let b = TreeParams {
             seed: 2,
