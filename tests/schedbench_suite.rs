@@ -356,6 +356,27 @@ fn a_queue_limit_runs_every_strategy_depth_first_and_is_recorded() {
     }
 }
 
+/// `--replot` takes no other option (exit 2), and a folder without records is an error naming
+/// the file (exit 1), not "0 plots".
+#[test]
+fn replot_takes_no_other_option_and_needs_records() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path().to_str().unwrap();
+    assert_exits_2(&["--replot", d, "--json"], "cannot be used with");
+    for contents in [None, Some("")] {
+        if let Some(c) = contents {
+            std::fs::write(dir.path().join("runs.jsonl"), c).unwrap();
+        }
+        let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
+            .args(["--replot", d])
+            .output()
+            .expect("schedbench runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(err.contains("runs.jsonl"), "{err}");
+    }
+}
+
 /// `--child-enqueue` builds the tree's program with that form, which the record's params
 /// name; the default (by strategy) adds nothing to them.
 #[test]

@@ -644,8 +644,8 @@ fn megakernels_with_atomic_slots_match_the_cpu_reference_exactly() {
     gpu.coherent = false;
     let mut rng = Lcg(0xa70c);
     let (mut runs, mut grown, mut local_runs) = (0, 0, 0);
-    // Children enqueued whole, and (the default) word by word.
-    for (payload, children) in [(1u32, ChildEnqueue::Whole), (62, ChildEnqueue::ByStrategy)] {
+    // Children enqueued whole, and word by word.
+    for (payload, children) in [(1u32, ChildEnqueue::Whole), (62, ChildEnqueue::Words)] {
         let shape = TreeParams {
             roots: 1,
             max_depth: 1,
@@ -1338,14 +1338,24 @@ fn device_driven_rounds_past_the_dispatch_limit_run_every_input_once() {
 fn every_thread_that_calls_enqueue_adds_an_item_on_every_strategy() {
     let gpu = gpu();
     let item = ItemType::new("Word", "struct Word { v: u32 }");
-    let fan_body = "fn fan_execute(item: Word, inv: Invocation) {\n\
-                    enqueue_sink(Word(item.v * 4u + inv.thread));\n\
-                    if inv.thread == 0u { enqueue_once(item); }\n}";
-    let program = |declared: u32| {
+    // The sinks' items enqueued whole, or (`words`) reserved and stored a word at a time.
+    let fan_body = |words: bool| {
+        let to_sink = if words {
+            "let slot = reserve_sink();\n\
+             if slot_reserved(slot) { store_word(slot, Word_v_word, item.v * 4u + inv.thread); }"
+        } else {
+            "enqueue_sink(Word(item.v * 4u + inv.thread));"
+        };
+        format!(
+            "fn fan_execute(item: Word, inv: Invocation) {{\n{to_sink}\n\
+             if inv.thread == 0u {{ enqueue_once(item); }}\n}}"
+        )
+    };
+    let program_of = |declared: u32, words: bool| {
         let fan = Procedure::new("fan", item.clone(), 4)
             .emits("sink", declared)
             .emits("once", 1)
-            .body(fan_body);
+            .body(&fan_body(words));
         let sink = Procedure::new("sink", item.clone(), 1).body(
             "fn sink_execute(item: Word, inv: Invocation) { if inv.live { atomicAdd(&seen[item.v], 1u); } }",
         );
@@ -1362,20 +1372,26 @@ fn every_thread_that_calls_enqueue_adds_an_item_on_every_strategy() {
     };
     let n = 100u32;
     let seeds = [Seed::new("fan", &(0..n).collect::<Vec<u32>>())];
-    let exact = program(4);
-    for kind in StrategyKind::ALL {
-        let seen = gpu.storage_buffer("seen", 5 * n as u64).unwrap();
-        let bind = exact.user.bind_group(&gpu, &[&seen]).unwrap();
-        let s = Scheduler::new(&gpu, &exact, kind, 64).unwrap();
-        let stats = s.run(&gpu, &seeds, Some(&bind)).unwrap();
-        assert_eq!(
-            stats.executed,
-            [n as u64, 4 * n as u64, n as u64],
-            "{kind:?}"
-        );
-        let counts = gpu.read_words(&seen, 0, 5 * n as u64).unwrap();
-        assert!(counts.iter().all(|&c| c == 1), "{kind:?}: {counts:?}");
+    for words in [false, true] {
+        let exact = program_of(4, words);
+        for kind in StrategyKind::ALL {
+            let seen = gpu.storage_buffer("seen", 5 * n as u64).unwrap();
+            let bind = exact.user.bind_group(&gpu, &[&seen]).unwrap();
+            let s = Scheduler::new(&gpu, &exact, kind, 64).unwrap();
+            let stats = s.run(&gpu, &seeds, Some(&bind)).unwrap();
+            assert_eq!(
+                stats.executed,
+                [n as u64, 4 * n as u64, n as u64],
+                "{kind:?}, words {words}"
+            );
+            let counts = gpu.read_words(&seen, 0, 5 * n as u64).unwrap();
+            assert!(
+                counts.iter().all(|&c| c == 1),
+                "{kind:?}, words {words}: {counts:?}"
+            );
+        }
     }
+    let exact = program_of(4, false);
     // The device-driven multi-pass's dispatch groups: a round is one dispatch fused, one per
     // procedure apart, and with the sinks apart one for `fan` and one for `sink` and `once`
     // together (`mp_group_1`, which picks between their loops); with the sinks first, one
@@ -1413,9 +1429,12 @@ fn every_thread_that_calls_enqueue_adds_an_item_on_every_strategy() {
         let counts = gpu.read_words(&seen, 0, 5 * n as u64).unwrap();
         assert!(counts.iter().all(|&c| c == 2), "fused {fused}: {counts:?}");
     }
-    // Declaring 3 for 4 threads' calls is an emit-limit error everywhere.
-    let short = program(3);
-    for kind in StrategyKind::ALL {
+    // Declaring 3 for 4 threads' calls is an emit-limit error everywhere, either way.
+    for (kind, words) in StrategyKind::ALL
+        .into_iter()
+        .flat_map(|k| [(k, false), (k, true)])
+    {
+        let short = program_of(3, words);
         let seen = gpu.storage_buffer("seen", 5 * n as u64).unwrap();
         let bind = short.user.bind_group(&gpu, &[&seen]).unwrap();
         let s = Scheduler::new(&gpu, &short, kind, 64).unwrap();
@@ -1427,9 +1446,9 @@ fn every_thread_that_calls_enqueue_adds_an_item_on_every_strategy() {
             }) => assert_eq!(
                 (procedure.as_str(), target.as_str(), declared),
                 ("fan", "sink", 3),
-                "{kind:?}"
+                "{kind:?}, words {words}"
             ),
-            other => panic!("{kind:?}: expected an emit-limit error, got {other:?}"),
+            other => panic!("{kind:?}, words {words}: expected an emit-limit error, got {other:?}"),
         }
     }
 }

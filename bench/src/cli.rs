@@ -13,10 +13,13 @@ use workloads::tree::{ChildEnqueue, Fanout, TreeParams, TreePreset};
 const EXAMPLES: &str = "Examples:
   schedbench --workload tree --strategy all --runs 10
   schedbench --workload tree --preset deep --strategy megakernel --json
+  schedbench --workload tree --preset large-payload --strategy all --child-enqueue whole
   schedbench --workload reyes --scene killeroo --width 398 --height 258
   schedbench --workload mandelbrot --size-px 4096
   schedbench --workload bfs --scale 22 --strategy frontier
-  schedbench --suite --size small --out report/";
+  schedbench --suite --size small --out report/
+  schedbench --suite --size small --workload tree --out report/
+  schedbench --replot report/";
 
 /// Runs workloads under the scheduler's strategies (and their CPU implementations), checks every
 /// run against the CPU reference, and prints a table of medians (or JSON lines); `--suite`
@@ -34,8 +37,8 @@ pub struct Cli {
     pub out: Option<PathBuf>,
 
     /// Draw a suite's plots again from DIR/runs.jsonl, into DIR, and run nothing (e.g. for a
-    /// suite whose plots a remote machine could not send back).
-    #[arg(long, value_name = "DIR", conflicts_with = "suite")]
+    /// suite whose plots a remote machine could not send back); takes no other option.
+    #[arg(long, value_name = "DIR", exclusive = true)]
     pub replot: Option<PathBuf>,
 
     /// The suite's problem sizes: `small` runs in minutes on lavapipe, `full` is for a GPU.
@@ -97,8 +100,8 @@ pub struct Cli {
 
     /// How a branch hands its children to the queues: whole (built, then `enqueue_<t>`), words
     /// (`reserve_<t>`, then `store_word` as each word is computed) or by-strategy (each strategy's
-    /// faster form: words, but whole in the multi-passes for items of 16 words or more)
-    /// [default: by-strategy].
+    /// faster form: words, but whole in the multi-passes for items of 16 words or more, and
+    /// whole everywhere for those on a CPU adapter) [default: by-strategy].
     #[arg(long, value_name = "FORM", value_parser = parse_child_enqueue, help_heading = "Tree")]
     pub child_enqueue: Option<ChildEnqueue>,
 

@@ -57,12 +57,13 @@ pub enum Error {
         /// The I/O error.
         source: std::io::Error,
     },
-    /// A line of a suite's `runs.jsonl` that is not a run record (`--replot`).
-    #[error("{}:{line}: not a run record: {message}", path.display())]
+    /// A line of a suite's `runs.jsonl` that is not a run record, or a file of none
+    /// (`--replot`).
+    #[error("{}{}: {message}", path.display(), if *line > 0 { format!(":{line}: not a run record") } else { String::new() })]
     Record {
         /// The records' file.
         path: PathBuf,
-        /// Its line, from 1.
+        /// Its line, from 1; 0 for the whole file.
         line: usize,
         /// The parser's error.
         message: String,

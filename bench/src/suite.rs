@@ -197,7 +197,8 @@ pub fn run_suite(gpu: &Gpu, o: &SuiteOptions) -> Result<bool, Error> {
 
 /// Draws the plots of the suite whose records are `dir/runs.jsonl` into `dir` (as
 /// [`run_suite`] does after its runs); returns their paths. Errors: the file cannot be read
-/// ([`Error::File`]), a line is not a record ([`Error::Record`]), a plot cannot be written.
+/// ([`Error::File`]), a line is not a record or there is none ([`Error::Record`]), a plot
+/// cannot be written.
 pub fn replot(dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>, Error> {
     let path = dir.join("runs.jsonl");
     let text = std::fs::read_to_string(&path).map_err(|source| Error::File {
@@ -217,6 +218,13 @@ pub fn replot(dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>, Error> {
                 message: e.to_string(),
             })?,
         );
+    }
+    if records.is_empty() {
+        return Err(Error::Record {
+            path,
+            line: 0,
+            message: "no run records to plot".into(),
+        });
     }
     plot::write_plots(dir, &records)
 }

@@ -53,7 +53,9 @@ pub enum ChildEnqueue {
     /// `reserve_<t>()`, then `store_word` of each word as it is computed.
     Words,
     /// Each strategy's faster form: words, but whole in the multi-passes for items of
-    /// [`WHOLE_IN_MULTIPASS_MIN_WORDS`] or more (the body branches on `SCHED_MEGAKERNEL`). On
+    /// [`WHOLE_IN_MULTIPASS_MIN_WORDS`] or more (the body branches on `SCHED_MEGAKERNEL`), and
+    /// whole in every strategy for those on a CPU adapter, where lavapipe's megakernel ran the
+    /// 64-word tree of one root 1.7x slower by words (53 against 31 ms). On
     /// the H100 (docs/results.md, 2026-12-06 (fifteenth session)) words took the 64-root
     /// large-payload tree's megakernel from 177 registers to 112 and from 0.538 to 0.449 ms,
     /// and every other preset's by up to 3%; the multi-passes ran the 3-word items of the other
@@ -476,10 +478,16 @@ impl TreeParams {
             .merge(done)
     }
 
-    /// The program: `branch` (emits up to the fan-out to `branch` and to `leaf`) and `leaf`,
-    /// with the output buckets and run-time shape as user bindings. Errors:
+    /// The program for a GPU: `branch` (emits up to the fan-out to `branch` and to `leaf`) and
+    /// `leaf`, with the output buckets and run-time shape as user bindings. Errors:
     /// [`RunError::Program`] for a payload outside `1..=254` words.
     pub fn program(&self) -> Result<Program, RunError> {
+        self.program_on(false)
+    }
+
+    /// [`TreeParams::program`] for a CPU adapter (`cpu`, such as lavapipe) or a GPU: they
+    /// differ only in the form [`ChildEnqueue::ByStrategy`] picks.
+    pub fn program_on(&self, cpu: bool) -> Result<Program, RunError> {
         let p = self.payload_words;
         if p == 0 || p > 254 {
             return Err(RunError::Program("payload words must be 1..=254".into()));
@@ -509,7 +517,7 @@ impl TreeParams {
             // A node's children run next on its workgroup while they fit (docs/scheduler.md 2.7).
             .local("branch")
             .local("leaf")
-            .body(&unrolled(&branch_body(self.children, p), p));
+            .body(&unrolled(&branch_body(self.children, p, cpu), p));
         let leaf = Procedure::new("leaf", item, 1).body(&unrolled(LEAF_WGSL, p));
         Program::new(vec![branch, leaf], user)
     }
@@ -604,14 +612,15 @@ const CHILD_WORDS_WGSL: &str = r#"
 /// [`scheduler::ItemLayout::for_program`] turns to planar queues, a word a plane.
 pub const WHOLE_IN_MULTIPASS_MIN_WORDS: u32 = 16;
 
-/// The `branch` body (payload loops not yet unrolled) for `children` and items of
-/// `payload_words + 2` words.
-fn branch_body(children: ChildEnqueue, payload_words: u32) -> String {
-    let words_everywhere = payload_words + 2 < WHOLE_IN_MULTIPASS_MIN_WORDS;
+/// The `branch` body (payload loops not yet unrolled) for `children`, items of
+/// `payload_words + 2` words, and a CPU adapter (`cpu`) or a GPU.
+fn branch_body(children: ChildEnqueue, payload_words: u32, cpu: bool) -> String {
+    let large = payload_words + 2 >= WHOLE_IN_MULTIPASS_MIN_WORDS;
     let child = match children {
         ChildEnqueue::Whole => CHILD_WHOLE_WGSL.to_string(),
         ChildEnqueue::Words => CHILD_WORDS_WGSL.to_string(),
-        ChildEnqueue::ByStrategy if words_everywhere => CHILD_WORDS_WGSL.to_string(),
+        ChildEnqueue::ByStrategy if !large => CHILD_WORDS_WGSL.to_string(),
+        ChildEnqueue::ByStrategy if cpu => CHILD_WHOLE_WGSL.to_string(),
         ChildEnqueue::ByStrategy => format!(
             "if SCHED_MEGAKERNEL {{{CHILD_WORDS_WGSL}        }} else {{{CHILD_WHOLE_WGSL}        }}"
         ),
@@ -698,7 +707,7 @@ impl TreeRun {
     /// Builds the program and the output buffers. Errors: [`RunError::Program`] (see
     /// [`TreeParams::program`]), [`RunError::Device`] if a buffer cannot be made.
     pub fn new(gpu: &Gpu, params: TreeParams) -> Result<TreeRun, RunError> {
-        let program = params.program()?;
+        let program = params.program_on(gpu.is_cpu_adapter())?;
         let out = gpu.storage_buffer("tree out", (BUCKETS * 4) as u64)?;
         let cfg = gpu.storage_buffer("tree cfg", 5)?;
         let bind = program.user.bind_group(gpu, &[&out, &cfg])?;
@@ -1088,17 +1097,21 @@ mod tests {
             (ChildEnqueue::Words, 3, words),
             (ChildEnqueue::ByStrategy, 14, words),
         ] {
-            let b = super::unrolled(&super::branch_body(children, p), p);
+            let b = super::unrolled(&super::branch_body(children, p, false), p);
             assert!(!b.contains("TREE_P") && b.contains(line), "{line}: {b}");
         }
-        assert!(!super::branch_body(ChildEnqueue::Whole, 62).contains("store_word"));
-        assert!(!super::branch_body(ChildEnqueue::Words, 62).contains("enqueue_"));
-        // By strategy: words everywhere for items under 16 words, whole in the multi-passes
-        // from there.
-        let small = super::branch_body(ChildEnqueue::ByStrategy, 13);
-        assert!(!small.contains("enqueue_") && !small.contains("SCHED_MEGAKERNEL"));
-        let large = super::branch_body(ChildEnqueue::ByStrategy, 14);
+        for cpu in [false, true] {
+            assert!(!super::branch_body(ChildEnqueue::Whole, 62, cpu).contains("store_word"));
+            assert!(!super::branch_body(ChildEnqueue::Words, 62, cpu).contains("enqueue_"));
+            // By strategy: words everywhere for items under 16 words.
+            let small = super::branch_body(ChildEnqueue::ByStrategy, 13, cpu);
+            assert!(!small.contains("enqueue_") && !small.contains("SCHED_MEGAKERNEL"));
+        }
+        // From there, whole in the multi-passes on a GPU, everywhere on a CPU adapter.
+        let large = super::branch_body(ChildEnqueue::ByStrategy, 14, false);
         assert!(large.contains("if SCHED_MEGAKERNEL {") && large.contains("enqueue_"));
+        let on_cpu = super::branch_body(ChildEnqueue::ByStrategy, 14, true);
+        assert!(!on_cpu.contains("store_word") && !on_cpu.contains("SCHED_MEGAKERNEL"));
         let l = super::unrolled(super::LEAF_WGSL, 2);
         assert!(
             l.contains("h = tree_hash(h ^ item.payload[1u]);") && !l.contains("TREE_P"),
