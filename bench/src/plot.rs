@@ -1,6 +1,6 @@
 //! The suite's plots (`plotters`): per workload one PNG with three panels against the problem
 //! size (work items of the CPU reference), log axes: median wall ms, median GPU ms, and items
-//! per second of wall time, one line per strategy. Text is drawn with `ab_glyph` from a font
+//! per second of wall time, one line per strategy, named in one legend under the title. Text is drawn with `ab_glyph` from a font
 //! compiled into the binary (Ubuntu Light, from `epaint_default_fonts`), so no system font or
 //! fontconfig is needed; pixels go into a buffer that the `image` crate encodes.
 
@@ -9,12 +9,15 @@ use crate::files::write_file;
 use crate::record::RunRecord;
 use crate::summary::{Cell, cells, plot_file_name};
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::{FontStyle, register_font};
 use std::path::{Path, PathBuf};
 use std::sync::Once;
 
 const WIDTH: u32 = 1500;
-const HEIGHT: u32 = 520;
+const HEIGHT: u32 = 550;
+/// The legend's row under the title.
+const LEGEND_HEIGHT: u32 = 30;
 const FONT: &str = "sans-serif";
 
 /// Strategy colours, in the order strategies first appear.
@@ -96,6 +99,31 @@ fn log_range(v: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
     lo / 1.5..hi * 1.5
 }
 
+/// Tick values for a log axis over `r`: the powers of ten in it where it spans more than three
+/// decades; 1, 2 and 5 times them where it spans fewer; every multiple 1..9 where that still
+/// gives fewer than three ticks (plotters' own key points leave a range inside one decade
+/// without a label).
+fn log_ticks(r: &std::ops::Range<f64>) -> Vec<f64> {
+    let (first, last) = (r.start.log10().floor() as i32, r.end.log10().ceil() as i32);
+    let pick = |multiples: &[f64]| -> Vec<f64> {
+        (first..=last)
+            .flat_map(|d| multiples.iter().map(move |m| m * 10f64.powi(d)))
+            .filter(|v| r.contains(v))
+            .collect()
+    };
+    let decades = (r.end / r.start).log10();
+    let ticks = pick(if decades > 3.0 {
+        &[1.0]
+    } else {
+        &[1.0, 2.0, 5.0]
+    });
+    if ticks.len() >= 3 {
+        ticks
+    } else {
+        pick(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0])
+    }
+}
+
 /// Draws one workload's plot into an RGB buffer of `WIDTH` x `HEIGHT`.
 fn draw(workload: &str, cs: &[Cell], buf: &mut [u8]) -> Result<(), Error> {
     register();
@@ -112,6 +140,25 @@ fn draw(workload: &str, cs: &[Cell], buf: &mut [u8]) -> Result<(), Error> {
             strategies.push(&c.strategy);
         }
     }
+    // One legend for the three panels, in a row of its own under the title, where it covers
+    // no line (one in each panel hid points).
+    let (legend, root) = root.split_vertically(LEGEND_HEIGHT);
+    let mut at = 90;
+    for (i, name) in strategies.iter().enumerate() {
+        let colour = PALETTE[i % PALETTE.len()];
+        let y = LEGEND_HEIGHT as i32 / 2;
+        legend
+            .draw(&PathElement::new(
+                vec![(at, y), (at + 24, y)],
+                colour.stroke_width(3),
+            ))
+            .map_err(|e| err(&e))?;
+        let style = TextStyle::from((FONT, 14).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
+        legend
+            .draw(&Text::new(name.to_string(), (at + 30, y), style))
+            .map_err(|e| err(&e))?;
+        at += 40 + 8 * name.len() as i32;
+    }
     let x_range = log_range(cs.iter().map(|c| c.problem_items as f64));
     for (area, panel) in root.split_evenly((1, PANELS.len())).iter().zip(&PANELS) {
         let y_range = log_range(cs.iter().filter(|c| c.ok()).filter_map(panel.value));
@@ -120,7 +167,10 @@ fn draw(workload: &str, cs: &[Cell], buf: &mut [u8]) -> Result<(), Error> {
             .margin(12)
             .x_label_area_size(44)
             .y_label_area_size(70)
-            .build_cartesian_2d(x_range.clone().log_scale(), y_range.log_scale())
+            .build_cartesian_2d(
+                (x_range.clone().log_scale()).with_key_points(log_ticks(&x_range)),
+                (y_range.clone().log_scale()).with_key_points(log_ticks(&y_range)),
+            )
             .map_err(|e| err(&e))?;
         chart
             .configure_mesh()
@@ -146,23 +196,11 @@ fn draw(workload: &str, cs: &[Cell], buf: &mut [u8]) -> Result<(), Error> {
             }
             chart
                 .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
-                .map_err(|e| err(&e))?
-                .label(*name)
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2))
-                });
+                .map_err(|e| err(&e))?;
             chart
                 .draw_series(points.iter().map(|&p| Circle::new(p, 4, colour.filled())))
                 .map_err(|e| err(&e))?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .label_font((FONT, 13))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| err(&e))?;
     }
     root.present().map_err(|e| err(&e))?;
     Ok(())
@@ -202,6 +240,25 @@ mod tests {
         assert_eq!(si(0.05), "0.05");
         assert_eq!(si(12.5), "12.5");
         assert_eq!(si(131_072.0), "131k");
+    }
+
+    /// Every axis gets at least three labelled ticks, inside its range, fewer than a dozen.
+    #[test]
+    fn log_axes_have_a_few_ticks_whatever_their_span() {
+        for r in [
+            24.0..65.0,
+            0.8..3.0,
+            1.0e3..1.0e7,
+            0.05..0.2,
+            131_000.0..8.4e6,
+        ] {
+            let t = log_ticks(&r);
+            assert!((3..12).contains(&t.len()), "{r:?}: {t:?}");
+            assert!(t.iter().all(|v| r.contains(v)), "{r:?}: {t:?}");
+            assert!(t.windows(2).all(|w| w[0] < w[1]), "{r:?}: {t:?}");
+        }
+        assert_eq!(log_ticks(&(24.0..65.0)), vec![30.0, 40.0, 50.0, 60.0]);
+        assert_eq!(log_ticks(&(1.0e3..1.0e7)), vec![1e3, 1e4, 1e5, 1e6]);
     }
 
     #[test]
