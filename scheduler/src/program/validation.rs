@@ -262,7 +262,13 @@ pub(crate) fn check(program: &Program) -> Result<Vec<String>, RunError> {
         }
         let message = chain.pop().unwrap_or_default();
         let spans: Vec<(Span, String)> = e.spans().cloned().collect();
-        RunError::Program(shared.report(&message, &spans, &chain, true))
+        let mut report = shared.report(&message, &spans, &chain, true);
+        // A call's argument of the wrong type names neither the function nor the type.
+        if message.contains("doesn't match the type") && report.contains("store_word(") {
+            report += "\nhint: store_word(slot, word, value) takes value as a u32: store an \
+                       f32 or i32 as bitcast<u32>(value)";
+        }
+        RunError::Program(report)
     })?;
     check_module(&shared, &module)?;
     log::debug!("SPIR-V check skipped: the source with its entry points does not compile");
@@ -830,6 +836,18 @@ mod tests {
              let s = reserve_sink();\n    store_word(s, Word_v_word, item.v);\n}",
         );
         Program::new(vec![declared, sink()], UserBindings::none()).unwrap();
+    }
+
+    /// A value other than a `u32` given to `store_word` is naga's type error plus a hint.
+    #[test]
+    fn a_float_given_to_store_word_is_reported_with_the_bitcast() {
+        let one = Procedure::new("one", word(), 1).emits("sink", 1).body(
+            "fn one_execute(item: Word, inv: Invocation) {\n    \
+             let s = reserve_sink();\n    let w = 1.5;\n    store_word(s, Word_v_word, w);\n}",
+        );
+        let m = error(vec![one, sink()], UserBindings::none());
+        assert!(m.contains("body line 4"), "{m}");
+        assert!(m.contains("bitcast<u32>"), "{m}");
     }
 
     #[test]
