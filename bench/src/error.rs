@@ -57,17 +57,19 @@ pub enum Error {
         /// The I/O error.
         source: std::io::Error,
     },
-    /// A line of a suite's `runs.jsonl` that is not a run record, or a file of none
-    /// (`--replot`).
-    #[error("{}{}: {message}", path.display(), if *line > 0 { format!(":{line}: not a run record") } else { String::new() })]
+    /// A line of a suite's `runs.jsonl` that is not a run record (`--replot`).
+    #[error("{}:{line}: not a run record: {message}", path.display())]
     Record {
         /// The records' file.
         path: PathBuf,
-        /// Its line, from 1; 0 for the whole file.
+        /// Its line, from 1.
         line: usize,
         /// The parser's error.
         message: String,
     },
+    /// A suite's `runs.jsonl` without a run record (`--replot`).
+    #[error("{}: no run records to plot", .0.display())]
+    NoRecords(PathBuf),
     /// A plot the plotting backend could not draw.
     #[error("plot {workload}: {message}")]
     Plot {

@@ -1,8 +1,9 @@
 //! The suite's plots (`plotters`): per workload one PNG with three panels against the problem
 //! size (work items of the CPU reference), log axes: median wall ms, median GPU ms, and items
-//! per second of wall time, one line per strategy, named in one legend under the title. Text is drawn with `ab_glyph` from a font
-//! compiled into the binary (Ubuntu Light, from `epaint_default_fonts`), so no system font or
-//! fontconfig is needed; pixels go into a buffer that the `image` crate encodes.
+//! per second of wall time, one line per strategy, named in one legend under the title. Text
+//! is drawn with `ab_glyph` from a font compiled into the binary (Ubuntu Light, from
+//! `epaint_default_fonts`), so no system font or fontconfig is needed; pixels go into a buffer
+//! that the `image` crate encodes.
 
 use crate::error::Error;
 use crate::files::write_file;
@@ -143,19 +144,18 @@ fn draw(workload: &str, cs: &[Cell], buf: &mut [u8]) -> Result<(), Error> {
     // One legend for the three panels, in a row of its own under the title, where it covers
     // no line (one in each panel hid points).
     let (legend, root) = root.split_vertically(LEGEND_HEIGHT);
-    let mut at = 90;
+    let (mut at, y) = (90, LEGEND_HEIGHT as i32 / 2);
+    let style = TextStyle::from((FONT, 14).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
     for (i, name) in strategies.iter().enumerate() {
         let colour = PALETTE[i % PALETTE.len()];
-        let y = LEGEND_HEIGHT as i32 / 2;
         legend
             .draw(&PathElement::new(
                 vec![(at, y), (at + 24, y)],
                 colour.stroke_width(3),
             ))
             .map_err(|e| err(&e))?;
-        let style = TextStyle::from((FONT, 14).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
         legend
-            .draw(&Text::new(name.to_string(), (at + 30, y), style))
+            .draw(&Text::new(name.to_string(), (at + 30, y), style.clone()))
             .map_err(|e| err(&e))?;
         at += 40 + 8 * name.len() as i32;
     }

@@ -197,7 +197,8 @@ pub fn run_suite(gpu: &Gpu, o: &SuiteOptions) -> Result<bool, Error> {
 
 /// Draws the plots of the suite whose records are `dir/runs.jsonl` into `dir` (as
 /// [`run_suite`] does after its runs); returns their paths. Errors: the file cannot be read
-/// ([`Error::File`]), a line is not a record or there is none ([`Error::Record`]), a plot
+/// ([`Error::File`]), a line is not a record ([`Error::Record`]) or none is
+/// ([`Error::NoRecords`]), a plot
 /// cannot be written.
 pub fn replot(dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>, Error> {
     let path = dir.join("runs.jsonl");
@@ -220,11 +221,7 @@ pub fn replot(dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>, Error> {
         );
     }
     if records.is_empty() {
-        return Err(Error::Record {
-            path,
-            line: 0,
-            message: "no run records to plot".into(),
-        });
+        return Err(Error::NoRecords(path));
     }
     plot::write_plots(dir, &records)
 }

@@ -100,14 +100,6 @@ pub fn source(
     // Bodies read their items through the slot accessors, a local batch's from its buffer in
     // the workgroup's area of the slots (`mk_execute`); local emits are stored with them too.
     s += &items.execute_switch(program, "sched_slot");
-    // Where item `s` of queue `q`'s slots starts (planar: and its stride).
-    let slot_at = |q: &str| {
-        if planar {
-            format!("q_slot_base({q}) + s, q_cap({q})")
-        } else {
-            format!("q_slot_base({q}) + s * sched_words({q})")
-        }
-    };
     // Outbox item `j` of part (q, t) and its stride.
     let (ob_at, ob_stride) = if planar {
         ("sched_outbox + ob_off(q, t) + j", "ob_cap(q, t)")
@@ -143,42 +135,14 @@ pub fn source(
         s += &items.typed_fns(program, "sched_ob");
     }
     for (t, p) in program.procs.iter().enumerate() {
-        let ty = &p.layout.name;
-        // Local first, where q keeps its emits to t and the buffer has room this batch.
-        let local_store = if local.cap[t] > 0 {
-            let at = if planar {
-                format!("sched_local_out({t}u) + l, LOCAL_CAP[{t}u]")
-            } else {
-                format!("sched_local_out({t}u) + l * sched_words({t}u)")
-            };
-            format!(
-                "if LOCAL_EDGE[sched_proc * NQ + {t}u] != 0u {{\n        \
-                     let l = atomicAdd(&wg_local_n[{t}u], 1u);\n        \
-                     if l < wg_local_lim[{t}u] {{ sched_slot_store_{ty}({at}, item); return; }}\n    }}\n    "
-            )
-        } else {
-            String::new()
-        };
-        let store = if direct.is_some() {
-            let at = slot_at(&format!("{t}u"));
-            format!(
-                "let s = sched_direct_slot({t}u);\n    if s != 0xffffffffu {{ sched_slot_store_{ty}({at}, item); }}"
-            )
-        } else {
-            let stride = if planar {
-                format!(", mk_outbox_stride(sched_proc, {t}u)")
-            } else {
-                String::new()
-            };
-            format!(
-                "let at = sched_outbox_slot({t}u);\n    if at != 0xffffffffu {{ sched_ob_store_{ty}(at{stride}, item); }}"
-            )
-        };
-        s += &format!(
-            "fn enqueue_{name}(item: {ty}) {{\n    if !sched_active {{ return; }}\n    {local_store}{store}\n}}\n",
-            name = p.proc.name,
+        s += &emit_fns(
+            t,
+            &p.proc.name,
+            &p.layout.name,
+            planar,
+            local.cap[t] > 0,
+            direct.is_some(),
         );
-        s += &reserve_fn(t, &p.proc.name, planar, local.cap[t] > 0, direct.is_some());
     }
     // Guarded word by word, as `enqueue_<name>` is once: a dropped item's words go nowhere.
     s += "fn store_word(slot: ItemSlot, word: u32, value: u32) {\n    \
@@ -189,40 +153,30 @@ pub fn source(
     s
 }
 
-/// `reserve_<name>()` for target `t`: the slot `enqueue_<name>` would store its item in (local
-/// buffer, direct ticket or outbox, in that order), for `store_word` to fill word by word.
-fn reserve_fn(t: usize, name: &str, planar: bool, local: bool, direct: bool) -> String {
-    let (local_at, local_stride) = if planar {
-        (
-            format!("sched_local_out({t}u) + l"),
-            format!("LOCAL_CAP[{t}u]"),
-        )
-    } else {
-        (
-            format!("sched_local_out({t}u) + l * sched_words({t}u)"),
-            "1u".into(),
-        )
-    };
-    let local = if local {
-        format!(
-            "if LOCAL_EDGE[sched_proc * NQ + {t}u] != 0u {{\n        \
-                 let l = atomicAdd(&wg_local_n[{t}u], 1u);\n        \
-                 if l < wg_local_lim[{t}u] {{ r.at = {local_at}; r.stride = {local_stride}; return r; }}\n    }}\n    "
-        )
-    } else {
-        String::new()
-    };
-    let store = if direct {
-        let (at, stride) = if planar {
-            (format!("q_slot_base({t}u) + s"), format!("q_cap({t}u)"))
+/// `enqueue_<name>(item)` and `reserve_<name>()` for target `t` (item type `ty`): both take the
+/// same place for an emit, tried in this order: a slot of t's local buffer where the running
+/// procedure keeps its emits to t and the buffer has room this batch (`local`), else a ticket
+/// of t's queue (`direct`) or an entry of the workgroup's outbox. `enqueue_` stores the whole
+/// item there; `reserve_` returns the place as an `ItemSlot` (first word, stride between words)
+/// for `store_word`.
+fn emit_fns(t: usize, name: &str, ty: &str, planar: bool, local: bool, direct: bool) -> String {
+    // Item `index` of a region at `base` holding `cap` items: its first word and word stride.
+    let place = |base: String, index: &str, cap: String| {
+        if planar {
+            (format!("{base} + {index}"), cap)
         } else {
-            (
-                format!("q_slot_base({t}u) + s * sched_words({t}u)"),
-                "1u".into(),
-            )
-        };
-        format!(
-            "let s = sched_direct_slot({t}u);\n    if s != 0xffffffffu {{ r.at = {at}; r.stride = {stride}; }}"
+            (format!("{base} + {index} * sched_words({t}u)"), "1u".into())
+        }
+    };
+    let local_at = place(
+        format!("sched_local_out({t}u)"),
+        "l",
+        format!("LOCAL_CAP[{t}u]"),
+    );
+    let (global_at, outbox) = if direct {
+        (
+            place(format!("q_slot_base({t}u)"), "s", format!("q_cap({t}u)")),
+            false,
         )
     } else {
         let stride = if planar {
@@ -230,13 +184,52 @@ fn reserve_fn(t: usize, name: &str, planar: bool, local: bool, direct: bool) -> 
         } else {
             "1u".into()
         };
-        format!(
-            "let at = sched_outbox_slot({t}u);\n    if at != 0xffffffffu {{ r.at = at; r.stride = {stride}; r.outbox = 1u; }}"
-        )
+        (("at".to_string(), stride), true)
     };
+    // The typed store's arguments: the first word and, planar, the stride.
+    let args = |(at, stride): &(String, String)| match planar {
+        true => format!("{at}, {stride}"),
+        false => at.clone(),
+    };
+    let store = if outbox {
+        "sched_ob_store"
+    } else {
+        "sched_slot_store"
+    };
+    let slot = |(at, stride): &(String, String)| format!("r.at = {at}; r.stride = {stride};");
+    // The function's body around what it does at the place: `take_local` (which returns) and
+    // `take_global`.
+    let body = |take_local: String, take_global: String| {
+        let local = if local {
+            format!(
+                "if LOCAL_EDGE[sched_proc * NQ + {t}u] != 0u {{\n        \
+                     let l = atomicAdd(&wg_local_n[{t}u], 1u);\n        \
+                     if l < wg_local_lim[{t}u] {{ {take_local} }}\n    }}\n    "
+            )
+        } else {
+            String::new()
+        };
+        let global = if outbox {
+            format!(
+                "let at = sched_outbox_slot({t}u);\n    if at != 0xffffffffu {{ {take_global} }}"
+            )
+        } else {
+            format!("let s = sched_direct_slot({t}u);\n    if s != 0xffffffffu {{ {take_global} }}")
+        };
+        format!("{local}{global}")
+    };
+    let enqueue = body(
+        format!("sched_slot_store_{ty}({}, item); return;", args(&local_at)),
+        format!("{store}_{ty}({}, item);", args(&global_at)),
+    );
+    let reserve = body(
+        format!("{} return r;", slot(&local_at)),
+        slot(&global_at) + if outbox { " r.outbox = 1u;" } else { "" },
+    );
     format!(
-        "fn reserve_{name}() -> ItemSlot {{\n    var r = ItemSlot(0xffffffffu, 1u, 0u);\n    \
-         if !sched_active {{ return r; }}\n    {local}{store}\n    return r;\n}}\n"
+        "fn enqueue_{name}(item: {ty}) {{\n    if !sched_active {{ return; }}\n    {enqueue}\n}}\n\
+         fn reserve_{name}() -> ItemSlot {{\n    var r = ItemSlot(0xffffffffu, 1u, 0u);\n    \
+         if !sched_active {{ return r; }}\n    {reserve}\n    return r;\n}}\n"
     )
 }
 

@@ -162,10 +162,15 @@ pub(super) fn rounds_source(
         items.typed_fns(program, "mp_in")
     };
     s += &items.typed_fns(program, "mp_out");
-    // Where item `at` of queue `t` starts, and (planar) the stride between its words.
-    let item_at = |t: &str| match items {
-        ItemLayout::Interleaved => format!("q_base({t}) + at * sched_words({t})"),
-        ItemLayout::Planar => format!("q_base({t}) + at, q_cap({t})"),
+    // Where item `at` of queue `t` starts, and the stride between its words.
+    let place = |t: &str| match items {
+        ItemLayout::Interleaved => (format!("q_base({t}) + at * sched_words({t})"), "1u".into()),
+        ItemLayout::Planar => (format!("q_base({t}) + at"), format!("q_cap({t})")),
+    };
+    // The same as a typed load's or store's arguments (planar: with the stride).
+    let item_at = |t: &str| match (items, place(t)) {
+        (ItemLayout::Interleaved, (at, _)) => at,
+        (ItemLayout::Planar, (at, stride)) => format!("{at}, {stride}"),
     };
     // The loop, its item runner named `mp_execute{suffix}`, as `run_procedure{suffix}` (the
     // file's header comment, up to its first blank line, stays out of the copies).
@@ -182,6 +187,7 @@ pub(super) fn rounds_source(
         s += &instantiate("");
     }
     for (t, p) in program.procs.iter().enumerate() {
+        let (slot_at, slot_stride) = place(&format!("{t}u"));
         s += &format!(
             "fn enqueue_{name}(item: {ty}) {{\n    if !sched_active {{ return; }}\n    \
              let at = sched_append_slot({t}u);\n    if at == 0xffffffffu {{ return; }}\n    \
@@ -195,14 +201,6 @@ pub(super) fn rounds_source(
             name = p.proc.name,
             ty = p.layout.name,
             store_at = item_at(&format!("{t}u")),
-            slot_at = match items {
-                ItemLayout::Interleaved => format!("q_base({t}u) + at * sched_words({t}u)"),
-                ItemLayout::Planar => format!("q_base({t}u) + at"),
-            },
-            slot_stride = match items {
-                ItemLayout::Interleaved => "1u".to_string(),
-                ItemLayout::Planar => format!("q_cap({t}u)"),
-            },
             run_item = run_item(&p.layout.name, "mp_in", &item_at("t"), &p.proc.execute_fn()),
             body = body(t),
         );

@@ -55,12 +55,12 @@ pub enum ChildEnqueue {
     /// Each strategy's faster form: words, but whole in the multi-passes for items of
     /// [`WHOLE_IN_MULTIPASS_MIN_WORDS`] or more (the body branches on `SCHED_MEGAKERNEL`), and
     /// whole in every strategy for those on a CPU adapter, where lavapipe's megakernel ran the
-    /// 64-word tree of one root 1.7x slower by words (53 against 31 ms). On
-    /// the H100 (docs/results.md, 2026-12-06 (fifteenth session)) words took the 64-root
-    /// large-payload tree's megakernel from 177 registers to 112 and from 0.538 to 0.449 ms,
-    /// and every other preset's by up to 3%; the multi-passes ran the 3-word items of the other
-    /// presets 0-2% faster by words, but the 64-word ones 2-16% slower (device-driven 0.593 ->
-    /// 0.645 ms at 64 roots, with 128 registers whole and 80 by words).
+    /// 64-word tree of one root 1.7x slower by words (53 against 31 ms). On the H100
+    /// (docs/results.md, 2026-12-06 (fifteenth session)) words took the 64-root large-payload
+    /// tree's megakernel from 177 registers to 112 and from 0.538 to 0.449 ms, and every other
+    /// preset's by up to 3%; the multi-passes ran the 3-word items of the other presets 0-2%
+    /// faster by words, but the 64-word ones 2-16% slower (device-driven 0.593 -> 0.645 ms at
+    /// 64 roots, with 128 registers whole and 80 by words).
     #[default]
     ByStrategy,
 }
