@@ -1367,6 +1367,23 @@ fn nearest_rasterization_with_motion_or_depth_of_field_is_a_usage_error() {
     assert!(!dir.join("x.png").exists());
 }
 
+/// The multi-pass floor replays one kept frame's work: `reyes bench` and `reyes view`, whose
+/// frames move, refuse it as a usage error (exit 2) that names it and says where it works,
+/// before opening a device or a window.
+#[test]
+fn the_multipass_floor_is_refused_where_frames_move() {
+    let dir = scratch("floor-moving");
+    for cmd in ["bench", "view"] {
+        let args = [cmd, "--strategy", "multipass-floor"];
+        let (code, _, err) = reyes_any(&dir, &args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(
+            err.contains("multipass-floor") && err.contains("reyes render --runs"),
+            "{err}"
+        );
+    }
+}
+
 /// `-o` naming a symbolic link writes the file it points to and keeps the link; naming a FIFO
 /// writes the PNG into it, in place: neither becomes a regular file (as root, `-o /dev/null`
 /// must not replace /dev/null).

@@ -396,6 +396,40 @@ fn the_child_enqueue_form_is_asked_for_and_recorded() {
     );
 }
 
+/// `--strategy multipass-floor` is named, not part of `all`: its warm-up keeps the tree's
+/// items, and every timed run replays them in one round, one launch per procedure, verified
+/// against the CPU reference.
+#[test]
+fn the_multipass_floor_is_named_and_replays_in_one_round() {
+    let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
+        .args(["--workload", "tree", "--preset", "binary", "--roots", "2"])
+        .args([
+            "--depth",
+            "6",
+            "--strategy",
+            "multipass-floor",
+            "--runs",
+            "2",
+            "--json",
+        ])
+        .output()
+        .expect("schedbench runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let records: Vec<serde_json::Value> = stdout
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(records.len(), 2, "{stdout}");
+    for r in &records {
+        assert_eq!(r["strategy"], "multipass-floor", "{r}");
+        assert_eq!(r["verified"], true, "{r}");
+        assert_eq!(r["rounds"], 1, "{r}");
+        assert_eq!(r["launches"], 2, "branch and leaf: {r}");
+    }
+}
+
 /// The first JSON record of `schedbench --workload tree --strategy megakernel --runs 1 --json
 /// ARGS`, which must exit 0 with a verified run.
 fn first_json_record(args: &[&str]) -> serde_json::Value {

@@ -864,6 +864,64 @@ fn multi_pass_rounds_that_cannot_fit_a_queue_at_its_limit_run_in_part_and_stay_e
     }
 }
 
+/// The multi-pass floor (`HostMultipassConfig::replay_floor`): a tree's first run is a
+/// host-driven run that keeps every item it executed (in rounds run in part too, its queues
+/// capped at 32 slots), and each later run of the same seeds replays them in one round, one
+/// dispatch per procedure: the CPU reference's leaves every time, in both item layouts, with
+/// exactly the items the first run executed. A tree of other seeds is kept anew, and both
+/// stay kept.
+#[test]
+fn the_multipass_floor_replays_every_item_once_in_one_round() {
+    let gpu = gpu();
+    for (params, max_capacity) in [(small_tree(7), 1 << 16), (breadth_tree(), 32)] {
+        let reference = params.reference();
+        let run = TreeRun::new(&gpu, params.clone()).unwrap();
+        let other = TreeParams {
+            roots: params.roots + 1,
+            ..params.clone()
+        };
+        let other_reference = other.reference();
+        let other = TreeRun::new(&gpu, other).unwrap();
+        for item_layout in [ItemLayout::Interleaved, ItemLayout::Planar] {
+            let config = HostMultipassConfig {
+                initial_capacity: 16,
+                max_capacity,
+                item_layout: Some(item_layout),
+                replay_floor: true,
+                ..Default::default()
+            };
+            let s = Scheduler::multipass_host(&gpu, &run.program, config).unwrap();
+            assert_eq!(s.kind(), StrategyKind::MultipassFloor);
+            let (kept, result) = run.run(&gpu, &s).unwrap();
+            assert_eq!(result, reference, "{kept:?}");
+            assert_eq!(kept.strategy, "multipass-floor capture");
+            assert!(kept.rounds > 2, "{kept:?}");
+            assert_eq!(kept.partial_rounds > 0, max_capacity == 32, "{kept:?}");
+            for (r, want, new) in [(&run, &reference, false), (&other, &other_reference, true)] {
+                let mut executed = (!new).then(|| kept.executed.clone());
+                for _ in 0..2 {
+                    let (stats, result) = r.run(&gpu, &s).unwrap();
+                    assert_eq!(&result, want, "{item_layout:?} {stats:?}");
+                    let Some(executed) = &executed else {
+                        assert_eq!(stats.strategy, "multipass-floor capture");
+                        executed = Some(stats.executed);
+                        continue;
+                    };
+                    assert_eq!(stats.strategy, "multipass-floor");
+                    assert_eq!(stats.rounds, 1, "{stats:?}");
+                    assert_eq!(&stats.executed, executed, "{stats:?}");
+                    let procedures = executed.iter().filter(|&&k| k > 0).count();
+                    assert_eq!(stats.launches, procedures as u64, "{stats:?}");
+                }
+            }
+            // The first tree is still kept beside the other.
+            let (stats, result) = run.run(&gpu, &s).unwrap();
+            assert_eq!(result, reference);
+            assert_eq!(stats.rounds, 1, "{stats:?}");
+        }
+    }
+}
+
 /// A megakernel whose queues, at their limit, cannot hold a tree's breadth (it claims each
 /// queue oldest first, so a tree fills it level by level) sets the oldest half of the live
 /// items aside on the host and runs the newest, depth first (`megakernel/park.rs`): the tree
@@ -1023,6 +1081,7 @@ fn a_run_started_at_capacity_16_grows_geometrically_and_stays_exact() {
                     assert_eq!(stats.submits, stats.rounds, "{stats:?}");
                     assert_eq!(stats.rounds, base.rounds, "{stats:?}");
                 }
+                StrategyKind::MultipassFloor => unreachable!("not in StrategyKind::ALL"),
             }
         }
     }

@@ -52,6 +52,9 @@ pub struct Cli {
     /// megakernel, megakernel-fifo, multipass, multipass-host (rounds planned by the host
     /// from read-back queue counts), cpu (the workload's rayon implementation),
     /// a workload's own baseline (e.g. bfs's frontier), or all (the megakernel under --policy).
+    /// Also multipass-floor, a reference that all leaves out: the warm-up is a host-driven run
+    /// that keeps the items it executed, and every timed run replays them in one round (the
+    /// bodies' work without the rounds' cost: what no multi-pass can beat).
     #[arg(long, default_value = "all", conflicts_with = "suite")]
     pub strategy: String,
 

@@ -110,13 +110,25 @@ impl Strategy {
         !matches!(self, Strategy::Cpu)
     }
 
-    /// The strategy named `s` among `all` (`megakernel-priority` is accepted for `megakernel`).
+    /// The strategy named `s` among `all` (`megakernel-priority` is accepted for `megakernel`;
+    /// `multipass-floor`, never in a workload's list, wherever `multipass-host` is).
     pub fn find(all: &[Strategy], s: &str) -> Option<Strategy> {
         let s = if s == "megakernel-priority" {
             "megakernel"
         } else {
             s
         };
+        let floor = StrategyKind::MultipassFloor;
+        if s == floor.name() {
+            let host = StrategyKind::MultipassHost.name();
+            return all
+                .iter()
+                .any(|x| x.name() == host)
+                .then_some(Strategy::Scheduler {
+                    kind: floor,
+                    policy: Policy::Priority,
+                });
+        }
         all.iter().find(|x| x.name() == s).cloned()
     }
 }
@@ -325,11 +337,12 @@ pub fn compile(
                 ..Default::default()
             },
         ),
-        StrategyKind::MultipassHost => Scheduler::multipass_host(
+        StrategyKind::MultipassHost | StrategyKind::MultipassFloor => Scheduler::multipass_host(
             gpu,
             program,
             HostMultipassConfig {
                 initial_capacity: capacity,
+                replay_floor: *kind == StrategyKind::MultipassFloor,
                 item_layout: config.item_layout,
                 max_capacity: config
                     .max_capacity
@@ -367,5 +380,13 @@ mod tests {
             all.iter().filter(|s| s.is_megakernel()).count(),
             Policy::ALL.len()
         );
+        // The floor is named, never listed, and found wherever the host-driven multi-pass is.
+        let floor = StrategyKind::MultipassFloor;
+        assert!(!names.contains(&floor.name().to_string()));
+        let found = Strategy::find(&all, floor.name()).unwrap();
+        assert_eq!(found.name(), "multipass-floor");
+        assert!(found.is_gpu() && !found.is_megakernel());
+        let cpu_only = [Strategy::Cpu];
+        assert_eq!(Strategy::find(&cpu_only, floor.name()), None);
     }
 }

@@ -125,11 +125,12 @@ pub fn cells(records: &[RunRecord]) -> Vec<(String, Vec<Cell>)> {
 }
 
 /// The best baseline of one size: the verified non-megakernel cell with the least median
-/// wall time.
+/// wall time (never the multi-pass floor, a reference no user would run).
 pub fn best_baseline<'a>(size_cells: &[&'a Cell]) -> Option<&'a Cell> {
     size_cells
         .iter()
         .filter(|c| !c.megakernel && c.ok() && c.wall.is_some())
+        .filter(|c| c.strategy != scheduler::StrategyKind::MultipassFloor.name())
         .min_by(|a, b| a.wall.unwrap().0.total_cmp(&b.wall.unwrap().0))
         .copied()
 }

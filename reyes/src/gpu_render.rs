@@ -343,15 +343,18 @@ impl GpuRenderer {
                     ..Default::default()
                 },
             )?,
-            StrategyKind::MultipassHost => Scheduler::multipass_host(
-                gpu,
-                program,
-                scheduler::HostMultipassConfig {
-                    initial_capacity: INITIAL_CAPACITY,
-                    stage_timing,
-                    ..Default::default()
-                },
-            )?,
+            StrategyKind::MultipassHost | StrategyKind::MultipassFloor => {
+                Scheduler::multipass_host(
+                    gpu,
+                    program,
+                    scheduler::HostMultipassConfig {
+                        initial_capacity: INITIAL_CAPACITY,
+                        stage_timing,
+                        replay_floor: strategy == StrategyKind::MultipassFloor,
+                        ..Default::default()
+                    },
+                )?
+            }
             // lavapipe ends every loop of an invocation after 65,535 iterations in total over
             // the persistent loop and what it nests; blurred micropolygons sample in loops that
             // grow with the blur, so there each launch runs one turn (the host relaunches).

@@ -20,6 +20,11 @@ pub enum StrategyKind {
     /// `multipass-host`: rounds planned by the host from read-back counts (exact direct
     /// dispatches), compaction fused into the producing pass.
     MultipassHost,
+    /// `multipass-floor`: a reference, not a strategy to deploy: the host-driven multi-pass
+    /// replaying the items of an earlier run of the same seeds in one round
+    /// ([`HostMultipassConfig::replay_floor`]), so its GPU time is the bodies' work without
+    /// the rounds' cost, a floor for any multi-pass. Not in [`StrategyKind::ALL`].
+    MultipassFloor,
 }
 
 impl StrategyKind {
@@ -30,18 +35,28 @@ impl StrategyKind {
         StrategyKind::MultipassHost,
     ];
 
-    /// The name command lines and reports use: `megakernel`, `multipass`, `multipass-host`.
+    /// Every strategy a command line may name: [`StrategyKind::ALL`] and the floor.
+    pub const NAMED: [StrategyKind; 4] = [
+        StrategyKind::Megakernel,
+        StrategyKind::Multipass,
+        StrategyKind::MultipassHost,
+        StrategyKind::MultipassFloor,
+    ];
+
+    /// The name command lines and reports use: `megakernel`, `multipass`, `multipass-host`,
+    /// `multipass-floor`.
     pub fn name(self) -> &'static str {
         match self {
             StrategyKind::Megakernel => "megakernel",
             StrategyKind::Multipass => "multipass",
             StrategyKind::MultipassHost => "multipass-host",
+            StrategyKind::MultipassFloor => "multipass-floor",
         }
     }
 
     /// The strategy named `s` (as [`StrategyKind::name`] spells it), if any.
     pub fn parse(s: &str) -> Option<StrategyKind> {
-        Self::ALL.into_iter().find(|k| k.name() == s)
+        Self::NAMED.into_iter().find(|k| k.name() == s)
     }
 }
 
@@ -67,7 +82,8 @@ pub enum Scheduler {
     Megakernel(Megakernel),
     /// The device-driven multi-pass baseline (`multipass`).
     Multipass(Multipass),
-    /// The host-driven multi-pass baseline (`multipass-host`).
+    /// The host-driven multi-pass baseline (`multipass-host`), or with
+    /// [`HostMultipassConfig::replay_floor`] the multi-pass floor (`multipass-floor`).
     MultipassHost(HostMultipass),
 }
 
@@ -129,11 +145,12 @@ impl Scheduler {
                     ..Default::default()
                 },
             ),
-            StrategyKind::MultipassHost => Self::multipass_host(
+            StrategyKind::MultipassHost | StrategyKind::MultipassFloor => Self::multipass_host(
                 gpu,
                 program,
                 HostMultipassConfig {
                     initial_capacity,
+                    replay_floor: kind == StrategyKind::MultipassFloor,
                     ..Default::default()
                 },
             ),
@@ -163,6 +180,7 @@ impl Scheduler {
         match self {
             Scheduler::Megakernel(_) => StrategyKind::Megakernel,
             Scheduler::Multipass(_) => StrategyKind::Multipass,
+            Scheduler::MultipassHost(m) if m.replays_floor() => StrategyKind::MultipassFloor,
             Scheduler::MultipassHost(_) => StrategyKind::MultipassHost,
         }
     }

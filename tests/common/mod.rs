@@ -43,10 +43,12 @@ pub fn renderer(kind: StrategyKind) -> &'static GpuRenderer {
     static MK: OnceLock<GpuRenderer> = OnceLock::new();
     static MP: OnceLock<GpuRenderer> = OnceLock::new();
     static MPH: OnceLock<GpuRenderer> = OnceLock::new();
+    static FLOOR: OnceLock<GpuRenderer> = OnceLock::new();
     let cell = match kind {
         StrategyKind::Megakernel => &MK,
         StrategyKind::Multipass => &MP,
         StrategyKind::MultipassHost => &MPH,
+        StrategyKind::MultipassFloor => &FLOOR,
     };
     cell.get_or_init(|| GpuRenderer::new(gpu(), kind).unwrap())
 }

@@ -114,6 +114,14 @@ impl Command {
             let flag = if r.spin.is_some() { "--spin" } else { "--dof" };
             return Err(CliError::Conflict { flag });
         }
+        if let Some(r) = self.render_args()
+            && r.strategy == Some(StrategyKind::MultipassFloor)
+            && matches!(self, Command::Bench(_) | Command::View(_))
+        {
+            return Err(CliError::FloorNotHere {
+                command: self.name(),
+            });
+        }
         Ok(())
     }
 }
@@ -169,7 +177,10 @@ pub struct RenderArgs {
     pub raster: Raster,
 
     /// GPU strategy: megakernel, multipass or multipass-host [default: megakernel; multipass
-    /// on a CPU adapter such as lavapipe, where it is several times faster].
+    /// on a CPU adapter such as lavapipe, where it is several times faster]; or
+    /// multipass-floor, a reference for `render --runs` and `measure` only: from the second
+    /// run on, every item the first run executed in one round (the bodies' work without the
+    /// rounds' cost; docs/scheduler.md 5.4).
     #[arg(long, value_name = "NAME", value_parser = parse_strategy)]
     pub strategy: Option<StrategyKind>,
 
@@ -862,7 +873,7 @@ fn parse_dof(v: &str) -> Result<DepthOfField, String> {
 
 fn parse_strategy(v: &str) -> Result<StrategyKind, String> {
     StrategyKind::parse(v).ok_or_else(|| {
-        let names: Vec<&str> = StrategyKind::ALL.iter().map(|k| k.name()).collect();
+        let names: Vec<&str> = StrategyKind::NAMED.iter().map(|k| k.name()).collect();
         format!("unknown strategy `{v}` (one of {})", names.join(", "))
     })
 }

@@ -21,6 +21,17 @@ pub enum CliError {
         /// The flag that conflicts with `--raster nearest`.
         flag: &'static str,
     },
+    /// `--strategy multipass-floor` where the frames move: the floor replays one kept
+    /// frame's work (`scheduler::HostMultipassConfig::replay_floor`).
+    #[error(
+        "`reyes {command} --strategy multipass-floor`: the multi-pass floor replays the work of \
+         one kept frame and cannot render a moving view; use it with `reyes render --runs N` \
+         or `reyes measure`"
+    )]
+    FloorNotHere {
+        /// The subcommand.
+        command: &'static str,
+    },
     /// A scene file that could not be read or parsed.
     #[error(transparent)]
     Scene(#[from] SceneError),
@@ -190,6 +201,7 @@ impl CliError {
     pub fn exit_code(&self) -> u8 {
         match self {
             CliError::Conflict { .. }
+            | CliError::FloorNotHere { .. }
             | CliError::NoFrameSelected { .. }
             | CliError::UnnumberedOutput { .. } => 2,
             _ => 1,

@@ -223,7 +223,8 @@ impl RealtimeRenderer {
     /// Uploads `scene` for frames of `options` under `strategy`, compiles the pipelines, and
     /// renders the unturned frame once with [`GpuRenderer::render`] to size the pipelined run
     /// ([`HEADROOM`] above its needs). Errors: the options' ([`FrameData::new`], as
-    /// [`RunError::Program`]), and those of a render.
+    /// [`RunError::Program`]), [`StrategyKind::MultipassFloor`] ([`RunError::Program`]: it
+    /// replays one kept frame's work and cannot follow a moving view), and those of a render.
     pub fn new(
         gpu: &Gpu,
         scene: &Scene,
@@ -231,6 +232,13 @@ impl RealtimeRenderer {
         strategy: StrategyKind,
         pixels: Pixels,
     ) -> Result<RealtimeRenderer, RunError> {
+        if strategy == StrategyKind::MultipassFloor {
+            return Err(RunError::Program(
+                "the multi-pass floor replays one kept frame's work and cannot render frames \
+                 of a moving view"
+                    .into(),
+            ));
+        }
         let mut base =
             FrameData::new(scene, options).map_err(|e| RunError::Program(e.to_string()))?;
         // `base.frame` has culling off: pipelined frames that cull say so per phase

@@ -6,6 +6,8 @@
 //! cost is one host round trip per round. Shader: `shaders/multipass_host.wgsl`; protocol and
 //! capacity rules: `docs/scheduler.md` section 5.2.
 
+mod floor;
+
 use std::time::Instant;
 
 use crate::error::RunError;
@@ -58,6 +60,14 @@ pub struct HostMultipassConfig {
     /// as `MultipassConfig::stage_timing` does for the device-driven multi-pass, so that the
     /// two can be compared procedure by procedure. Default `false`: a round is one pass.
     pub stage_timing: bool,
+    /// The multi-pass floor (`multipass-floor`, `host/floor.rs`): a run of seeds this
+    /// scheduler has run before replays every item that run executed in one round, each
+    /// procedure's in one dispatch, so its GPU time is the bodies' work without the rounds'
+    /// cost; a run of new seeds is a host-driven run that keeps its items (its statistics'
+    /// `strategy` says `multipass-floor capture`). For benchmarks that repeat one piece of
+    /// work only: a replay does the kept run's work whatever the user's inputs are now.
+    /// Default `false`.
+    pub replay_floor: bool,
 }
 
 impl Default for HostMultipassConfig {
@@ -69,6 +79,7 @@ impl Default for HostMultipassConfig {
             item_layout: None,
             size_from_last_run: true,
             stage_timing: false,
+            replay_floor: false,
         }
     }
 }
@@ -90,6 +101,8 @@ pub struct HostMultipass {
     cache: std::sync::Mutex<Option<HostRounds>>,
     /// The mapped buffer the counts come back through, kept between runs.
     readback: std::sync::Mutex<Option<Readback>>,
+    /// Runs kept for the floor's replays (`config.replay_floor`).
+    floors: floor::Floors,
 }
 
 /// Buffers of one queue layout: `items[p]` and `counts[p]` are the inputs of rounds of parity `p`
@@ -123,6 +136,11 @@ impl HostMultipass {
     /// The program this multi-pass runs.
     pub fn program(&self) -> &Program {
         &self.program
+    }
+
+    /// Whether this is the multi-pass floor ([`HostMultipassConfig::replay_floor`]).
+    pub fn replays_floor(&self) -> bool {
+        self.config.replay_floor
     }
 
     /// How its round buffers hold items (the configured layout, or the adapter's).
@@ -169,6 +187,7 @@ impl HostMultipass {
             kernels,
             cache: Default::default(),
             readback: Default::default(),
+            floors: Default::default(),
         })
     }
 
@@ -229,6 +248,15 @@ impl HostMultipass {
         self.kernels.check_user_group(user)?;
         let start = Instant::now();
         let nq = self.program.queue_count();
+        // The floor: a replay of the items a run of these seeds executed, else a run that keeps
+        // them.
+        let floor_key = self.config.replay_floor.then(|| floor::seeds_key(seeds));
+        if let Some(c) = floor_key.and_then(|k| self.floors.take(k)) {
+            let replayed = self.replay(gpu, &c, user, reads, start);
+            self.floors.keep(c);
+            return replayed;
+        }
+        let mut capture = floor_key.map(|_| floor::Capturer::new(nq));
         // Two copies of the items per slot; run_start adds a flag word, which this strategy
         // does not have, so the budget is kept with a little to spare.
         let RunStart {
@@ -253,7 +281,10 @@ impl HostMultipass {
             })
             .collect();
         let mut stats = RunStats {
-            strategy: "multipass-host".into(),
+            strategy: match floor_key {
+                Some(_) => "multipass-floor capture".into(),
+                None => "multipass-host".into(),
+            },
             item_layout: self.item_layout().name().into(),
             executed: vec![0; nq],
             peak_occupancy: vec![0; nq],
@@ -262,13 +293,8 @@ impl HostMultipass {
         // The caller's ranges follow the counts.
         let count_words = (nq + EXTRA_WORDS) as u64;
         let kept = self.readback.lock().unwrap().take();
-        // Timestamps come back once per 64 rounds: one pass a round, or with stage timing one
-        // per procedure (stages 0..nq; stage nq, queue work, has no pass here).
-        let stages = self.config.stage_timing;
-        let mut timer = match stages {
-            true => RunTimer::new(gpu, nq + 1, nq as u32, 64),
-            false => RunTimer::new(gpu, 1, 1, 64),
-        };
+        // Timestamps come back once per 64 rounds.
+        let mut timer = self.run_timer(gpu, 64);
         let words = count_words + ranges_words(reads) + timer.words();
         let rb = Readback::reuse(kept, gpu, "round counts read-back", words);
         let cached = self.cache.lock().unwrap().take();
@@ -369,36 +395,7 @@ impl HostMultipass {
                 gpu.queue
                     .write_buffer(&d.counts[1 - par], 0, bytemuck::cast_slice(&carried));
             }
-            // One pass of the round's dispatches, or with stage timing one per procedure.
-            let dispatches: Vec<(usize, u32)> = run
-                .iter()
-                .enumerate()
-                .filter(|&(_, &k)| k > 0)
-                .map(|(q, &k)| {
-                    let per_step = self.program.procs[q].items_per_step;
-                    (q, k.div_ceil(per_step).min(MAX_WORKGROUPS_PER_DIMENSION))
-                })
-                .collect();
-            let passes: Vec<&[(usize, u32)]> = match stages {
-                true => dispatches.chunks(1).collect(),
-                false => vec![&dispatches[..]],
-            };
-            for group in passes {
-                let stage = if stages { group[0].0 } else { 0 };
-                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("multipass-host round"),
-                    timestamp_writes: timer.writes(stage),
-                });
-                pass.set_bind_group(0, &d.bind[par], &[]);
-                if let Some(u) = user {
-                    pass.set_bind_group(1, u, &[]);
-                }
-                for &(q, wgs) in group {
-                    pass.set_pipeline(&self.kernels.pipelines[q]);
-                    pass.dispatch_workgroups(wgs, 1, 1);
-                    stats.launches += 1;
-                }
-            }
+            self.encode_round(&mut enc, (&d, par), &run, user, &mut timer, &mut stats);
             rb.copy(&mut enc, &d.counts[1 - par], 0, 0, count_words);
             // A full query set's timestamps come back after the counts, in the same wait.
             let stamps = timer.end_submission(&mut enc, &rb, count_words);
@@ -411,57 +408,132 @@ impl HostMultipass {
                 stats.executed[q] += run[q] as u64;
                 stats.peak_occupancy[q] = stats.peak_occupancy[q].max(n[q] as u64);
             }
-            let (a, b) = (out[nq + H_ERR_A] as usize, out[nq + H_ERR_B] as usize);
-            match out[nq + H_ERROR] {
-                0 => {}
-                ERR_EMIT => {
-                    return Err(RunError::EmitLimit {
-                        procedure: self.program.procs[a].proc.name.clone(),
-                        target: self.program.procs[b].proc.name.clone(),
-                        declared: self.program.procs[a].emits[b],
-                    });
-                }
-                ERR_ROOM => {
-                    return Err(RunError::Device(format!(
-                        "host-driven multi-pass: an append past the capacity the host made room \
-                         for (queue {a}, slot {b})"
-                    )));
-                }
-                e => {
-                    return Err(RunError::Device(format!(
-                        "host-driven multi-pass: unknown error code {e} (words {a}, {b})"
-                    )));
-                }
+            self.round_error(&out)?;
+            if let Some(c) = capture.as_mut() {
+                c.keep_round(gpu, items, (&d.items[par], &d.layout), &n, &run)?;
             }
             n.copy_from_slice(&out[..nq]);
             par = 1 - par;
         }
         stats.queue_bytes = d.layout.total_words * 4 * 2;
-        // The caller's ranges and the timestamps not yet read: one submission and one wait,
-        // into the kept read-back (none when there is neither).
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        copy_ranges(&rb, &mut enc, reads, count_words);
-        let at = count_words + ranges_words(reads);
-        let stamps = timer.copy_rest(&mut enc, &rb, at);
-        let words = match reads.is_empty() && stamps == 0 {
-            true => Vec::new(),
-            false => {
-                gpu.submit(enc);
-                rb.read(gpu, at + stamps)?
-            }
-        };
-        let results = match reads.is_empty() {
-            true => Vec::new(),
-            false => split_ranges(&words[count_words as usize..], reads),
-        };
-        let stage_ms = timer.finish(words.get(at as usize..).unwrap_or(&[]));
-        stats.gpu_ms = stage_ms.as_ref().map(|ms| ms.iter().sum());
-        if stages {
-            stats.stage_gpu_ms = stage_ms.unwrap_or_default();
+        let results = self.finish_reads(gpu, &rb, timer, reads, count_words, &mut stats)?;
+        if let (Some(key), Some(c)) = (floor_key, capture) {
+            self.floors.keep(c.finish(gpu, self, key)?);
         }
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
         *self.cache.lock().unwrap() = Some(d);
         *self.readback.lock().unwrap() = Some(rb);
         Ok((stats, results))
+    }
+
+    /// A timer of `submissions` rounds between read-backs: one pass a round, or with stage
+    /// timing one per procedure (stages 0..nq; stage nq, queue work, has no pass here).
+    fn run_timer(&self, gpu: &Gpu, submissions: u32) -> RunTimer {
+        let nq = self.program.queue_count();
+        match self.config.stage_timing {
+            true => RunTimer::new(gpu, nq + 1, nq as u32, submissions),
+            false => RunTimer::new(gpu, 1, 1, submissions),
+        }
+    }
+
+    /// Records a round's dispatches: one per procedure with inputs (`run[q]` of them), sized to
+    /// them, in one pass, or with stage timing one pass per procedure; reads `rounds.0`'s
+    /// buffers of parity `rounds.1`.
+    fn encode_round(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        (d, par): (&HostRounds, usize),
+        run: &[u32],
+        user: Option<&wgpu::BindGroup>,
+        timer: &mut RunTimer,
+        stats: &mut RunStats,
+    ) {
+        let stages = self.config.stage_timing;
+        let dispatches: Vec<(usize, u32)> = run
+            .iter()
+            .enumerate()
+            .filter(|&(_, &k)| k > 0)
+            .map(|(q, &k)| {
+                let per_step = self.program.procs[q].items_per_step;
+                (q, k.div_ceil(per_step).min(MAX_WORKGROUPS_PER_DIMENSION))
+            })
+            .collect();
+        let passes: Vec<&[(usize, u32)]> = match stages {
+            true => dispatches.chunks(1).collect(),
+            false => vec![&dispatches[..]],
+        };
+        for group in passes {
+            let stage = if stages { group[0].0 } else { 0 };
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("multipass-host round"),
+                timestamp_writes: timer.writes(stage),
+            });
+            pass.set_bind_group(0, &d.bind[par], &[]);
+            if let Some(u) = user {
+                pass.set_bind_group(1, u, &[]);
+            }
+            for &(q, wgs) in group {
+                pass.set_pipeline(&self.kernels.pipelines[q]);
+                pass.dispatch_workgroups(wgs, 1, 1);
+                stats.launches += 1;
+            }
+        }
+    }
+
+    /// The error a round's read-back counts (`out`: the next round's counts, then the error
+    /// words) report, if any.
+    fn round_error(&self, out: &[u32]) -> Result<(), RunError> {
+        let nq = self.program.queue_count();
+        let (a, b) = (out[nq + H_ERR_A] as usize, out[nq + H_ERR_B] as usize);
+        match out[nq + H_ERROR] {
+            0 => Ok(()),
+            ERR_EMIT => Err(RunError::EmitLimit {
+                procedure: self.program.procs[a].proc.name.clone(),
+                target: self.program.procs[b].proc.name.clone(),
+                declared: self.program.procs[a].emits[b],
+            }),
+            ERR_ROOM => Err(RunError::Device(format!(
+                "host-driven multi-pass: an append past the capacity the host made room for \
+                 (queue {a}, slot {b})"
+            ))),
+            e => Err(RunError::Device(format!(
+                "host-driven multi-pass: unknown error code {e} (words {a}, {b})"
+            ))),
+        }
+    }
+
+    /// The run's last read: the caller's ranges (from word `at` of `rb`) and the timestamps
+    /// not yet read, in one submission and one wait (none when there is neither); sets the
+    /// run's GPU times in `stats`. Returns one vector per range.
+    fn finish_reads(
+        &self,
+        gpu: &Gpu,
+        rb: &Readback,
+        timer: RunTimer,
+        reads: &[ReadRange],
+        at: u64,
+        stats: &mut RunStats,
+    ) -> Result<Vec<Vec<u32>>, RunError> {
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        copy_ranges(rb, &mut enc, reads, at);
+        let stamps_at = at + ranges_words(reads);
+        let stamps = timer.copy_rest(&mut enc, rb, stamps_at);
+        let words = match reads.is_empty() && stamps == 0 {
+            true => Vec::new(),
+            false => {
+                gpu.submit(enc);
+                rb.read(gpu, stamps_at + stamps)?
+            }
+        };
+        let results = match reads.is_empty() {
+            true => Vec::new(),
+            false => split_ranges(&words[at as usize..], reads),
+        };
+        let stage_ms = timer.finish(words.get(stamps_at as usize..).unwrap_or(&[]));
+        stats.gpu_ms = stage_ms.as_ref().map(|ms| ms.iter().sum());
+        if self.config.stage_timing {
+            stats.stage_gpu_ms = stage_ms.unwrap_or_default();
+        }
+        Ok(results)
     }
 }
