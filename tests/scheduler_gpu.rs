@@ -920,6 +920,18 @@ fn the_multipass_floor_replays_every_item_once_in_one_round() {
             assert_eq!(stats.rounds, 1, "{stats:?}");
         }
     }
+    // No seeds: kept and replayed as nothing, no round, no launch.
+    let word = ItemType::new("Word", "struct Word { v: u32 }");
+    let count = Procedure::new("count", word, 1)
+        .emits("count", 1)
+        .body("fn count_execute(item: Word, inv: Invocation) { if item.v > 0u { enqueue_count(Word(item.v - 1u)); } }");
+    let program = Program::new(vec![count], UserBindings::none()).unwrap();
+    let s = Scheduler::new(&gpu, &program, StrategyKind::MultipassFloor, 16).unwrap();
+    for strategy in ["multipass-floor capture", "multipass-floor"] {
+        let stats = s.run(&gpu, &[], None).unwrap();
+        assert_eq!(stats.strategy, strategy);
+        assert_eq!((stats.executed[0], stats.rounds, stats.launches), (0, 0, 0));
+    }
 }
 
 /// A megakernel whose queues, at their limit, cannot hold a tree's breadth (it claims each

@@ -169,8 +169,8 @@ impl Floors {
 
 impl HostMultipass {
     /// Replays kept run `f`: one round of every item it executed. Statistics: that round (one
-    /// round and submission, one launch per procedure with items), `strategy`
-    /// `multipass-floor`.
+    /// round, none for a run of no items; one submission; one launch per procedure with
+    /// items), `strategy` `multipass-floor`.
     pub(super) fn replay(
         &self,
         gpu: &Gpu,
@@ -185,7 +185,7 @@ impl HostMultipass {
             item_layout: self.item_layout().name().into(),
             executed: f.executed.iter().map(|&k| k as u64).collect(),
             peak_occupancy: f.executed.iter().map(|&k| k as u64).collect(),
-            rounds: 1,
+            rounds: f.executed.iter().any(|&k| k > 0) as u64,
             submits: 1,
             queue_bytes: f.rounds.layout.total_words * 4 * 2,
             ..Default::default()
