@@ -398,36 +398,78 @@ fn the_child_enqueue_form_is_asked_for_and_recorded() {
 
 /// `--strategy multipass-floor` is named, not part of `all`: its warm-up keeps the tree's
 /// items, and every timed run replays them in one round, one launch per procedure, verified
-/// against the CPU reference.
+/// against the CPU reference. A comma-separated list runs each named strategy once, in order.
+/// BFS, whose bodies emit more when every level runs at once, replays verified too (room for
+/// the round's worst case), and an unknown name lists the floor among the known ones.
 #[test]
 fn the_multipass_floor_is_named_and_replays_in_one_round() {
-    let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
-        .args(["--workload", "tree", "--preset", "binary", "--roots", "2"])
-        .args([
-            "--depth",
-            "6",
-            "--strategy",
+    let records = |args: &[&str]| -> Vec<serde_json::Value> {
+        let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
+            .args(args)
+            .args(["--runs", "2", "--json"])
+            .output()
+            .expect("schedbench runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {err}");
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        stdout
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect()
+    };
+    let tree = [
+        "--workload",
+        "tree",
+        "--preset",
+        "binary",
+        "--roots",
+        "2",
+        "--depth",
+        "6",
+    ];
+    let rs = records(
+        &[
+            &tree[..],
+            &[
+                "--strategy",
+                "multipass-floor,multipass-host,multipass-floor",
+            ],
+        ]
+        .concat(),
+    );
+    let names: Vec<&str> = rs.iter().map(|r| r["strategy"].as_str().unwrap()).collect();
+    assert_eq!(
+        names,
+        [
             "multipass-floor",
-            "--runs",
-            "2",
-            "--json",
-        ])
-        .output()
-        .expect("schedbench runs");
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(0), "{err}");
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let records: Vec<serde_json::Value> = stdout
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
-    assert_eq!(records.len(), 2, "{stdout}");
-    for r in &records {
-        assert_eq!(r["strategy"], "multipass-floor", "{r}");
+            "multipass-floor",
+            "multipass-host",
+            "multipass-host"
+        ]
+    );
+    for r in &rs {
         assert_eq!(r["verified"], true, "{r}");
+    }
+    for r in &rs[..2] {
         assert_eq!(r["rounds"], 1, "{r}");
         assert_eq!(r["launches"], 2, "branch and leaf: {r}");
     }
+    assert!(rs[2]["rounds"].as_u64().unwrap() > 1, "{}", rs[2]);
+    for r in records(&[
+        "--workload",
+        "bfs",
+        "--scale",
+        "8",
+        "--strategy",
+        "multipass-floor",
+    ]) {
+        assert_eq!(r["verified"], true, "{r}");
+        assert_eq!(r["rounds"], 1, "{r}");
+    }
+    assert_exits_2(
+        &["--strategy", "nope"],
+        "multipass-host, cpu, multipass-floor)",
+    );
 }
 
 /// The first JSON record of `schedbench --workload tree --strategy megakernel --runs 1 --json

@@ -50,11 +50,13 @@ pub struct Cli {
     pub workload: Option<WorkloadName>,
 
     /// megakernel, megakernel-fifo, multipass, multipass-host (rounds planned by the host
-    /// from read-back queue counts), cpu (the workload's rayon implementation),
-    /// a workload's own baseline (e.g. bfs's frontier), or all (the megakernel under --policy).
-    /// Also multipass-floor, a reference that all leaves out: the warm-up is a host-driven run
-    /// that keeps the items it executed, and every timed run replays them in one round (the
-    /// bodies' work without the rounds' cost: what no multi-pass can beat).
+    /// from read-back queue counts), cpu (the workload's rayon implementation), a workload's
+    /// own baseline (e.g. bfs's frontier), or all (all of these but megakernel-fifo and
+    /// multipass-floor; the megakernel under --policy); or a comma-separated list of them
+    /// (e.g. all,multipass-floor). multipass-floor is a reference: its untimed warm-up is a
+    /// host-driven run that keeps the items it executed, and each timed run replays them in
+    /// one round, one dispatch per procedure (the bodies' work without the rounds' cost: what
+    /// no multi-pass can beat; docs/scheduler.md 5.4).
     #[arg(long, default_value = "all", conflicts_with = "suite")]
     pub strategy: String,
 
@@ -460,7 +462,11 @@ impl Cli {
             }
         }
         if !self.priority.is_empty()
-            && (self.policy != Policy::Priority || self.strategy == "megakernel-fifo")
+            && (self.policy != Policy::Priority
+                || self
+                    .strategy
+                    .split(',')
+                    .any(|s| s.trim() == "megakernel-fifo"))
         {
             Self::usage_error(
                 ErrorKind::ArgumentConflict,

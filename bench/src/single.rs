@@ -58,34 +58,45 @@ fn workload(cli: &Cli) -> Result<Box<dyn Workload>, Error> {
     }
 }
 
-/// The strategies `--strategy` names among the workload's.
+/// The strategies `--strategy` names among the workload's: one name, `all`, or a
+/// comma-separated list of them (each strategy once, in the order named).
 fn strategies(cli: &Cli, w: &dyn Workload) -> Vec<Strategy> {
     let all = w.strategies();
     let wanted = |s: &Strategy| s.policy().is_none_or(|p| p == cli.policy);
-    match cli.strategy.as_str() {
-        "all" => all.into_iter().filter(wanted).collect(),
-        s => {
-            let found = if s == StrategyKind::Megakernel.name() {
-                all.into_iter().find(|x| x.is_megakernel() && wanted(x))
-            } else {
-                Strategy::find(&all, s)
-            };
-            match found {
-                Some(x) => vec![x],
-                None => {
-                    let names: Vec<String> = w.strategies().iter().map(|s| s.name()).collect();
-                    Cli::usage_error(
-                        ErrorKind::InvalidValue,
-                        format!(
-                            "--strategy: unknown strategy `{s}` for {} (known: all, {})",
-                            w.name(),
-                            names.join(", ")
-                        ),
-                    )
-                }
+    let mut out: Vec<Strategy> = Vec::new();
+    for s in cli.strategy.split(',').map(str::trim) {
+        let found = match s {
+            "all" => all.iter().filter(|x| wanted(x)).cloned().collect(),
+            s if s == StrategyKind::Megakernel.name() => all
+                .iter()
+                .find(|x| x.is_megakernel() && wanted(x))
+                .cloned()
+                .into_iter()
+                .collect(),
+            s => Strategy::find(&all, s).into_iter().collect::<Vec<_>>(),
+        };
+        if found.is_empty() {
+            let mut names: Vec<String> = all.iter().map(|s| s.name()).collect();
+            let floor = StrategyKind::MultipassFloor.name();
+            if Strategy::find(&all, floor).is_some() {
+                names.push(floor.into());
+            }
+            Cli::usage_error(
+                ErrorKind::InvalidValue,
+                format!(
+                    "--strategy: unknown strategy `{s}` for {} (known: all, {})",
+                    w.name(),
+                    names.join(", ")
+                ),
+            )
+        }
+        for x in found {
+            if !out.contains(&x) {
+                out.push(x);
             }
         }
     }
+    out
 }
 
 /// Runs and prints; Ok(true) when every run was verified.

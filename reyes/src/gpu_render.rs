@@ -320,6 +320,11 @@ impl GpuRenderer {
         })
     }
 
+    /// The strategy its scheduler runs.
+    pub fn strategy(&self) -> StrategyKind {
+        self.scheduler.kind()
+    }
+
     /// The renderer's pipelines besides the scheduler's ([`Pipelines`]), for another renderer
     /// on the same device to share ([`RasterPeer::with_pipelines`](crate::raster_peer::RasterPeer::with_pipelines)).
     pub fn pipelines(&self) -> &Pipelines {

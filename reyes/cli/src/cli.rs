@@ -178,9 +178,10 @@ pub struct RenderArgs {
 
     /// GPU strategy: megakernel, multipass or multipass-host [default: megakernel; multipass
     /// on a CPU adapter such as lavapipe, where it is several times faster]; or
-    /// multipass-floor, a reference for `render --runs` and `measure` only: from the second
-    /// run on, every item the first run executed in one round (the bodies' work without the
-    /// rounds' cost; docs/scheduler.md 5.4).
+    /// multipass-floor, a reference for `render` and `measure` (bench and view refuse it): an
+    /// untimed host-driven frame keeps every item it executed, and each timed frame replays
+    /// them in one round, one dispatch per procedure (the bodies' work without the rounds'
+    /// cost; docs/scheduler.md 5.4).
     #[arg(long, value_name = "NAME", value_parser = parse_strategy)]
     pub strategy: Option<StrategyKind>,
 

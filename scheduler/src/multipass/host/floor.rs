@@ -103,26 +103,32 @@ impl Capturer {
         Ok(())
     }
 
-    /// The kept run: its items written once into round buffers of their own, sized for all of
-    /// them as one round's inputs and for as many children again per queue (a quarter more for
-    /// bodies whose emits vary from run to run; an append past that is an error, never lost
-    /// work).
+    /// The kept run: its items written once into round buffers of their own, as one round's
+    /// inputs, with room for that round's worst case (its inputs times the declared emits,
+    /// as any host-driven round) where that fits the device's largest binding; else for as
+    /// many children again per queue as the kept run made and a quarter more, and a replay
+    /// whose bodies emit more (emits that depend on the order items run in) is an error
+    /// ([`HostMultipass::replay`]), never lost work.
     pub fn finish(self, gpu: &Gpu, mp: &HostMultipass, key: u64) -> Result<Floor, RunError> {
-        let capacity: Vec<u32> = self
+        let nq = self.executed.len();
+        let worst: Vec<u32> = (0..nq)
+            .map(|t| {
+                let w: u64 = (0..nq)
+                    .map(|p| self.executed[p] as u64 * mp.program.procs[p].emits[t] as u64)
+                    .sum();
+                w.max(self.executed[t] as u64).clamp(1, u32::MAX as u64) as u32
+            })
+            .collect();
+        let kept: Vec<u32> = self
             .executed
             .iter()
             .map(|&k| k.saturating_add(k / 4).max(1))
             .collect();
-        let layout = QueueLayout::new(&mp.program, capacity)?;
-        if layout.total_words * 4 > gpu.max_binding_bytes() {
-            return Err(RunError::Program(format!(
-                "multipass-floor: the {} items of the run, as one round, need {} bytes of \
-                 queue storage, more than this device's storage binding limit of {} bytes",
-                self.executed.iter().map(|&k| k as u64).sum::<u64>(),
-                layout.total_words * 4,
-                gpu.max_binding_bytes()
-            )));
-        }
+        let roomy = QueueLayout::new(&mp.program, worst)?;
+        let layout = match roomy.total_words * 4 <= gpu.max_binding_bytes() {
+            true => roomy,
+            false => QueueLayout::new(&mp.program, kept)?,
+        };
         let rounds = mp.rounds_buffers(gpu, layout)?;
         for (q, words) in self.items.iter().enumerate() {
             mp.item_layout()
@@ -211,7 +217,19 @@ impl HostMultipass {
         rb.copy(&mut enc, &d.counts[1], 0, 0, count_words);
         gpu.submit(enc);
         let out = rb.read(gpu, count_words)?;
-        let checked = self.round_error(&out);
+        let checked = match out[nq + super::H_ERROR] {
+            super::ERR_ROOM => Err(RunError::Device(format!(
+                "multipass-floor: the replay's bodies emitted more children to queue `{}` \
+                 than the kept run did and a quarter more: their emits depend on the order \
+                 items run in, which a replay of all of them at once changes; the floor \
+                 cannot time this workload at this size",
+                self.program
+                    .procs
+                    .get(out[nq + super::H_ERR_A] as usize)
+                    .map_or("?", |p| p.proc.name.as_str())
+            ))),
+            _ => self.round_error(&out),
+        };
         let results = checked
             .and_then(|()| self.finish_reads(gpu, &rb, timer, reads, count_words, &mut stats));
         *self.readback.lock().unwrap() = Some(rb);
