@@ -655,7 +655,17 @@ fn the_multipass_floor_draws_the_host_driven_image() {
             assert_eq!(f.counters, host.counters);
             assert_eq!(f.runs, host.runs);
         }
-        assert_eq!(replayed.run.rounds, replayed.runs as u64, "one round a run");
+        // One submission a run; one round a run of any items (a bucket may hold none).
+        assert_eq!(
+            replayed.run.submits, replayed.runs as u64,
+            "{:?}",
+            replayed.run
+        );
+        assert!(
+            replayed.run.rounds <= replayed.runs as u64,
+            "{:?}",
+            replayed.run
+        );
         assert!(
             replayed.run.launches < kept.run.launches,
             "{:?}",
