@@ -296,18 +296,25 @@ fn a_memory_budget_renders_in_buckets_to_the_same_image() {
     }
 }
 
+/// The built-in teapot at 96x72, and the same frame under a 64 KiB memory budget, which
+/// renders in buckets whose patches do not fit the queues at once (the field report:
+/// `--memory-budget 64K --strategy multipass` failed with "capacity 16, needs 19").
+fn small_teapot_whole_and_tight() -> (FrameData, FrameData) {
+    let whole = FrameData::new(&scene::builtin_teapot(), &small(96, 72)).unwrap();
+    let tight = FrameData {
+        memory_budget: Some(64 << 10),
+        ..whole.clone()
+    };
+    (whole, tight)
+}
+
 /// Under a budget so small that a bucket's patches do not fit the queues at once (the field
 /// report: `--memory-budget 64K --strategy multipass` failed with "capacity 16, needs 19"),
 /// every strategy splits the bucket's patches into batches and renders the image it renders
 /// without a budget, bit for bit.
 #[test]
 fn patches_that_do_not_fit_the_queues_render_in_batches_to_the_same_image() {
-    let scene = scene::builtin_teapot();
-    let whole = FrameData::new(&scene, &small(96, 72)).unwrap();
-    let tight = FrameData {
-        memory_budget: Some(64 << 10),
-        ..whole.clone()
-    };
+    let (whole, tight) = small_teapot_whole_and_tight();
     let (mut split, mut partial) = (0, 0);
     for kind in StrategyKind::ALL {
         let r = renderer(kind);
@@ -540,8 +547,7 @@ fn metal_surfaces_render_like_the_cpu_pipeline_with_tinted_highlights() {
 #[test]
 fn fused_multipass_rounds_draw_the_same_image() {
     use scheduler::{MultipassConfig, Scheduler};
-    let scene = scene::builtin_teapot();
-    let data = FrameData::new(&scene, &small(96, 72)).unwrap();
+    let (data, tight) = small_teapot_whole_and_tight();
     let features = data.features();
     let program = reyes::gpu_render::program_for(features).unwrap();
     let render_with = |fused, fused_sinks_apart, fused_sinks_first, data: &FrameData| {
@@ -596,10 +602,6 @@ fn fused_multipass_rounds_draw_the_same_image() {
     );
     // Under a 64 KiB budget, as patches_that_do_not_fit_the_queues_render_in_batches...: the
     // groups' dispatches through buckets, growth and rounds run in part.
-    let tight = FrameData {
-        memory_budget: Some(64 << 10),
-        ..data.clone()
-    };
     let b = render_data(true, true, &tight);
     assert!(
         apart.image == b.image,
@@ -633,12 +635,7 @@ fn fused_multipass_rounds_draw_the_same_image() {
 /// memory budget the frame runs once per bucket and batch, and each run keeps its own items.
 #[test]
 fn the_multipass_floor_draws_the_host_driven_image() {
-    let scene = scene::builtin_teapot();
-    let whole = FrameData::new(&scene, &small(96, 72)).unwrap();
-    let bucketed = FrameData {
-        memory_budget: Some(64 << 10),
-        ..whole.clone()
-    };
+    let (whole, bucketed) = small_teapot_whole_and_tight();
     let floor = renderer(StrategyKind::MultipassFloor);
     for data in [&whole, &bucketed] {
         let host = renderer(StrategyKind::MultipassHost)

@@ -295,14 +295,7 @@ fn a_local_area_in_workgroup_memory_is_asked_for_and_recorded() {
     let bytes = area(&["--local-workgroup-bytes", "2048"]).as_u64().unwrap();
     assert!(bytes > 0 && bytes <= 2048, "{bytes}");
     let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
-        .args([
-            "--workload",
-            "tree",
-            "--strategy",
-            "megakernel",
-            "--runs",
-            "1",
-        ])
+        .args(ONE_MEGAKERNEL_TREE)
         .args(tree)
         .args(["--no-local-queues", "--local-workgroup-bytes", "2048"])
         .output()
@@ -320,28 +313,27 @@ fn a_local_area_in_workgroup_memory_is_asked_for_and_recorded() {
 /// work parked on the host, and the records count both.
 #[test]
 fn a_queue_limit_runs_every_strategy_depth_first_and_is_recorded() {
-    let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
-        .args(["--workload", "tree", "--roots", "2", "--depth", "9"])
-        .args([
-            "--fanout",
-            "fixed:2",
-            "--payload",
-            "2",
-            "--max-capacity",
-            "32",
-        ])
-        .args(["--strategy", "all", "--runs", "1", "--json"])
-        .output()
-        .expect("schedbench runs");
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(0), "{err}");
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let records: Vec<serde_json::Value> = (stdout.lines())
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
+    let records = json_records(&[
+        "--workload",
+        "tree",
+        "--roots",
+        "2",
+        "--depth",
+        "9",
+        "--fanout",
+        "fixed:2",
+        "--payload",
+        "2",
+        "--max-capacity",
+        "32",
+        "--strategy",
+        "all",
+        "--runs",
+        "1",
+    ]);
     let by = |name: &str| {
         let r = records.iter().find(|r| r["strategy"] == name);
-        r.unwrap_or_else(|| panic!("no {name} record: {stdout}"))
+        r.unwrap_or_else(|| panic!("no {name} record: {records:?}"))
             .clone()
     };
     for r in &records {
@@ -349,10 +341,13 @@ fn a_queue_limit_runs_every_strategy_depth_first_and_is_recorded() {
     }
     assert!(
         by("megakernel")["parked_items"].as_u64().unwrap() > 0,
-        "{stdout}"
+        "{records:?}"
     );
     for mp in ["multipass", "multipass-host"] {
-        assert!(by(mp)["partial_rounds"].as_u64().unwrap() > 0, "{stdout}");
+        assert!(
+            by(mp)["partial_rounds"].as_u64().unwrap() > 0,
+            "{records:?}"
+        );
     }
 }
 
@@ -403,20 +398,7 @@ fn the_child_enqueue_form_is_asked_for_and_recorded() {
 /// the round's worst case), and an unknown name lists the floor among the known ones.
 #[test]
 fn the_multipass_floor_is_named_and_replays_in_one_round() {
-    let records = |args: &[&str]| -> Vec<serde_json::Value> {
-        let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
-            .args(args)
-            .args(["--runs", "2", "--json"])
-            .output()
-            .expect("schedbench runs");
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(0), "{args:?}: {err}");
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        stdout
-            .lines()
-            .map(|l| serde_json::from_str(l).unwrap())
-            .collect()
-    };
+    let records = |args: &[&str]| json_records(&[args, &["--runs", "2"]].concat());
     let tree = [
         "--workload",
         "tree",
@@ -472,22 +454,40 @@ fn the_multipass_floor_is_named_and_replays_in_one_round() {
     );
 }
 
+/// One timed megakernel run of a tree (the command line's tree options follow).
+const ONE_MEGAKERNEL_TREE: [&str; 6] = [
+    "--workload",
+    "tree",
+    "--strategy",
+    "megakernel",
+    "--runs",
+    "1",
+];
+
 /// The first JSON record of `schedbench --workload tree --strategy megakernel --runs 1 --json
 /// ARGS`, which must exit 0 with a verified run.
 fn first_json_record(args: &[&str]) -> serde_json::Value {
+    let r = json_records(&[&ONE_MEGAKERNEL_TREE[..], args].concat()).remove(0);
+    assert_eq!(r["verified"], true, "{r}");
+    r
+}
+
+/// The records of `schedbench ARGS --json`, which must exit 0, one per line of its output.
+fn json_records(args: &[&str]) -> Vec<serde_json::Value> {
     let out = Command::new(env!("CARGO_BIN_EXE_schedbench"))
-        .args(["--workload", "tree", "--strategy", "megakernel"])
-        .args(["--runs", "1", "--json"])
         .args(args)
+        .arg("--json")
         .output()
         .expect("schedbench runs");
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(0), "{args:?}: {err}");
     let stdout = String::from_utf8_lossy(&out.stdout);
-    let line = stdout.lines().next().unwrap();
-    let r: serde_json::Value = serde_json::from_str(line).unwrap();
-    assert_eq!(r["verified"], true, "{line}");
-    r
+    let records: Vec<serde_json::Value> = stdout
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert!(!records.is_empty(), "{args:?}: no records: {err}");
+    records
 }
 
 /// `schedbench --strategy cpu ARGS` exits 2 (a usage error) with `expected` in its message.

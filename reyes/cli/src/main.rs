@@ -347,28 +347,27 @@ fn gpu_frame(
     data: &FrameData,
     progress: &indicatif::ProgressBar,
 ) -> Result<(reyes::gpu_render::GpuFrame, Times), CliError> {
-    Ok(
-        if a.runs > 1 || renderer.strategy() == StrategyKind::MultipassFloor {
-            let t = renderer.timed_frames(gpu, data, a.runs, &|n| progress.inc(n))?;
-            for (i, (g, w)) in t.gpu_ms.iter().zip(&t.wall_ms).enumerate() {
-                let g = g.map_or("n/a".into(), |g| format!("{g:.3}"));
-                reyes_cli::progress::note(format!("run {i}: GPU {g} ms, wall {w:.2} ms"));
-            }
-            let times = t
-                .gpu_ms
-                .iter()
-                .copied()
-                .zip(t.wall_ms.iter().copied())
-                .collect();
-            (t.last, times)
-        } else {
-            let f = renderer.render(gpu, data)?;
-            progress.inc(1);
-            let gpu_ms = f.run.gpu_ms.zip(f.resolve_gpu_ms).map(|(x, y)| x + y);
-            let wall_ms = f.wall_ms;
-            (f, vec![(gpu_ms, wall_ms)])
-        },
-    )
+    let timed = a.runs > 1 || renderer.strategy() == StrategyKind::MultipassFloor;
+    Ok(if timed {
+        let t = renderer.timed_frames(gpu, data, a.runs, &|n| progress.inc(n))?;
+        for (i, (g, w)) in t.gpu_ms.iter().zip(&t.wall_ms).enumerate() {
+            let g = g.map_or("n/a".into(), |g| format!("{g:.3}"));
+            reyes_cli::progress::note(format!("run {i}: GPU {g} ms, wall {w:.2} ms"));
+        }
+        let times = t
+            .gpu_ms
+            .iter()
+            .copied()
+            .zip(t.wall_ms.iter().copied())
+            .collect();
+        (t.last, times)
+    } else {
+        let f = renderer.render(gpu, data)?;
+        progress.inc(1);
+        let gpu_ms = f.run.gpu_ms.zip(f.resolve_gpu_ms).map(|(x, y)| x + y);
+        let wall_ms = f.wall_ms;
+        (f, vec![(gpu_ms, wall_ms)])
+    })
 }
 
 /// Writes a GPU frame's outputs (image, --float, --depth, --exr, --stats with the times and,

@@ -14,7 +14,7 @@ use crate::error::RunError;
 use crate::gpu::{Gpu, MAX_WORKGROUPS_PER_DIMENSION};
 use crate::growth::{grow, start_capacity};
 use crate::item_layout::ItemLayout;
-use crate::multipass::partial::{at_limit, needs_partial, partial_round};
+use crate::multipass::partial::{at_limit, needs_partial, partial_round, worst_case};
 use crate::pipeline::{Kernels, storage_entry};
 use crate::program::{Program, Seed};
 use crate::queue_layout::{QueueLayout, RunStart};
@@ -324,9 +324,7 @@ impl HostMultipass {
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             // Room for the round's worst case in every target, before it runs: a target that
             // lacks it grows; one that cannot (at its limit) makes this a partial round.
-            let worst: Vec<u64> = (0..nq)
-                .map(|t| (0..nq).map(|p| n[p] as u64 * emits[p][t] as u64).sum())
-                .collect();
+            let worst = worst_case(&n, &emits);
             let mut grown = capacity.clone();
             for (t, cap) in grown.iter_mut().enumerate() {
                 if worst[t] > *cap as u64 && *cap < max_cap[t] {

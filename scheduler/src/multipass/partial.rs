@@ -25,6 +25,14 @@ pub fn at_limit(capacity: &[u32], max_cap: &[u32]) -> Vec<bool> {
     capacity.iter().zip(max_cap).map(|(c, m)| c >= m).collect()
 }
 
+/// Per target `t`: the most items a round of `n[p]` inputs per queue may emit to it,
+/// `sum_p n[p] * emits[p][t]` (`emits[p][t]`: declared worst case per input of `p`).
+pub fn worst_case(n: &[u32], emits: &[Vec<u32>]) -> Vec<u64> {
+    (0..n.len())
+        .map(|t| (0..n.len()).map(|p| n[p] as u64 * emits[p][t] as u64).sum())
+        .collect()
+}
+
 /// True when a round must run in part: a target at its limit (`at_limit[t]`) would receive
 /// more than half its capacity in the worst case `m[t]`.
 pub fn needs_partial(m: &[u64], cap: &[u32], at_limit: &[bool]) -> bool {
@@ -65,17 +73,13 @@ pub fn partial_round(n: &[u32], cap: &[u32], emits: &[Vec<u32>]) -> Option<Vec<u
 
 #[cfg(test)]
 mod tests {
-    use super::{needs_partial, partial_round};
+    use super::{needs_partial, partial_round, worst_case};
 
     /// Carried inputs plus worst-case outputs of the plan, per queue.
     fn used(n: &[u32], k: &[u32], emits: &[Vec<u32>]) -> Vec<u64> {
+        let out = worst_case(k, emits);
         (0..n.len())
-            .map(|t| {
-                (n[t] - k[t]) as u64
-                    + (0..n.len())
-                        .map(|p| k[p] as u64 * emits[p][t] as u64)
-                        .sum::<u64>()
-            })
+            .map(|t| (n[t] - k[t]) as u64 + out[t])
             .collect()
     }
 

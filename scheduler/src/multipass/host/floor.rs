@@ -25,6 +25,7 @@ use super::{EXTRA_WORDS, HostMultipass, HostRounds, first_counts};
 use crate::error::RunError;
 use crate::gpu::Gpu;
 use crate::item_layout::ItemLayout;
+use crate::multipass::partial::worst_case;
 use crate::program::Seed;
 use crate::queue_layout::QueueLayout;
 use crate::readback::{ReadRange, Readback};
@@ -110,14 +111,11 @@ impl Capturer {
     /// whose bodies emit more (emits that depend on the order items run in) is an error
     /// ([`HostMultipass::replay`]), never lost work.
     pub fn finish(self, gpu: &Gpu, mp: &HostMultipass, key: u64) -> Result<Floor, RunError> {
-        let nq = self.executed.len();
-        let worst: Vec<u32> = (0..nq)
-            .map(|t| {
-                let w: u64 = (0..nq)
-                    .map(|p| self.executed[p] as u64 * mp.program.procs[p].emits[t] as u64)
-                    .sum();
-                w.max(self.executed[t] as u64).clamp(1, u32::MAX as u64) as u32
-            })
+        let emits: Vec<Vec<u32>> = mp.program.procs.iter().map(|p| p.emits.clone()).collect();
+        let worst: Vec<u32> = worst_case(&self.executed, &emits)
+            .into_iter()
+            .zip(&self.executed)
+            .map(|(w, &k)| w.max(k as u64).clamp(1, u32::MAX as u64) as u32)
             .collect();
         let kept: Vec<u32> = self
             .executed
